@@ -1,0 +1,45 @@
+# One-line helpers so that each unit's CMakeLists.txt says only what it is made of.
+
+# Warnings for Caliper's own code (never for generated code).
+function(caliper_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow=local -Wno-missing-field-initializers)
+  if(CALIPER_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()
+
+# caliper_library(NAME SOURCES a.cc b.cc DEPS x y [PRIVATE_DEPS z]): libs/<name> -> caliper::<name>
+function(caliper_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(caliper_${name} STATIC ${ARG_SOURCES})
+  add_library(caliper::${name} ALIAS caliper_${name})
+  target_include_directories(caliper_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(caliper_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  set_target_properties(caliper_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  caliper_warnings(caliper_${name})
+endfunction()
+
+# caliper_executable(NAME SOURCES ... DEPS ...): a program placed in <build>/bin
+function(caliper_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
+  caliper_warnings(${name})
+endfunction()
+
+# caliper_test(NAME SOURCES ... DEPS ... [LABELS l] [TIMEOUT s]): a GoogleTest program run by ctest
+function(caliper_test name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  caliper_warnings(${name})
+  add_test(NAME ${name} COMMAND ${name})
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 120)
+  endif()
+  set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT}
+    LABELS "${ARG_LABELS}"
+    ENVIRONMENT "CALIPER_BIN_DIR=${CMAKE_BINARY_DIR}/bin;CALIPER_CONFIG_DIR=${CMAKE_SOURCE_DIR}/config;CALIPER_SOURCE_DIR=${CMAKE_SOURCE_DIR}")
+endfunction()

@@ -1,0 +1,460 @@
+// caliper-ctl: the command line client, in the spirit of rtshell.
+#include <signal.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "caliper/core/system.h"
+#include "caliper/logging.hh"
+#include "caliper/logging/record.h"
+#include "caliper/rtc.hh"
+#include "caliper/rtc/log_service_sink.h"
+#include "caliper/rtc/naming.h"
+
+namespace caliper::ctl {
+namespace {
+
+namespace RTC = ::Caliper::RTC;
+namespace LogIdl = ::Caliper::Logging;
+
+/// A usage error: the message, then the verb's help; exit code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+/// A failure the user should read: exit code 1.
+struct Failure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string nameservice;
+  double timeout_s = 5.0;
+};
+
+class Client {
+ public:
+  explicit Client(const Options& options) : options_(options) {
+    const std::string ms = std::to_string(static_cast<int>(options.timeout_s * 1000));
+    std::vector<std::string> args = {"caliper-ctl", "-ORBendPoint", "giop:tcp:127.0.0.1:",
+                                     "-ORBclientCallTimeOutPeriod", ms,
+                                     "-ORBclientConnectTimeOutPeriod", ms};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    int argc = static_cast<int>(argv.size());
+    orb_ = CORBA::ORB_init(argc, argv.data());
+    address_ = rtc::NamingAddress(options.nameservice);
+  }
+  ~Client() {
+    try {
+      orb_->destroy();
+    } catch (...) {
+    }
+  }
+
+  CosNaming::NamingContext_ptr Root() {
+    try {
+      return rtc::ResolveRoot(orb_, address_);
+    } catch (const rtc::Unreachable& e) {
+      throw Failure(std::string(e.what()) +
+                    "\n  (is a session running? start one with `launch/caliper demo`, or pass "
+                    "--nameservice corbaname::HOST:PORT)");
+    }
+  }
+
+  rtc::ComponentEntry Find(const std::string& name) {
+    CosNaming::NamingContext_var root = Root();
+    try {
+      return rtc::FindComponent(root, name);
+    } catch (const rtc::NotFound& e) {
+      throw Failure(e.what());
+    }
+  }
+
+  RTC::LightweightRTObject_ptr Component(const std::string& name, std::string* path = nullptr) {
+    rtc::ComponentEntry e = Find(name);
+    if (path) *path = e.path;
+    try {
+      RTC::LightweightRTObject_var obj = RTC::LightweightRTObject::_narrow(e.object);
+      if (CORBA::is_nil(obj)) throw Failure(e.path + " is not a Caliper component");
+      return obj._retn();
+    } catch (const CORBA::Exception& ex) {
+      throw Failure(Unreachable(e.path, ex));
+    }
+  }
+
+  static std::string Unreachable(const std::string& path, const CORBA::Exception& e) {
+    return "cannot reach " + path + ": " + rtc::Describe(e) +
+           " (the process may have died; its name is stale)";
+  }
+
+  CORBA::ORB_ptr orb() { return orb_.in(); }
+  const std::string& address() const { return address_; }
+
+ private:
+  Options options_;
+  CORBA::ORB_var orb_;
+  std::string address_;
+};
+
+const char* StateName(RTC::LifeCycleState s) {
+  switch (s) {
+    case RTC::CREATED_STATE: return "CREATED";
+    case RTC::INACTIVE_STATE: return "INACTIVE";
+    case RTC::ACTIVE_STATE: return "ACTIVE";
+    case RTC::ERROR_STATE: return "ERROR";
+  }
+  return "?";
+}
+
+const char* CodeName(RTC::ReturnCode c) {
+  switch (c) {
+    case RTC::RTC_OK: return "RTC_OK";
+    case RTC::RTC_ERROR: return "RTC_ERROR";
+    case RTC::BAD_PARAMETER: return "BAD_PARAMETER";
+    case RTC::UNSUPPORTED: return "UNSUPPORTED";
+    case RTC::OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
+    case RTC::PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
+  }
+  return "?";
+}
+
+RTC::LifeCycleState StateOf(RTC::LightweightRTObject_ptr comp) {
+  RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+  if (ecs->length() == 0) throw Failure("the component owns no execution context");
+  return ecs[0]->get_component_state(comp);
+}
+
+struct Verb {
+  std::string usage;
+  std::string summary;
+  std::function<int(Client&, std::vector<std::string>&)> run;
+};
+
+/// Takes `--flag VALUE` out of args; returns true when it was there.
+bool TakeOption(std::vector<std::string>& args, const std::string& flag, std::string* value) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] != flag) continue;
+    if (i + 1 >= args.size()) throw UsageError(flag + " needs a value");
+    *value = args[i + 1];
+    args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
+    return true;
+  }
+  return false;
+}
+
+bool TakeFlag(std::vector<std::string>& args, const std::string& flag) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == flag) {
+      args.erase(args.begin() + static_cast<long>(i));
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string OneName(std::vector<std::string>& args) {
+  if (args.size() != 1) throw UsageError("expected exactly one component name");
+  return args[0];
+}
+
+int List(Client& client, std::vector<std::string>& args) {
+  if (!args.empty()) throw UsageError("ls takes no arguments");
+  CosNaming::NamingContext_var root = client.Root();
+  const auto entries = rtc::ListComponents(root);
+  std::cout << std::left << std::setw(14) << "NAME" << std::setw(12) << "STATE" << std::setw(10)
+            << "TYPE" << std::setw(8) << "PID" << "PATH\n";
+  for (const auto& e : entries) {
+    std::string state = "UNREACHABLE", type = "-", pid = "-";
+    try {
+      RTC::LightweightRTObject_var comp = RTC::LightweightRTObject::_narrow(e.object);
+      if (!CORBA::is_nil(comp)) {
+        state = StateName(StateOf(comp));
+        RTC::ComponentProfile_var profile = comp->get_component_profile();
+        type = profile->type_name.in();
+        for (CORBA::ULong i = 0; i < profile->properties.length(); ++i)
+          if (std::string(profile->properties[i].name) == "pid")
+            pid = profile->properties[i].value.in();
+      }
+    } catch (const CORBA::Exception&) {
+    } catch (const Failure&) {
+    }
+    std::cout << std::setw(14) << e.instance << std::setw(12) << state << std::setw(10) << type
+              << std::setw(8) << pid << e.path << "\n";
+  }
+  if (entries.empty()) std::cout << "(no components bound in " << client.address() << ")\n";
+  return 0;
+}
+
+int State(Client& client, std::vector<std::string>& args) {
+  std::string path;
+  RTC::LightweightRTObject_var comp = client.Component(OneName(args), &path);
+  try {
+    const auto state = StateOf(comp);
+    std::cout << StateName(state) << "\n";
+    if (state == RTC::ERROR_STATE) {
+      CORBA::String_var why = comp->get_last_error();
+      std::cout << "reason: " << why.in() << "\n";
+    }
+    return 0;
+  } catch (const CORBA::Exception& e) {
+    throw Failure(Client::Unreachable(path, e));
+  }
+}
+
+int Transition(Client& client, std::vector<std::string>& args, const std::string& verb) {
+  std::string path;
+  const std::string name = OneName(args);
+  RTC::LightweightRTObject_var comp = client.Component(name, &path);
+  try {
+    RTC::ReturnCode rc;
+    if (verb == "exit") {
+      rc = comp->exit();
+    } else {
+      RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+      if (ecs->length() == 0) throw Failure(path + " owns no execution context");
+      RTC::ExecutionContext_ptr ec = ecs[0];
+      rc = verb == "activate"     ? ec->activate_component(comp)
+           : verb == "deactivate" ? ec->deactivate_component(comp)
+                                  : ec->reset_component(comp);
+    }
+    if (rc != RTC::RTC_OK) {
+      std::string msg = verb + " " + name + ": " + CodeName(rc);
+      if (verb != "exit") msg += std::string(" (state is ") + StateName(StateOf(comp)) + ")";
+      CORBA::String_var why = comp->get_last_error();
+      if (rc == RTC::RTC_ERROR && std::strlen(why.in()) > 0) msg += "; reason: " + std::string(why);
+      throw Failure(msg);
+    }
+    if (verb == "exit")
+      std::cout << name << ": exiting\n";
+    else
+      std::cout << name << ": " << StateName(StateOf(comp)) << "\n";
+    return 0;
+  } catch (const CORBA::Exception& e) {
+    throw Failure(Client::Unreachable(path, e));
+  }
+}
+
+void Print(const LogIdl::StoredRecord& s) {
+  const auto& r = s.rec;
+  std::cout << core::FormatTime(r.time_us) << " " << std::left << std::setw(6)
+            << logging::PriorityName(r.priority) << std::setw(10) << r.instance.in() << " ["
+            << r.category.in() << "] " << r.message.in() << "\n";
+}
+
+class FollowListener : public virtual POA_Caliper::Logging::LogListener {
+ public:
+  FollowListener(const LogIdl::RecordFilter& filter, CORBA::ULongLong* printed_serial)
+      : filter_(filter), printed_(printed_serial) {}
+  void on_records(const LogIdl::StoredRecordSeq& records) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (CORBA::ULong i = 0; i < records.length(); ++i) {
+      const auto& s = records[i];
+      if (s.serial <= *printed_ || !Matches(s.rec)) continue;
+      Print(s);
+      *printed_ = s.serial;
+    }
+    std::cout.flush();
+  }
+  std::mutex mutex_;
+
+ private:
+  bool Matches(const LogIdl::Record& r) const {
+    if (r.priority > filter_.max_priority) return false;
+    if (std::string(r.category).rfind(filter_.category_prefix.in(), 0) != 0) return false;
+    if (std::strlen(filter_.instance) > 0 && std::string(r.instance) != filter_.instance.in())
+      return false;
+    if (std::strlen(filter_.regex) > 0 &&
+        !std::regex_search(std::string(r.message), std::regex(filter_.regex.in())))
+      return false;
+    return true;
+  }
+  LogIdl::RecordFilter filter_;
+  CORBA::ULongLong* printed_;
+};
+
+int Log(Client& client, std::vector<std::string>& args) {
+  LogIdl::RecordFilter q;
+  q.max_priority = logging::kDebug;
+  q.category_prefix = "";
+  q.instance = "";
+  q.regex = "";
+  q.from_time_us = 0;
+  q.to_time_us = 0;
+  q.after_serial = 0;
+  q.limit = 50;
+  std::string value, service = "logger0";
+  if (TakeOption(args, "--min-priority", &value)) {
+    int p;
+    if (!logging::ParsePriority(value, &p))
+      throw UsageError("--min-priority: '" + value + "' is not fatal|error|warn|info|debug");
+    q.max_priority = p;
+  }
+  if (TakeOption(args, "--category", &value)) q.category_prefix = value.c_str();
+  if (TakeOption(args, "--component", &value)) q.instance = value.c_str();
+  if (TakeOption(args, "--grep", &value)) {
+    try {
+      std::regex check(value);
+    } catch (const std::regex_error& e) {
+      throw UsageError("--grep: bad regular expression '" + value + "': " + e.what());
+    }
+    q.regex = value.c_str();
+  }
+  if (TakeOption(args, "--limit", &value)) q.limit = static_cast<CORBA::ULong>(std::stoul(value));
+  TakeOption(args, "--service", &service);
+  const bool follow = TakeFlag(args, "--follow");
+  if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
+
+  rtc::ComponentEntry entry = client.Find(service);
+  try {
+    LogIdl::LogService_var logger = LogIdl::LogService::_narrow(entry.object);
+    if (CORBA::is_nil(logger)) throw Failure(entry.path + " is not a Logging component");
+    CORBA::ULongLong printed = 0;
+    FollowListener* listener = nullptr;
+    CORBA::ULongLong listener_id = 0;
+    if (follow) {
+      // listen first, then print the backlog: nothing falls between the two
+      CORBA::Object_var poa_obj = client.orb()->resolve_initial_references("RootPOA");
+      PortableServer::POA_var poa = PortableServer::POA::_narrow(poa_obj);
+      poa->the_POAManager()->activate();
+      listener = new FollowListener(q, &printed);
+      PortableServer::ObjectId_var id = poa->activate_object(listener);
+      CORBA::Object_var ref = poa->id_to_reference(id);
+      listener_id = logger->add_listener(LogIdl::LogListener::_narrow(ref));
+      listener->mutex_.lock();
+    }
+    LogIdl::StoredRecordSeq_var records = logger->query(q);
+    for (CORBA::ULong i = 0; i < records->length(); ++i) {
+      Print(records[i]);
+      printed = records[i].serial;
+    }
+    std::cout.flush();
+    if (!follow) return 0;
+    listener->mutex_.unlock();
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    int sig = 0;
+    sigwait(&set, &sig);
+    try {
+      logger->remove_listener(listener_id);
+    } catch (const CORBA::Exception&) {
+    }
+    return 0;
+  } catch (const LogIdl::InvalidQuery& e) {
+    throw UsageError(e.reason.in());
+  } catch (const CORBA::Exception& e) {
+    throw Failure(Client::Unreachable(entry.path, e));
+  }
+}
+
+std::map<std::string, Verb> Verbs() {
+  std::map<std::string, Verb> verbs;
+  verbs["ls"] = {"ls", "list the components in the naming service with their states", List};
+  verbs["state"] = {"state NAME", "print a component's lifecycle state (and why, in ERROR)", State};
+  for (const std::string v : {"activate", "deactivate", "reset", "exit"}) {
+    verbs[v] = {v + " NAME",
+                v == "exit" ? "end a component's process cleanly"
+                            : v + " a component in its execution context",
+                [v](Client& c, std::vector<std::string>& a) { return Transition(c, a, v); }};
+  }
+  verbs["log"] = {"log [--follow] [--min-priority P] [--category PREFIX] [--component NAME]\n"
+                  "          [--grep REGEX] [--limit N] [--service LOGGER]",
+                  "print the session log (the newest N records, 50 by default); --follow keeps "
+                  "printing new ones until Ctrl-C",
+                  Log};
+  return verbs;
+}
+
+void PrintHelp(const std::map<std::string, Verb>& verbs) {
+  std::cout << "Usage: caliper-ctl [--nameservice corbaname::HOST:PORT] [--timeout S] VERB ...\n\n"
+            << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
+            << "$CALIPER_NAMESERVICE, else corbaname::127.0.0.1:2809. NAME is an instance name\n"
+            << "(model0), host/model0, or host.host_cxt/model0.rtc.\n\nVerbs:\n";
+  for (const auto& [name, verb] : verbs)
+    std::cout << "  " << std::left << std::setw(12) << name << verb.summary << "\n";
+  std::cout << "\n`caliper-ctl VERB --help` describes one verb. Exit status: 0 done, 1 failed, "
+               "2 bad usage.\n";
+}
+
+int Main(int argc, char** argv) {
+  // SIGINT/SIGTERM are taken with sigwait by `log --follow`; block them in every thread
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+
+  const auto verbs = Verbs();
+  Options options;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  size_t i = 0;
+  for (; i < args.size() && args[i].rfind("--", 0) == 0; ++i) {
+    if (args[i] == "--help") {
+      PrintHelp(verbs);
+      return 0;
+    }
+    if (i + 1 >= args.size()) {
+      std::cerr << "caliper-ctl: " << args[i] << " needs a value\n";
+      return 2;
+    }
+    if (args[i] == "--nameservice") {
+      options.nameservice = args[++i];
+    } else if (args[i] == "--timeout") {
+      options.timeout_s = std::atof(args[++i].c_str());
+      if (options.timeout_s <= 0) {
+        std::cerr << "caliper-ctl: --timeout wants seconds > 0\n";
+        return 2;
+      }
+    } else {
+      std::cerr << "caliper-ctl: unknown option " << args[i] << " (see --help)\n";
+      return 2;
+    }
+  }
+  if (i >= args.size()) {
+    PrintHelp(verbs);
+    return 2;
+  }
+  const std::string verb_name = args[i];
+  std::vector<std::string> rest(args.begin() + static_cast<long>(i) + 1, args.end());
+  const auto it = verbs.find(verb_name);
+  if (it == verbs.end()) {
+    std::cerr << "caliper-ctl: unknown verb '" << verb_name << "' (see --help)\n";
+    return 2;
+  }
+  const Verb& verb = it->second;
+  if (TakeFlag(rest, "--help") || TakeFlag(rest, "-h")) {
+    std::cout << "Usage: caliper-ctl " << verb.usage << "\n  " << verb.summary << "\n";
+    return 0;
+  }
+  try {
+    Client client(options);
+    return verb.run(client, rest);
+  } catch (const UsageError& e) {
+    std::cerr << "caliper-ctl " << verb_name << ": " << e.what() << "\nUsage: caliper-ctl "
+              << verb.usage << "\n";
+    return 2;
+  } catch (const Failure& e) {
+    std::cerr << "caliper-ctl " << verb_name << ": " << e.what() << "\n";
+    return 1;
+  } catch (const CORBA::Exception& e) {
+    std::cerr << "caliper-ctl " << verb_name << ": " << rtc::Describe(e) << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "caliper-ctl " << verb_name << ": " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace
+}  // namespace caliper::ctl
+
+int main(int argc, char** argv) { return caliper::ctl::Main(argc, argv); }

@@ -1,0 +1,18 @@
+// caliper-sample: a minimal component for demos and tests of the runtime and logging.
+#include "caliper/rtc/rtobject_servant.h"
+#include "sample_component.h"
+
+int main(int argc, char** argv) {
+  using namespace caliper;
+  rtc::ComponentType type;
+  type.name = "sample";
+  type.description = "Sample component: logs numbered records while ACTIVE.";
+  type.category = "example";
+  type.config_keys = sample::SampleComponent::ConfigKeys();
+  return rtc::RunComponent(
+      argc, argv, type,
+      [](rtc::Runtime& rt) { return std::make_unique<sample::SampleComponent>(rt); },
+      [](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
+        return new rtc::DataFlowServant(rt);
+      });
+}

@@ -1,0 +1,27 @@
+#pragma once
+// Small facts about the process and the clock.
+
+#include <cstdint>
+#include <string>
+
+namespace caliper::core {
+
+/// Short host name (without domain), as used in naming contexts `<host>.host_cxt`.
+std::string HostName();
+
+/// Wall-clock time [us since 1970-01-01 UTC].
+int64_t NowMicros();
+
+/// `YYYY-mm-dd HH:MM:SS.uuu` in local time for a time stamp [us since epoch].
+std::string FormatTime(int64_t time_us);
+
+/// Expands a leading `~` to $HOME.
+std::string ExpandHome(const std::string& path);
+
+/// Creates a directory and its parents; throws std::runtime_error with the reason on failure.
+void MakeDirectories(const std::string& path);
+
+/// True when a process with this pid exists.
+bool ProcessAlive(long pid);
+
+}  // namespace caliper::core

@@ -1,0 +1,359 @@
+#include "caliper/rtc/runtime.h"
+
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <thread>
+
+#include "caliper/core/system.h"
+#include "caliper/logging/batching_appender.h"
+#include "caliper/logging/log.h"
+#include "caliper/rtc/log_service_sink.h"
+#include "caliper/rtc/naming.h"
+#include "caliper/rtc/rtobject_servant.h"
+
+namespace caliper::rtc {
+
+namespace {
+
+using core::ConfigKey;
+using Type = ConfigKey::Type;
+
+std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
+  return {
+      {"naming.service", Type::kString, "", "naming service address corbaname::HOST:PORT "
+       "('' = $CALIPER_NAMESERVICE or corbaname::127.0.0.1:2809)"},
+      {"naming.instance", Type::kString, type_name, "instance base name (bound as NAME0, NAME1, ...)"},
+      {"naming.update.interval", Type::kDouble, "10", "re-registration period [s]", 0.05, 3600},
+      {"corba.endpoint", Type::kString, "giop:tcp:127.0.0.1:", "omniORB endpoint to listen on"},
+      {"corba.call_timeout", Type::kDouble, "5", "timeout of outgoing calls [s]", 0.01, 3600},
+      {"exec.kind", Type::kString, "periodic", "execution context kind", 0, 0,
+       {"periodic", "external"}},
+      {"exec.rate", Type::kDouble, "100", "execution context rate [Hz]", 1e-3, 1e6},
+      {"exec.auto_activate", Type::kBool, "false", "activate the component once it is bound"},
+      {"log.level", Type::kString, "info", "least severe priority printed on the console", 0, 0,
+       {"fatal", "alert", "crit", "error", "warn", "notice", "info", "debug"}},
+      {"log.service", Type::kString, "logger0", "instance name of the Logging component"},
+      {"log.spool_dir", Type::kString, "~/.cache/caliper/spool",
+       "where log records wait while the Logging component is unreachable"},
+  };
+}
+
+std::string ConfigDirectory() {
+  const char* env = std::getenv("CALIPER_CONFIG_DIR");
+  if (env != nullptr && *env != '\0') return env;
+  return std::string(CALIPER_SOURCE_DIR) + "/config";
+}
+
+void PrintUsage(const ComponentType& type, const core::Config& config) {
+  std::cout << "Usage: caliper-" << type.name << " [options]\n"
+            << type.description << "\n\n"
+            << "Options:\n"
+            << "  -f FILE              read configuration FILE (after " << ConfigDirectory() << "/"
+            << type.name << ".conf)\n"
+            << "  -o KEY=VALUE         set one configuration key (repeatable, applied last)\n"
+            << "  --nameservice ADDR   naming service, e.g. corbaname::127.0.0.1:2809\n"
+            << "  --instance NAME      instance base name (bound as NAME0, NAME1, ...)\n"
+            << "  -h, --help           this text\n"
+            << "  -ORB...              passed to omniORB\n\n"
+            << "Configuration keys:\n"
+            << config.Help() << "\n"
+            << "The component binds as <host>.host_cxt/<instance>.rtc in the naming service and\n"
+            << "stops cleanly on SIGINT or SIGTERM.\n";
+}
+
+/// Waits for SIGINT/SIGTERM/SIGHUP on a thread of its own: no signal handler runs at all.
+class SignalWatcher {
+ public:
+  explicit SignalWatcher(Runtime* runtime) : runtime_(runtime) {
+    thread_ = std::thread([this] { Watch(); });
+  }
+  ~SignalWatcher() {
+    done_ = true;
+    thread_.join();
+  }
+  static void BlockSignals() {
+    sigset_t set = Set();
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  }
+
+ private:
+  static sigset_t Set() {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGHUP);
+    return set;
+  }
+  void Watch() {
+    const sigset_t set = Set();
+    const timespec timeout = {0, 200 * 1000 * 1000};
+    while (!done_) {
+      const int sig = sigtimedwait(&set, nullptr, &timeout);
+      if (sig > 0) {
+        logging::Get("rtc").notice("signal %d: shutting down", sig);
+        runtime_->RequestExit();
+      }
+    }
+  }
+  Runtime* runtime_;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+}  // namespace
+
+Runtime::Runtime(ComponentType type, core::Config config)
+    : type_(std::move(type)), config_(std::move(config)), host_(core::HostName()) {}
+
+std::string Runtime::instance() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return instance_;
+}
+
+std::string Runtime::naming_path() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return host_ + ".host_cxt/" + instance_ + ".rtc";
+}
+
+void Runtime::RequestExit() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  exit_requested_ = true;
+  exit_cv_.notify_all();
+}
+
+CORBA::Object_ptr Runtime::Activate(PortableServer::Servant servant) {
+  PortableServer::ObjectId_var id = poa_->activate_object(servant);
+  servant->_remove_ref();
+  return poa_->id_to_reference(id.in());
+}
+
+void Runtime::WaitForExit() {
+  const auto interval = std::chrono::duration<double>(config_.GetDouble("naming.update.interval"));
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!exit_requested_) {
+    if (exit_cv_.wait_for(lock, interval, [&] { return exit_requested_; })) break;
+    lock.unlock();
+    Rebind();
+    lock.lock();
+  }
+}
+
+namespace {
+
+CosNaming::NamingContext_ptr HostContext(CosNaming::NamingContext_ptr root,
+                                         const std::string& host) {
+  CosNaming::Name name;
+  name.length(1);
+  name[0].id = host.c_str();
+  name[0].kind = "host_cxt";
+  try {
+    return root->bind_new_context(name);
+  } catch (const CosNaming::NamingContext::AlreadyBound&) {
+    CORBA::Object_var obj = root->resolve(name);
+    return CosNaming::NamingContext::_narrow(obj);
+  }
+}
+
+CosNaming::Name Leaf(const std::string& instance) {
+  CosNaming::Name name;
+  name.length(1);
+  name[0].id = instance.c_str();
+  name[0].kind = "rtc";
+  return name;
+}
+
+}  // namespace
+
+void Runtime::BindUnique() {
+  CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
+  CosNaming::NamingContext_var host = HostContext(root, host_);
+  const std::string base = config_.GetString("naming.instance");
+  for (int i = 0;; ++i) {
+    const std::string candidate = base + std::to_string(i);
+    const CosNaming::Name leaf = Leaf(candidate);
+    try {
+      host->bind(leaf, self_);
+    } catch (const CosNaming::NamingContext::AlreadyBound&) {
+      CORBA::Object_var existing = host->resolve(leaf);
+      if (!existing->_is_equivalent(self_) && ObjectAlive(existing)) continue;
+      host->rebind(leaf, self_);  // a stale binding of a process that died
+      logging::Get("rtc").info("took over the stale name %s", candidate.c_str());
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    instance_ = candidate;
+    bound_ = true;
+    break;
+  }
+  logging::SetInstance(instance());
+}
+
+void Runtime::Rebind() {
+  static bool warned = false;
+  try {
+    CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
+    CosNaming::NamingContext_var host = HostContext(root, host_);
+    host->rebind(Leaf(instance()), self_);
+    if (warned) logging::Get("rtc").notice("registered again in %s", naming_address_.c_str());
+    warned = false;
+  } catch (const std::exception& e) {
+    if (!warned) logging::Get("rtc").warn("re-registration failed (will retry): %s", e.what());
+    warned = true;
+  } catch (const CORBA::Exception& e) {
+    if (!warned)
+      logging::Get("rtc").warn("re-registration failed (will retry): %s", Describe(e).c_str());
+    warned = true;
+  }
+}
+
+void Runtime::Unbind() {
+  try {
+    CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
+    const CosNaming::Name name = ComponentName(host_, instance());
+    CORBA::Object_var existing = root->resolve(name);
+    if (existing->_is_equivalent(self_)) root->unbind(name);
+  } catch (...) {
+    // the naming service is gone or the name was taken over: nothing of ours to remove
+  }
+}
+
+int RunComponent(int argc, char** argv, const ComponentType& type,
+                 const ComponentFactory& make_component, const ServantFactory& make_servant) {
+  SignalWatcher::BlockSignals();  // before any thread exists, so that all inherit the mask
+  const std::string program = "caliper-" + type.name;
+
+  core::Config config(CommonKeys(type.name));
+  config.AddKeys(type.config_keys);
+  std::vector<std::string> orb_args{argv[0]};
+  try {
+    const std::string default_file = ConfigDirectory() + "/" + type.name + ".conf";
+    if (access(default_file.c_str(), R_OK) == 0) config.LoadFile(default_file);
+    std::vector<std::string> overrides;
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto next = [&]() -> std::string {
+        if (i + 1 >= argc) throw core::ConfigError("option " + arg + " needs a value");
+        return argv[++i];
+      };
+      if (arg == "-h" || arg == "--help") {
+        PrintUsage(type, config);
+        return 0;
+      } else if (arg == "-f") {
+        config.LoadFile(next());
+      } else if (arg == "-o") {
+        overrides.push_back(next());
+      } else if (arg == "--nameservice") {
+        overrides.push_back("naming.service=" + next());
+      } else if (arg == "--instance") {
+        overrides.push_back("naming.instance=" + next());
+      } else if (arg.rfind("-ORB", 0) == 0) {
+        orb_args.push_back(arg);
+        orb_args.push_back(next());
+      } else {
+        throw core::ConfigError("unknown argument '" + arg + "' (see --help)");
+      }
+    }
+    for (const auto& o : overrides) config.SetAssignment(o, "-o");
+  } catch (const core::ConfigError& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return 2;
+  }
+
+  int console_priority = logging::kInfo;
+  logging::ParsePriority(config.GetString("log.level"), &console_priority);
+  logging::Initialize(type.name, console_priority);
+  auto& log = logging::Get("rtc");
+  for (const auto& w : config.warnings()) log.warn("%s", w.c_str());
+
+  Runtime runtime(type, config);
+  runtime.naming_address_ = NamingAddress(config.GetString("naming.service"));
+  {
+    std::lock_guard<std::mutex> lock(runtime.mutex_);
+    runtime.instance_ = config.GetString("naming.instance");
+  }
+  logging::SetInstance(runtime.instance());
+
+  const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
+  orb_args.insert(orb_args.end(),
+                  {"-ORBendPoint", config.GetString("corba.endpoint"),
+                   "-ORBclientCallTimeOutPeriod", std::to_string(timeout_ms),
+                   "-ORBclientConnectTimeOutPeriod", std::to_string(timeout_ms)});
+  std::vector<char*> orb_argv;
+  for (auto& a : orb_args) orb_argv.push_back(a.data());
+  int orb_argc = static_cast<int>(orb_argv.size());
+
+  int exit_code = 0;
+  try {
+    runtime.orb_ = CORBA::ORB_init(orb_argc, orb_argv.data());
+    CORBA::Object_var poa_obj = runtime.orb_->resolve_initial_references("RootPOA");
+    runtime.poa_ = PortableServer::POA::_narrow(poa_obj);
+    runtime.poa_->the_POAManager()->activate();
+
+    if (type.remote_logging) {
+      logging::AppenderOptions options;
+      options.spool_dir = core::ExpandHome(config.GetString("log.spool_dir"));
+      options.spool_name = type.name + "-" + std::to_string(getpid());
+      logging::AddAppender(new logging::BatchingAppender(
+          "log-service",
+          std::make_unique<LogServiceSink>(runtime.orb_, runtime.naming_address_,
+                                           config.GetString("log.service")),
+          options));
+    }
+
+    runtime.component_ = make_component(runtime);
+    runtime.lifecycle_ = std::make_unique<Lifecycle>(runtime.component_.get());
+    const bool periodic = config.GetString("exec.kind") == "periodic";
+    runtime.context_ = std::make_unique<ExecutionContext>(
+        runtime.lifecycle_.get(), periodic ? ContextKind::kPeriodic : ContextKind::kExternal,
+        config.GetDouble("exec.rate"));
+    runtime.context_ref_ = runtime.Activate(new ExecutionContextServant(runtime));
+    runtime.self_ = runtime.Activate(make_servant(runtime, *runtime.component_));
+
+    const ReturnCode init = runtime.lifecycle_->Initialize();
+    if (init != ReturnCode::kOk) {
+      log.error("initialization failed: %s", runtime.lifecycle_->last_error().c_str());
+      exit_code = 1;
+    } else {
+      runtime.BindUnique();
+      log.notice("%s is up as %s in %s (pid %d)", type.name.c_str(), runtime.naming_path().c_str(),
+                 runtime.naming_address_.c_str(), static_cast<int>(getpid()));
+      runtime.context_->Start();
+      if (config.GetBool("exec.auto_activate")) runtime.lifecycle_->Activate();
+
+      SignalWatcher signals(&runtime);
+      runtime.WaitForExit();
+
+      log.notice("shutting down");
+      if (runtime.lifecycle_->state() == State::kActive) runtime.lifecycle_->Deactivate();
+      if (runtime.context_->is_running()) runtime.context_->Stop();
+      if (!runtime.lifecycle_->finalized()) runtime.lifecycle_->Finalize();
+      runtime.Unbind();
+      log.notice("stopped");
+    }
+  } catch (const Unreachable& e) {
+    log.error("%s", e.what());
+    exit_code = 1;
+  } catch (const CORBA::Exception& e) {
+    log.error("CORBA error: %s", Describe(e).c_str());
+    exit_code = 1;
+  } catch (const std::exception& e) {
+    log.error("%s", e.what());
+    exit_code = 1;
+  }
+  logging::Shutdown();  // delivers or spools the last records while the ORB still works
+  if (!CORBA::is_nil(runtime.orb_)) {
+    try {
+      runtime.orb_->shutdown(true);
+      runtime.orb_->destroy();
+    } catch (const CORBA::Exception&) {
+    }
+  }
+  return exit_code;
+}
+
+}  // namespace caliper::rtc
