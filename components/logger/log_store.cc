@@ -1,6 +1,7 @@
 #include "log_store.h"
 
 #include <dirent.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <ctime>
@@ -88,20 +89,43 @@ std::vector<StoredRecord> LogStore::Submit(const std::vector<logging::Record>& r
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<StoredRecord> stored;
   std::string text;
+  // the batch counts as stored only once it is in the file, so that a retry after a failed
+  // write is not taken for a duplicate
+  std::map<std::string, uint64_t> last_seq;
+  uint64_t serial = serial_;
   for (const auto& r : records) {
-    uint64_t& last = last_seq_[r.source];
-    if (r.seq != 0 && r.seq <= last) continue;  // delivered before: a retried batch
-    if (r.seq != 0) last = r.seq;
+    if (r.seq != 0) {
+      auto last = last_seq.find(r.source);
+      if (last == last_seq.end()) {
+        auto known = last_seq_.find(r.source);
+        last = last_seq.emplace(r.source, known == last_seq_.end() ? 0 : known->second).first;
+      }
+      if (r.seq <= last->second) continue;  // delivered before: a retried batch
+      last->second = r.seq;
+    }
     text += logging::FormatLine(r);
     text += '\n';
-    stored.push_back({++serial_, r});
+    stored.push_back({++serial, r});
   }
   if (!text.empty()) {
+    struct stat before;
+    const bool sized = stat(path_.c_str(), &before) == 0;
     // one write per batch: a record reaches the file whole or, after a crash, is cut off whole
     file_ << text;
     file_.flush();
-    if (!file_) throw std::runtime_error("cannot write session log " + path_);
+    if (!file_) {
+      // drop what could not be written and cut off any fragment that was, then start afresh
+      std::string why = "cannot write session log " + path_;
+      file_.close();
+      if (!sized || truncate(path_.c_str(), before.st_size) != 0)
+        why += " (a partial line may be left in it)";
+      file_.clear();
+      file_.open(path_, std::ios::app | std::ios::binary);
+      throw std::runtime_error(why);
+    }
   }
+  serial_ = serial;
+  for (const auto& [source, seq] : last_seq) last_seq_[source] = seq;
   for (const auto& s : stored) {
     recent_.push_back(s);
     if (recent_.size() > memory_records_) recent_.pop_front();

@@ -66,7 +66,7 @@ TEST(BadInput, MalformedConfigurationStopsWithExitCode2) {
   for (const auto& c : cases) {
     std::vector<std::string> argv = {Bin("caliper-sample")};
     argv.insert(argv.end(), c.args.begin(), c.args.end());
-    const auto r = Run(argv);
+    const auto r = RunCommand(argv);
     EXPECT_EQ(r.exit_code, 2) << c.args[0] << " " << c.args.back();
     EXPECT_TRUE(Contains(r.err, c.message)) << r.err;
   }
@@ -78,7 +78,7 @@ TEST(BadInput, ConfigFileErrorsNameTheLine) {
   FILE* f = fopen(file.c_str(), "w");
   fputs("# a comment\nexec.rate = 10\nexec.rate = ten\n", f);
   fclose(f);
-  const auto r = Run({Bin("caliper-sample"), "-f", file});
+  const auto r = RunCommand({Bin("caliper-sample"), "-f", file});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(Contains(r.err, file + ":3: exec.rate = 'ten'")) << r.err;
 }
@@ -96,13 +96,13 @@ TEST(BadInput, UnknownKeysWarnButStart) {
 
 TEST(BadInput, ComponentWithoutNamingServiceSaysWhereItLooked) {
   const std::string address = "corbaname::127.0.0.1:" + std::to_string(FreePort());
-  const auto r = Run({Bin("caliper-sample"), "--nameservice", address});
+  const auto r = RunCommand({Bin("caliper-sample"), "--nameservice", address});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_TRUE(Contains(r.err, "cannot reach the naming service at " + address)) << r.err;
 }
 
 TEST(BadInput, HelpListsEveryConfigurationKey) {
-  const auto r = Run({Bin("caliper-sample"), "--help"});
+  const auto r = RunCommand({Bin("caliper-sample"), "--help"});
   EXPECT_EQ(r.exit_code, 0);
   for (const std::string key : {"exec.rate", "naming.update.interval", "sample.record_limit"})
     EXPECT_TRUE(Contains(r.out, key)) << key;

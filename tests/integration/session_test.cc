@@ -159,7 +159,9 @@ TEST_F(SessionTest, TenThousandRecordsSurviveAKilledLoggerExactlyOnceInOrder) {
     ASSERT_EQ(records[i].message,
               "record " + std::to_string(i + 1) + " of " + std::to_string(kRecords))
         << "at position " << i;
-    if (i > 0) ASSERT_GT(records[i].seq, records[i - 1].seq);
+    if (i > 0) {
+      ASSERT_GT(records[i].seq, records[i - 1].seq);
+    }
   }
   EXPECT_EQ(ListFiles(dir_.path() + "/logs", "caliper-").size(), 1u) << "one file per session";
 }

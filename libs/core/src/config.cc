@@ -66,7 +66,13 @@ Config::Config(std::vector<ConfigKey> schema) : schema_(std::move(schema)) {
 
 void Config::AddKeys(const std::vector<ConfigKey>& keys) {
   for (const auto& k : keys) {
-    schema_.push_back(k);
+    // a component may redeclare a common key (another default, other bounds): the last one wins
+    auto it = std::find_if(schema_.begin(), schema_.end(),
+                           [&](const ConfigKey& existing) { return existing.name == k.name; });
+    if (it != schema_.end())
+      *it = k;
+    else
+      schema_.push_back(k);
     values_[k.name] = k.default_value;
   }
 }

@@ -4,7 +4,9 @@
 #include <log4cpp/LoggingEvent.hh>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 
 #include "caliper/core/system.h"
@@ -34,17 +36,29 @@ void BatchingAppender::ClaimOrphans() {
   while (dirent* entry = readdir(dir)) names.emplace_back(entry->d_name);
   closedir(dir);
   const std::string suffix = ".spool";
+  const std::string claimed_mark = ".claimed-";
+  std::sort(names.begin(), names.end());
   for (const auto& name : names) {
-    if (name.size() <= suffix.size() ||
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+    // a spool of a dead process, `<stem>-<pid>.spool`, or one claimed by a process that died
+    // before it had replayed it, `<stem>-<pid>.claimed-<claimer pid>`
+    long owner = 0;
+    std::string stem;
+    const auto mark = name.find(claimed_mark);
+    if (mark != std::string::npos) {
+      stem = name.substr(0, mark);
+      owner = std::strtol(name.c_str() + mark + claimed_mark.size(), nullptr, 10);
+    } else if (name.size() > suffix.size() &&
+               name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      stem = name.substr(0, name.size() - suffix.size());
+      const auto dash = stem.rfind('-');
+      if (dash == std::string::npos) continue;
+      owner = std::strtol(stem.c_str() + dash + 1, nullptr, 10);
+    } else {
       continue;
-    const std::string stem = name.substr(0, name.size() - suffix.size());
-    const auto dash = stem.rfind('-');
-    if (dash == std::string::npos || stem == options_.spool_name) continue;
-    const long pid = std::strtol(stem.c_str() + dash + 1, nullptr, 10);
-    if (core::ProcessAlive(pid)) continue;
+    }
+    if (stem == options_.spool_name || owner == getpid() || core::ProcessAlive(owner)) continue;
     // rename is atomic: of two processes claiming the same orphan, one wins
-    const std::string claimed = options_.spool_dir + "/" + stem + ".claimed-" +
+    const std::string claimed = options_.spool_dir + "/" + stem + claimed_mark +
                                 std::to_string(getpid());
     if (std::rename((options_.spool_dir + "/" + name).c_str(), claimed.c_str()) == 0)
       orphan_files_.push_back(claimed);

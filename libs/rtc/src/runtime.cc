@@ -195,20 +195,24 @@ void Runtime::BindUnique() {
 
 void Runtime::Rebind() {
   static bool warned = false;
-  try {
-    CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
-    CosNaming::NamingContext_var host = HostContext(root, host_);
-    host->rebind(Leaf(instance()), self_);
-    if (warned) logging::Get("rtc").notice("registered again in %s", naming_address_.c_str());
-    warned = false;
-  } catch (const std::exception& e) {
-    if (!warned) logging::Get("rtc").warn("re-registration failed (will retry): %s", e.what());
-    warned = true;
-  } catch (const CORBA::Exception& e) {
-    if (!warned)
-      logging::Get("rtc").warn("re-registration failed (will retry): %s", Describe(e).c_str());
-    warned = true;
+  std::string failure;
+  // a restarted naming service first fails the call on the old connection: try twice
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    try {
+      CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
+      CosNaming::NamingContext_var host = HostContext(root, host_);
+      host->rebind(Leaf(instance()), self_);
+      if (warned) logging::Get("rtc").notice("registered again in %s", naming_address_.c_str());
+      warned = false;
+      return;
+    } catch (const std::exception& e) {
+      failure = e.what();
+    } catch (const CORBA::Exception& e) {
+      failure = Describe(e);
+    }
   }
+  if (!warned) logging::Get("rtc").warn("re-registration failed (will retry): %s", failure.c_str());
+  warned = true;
 }
 
 void Runtime::Unbind() {

@@ -128,7 +128,7 @@ void NamingService::Start(bool fresh) {
                          dir_ + "/omninames.log");
   const bool up = WaitFor(
       [&] {
-        return Run({"/usr/bin/nameclt", "-ORBInitRef", "NameService=" + address(), "list"},
+        return RunCommand({"/usr/bin/nameclt", "-ORBInitRef", "NameService=" + address(), "list"},
                    std::chrono::seconds(5))
                    .exit_code == 0;
       },
@@ -136,7 +136,7 @@ void NamingService::Start(bool fresh) {
   if (!up) throw std::runtime_error("omniNames did not start: " + process_->Output());
 }
 
-CommandResult Run(const std::vector<std::string>& argv, std::chrono::milliseconds timeout) {
+CommandResult RunCommand(const std::vector<std::string>& argv, std::chrono::milliseconds timeout) {
   char out_path[] = "/tmp/caliper-run-out-XXXXXX";
   char err_path[] = "/tmp/caliper-run-err-XXXXXX";
   const int out_fd = mkstemp(out_path);
@@ -181,7 +181,7 @@ std::string Bin(const std::string& name) {
 CommandResult Ctl(const std::string& address, const std::vector<std::string>& args) {
   std::vector<std::string> argv = {Bin("caliper-ctl"), "--nameservice", address};
   argv.insert(argv.end(), args.begin(), args.end());
-  return Run(argv);
+  return RunCommand(argv);
 }
 
 bool WaitFor(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {

@@ -73,7 +73,7 @@ struct CommandResult {
 };
 
 /// Runs a program to completion (at most `timeout`), capturing stdout and stderr separately.
-CommandResult Run(const std::vector<std::string>& argv,
+CommandResult RunCommand(const std::vector<std::string>& argv,
                   std::chrono::milliseconds timeout = std::chrono::seconds(20));
 
 /// Runs build/bin/caliper-ctl --nameservice ADDRESS args...
