@@ -244,7 +244,7 @@ int Transition(Client& client, std::vector<std::string>& args, const std::string
 
 void Print(const LogIdl::StoredRecord& s) {
   const auto& r = s.rec;
-  std::cout << core::FormatTime(r.time_us) << " " << std::left << std::setw(6)
+  std::cout << core::FormatTime(r.time_us) << " " << std::left << std::setw(7)
             << logging::PriorityName(r.priority) << std::setw(10) << r.instance.in() << " ["
             << r.category.in() << "] " << r.message.in() << "\n";
 }

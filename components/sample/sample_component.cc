@@ -40,8 +40,11 @@ rtc::ReturnCode SampleComponent::OnExecute() {
   for (int64_t i = 0; i < records_per_tick_; ++i) {
     if (record_limit_ != 0 && written_ >= record_limit_) break;
     ++written_;
-    records.info("record %lld of %lld", static_cast<long long>(written_),
-                 static_cast<long long>(record_limit_));
+    if (record_limit_ != 0)
+      records.info("record %lld of %lld", static_cast<long long>(written_),
+                   static_cast<long long>(record_limit_));
+    else
+      records.info("record %lld", static_cast<long long>(written_));
   }
   return rtc::ReturnCode::kOk;
 }
