@@ -80,43 +80,34 @@ ReturnCode Lifecycle::Finalize() {
   return rc;
 }
 
-ReturnCode Lifecycle::Activate() {
+ReturnCode Lifecycle::Transition(State from, const char* hook, ReturnCode (Component::*fn)(),
+                                 State to) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (finalized_ || state_ != State::kInactive) return ReturnCode::kPreconditionNotMet;
+  if (finalized_ || state_ != from) return ReturnCode::kPreconditionNotMet;
   std::string reason;
-  const ReturnCode rc = Call("on_activated", &Component::OnActivated, &reason);
+  const ReturnCode rc = Call(hook, fn, &reason);
   if (rc != ReturnCode::kOk) {
-    EnterErrorLocked(reason);
+    // a failing reset leaves the component in ERROR; any other failing transition enters it
+    if (from == State::kError)
+      last_error_ = reason;
+    else
+      EnterErrorLocked(reason);
     return rc;
   }
-  state_ = State::kActive;
+  state_ = to;
   return ReturnCode::kOk;
+}
+
+ReturnCode Lifecycle::Activate() {
+  return Transition(State::kInactive, "on_activated", &Component::OnActivated, State::kActive);
 }
 
 ReturnCode Lifecycle::Deactivate() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (finalized_ || state_ != State::kActive) return ReturnCode::kPreconditionNotMet;
-  std::string reason;
-  const ReturnCode rc = Call("on_deactivated", &Component::OnDeactivated, &reason);
-  if (rc != ReturnCode::kOk) {
-    EnterErrorLocked(reason);
-    return rc;
-  }
-  state_ = State::kInactive;
-  return ReturnCode::kOk;
+  return Transition(State::kActive, "on_deactivated", &Component::OnDeactivated, State::kInactive);
 }
 
 ReturnCode Lifecycle::Reset() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (finalized_ || state_ != State::kError) return ReturnCode::kPreconditionNotMet;
-  std::string reason;
-  const ReturnCode rc = Call("on_reset", &Component::OnReset, &reason);
-  if (rc != ReturnCode::kOk) {
-    last_error_ = reason;
-    return rc;
-  }
-  state_ = State::kInactive;
-  return ReturnCode::kOk;
+  return Transition(State::kError, "on_reset", &Component::OnReset, State::kInactive);
 }
 
 void Lifecycle::Execute() {

@@ -72,6 +72,7 @@ class Lifecycle {
  private:
   ReturnCode Call(const char* hook, ReturnCode (Component::*fn)(), std::string* reason);
   void EnterErrorLocked(const std::string& reason);
+  ReturnCode Transition(State from, const char* hook, ReturnCode (Component::*fn)(), State to);
 
   Component* component_;
   std::string log_area_;
