@@ -1,0 +1,76 @@
+#pragma once
+// Engine-free actuator models acting along a tendon. An engine adapter evaluates the tendon path,
+// calls Step() with its length and lengthening speed, and applies the returned tension along the
+// path. New kinds register a factory; the engine code never changes for them. SI units.
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "caliper/sgal/scene.h"
+
+namespace caliper::actuators {
+
+/// A named scalar an actuator exposes: a parameter (static, usually writable) or a state.
+struct Quantity {
+  std::string name;  // e.g. current, resistance, activation
+  std::string unit;  // SI: A, ohm, N/m, "" for dimensionless
+  bool writable = false;
+  bool is_static = false;  // model parameter (true) or state that changes each step (false)
+};
+
+/// A parameter a kind takes from sgal::Actuator::parameters.
+struct ParameterSpec {
+  std::string name;
+  std::string unit;
+  double default_value = 0;
+  bool required = false;  // no default: the model file must give it
+  std::string help;
+};
+
+class TendonActuator {
+ public:
+  virtual ~TendonActuator() = default;
+
+  /// Sets the internal state for a tendon path of this length at rest (t = 0).
+  virtual void Reset(double path_length) = 0;
+
+  /// Advances the internal state by dt [s], the path length [m] and lengthening speed [m/s] held
+  /// over the step; returns the tension [N] (>= 0) to apply along the path for this step.
+  virtual double Step(double path_length, double path_speed, double dt) = 0;
+
+  /// The tension of the last Step [N].
+  virtual double tension() const = 0;
+
+  /// The input: voltage [V], PWM duty [-] or excitation [-] depending on the kind.
+  virtual void SetCommand(double value) = 0;
+  virtual double command() const = 0;
+  virtual std::string command_unit() const = 0;
+
+  /// Parameters and states, by name.
+  virtual std::vector<Quantity> Quantities() const = 0;
+  /// Throws std::out_of_range for an unknown name.
+  virtual double Get(const std::string& name) const = 0;
+  /// Throws std::out_of_range (unknown) or std::invalid_argument (read-only, out of range).
+  virtual void Set(const std::string& name, double value) = 0;
+};
+
+using Factory = std::function<std::unique_ptr<TendonActuator>(const sgal::Actuator&)>;
+
+/// Registers a kind (a later registration of the same kind replaces it).
+void RegisterKind(const std::string& kind, std::vector<ParameterSpec> parameters, Factory factory);
+
+/// Makes the model of an actuator description. Throws std::invalid_argument naming the actuator,
+/// and the unknown kind, the missing parameter or the unknown parameter name.
+std::unique_ptr<TendonActuator> Make(const sgal::Actuator& description);
+
+/// The registered kinds and their parameters (for documentation, importers, exporters).
+std::vector<std::string> Kinds();
+const std::vector<ParameterSpec>& KindParameters(const std::string& kind);
+
+/// The value of a parameter from a description, or the kind's default.
+double ParameterOr(const sgal::Actuator& a, const std::string& name, double fallback);
+
+}  // namespace caliper::actuators

@@ -1,0 +1,96 @@
+#pragma once
+// The interface of a running physics scene (an engine adapter implements it) and the observer
+// that receives only what changed.
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "caliper/sgal/scene.h"
+
+namespace caliper::sgal {
+
+/// A step that produced non-finite or exploding state: which element, at what time.
+class SimulationFault : public std::runtime_error {
+ public:
+  SimulationFault(const std::string& what, std::string element, double time)
+      : std::runtime_error(what), element_(std::move(element)), time_(time) {}
+  const std::string& element() const { return element_; }
+  double time() const { return time_; }  // [s]
+
+ private:
+  std::string element_;
+  double time_;
+};
+
+struct BodyState {
+  Pose pose;                                                    // world frame
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // [m/s]
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // [rad/s]
+};
+
+struct TendonState {
+  std::vector<Eigen::Vector3d> points;  // current path in world coordinates [m]
+  double length = 0;                    // [m]
+  double speed = 0;                     // lengthening speed [m/s]
+  double tension = 0;                   // [N]
+  int contacts = 0;                     // points where it presses on bodies it is not routed over
+};
+
+/// A named scalar quantity of the scene: actuator states and parameters, body masses, ...
+struct ParameterInfo {
+  std::string id;    // e.g. motor1.current, upper_arm.mass
+  std::string unit;  // SI, e.g. A, kg, N/m
+  bool writable = false;
+  bool is_static = false;  // a model parameter (true) or a state that changes every step (false)
+};
+
+class PhysicsScene {
+ public:
+  virtual ~PhysicsScene() = default;
+
+  /// Advances by one fixed time step. Throws SimulationFault (and stays at the last good state)
+  /// when the state becomes non-finite or explodes.
+  virtual void Step() = 0;
+  virtual double time() const = 0;     // simulated time [s]
+  virtual uint64_t steps() const = 0;
+  virtual const Scene& description() const = 0;
+
+  virtual std::vector<BodyState> BodyStates() const = 0;  // in description().bodies order
+  virtual std::vector<TendonState> TendonStates() const = 0;
+
+  /// Sets an actuator's input (voltage, duty, excitation). Throws std::out_of_range for an
+  /// unknown name, std::invalid_argument for a non-finite value.
+  virtual void SetCommand(const std::string& actuator, double value) = 0;
+
+  virtual std::vector<ParameterInfo> Parameters() const = 0;
+  /// Throws std::out_of_range for an unknown id.
+  virtual double GetParameter(const std::string& id) const = 0;
+  /// Throws std::out_of_range (unknown), std::invalid_argument (read-only or bad value).
+  virtual void SetParameter(const std::string& id, double value) = 0;
+};
+
+/// Receives the bodies whose pose changed beyond a tolerance since it was last told.
+class SceneObserver {
+ public:
+  virtual ~SceneObserver() = default;
+  virtual void OnTransforms(uint64_t step, double time, const std::vector<int>& bodies,
+                            const std::vector<BodyState>& states) = 0;
+};
+
+/// Tracks the last pose each observer saw and reports only the changed ones.
+class ChangeFilter {
+ public:
+  ChangeFilter(double position_tolerance = 1e-6, double angle_tolerance = 1e-5);
+  /// Indices of bodies that moved beyond the tolerances since the last call; remembers them.
+  std::vector<int> Changed(const std::vector<BodyState>& states);
+
+ private:
+  double position_tolerance_;  // [m]
+  double angle_tolerance_;     // [rad]
+  std::vector<Pose> last_;
+};
+
+}  // namespace caliper::sgal
