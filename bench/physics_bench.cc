@@ -1,0 +1,135 @@
+// Physics benchmarks: Caliper's step against raw Bullet and MuJoCo 2.2.2 on the same 40-body,
+// 80-tendon tree, and the cost of tendon-skeleton contact. Prints one line per figure:
+//   RATIO <name> <value> (target <target>)
+// measured in this run (medians of several repetitions), never compared with stored times.
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "caliper/physics_bullet/bullet_scene.h"
+#include "raw_bullet.h"
+#include "tree_model.h"
+
+namespace caliper::bench {
+namespace {
+
+int steps = 2000;
+int repeats = 5;
+
+/// Median time of one step [us] over `repeats` runs of `steps` steps, after a warm-up.
+double Time(const std::function<void()>& make, const std::function<void()>& step) {
+  std::vector<double> runs;
+  for (int r = 0; r < repeats; ++r) {
+    make();
+    for (int i = 0; i < 100; ++i) step();
+    const auto begin = std::chrono::steady_clock::now();
+    for (int i = 0; i < steps; ++i) step();
+    const double us =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - begin).count();
+    runs.push_back(us / steps);
+  }
+  std::sort(runs.begin(), runs.end());
+  return runs[runs.size() / 2];
+}
+
+double TimeCaliper(const TreeOptions& tree, bool contact) {
+  std::unique_ptr<sgal::PhysicsScene> scene;
+  physics_bullet::Options options;
+  options.tendon_body_contact = contact;
+  const sgal::Scene description = MakeTree(tree);
+  return Time(
+      [&] {
+        scene = physics_bullet::MakeScene(description, options);
+        for (const auto& a : description.actuators) scene->SetCommand(a.name, 1.0);
+      },
+      [&] { scene->Step(); });
+}
+
+double TimeRawBullet(const TreeOptions& tree) {
+  std::unique_ptr<RawBulletWorld> world;
+  const sgal::Scene description = MakeTree(tree);
+  return Time([&] { world = std::make_unique<RawBulletWorld>(description); },
+              [&] { world->Step(1e-3); });
+}
+
+double TimeMuJoCo(const TreeOptions& tree) {
+  const std::string xml = MakeTreeMjcf(tree);
+  const char* path = "/tmp/caliper-bench-tree40.xml";
+  FILE* f = std::fopen(path, "w");
+  std::fputs(xml.c_str(), f);
+  std::fclose(f);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML(path, nullptr, error, sizeof error);
+  if (m == nullptr) {
+    std::fprintf(stderr, "MuJoCo rejected the generated model: %s\n", error);
+    std::exit(1);
+  }
+  mjData* d = nullptr;
+  const double us = Time(
+      [&] {
+        if (d) mj_deleteData(d);
+        d = mj_makeData(m);
+        for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 5.0;
+      },
+      [&] { mj_step(m, d); });
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return us;
+}
+
+void Ratio(const char* name, double value, double target) {
+  std::printf("RATIO %s %.3f (target %.2f)%s\n", name, value, target,
+              value <= target ? "" : "  <- above target");
+  std::fflush(stdout);
+}
+
+}  // namespace
+}  // namespace caliper::bench
+
+int main(int argc, char** argv) {
+  using namespace caliper::bench;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
+    else {
+      std::printf("Usage: physics_bench [--steps N] [--repeats R]\n"
+                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms; medians of R runs of N steps.\n");
+      return std::strcmp(argv[i], "--help") ? 2 : 0;
+    }
+  }
+  TreeOptions contact;  // floor and self contact
+  TreeOptions free;
+  free.floor = false;
+  free.self_contact = false;
+
+  const double caliper_contact = TimeCaliper(contact, true);
+  const double raw_contact = TimeRawBullet(contact);
+  std::printf("# step time [us]: Caliper %.1f, raw Bullet with 80 springs %.1f (floor + self contact)\n",
+              caliper_contact, raw_contact);
+  Ratio("caliper_vs_raw_bullet", caliper_contact / raw_contact, 1.15);
+
+  const double mujoco_contact = TimeMuJoCo(contact);
+  std::printf("# step time [us]: MuJoCo 2.2.2 %.1f (floor + self contact)\n", mujoco_contact);
+  Ratio("caliper_vs_mujoco_contact", caliper_contact / mujoco_contact, 1.0);
+
+  const double caliper_free = TimeCaliper(free, true);
+  const double mujoco_free = TimeMuJoCo(free);
+  std::printf("# step time [us]: Caliper %.1f, MuJoCo 2.2.2 %.1f (no contact)\n", caliper_free,
+              mujoco_free);
+  Ratio("caliper_vs_mujoco_no_contact", caliper_free / mujoco_free, 1.5);
+
+  TreeOptions spanning = free;
+  spanning.spanning_tendons = true;
+  const double on = TimeCaliper(spanning, true);
+  const double off = TimeCaliper(spanning, false);
+  std::printf("# step time [us]: tendons pressing on bodies, contact on %.1f, off %.1f\n", on, off);
+  Ratio("tendon_contact_on_vs_off", on / off, 2.0);
+  return 0;
+}

@@ -1,0 +1,107 @@
+#include "raw_bullet.h"
+
+#include <btBulletDynamicsCommon.h>
+
+#include <vector>
+
+namespace caliper::bench {
+
+namespace {
+btVector3 Bt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+btQuaternion Bt(const Eigen::Quaterniond& q) { return btQuaternion(q.x(), q.y(), q.z(), q.w()); }
+}  // namespace
+
+struct RawBulletWorld::Impl {
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher{&configuration};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<std::unique_ptr<btTypedConstraint>> constraints;
+  struct Spring {
+    btRigidBody* a;
+    btRigidBody* b;
+    btVector3 pa, pb;  // in the bodies' frames
+    double rest;
+  };
+  std::vector<Spring> springs;
+};
+
+RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Impl>()) {
+  Impl& w = *impl_;
+  w.world.setGravity(Bt(s.gravity));
+  for (const auto& b : s.bodies) {
+    auto compound = std::make_unique<btCompoundShape>();
+    for (const auto& shape : b.shapes) {
+      std::unique_ptr<btCollisionShape> child;
+      if (const auto* c = std::get_if<sgal::Capsule>(&shape.geometry))
+        child = std::make_unique<btCapsuleShapeZ>(c->radius, c->length);
+      else
+        child = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
+      compound->addChildShape(btTransform(Bt(shape.pose.orientation), Bt(shape.pose.position)),
+                              child.get());
+      w.shapes.push_back(std::move(child));
+    }
+    const bool dynamic = b.type == sgal::BodyType::kDynamic;
+    const double mass = dynamic ? b.inertia.mass : 0;
+    // the tree's tensors are diagonal in the body frame (capsules along x, y or z)
+    const btVector3 inertia = dynamic ? Bt(Eigen::Vector3d(b.inertia.tensor.diagonal())) : btVector3(0, 0, 0);
+    btRigidBody::btRigidBodyConstructionInfo info(mass, nullptr, compound.get(), inertia);
+    info.m_startWorldTransform = btTransform(Bt(b.pose.orientation), Bt(b.pose.position));
+    auto rb = std::make_unique<btRigidBody>(info);
+    rb->setActivationState(DISABLE_DEACTIVATION);
+    uint32_t group = 0, mask = 0;
+    for (const auto& shape : b.shapes) {
+      group |= shape.group;
+      mask |= shape.mask;
+    }
+    w.world.addRigidBody(rb.get(), static_cast<int>(group & 0x7fff), static_cast<int>(mask & 0x7fff));
+    w.shapes.push_back(std::move(compound));
+    w.bodies.push_back(std::move(rb));
+  }
+  auto body = [&](const std::string& name) { return w.bodies[s.BodyIndex(name)].get(); };
+  for (const auto& c : s.constraints) {
+    auto hinge = std::make_unique<btHingeConstraint>(
+        *body(c.body_a), *body(c.body_b),
+        btTransform(Bt(c.frame_a.orientation), Bt(c.frame_a.position)),
+        btTransform(Bt(c.frame_b.orientation), Bt(c.frame_b.position)));
+    w.world.addConstraint(hinge.get(), true);
+    w.constraints.push_back(std::move(hinge));
+  }
+  for (const auto& t : s.tendons) {
+    Impl::Spring spring{body(t.path.front().body), body(t.path.back().body),
+                        Bt(t.path.front().position), Bt(t.path.back().position), 0};
+    const btVector3 a = spring.a->getWorldTransform() * spring.pa;
+    const btVector3 b = spring.b->getWorldTransform() * spring.pb;
+    spring.rest = (b - a).length() * 0.98;  // slightly stretched: every spring pulls
+    w.springs.push_back(spring);
+  }
+}
+
+RawBulletWorld::~RawBulletWorld() {
+  for (auto& c : impl_->constraints) impl_->world.removeConstraint(c.get());
+  for (auto& b : impl_->bodies) impl_->world.removeRigidBody(b.get());
+}
+
+void RawBulletWorld::Step(double dt) {
+  constexpr double kStiffness = 2000, kDamping = 5;
+  for (auto& s : impl_->springs) {
+    const btVector3 a = s.a->getWorldTransform() * s.pa;
+    const btVector3 b = s.b->getWorldTransform() * s.pb;
+    btVector3 d = b - a;
+    const double length = d.length();
+    if (length <= s.rest || length < 1e-9) continue;
+    d /= length;
+    const btVector3 va = s.a->getVelocityInLocalPoint(a - s.a->getCenterOfMassPosition());
+    const btVector3 vb = s.b->getVelocityInLocalPoint(b - s.b->getCenterOfMassPosition());
+    double f = kStiffness * (length - s.rest) + kDamping * d.dot(vb - va);
+    if (f < 0) f = 0;
+    s.a->applyForce(d * f, a - s.a->getCenterOfMassPosition());
+    s.b->applyForce(-d * f, b - s.b->getCenterOfMassPosition());
+  }
+  impl_->world.stepSimulation(dt, 0, dt);
+}
+
+}  // namespace caliper::bench

@@ -1,0 +1,24 @@
+#pragma once
+// The benchmark robot: a 40-body tree (a 20-body spine with two 10-body arms, 39 hinges) with 80
+// tendons, as a Caliper scene, as raw Bullet (the baseline) and as MJCF for MuJoCo.
+
+#include <string>
+
+#include "caliper/sgal/scene.h"
+
+namespace caliper::bench {
+
+struct TreeOptions {
+  bool floor = true;           // a ground plane
+  bool self_contact = true;    // bodies collide with each other (not with their hinge neighbours)
+  bool spanning_tendons = false;  // tendons cross two joints, over the body between (they press on it)
+  std::string actuator_kind = "dc_motor_tendon";
+};
+
+/// The scene with `actuator_kind` actuators on its 80 tendons.
+sgal::Scene MakeTree(const TreeOptions& options);
+
+/// The same model as MJCF, with motors on spatial tendons.
+std::string MakeTreeMjcf(const TreeOptions& options);
+
+}  // namespace caliper::bench

@@ -1,0 +1,138 @@
+#pragma once
+// A DC motor driving a spool through a gearbox, engine-free: the electrical and mechanical
+// equations of TENDONS.md with the gearbox efficiency switching smoothly between driving and
+// back-driven, so that a loaded gear holds while the motor pushes hard enough. Usable on its own
+// (a load torque on the spool) or with a load that depends on the spool angle and speed (a
+// tendon with a series-elastic element). SI units.
+
+#include <string>
+
+namespace caliper::actuators {
+
+/// Motor, gearbox and spool constants. Defaults: the reference (ECCE) motor of TENDONS.md; the
+/// spool radius is Roboy's, the only one given there.
+struct DcMotorParameters {
+  double resistance = 0.516;           // armature resistance R [ohm]
+  double inductance = 5.73e-5;         // armature inductance L [H]
+  double torque_constant = 11.5e-3;    // k_t [N m/A]
+  double back_emf_constant = 11.5e-3;  // k_e [V s/rad]
+  double rotor_inertia = 14.5e-7;      // J_rotor [kg m^2]
+  double gear_inertia = 0.4e-7;        // J_gear, reflected to the motor shaft [kg m^2]
+  double gear_ratio = 128;             // N: motor speed / spool speed [-]
+  double efficiency = 0.59;            // eta: gearbox efficiency when the motor drives [-]
+  double bridge_resistance = 0;        // R_bridge: H-bridge resistance in series [ohm]
+  double current_limit = 0;            // |i| the driver allows [A]; 0: no limit
+  double spool_radius = 0.0045;        // r_s [m]
+  double max_substep = 1e-4;           // longest internal integration step [s]
+
+  /// Throws std::invalid_argument naming the first parameter out of range (non-finite values,
+  /// non-positive R, L, k_t, k_e, rotor inertia, N, r_s, max_substep, an efficiency outside
+  /// (0, 1], negative gear inertia, bridge resistance or current limit).
+  void Validate() const;
+};
+
+/// The state of the motor and spool.
+struct DcMotorState {
+  double current = 0;      // armature current i [A]
+  double spool_speed = 0;  // gearbox output speed w [rad/s], positive winds the line in
+  double spool_angle = 0;  // phi [rad]
+};
+
+/// rho of TENDONS.md: the factor dividing the spool torque seen by the motor, eta when the motor
+/// drives (i w > 0) and 1/eta when it is back-driven (i w < 0), blended by
+/// eta + (1/eta - eta) (tanh(-500 i w - 5) + 1) / 2.
+double GearEfficiencyFactor(double efficiency, double current, double spool_speed);
+
+/// A load on the spool that may depend on the spool's angle and speed and carry state of its own
+/// (a series-elastic element). The motor solves for the end of each sub-step with the load
+/// treated implicitly, so TorqueAt() is called several times per sub-step with trial values.
+class SpoolLoad {
+ public:
+  virtual ~SpoolLoad() = default;
+  /// The torque on the spool [N m], positive against positive spool speed, at the end of a
+  /// stretch of h [s] from the last accepted sub-step that ends at this spool angle [rad] and
+  /// speed [rad/s]. Must not change the load's state.
+  virtual double TorqueAt(double spool_angle, double spool_speed, double h) const = 0;
+  /// Accepts a sub-step of h [s] that ended at this spool angle [rad] and speed [rad/s].
+  virtual void Advance(double spool_angle, double spool_speed, double h) = 0;
+};
+
+/// A torque on the spool that does not depend on its motion.
+class ConstantSpoolLoad : public SpoolLoad {
+ public:
+  /// torque [N m], positive against positive spool speed.
+  explicit ConstantSpoolLoad(double torque) : torque_(torque) {}
+  double TorqueAt(double, double, double) const override { return torque_; }
+  void Advance(double, double, double) override {}
+
+ private:
+  double torque_;  // [N m]
+};
+
+/// The motor + gearbox + spool model:
+///   L di/dt = U - (R + R_bridge) i - k_e N w
+///   N J dw/dt = k_t i - tau / (rho N),  J = J_rotor + J_gear,  tau the spool load torque
+///   dphi/dt = w
+/// Step() integrates these with sub-steps of at most max_substep by a two-stage L-stable
+/// singly diagonally implicit Runge-Kutta method (second order); each stage is solved for the
+/// spool speed with the load, the current and the efficiency switch implicit. Explicit methods
+/// (RK4 at 1e-4 s) are not stable where a back-driven gear holds: the switch in rho makes the
+/// speed equation stiff there (time constant of a few microseconds).
+/// With a current limit the driver lowers the voltage so that |i| stays at the limit.
+class DcMotor {
+ public:
+  /// Throws std::invalid_argument when the parameters are out of range.
+  explicit DcMotor(const DcMotorParameters& parameters = {});
+
+  const DcMotorParameters& parameters() const { return parameters_; }
+  /// Replaces the parameters (the state is kept). Throws std::invalid_argument (see Validate).
+  void set_parameters(const DcMotorParameters& parameters);
+
+  const DcMotorState& state() const { return state_; }
+  void set_state(const DcMotorState& state) { state_ = state; }
+  /// Zero current, speed and angle.
+  void Reset();
+
+  /// A locked spool (held fixed, speed zero) or a free one.
+  void set_locked(bool locked);
+  bool locked() const { return locked_; }
+
+  /// Advances by dt [s] > 0 with the terminal voltage [V] held and the spool loaded by `load`.
+  /// Throws std::invalid_argument for a non-finite voltage or a dt that is not positive.
+  void Step(double voltage, double dt, SpoolLoad& load);
+  /// Advances by dt [s] with a constant load torque [N m] (positive against positive speed).
+  void Step(double voltage, double dt, double load_torque);
+
+  /// The voltage the driver applied at the end of the last step [V] (lower than the command
+  /// while the current is limited).
+  double applied_voltage() const { return applied_voltage_; }
+  /// The spool load torque at the end of the last step [N m].
+  double load_torque() const { return load_torque_; }
+  /// Motor shaft speed N w [rad/s].
+  double motor_speed() const { return parameters_.gear_ratio * state_.spool_speed; }
+  /// Electrical input power U i [W].
+  double electrical_power() const { return applied_voltage_ * state_.current; }
+  /// The total inertia J_rotor + J_gear at the motor shaft [kg m^2].
+  double inertia() const { return parameters_.rotor_inertia + parameters_.gear_inertia; }
+
+ private:
+  struct Stage {
+    double current = 0;      // [A]
+    double spool_speed = 0;  // [rad/s]
+    double spool_angle = 0;  // [rad]
+    double voltage = 0;      // applied [V]
+    double torque = 0;       // load [N m]
+  };
+  // Solves y = a + c f(y) for one implicit stage whose end lies h after the last sub-step.
+  Stage SolveStage(const DcMotorState& a, double c, double voltage, double h,
+                   const SpoolLoad& load) const;
+  void Substep(double voltage, double h, SpoolLoad& load);
+
+  DcMotorParameters parameters_;
+  DcMotorState state_;
+  bool locked_ = false;
+  double applied_voltage_ = 0;  // [V]
+  double load_torque_ = 0;      // [N m]
+};
+
+}  // namespace caliper::actuators

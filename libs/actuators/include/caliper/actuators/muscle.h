@@ -1,0 +1,163 @@
+#pragma once
+// Hill-type muscle models: the curves of OpenSim's Thelen2003Muscle and of MuJoCo's <muscle>
+// actuator as free functions, and the parameter sets of the tendon actuator kind `hill_muscle`
+// (muscle.cc). Normalised quantities: lengths by the optimal fibre length (Thelen) or by MuJoCo's
+// L0, velocities by (optimal length * maximum contraction velocity), forces by the maximum
+// isometric force. Thelen's sign convention: shortening velocity is negative.
+//
+// Kind `hill_muscle` (sgal::Actuator, command = excitation u in [0, 1], clamped):
+//   options["curves"] = "thelen2003" (default) | "mujoco"
+//   options["tendon"] = "rigid" (default) | "elastic" (thelen2003 only)
+//   parameters: ThelenMuscleParameters or MujocoMuscleParameters by their snake_case names, plus
+//   default_activation; a parameter of the other curve set is rejected.
+// Step(path_length, path_speed, dt) lets the path move at path_speed during the step, advances
+// the activation (and, with an elastic tendon, the fibre length) to the end of the step and
+// returns the tension there, with the path at path_length + path_speed * dt.
+
+#include <cmath>
+
+namespace caliper::actuators {
+
+// ---------------------------------------------------------------------------------------------
+// Thelen 2003 (OpenSim's Thelen2003Muscle)
+
+/// Curve parameters of OpenSim's Thelen2003Muscle; the defaults are OpenSim's (the paper's
+/// values are af 0.3, flen 1.8, fmax_tendon_strain 0.033).
+struct ThelenCurveParameters {
+  double kshape_active = 0.45;               // gamma of the active force-length Gaussian [-]
+  double kshape_passive = 5.0;               // k_PE, passive force-length shape [-]
+  double fmax_muscle_strain = 0.6;           // e0M: fibre strain where passive force = F0 [-]
+  double fmax_tendon_strain = 0.04;          // e0T: tendon strain where tendon force = F0 [-]
+  double af = 0.25;                          // A_f, force-velocity shape factor [-]
+  double flen = 1.4;                         // F_len, maximum lengthening force / F0 [-]
+  double fv_linear_extrap_threshold = 0.95;  // linear force-velocity beyond this * flen [-]
+};
+
+/// Active force-length multiplier exp(-(l - 1)^2 / gamma); l normalised fibre length.
+double ThelenActiveForceLength(double norm_fiber_length, double kshape_active = 0.45);
+
+/// Passive force-length (exp(k_PE (l - 1) / e0M) - 1) / (exp(k_PE) - 1) for l > 1, else 0.
+double ThelenPassiveForceLength(double norm_fiber_length, double kshape_passive = 5.0,
+                                double fmax_muscle_strain = 0.6);
+
+/// Constants of Thelen's tendon curve for a strain e0T at F0, derived as OpenSim does: an
+/// exponential toe F_toe (exp(k_toe e / e_toe) - 1) / (exp(k_toe) - 1) up to e_toe, then linear
+/// k_lin (e - e_toe) + F_toe, continuous in value and slope and equal to 1 at e0T.
+struct ThelenTendonConstants {
+  double toe_strain = 0;       // e_toe = 99 e0T e^3 / (166 e^3 - 67) (0.6086 e0T) [-]
+  double linear_stiffness = 0; // k_lin = 0.67 / (e0T - e_toe) (42.80 for e0T = 0.04) [-]
+  double toe_force = 0.33;     // F_toe [-]
+  double toe_shape = 3.0;      // k_toe [-]
+};
+ThelenTendonConstants ThelenTendonToe(double fmax_tendon_strain = 0.04);
+
+/// Normalised tendon force at a tendon strain (length / slack length - 1); 0 when slack.
+double ThelenTendonForceStrain(double strain, double fmax_tendon_strain = 0.04);
+/// d(normalised tendon force)/d(strain).
+double ThelenTendonStiffness(double strain, double fmax_tendon_strain = 0.04);
+
+/// Force-velocity multiplier at a normalised fibre velocity (OpenSim's sign: shortening < 0) and
+/// an activation: Thelen's eqs. 6-7 solved for the force, with the maximum shortening velocity
+/// (0.25 + 0.75 a), linear below zero force and beyond fv_linear_extrap_threshold * flen. At
+/// a = 1 and af = 0.25 the shortening branch is Hill's (1 + v) / (1 - 4 v).
+double ThelenForceVelocity(double norm_fiber_velocity, double activation,
+                           const ThelenCurveParameters& p = {});
+
+/// The inverse: the normalised fibre velocity at which the force-velocity multiplier is fv
+/// (OpenSim's calcdlceN with F = a fal fv), defined for every fv by the linear extrapolations.
+double ThelenForceVelocityInverse(double force_velocity, double activation,
+                                  const ThelenCurveParameters& p = {});
+/// d(normalised velocity)/d(fv) of ThelenForceVelocityInverse.
+double ThelenForceVelocityInverseSlope(double force_velocity, double activation,
+                                       const ThelenCurveParameters& p = {});
+
+/// First-order activation dynamics shared by OpenSim (Thelen, Millard) and MuJoCo:
+/// da/dt = (u - a) / tau, tau = tau_act (0.5 + 1.5 a) when u > a, else tau_deact / (0.5 + 1.5 a);
+/// u and a are clamped to [minimum_activation, 1] [1/s].
+double ActivationRate(double excitation, double activation, double activation_time_constant,
+                      double deactivation_time_constant, double minimum_activation = 0);
+
+/// Constant-thickness (fixed-width parallelogram) pennation: the fibre length [m] of a muscle
+/// whose fibres project `length_along_tendon` [m] on the tendon line, with height
+/// optimal_fiber_length * sin(pennation_at_optimal); and the pennation angle [rad] of a fibre.
+double PennatedFiberLength(double length_along_tendon, double optimal_fiber_length,
+                           double pennation_at_optimal);
+double PennationAngle(double fiber_length, double optimal_fiber_length,
+                      double pennation_at_optimal);
+
+// ---------------------------------------------------------------------------------------------
+// MuJoCo (engine_util_misc.c: mju_muscleGain, mju_muscleBias, mju_muscleDynamics)
+
+/// Active force-length: half-quadratics through (lmin, 0), ((lmin+1)/2, 0.5), (1, 1),
+/// ((1+lmax)/2, 0.5), (lmax, 0); 0 outside [lmin, lmax] (as upstream since 3.1.2; Debian's
+/// 2.2.2 returns negative values below lmin).
+double MujocoActiveForceLength(double norm_length, double lmin = 0.5, double lmax = 1.6);
+
+/// Force-velocity at V = velocity / (L0 vmax): 0 for V <= -1, (V + 1)^2 up to 0,
+/// fvmax - (y - V)^2 / y up to y = fvmax - 1, then fvmax.
+double MujocoForceVelocity(double norm_velocity, double fvmax = 1.2);
+
+/// Passive force: fpmax * 0.5 x^2 with x = (L - 1) / (b - 1) up to b = (1 + lmax) / 2, then
+/// fpmax (0.5 + (L - b) / (b - 1)); 0 for L <= 1.
+double MujocoPassiveForceLength(double norm_length, double lmax = 1.6, double fpmax = 1.3);
+
+/// mju_muscleDynamics: ctrl clamped to [0, 1], the time constant from act clamped to [0, 1],
+/// and (ctrl - act) / tau with act itself unclamped [1/s].
+double MujocoActivationRate(double ctrl, double act, double tau_act = 0.01,
+                            double tau_deact = 0.04);
+
+/// L0 = (lengthrange_hi - lengthrange_lo) / (range1 - range0) [m]: the actuator length range is
+/// mapped on the normalised range [range0, range1].
+double MujocoOptimalLength(double lengthrange_lo, double lengthrange_hi, double range0 = 0.75,
+                           double range1 = 1.05);
+/// L = range0 + (length - lengthrange_lo) / L0 [-].
+double MujocoNormalizedLength(double length, double lengthrange_lo, double lengthrange_hi,
+                              double range0 = 0.75, double range1 = 1.05);
+
+/// MuJoCo's force scale: `force` when it is >= 0, else scale / acc0 [N] (acc0 the norm of the
+/// joint acceleration caused by a unit actuator force, computed by MuJoCo's compiler).
+double MujocoForceScale(double force, double scale, double acc0);
+
+// ---------------------------------------------------------------------------------------------
+// Parameter sets of the kind hill_muscle
+
+/// options["curves"] = "thelen2003". Names in the actuator description are the field names.
+struct ThelenMuscleParameters {
+  double max_isometric_force = 1000;       // F0 [N]
+  double optimal_fiber_length = 0.1;       // [m] (required in a description)
+  double tendon_slack_length = 0.2;        // [m] (required in a description)
+  double pennation_angle = 0;              // at optimal fibre length [rad], in [0, pi/2)
+  double max_contraction_velocity = 10;    // [optimal fibre lengths / s]
+  double activation_time_constant = 0.015;   // [s]
+  double deactivation_time_constant = 0.050; // [s]
+  double minimum_activation = 0.01;        // [-], > 0 with an elastic tendon
+  double maximum_pennation_angle = 1.4706289056333368;  // acos(0.1) [rad]
+  ThelenCurveParameters curves;            // by the field names of ThelenCurveParameters
+};
+
+/// options["curves"] = "mujoco": MuJoCo's gainprm/biasprm (range0, range1, force, scale, lmin,
+/// lmax, vmax, fpmax, fvmax), the compiled actuator length range and acc0, dynprm (tau_act,
+/// tau_deact). The tendon is rigid and unpennated; L is the normalised path length.
+struct MujocoMuscleParameters {
+  double range0 = 0.75;          // normalised length at lengthrange_lo [-]
+  double range1 = 1.05;          // normalised length at lengthrange_hi [-]
+  double force = -1;             // F0 [N]; < 0: scale / acc0
+  double scale = 200;            // [(rad/s^2) or (m/s^2)], MuJoCo's force scale
+  double acc0 = 0;               // [(rad/s^2)/N], needed when force < 0
+  double lmin = 0.5;             // [-]
+  double lmax = 1.6;             // [-]
+  double vmax = 1.5;             // [L0/s]
+  double fpmax = 1.3;            // passive force at lmax [-]
+  double fvmax = 1.2;            // lengthening force limit [-]
+  double lengthrange_lo = 0;     // [m] (required in a description)
+  double lengthrange_hi = 0;     // [m] (required in a description)
+  double tau_act = 0.01;         // [s]
+  double tau_deact = 0.04;       // [s]
+};
+
+/// Throws std::invalid_argument naming the first parameter out of range (and the one it
+/// conflicts with).
+void Validate(const ThelenMuscleParameters& p, bool elastic_tendon);
+void Validate(const MujocoMuscleParameters& p);
+
+}  // namespace caliper::actuators

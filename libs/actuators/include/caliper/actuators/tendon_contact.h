@@ -1,0 +1,48 @@
+#pragma once
+// Tendons that never pass through the skeleton: where a path segment would cut through a body
+// that is not one of its declared wrap obstacles, the path is bent around the body's surface, as a
+// taut string would be. Stateless and engine-free: an engine supplies the shapes near a segment
+// (from its broadphase), this computes the detour points. SI units.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "caliper/actuators/tendon_path.h"
+#include "caliper/sgal/scene.h"
+
+namespace caliper::actuators {
+
+/// A collision shape placed in the world.
+struct WorldShape {
+  const sgal::Geometry* geometry = nullptr;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  int body = -1;
+};
+
+/// The part of the segment a + t (b - a), t in [0, 1], inside the shape grown by `margin`, or
+/// nothing. Exact for box, sphere, capsule, cylinder, cone (as its bounding cylinder) and plane;
+/// convex hulls and meshes are taken by their local bounding box.
+std::optional<std::pair<double, double>> SegmentInside(const WorldShape& shape,
+                                                      const Eigen::Vector3d& a,
+                                                      const Eigen::Vector3d& b, double margin);
+
+/// Gives the shapes that may touch the segment a-b (an engine's broadphase query).
+using ShapeQuery =
+    std::function<void(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       std::vector<WorldShape>* out)>;
+
+struct ContactOptions {
+  double margin = 0.001;  ///< tendon radius: how far the path stays from surfaces [m]
+  int max_depth = 3;      ///< bisections per crossing: up to 2^depth - 1 points per body
+};
+
+/// Bends a path around every body it would pass through, except the bodies the segment's own end
+/// points are fixed to. Inserted points carry the body they press on. Returns the number of
+/// inserted points; `path` (points and length) is updated in place.
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options);
+
+}  // namespace caliper::actuators

@@ -1,0 +1,218 @@
+#include "caliper/actuators/tendon_contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace caliper::actuators {
+
+namespace {
+
+using Interval = std::optional<std::pair<double, double>>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Intersects [lo, hi] with the slab lo_s <= p + t d <= hi_s along one axis.
+bool Slab(double p, double d, double lo_s, double hi_s, double* lo, double* hi) {
+  if (std::abs(d) < 1e-15) return p >= lo_s && p <= hi_s;
+  double t0 = (lo_s - p) / d, t1 = (hi_s - p) / d;
+  if (t0 > t1) std::swap(t0, t1);
+  *lo = std::max(*lo, t0);
+  *hi = std::min(*hi, t1);
+  return *lo <= *hi;
+}
+
+Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+  double lo = 0, hi = 1;
+  for (int i = 0; i < 3; ++i)
+    if (!Slab(p[i], d[i], -half[i], half[i], &lo, &hi)) return std::nullopt;
+  return std::make_pair(lo, hi);
+}
+
+/// Roots of |p + t d - c|^2 = r^2 restricted to [0, 1].
+Interval SphereInterval(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& p,
+                        const Eigen::Vector3d& d) {
+  const Eigen::Vector3d m = p - c;
+  const double A = d.squaredNorm(), B = m.dot(d), C = m.squaredNorm() - r * r;
+  if (A < 1e-30) return C <= 0 ? Interval(std::make_pair(0.0, 1.0)) : std::nullopt;
+  const double disc = B * B - A * C;
+  if (disc <= 0) return std::nullopt;
+  const double s = std::sqrt(disc);
+  const double lo = std::max(0.0, (-B - s) / A), hi = std::min(1.0, (-B + s) / A);
+  if (lo > hi) return std::nullopt;
+  return std::make_pair(lo, hi);
+}
+
+/// Infinite cylinder about z of radius r, cut to |z| <= half_length.
+Interval CylinderInterval(double r, double half_length, const Eigen::Vector3d& p,
+                          const Eigen::Vector3d& d) {
+  double lo = 0, hi = 1;
+  if (!Slab(p.z(), d.z(), -half_length, half_length, &lo, &hi)) return std::nullopt;
+  const double A = d.x() * d.x() + d.y() * d.y();
+  const double B = p.x() * d.x() + p.y() * d.y();
+  const double C = p.x() * p.x() + p.y() * p.y() - r * r;
+  if (A < 1e-30) {
+    if (C > 0) return std::nullopt;
+  } else {
+    const double disc = B * B - A * C;
+    if (disc <= 0) return std::nullopt;
+    const double s = std::sqrt(disc);
+    lo = std::max(lo, (-B - s) / A);
+    hi = std::min(hi, (-B + s) / A);
+  }
+  if (lo > hi) return std::nullopt;
+  return std::make_pair(lo, hi);
+}
+
+Interval Union(Interval a, Interval b) {
+  if (!a) return b;
+  if (!b) return a;
+  return std::make_pair(std::min(a->first, b->first), std::max(a->second, b->second));
+}
+
+Eigen::Vector3d MeshHalfExtents(const sgal::Mesh* mesh, Eigen::Vector3d* center) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInf), hi = -lo;
+  if (mesh != nullptr)
+    for (const auto& v : mesh->vertices) {
+      lo = lo.cwiseMin(v.cast<double>());
+      hi = hi.cwiseMax(v.cast<double>());
+    }
+  if (!(lo.array() <= hi.array()).all()) {
+    *center = Eigen::Vector3d::Zero();
+    return Eigen::Vector3d::Zero();
+  }
+  *center = (lo + hi) / 2;
+  return (hi - lo) / 2;
+}
+
+}  // namespace
+
+Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       double margin) {
+  const Eigen::Isometry3d inv = shape.pose.inverse();
+  const Eigen::Vector3d p = inv * a;
+  const Eigen::Vector3d d = inv.linear() * (b - a);
+  return std::visit(
+      [&](const auto& g) -> Interval {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, sgal::Box>) {
+          return BoxInterval(g.size / 2 + Eigen::Vector3d::Constant(margin), p, d);
+        } else if constexpr (std::is_same_v<T, sgal::Sphere>) {
+          return SphereInterval(Eigen::Vector3d::Zero(), g.radius + margin, p, d);
+        } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
+          const double r = g.radius + margin, h = g.length / 2;
+          Interval i = CylinderInterval(r, h, p, d);
+          i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d));
+          return Union(i, SphereInterval(Eigen::Vector3d(0, 0, -h), r, p, d));
+        } else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>) {
+          return CylinderInterval(g.radius + margin, g.length / 2 + margin, p, d);
+        } else if constexpr (std::is_same_v<T, sgal::Plane>) {
+          const double da = g.normal.dot(p) - g.offset - margin;
+          const double db = g.normal.dot(p + d) - g.offset - margin;
+          if (da >= 0 && db >= 0) return std::nullopt;
+          if (da < 0 && db < 0) return std::make_pair(0.0, 1.0);
+          const double t = da / (da - db);
+          return da < 0 ? std::make_pair(0.0, t) : std::make_pair(t, 1.0);
+        } else {
+          Eigen::Vector3d center;
+          const Eigen::Vector3d half = MeshHalfExtents(g.mesh.get(), &center);
+          if (half.isZero()) return std::nullopt;
+          return BoxInterval(half + Eigen::Vector3d::Constant(margin), p - center, d);
+        }
+      },
+      *shape.geometry);
+}
+
+namespace {
+
+/// Where the ray from `from` along unit `dir` leaves the shape (grown by margin); `from` inside.
+Eigen::Vector3d ExitPoint(const WorldShape& shape, const Eigen::Vector3d& from,
+                          const Eigen::Vector3d& dir, double margin, double reach) {
+  const auto inside = SegmentInside(shape, from, from + dir * reach, margin);
+  const double t = inside ? inside->second : 0.0;
+  return from + dir * (t * reach + 1e-9);
+}
+
+struct Crossing {
+  double t_in = 1, t_out = 0;
+  const WorldShape* shape = nullptr;
+};
+
+/// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body.
+Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       const std::vector<WorldShape>& shapes, int exclude_a, int exclude_b,
+                       double margin) {
+  Crossing best;
+  double best_len = 0;
+  for (const auto& s : shapes) {
+    if (s.body == exclude_a || s.body == exclude_b) continue;
+    const auto i = SegmentInside(s, a, b, margin);
+    if (!i || i->second - i->first <= 1e-9) continue;
+    if (i->second - i->first > best_len) {
+      best_len = i->second - i->first;
+      best = {i->first, i->second, &s};
+    }
+  }
+  return best;
+}
+
+void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
+            const ContactOptions& options, int depth, std::vector<WorldShape>* scratch,
+            std::vector<PathPoint>* out) {
+  if (depth <= 0) return;
+  scratch->clear();
+  query(a.position, b.position, scratch);
+  const std::vector<WorldShape> shapes = *scratch;
+  const Crossing c = FirstCrossing(a.position, b.position, shapes, a.body, b.body, options.margin);
+  if (c.shape == nullptr) return;
+  const Eigen::Vector3d ab = b.position - a.position;
+  const double len = ab.norm();
+  if (len < 1e-12) return;
+  const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
+  // push out perpendicular to the segment, away from the shape's centre
+  const Eigen::Vector3d centre = c.shape->pose.translation();
+  const Eigen::Vector3d u = ab / len;
+  Eigen::Vector3d away = (mid - centre) - u * u.dot(mid - centre);
+  if (away.norm() < 1e-9) {
+    // the segment runs through the centre: any perpendicular, chosen deterministically
+    away = u.unitOrthogonal();
+  }
+  away.normalize();
+  PathPoint q;
+  q.position = ExitPoint(*c.shape, mid, away, options.margin, 10 * len + 1.0);
+  q.body = c.shape->body;
+  q.on_wrap = true;
+  Refine(a, q, query, options, depth - 1, scratch, out);
+  out->push_back(q);
+  Refine(q, b, query, options, depth - 1, scratch, out);
+}
+
+}  // namespace
+
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options) {
+  if (path->points.size() < 2) return 0;
+  std::vector<PathPoint> out;
+  out.reserve(path->points.size() * 2);
+  std::vector<WorldShape> scratch;
+  int inserted = 0;
+  for (size_t i = 0; i + 1 < path->points.size(); ++i) {
+    const PathPoint& a = path->points[i];
+    const PathPoint& b = path->points[i + 1];
+    out.push_back(a);
+    const size_t before = out.size();
+    Refine(a, b, query, options, options.max_depth, &scratch, &out);
+    inserted += static_cast<int>(out.size() - before);
+  }
+  out.push_back(path->points.back());
+  if (inserted == 0) return 0;
+  // the detour lengthens the path: add what the new points add over the straight segments
+  double straight = 0, bent = 0;
+  for (size_t i = 0; i + 1 < path->points.size(); ++i)
+    straight += (path->points[i + 1].position - path->points[i].position).norm();
+  for (size_t i = 0; i + 1 < out.size(); ++i)
+    bent += (out[i + 1].position - out[i].position).norm();
+  path->length += bent - straight;
+  path->points = std::move(out);
+  return inserted;
+}
+
+}  // namespace caliper::actuators

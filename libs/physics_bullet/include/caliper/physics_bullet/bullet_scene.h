@@ -1,0 +1,24 @@
+#pragma once
+// The Bullet engine adapter: builds a btDiscreteDynamicsWorld from an sgal::Scene and steps it
+// with the tendon actuators. The only place in Caliper that includes Bullet.
+
+#include <memory>
+
+#include "caliper/sgal/physics_scene.h"
+
+namespace caliper::physics_bullet {
+
+struct Options {
+  /// Bend tendons around bodies they would pass through (see actuators/tendon_contact.h).
+  bool tendon_body_contact = true;
+  /// Poses beyond this distance from the origin [m] or speeds beyond this [m/s] count as an
+  /// exploding simulation.
+  double max_distance = 1e4;
+  double max_speed = 1e3;
+};
+
+/// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
+/// an actuator that cannot be made (unknown kind, missing parameter).
+std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
+
+}  // namespace caliper::physics_bullet
