@@ -23,7 +23,8 @@ void AddArmSegment(sgal::Body* body, const std::string& name, double radius, dou
   sgal::Pose pose;
   pose.position = Vector3d(length / 2, 0, 0);
   pose.orientation = Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), Vector3d::UnitX());
-  body->shapes.push_back(sgal::Shape{name, sgal::Capsule{radius, length}, pose, 1, 0xffffffffu, ""});
+  body->shapes.push_back(
+      sgal::Shape{name, sgal::Capsule{radius, length}, pose, 1, 0xffffffffu, ""});
   body->visuals.push_back(sgal::Visual{name, sgal::Capsule{radius, length}, pose, color});
 
   const double r2 = radius * radius, h = length;
@@ -74,8 +75,8 @@ PathElement Wrap(const std::string& obstacle, double side_x, double side_y) {
   return e;
 }
 
-sgal::Constraint Hinge(const std::string& name, const std::string& child,
-                       const std::string& parent, const Vector3d& in_parent) {
+sgal::Constraint Hinge(const std::string& name, const std::string& child, const std::string& parent,
+                       const Vector3d& in_parent) {
   sgal::Constraint c;
   c.name = name;
   c.kind = sgal::ConstraintKind::kHinge;
@@ -162,7 +163,8 @@ sgal::Scene MakeArm26() {
                    Hinge("elbow", "forearm", "upper_arm", Vector3d(0.5, 0, 0))};
 
   // sites: s0 (world) -0.15 0 0; s1..s6 on the upper arm; s7, s8 on the forearm; side sites x0
-  // (world, 0 -0.15 0) and x1 (upper arm, 0.5 -0.15 0), here relative to the wrapped cylinder's body
+  // (world, 0 -0.15 0) and x1 (upper arm, 0.5 -0.15 0), here relative to the wrapped cylinder's
+  // body
   const PathElement s0 = Site("", -0.15, 0);
   const PathElement s1 = Site("upper_arm", 0.15, 0.06), s2 = Site("upper_arm", 0.15, -0.06);
   const PathElement s3 = Site("upper_arm", 0.4, 0.06), s4 = Site("upper_arm", 0.4, -0.06);
@@ -209,11 +211,11 @@ sgal::Scene MakeArm26() {
     a.tendon = c.name;
     a.options["curves"] = "mujoco";
     a.parameters = {
-        {"length_range_lo", c.length_lo},  // [m]
-        {"length_range_hi", c.length_hi},  // [m]
+        {"lengthrange_lo", c.length_lo},  // [m]
+        {"lengthrange_hi", c.length_hi},  // [m]
         {"acc0", c.acc0},
-        {"range_lo", 0.75},
-        {"range_hi", 1.05},
+        {"range0", 0.75},
+        {"range1", 1.05},
         {"force", -1},
         {"scale", 200},
         {"lmin", 0.5},
@@ -230,15 +232,15 @@ sgal::Scene MakeArm26() {
 }
 
 std::vector<actuators::WorldElement> Arm26Elements(const sgal::Scene& scene,
-                                                   const sgal::Tendon& tendon,
-                                                   double shoulder_rad, double elbow_rad) {
+                                                   const sgal::Tendon& tendon, double shoulder_rad,
+                                                   double elbow_rad) {
   return Arm26Elements(scene, tendon, shoulder_rad, elbow_rad, 0, 0);
 }
 
 std::vector<actuators::WorldElement> Arm26Elements(const sgal::Scene& scene,
-                                                   const sgal::Tendon& tendon,
-                                                   double shoulder_rad, double elbow_rad,
-                                                   double shoulder_speed, double elbow_speed) {
+                                                   const sgal::Tendon& tendon, double shoulder_rad,
+                                                   double elbow_rad, double shoulder_speed,
+                                                   double elbow_speed) {
   const std::vector<BodyMotion> motion =
       Kinematics(scene, shoulder_rad, elbow_rad, shoulder_speed, elbow_speed);
   auto body_motion = [&](const std::string& body) {

@@ -22,14 +22,14 @@ sgal::Scene MakeArm26();
 /// The path elements of `tendon` (one of MakeArm26()'s) in world coordinates with the shoulder and
 /// elbow at the given angles [rad], all at rest. Body indices are those of the scene.
 std::vector<actuators::WorldElement> Arm26Elements(const sgal::Scene& scene,
-                                                   const sgal::Tendon& tendon,
-                                                   double shoulder_rad, double elbow_rad);
+                                                   const sgal::Tendon& tendon, double shoulder_rad,
+                                                   double elbow_rad);
 
 /// The same with joint speeds [rad/s]: points carry their velocities and wrap elements the
 /// velocity of their obstacle's origin.
 std::vector<actuators::WorldElement> Arm26Elements(const sgal::Scene& scene,
-                                                   const sgal::Tendon& tendon,
-                                                   double shoulder_rad, double elbow_rad,
-                                                   double shoulder_speed, double elbow_speed);
+                                                   const sgal::Tendon& tendon, double shoulder_rad,
+                                                   double elbow_rad, double shoulder_speed,
+                                                   double elbow_speed);
 
 }  // namespace caliper::testing

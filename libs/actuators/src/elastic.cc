@@ -242,8 +242,7 @@ std::vector<std::pair<double, double>> TableSpring::Parse(const std::string& tex
       used = 0;
     }
     if (used != word.size())
-      throw std::invalid_argument("table spring: '" + word + "' is not a number in '" + text +
-                                  "'");
+      throw std::invalid_argument("table spring: '" + word + "' is not a number in '" + text + "'");
     numbers.push_back(value);
   }
   if (numbers.empty() || numbers.size() % 2 != 0)
@@ -305,7 +304,8 @@ std::vector<ParameterSpec> ElasticParameterSpecs() {
 
 std::unique_ptr<ElasticElement> MakeElasticElement(const sgal::Actuator& a) {
   std::map<std::string, double> defaults;
-  for (const ParameterSpec& spec : ElasticParameterSpecs()) defaults[spec.name] = spec.default_value;
+  for (const ParameterSpec& spec : ElasticParameterSpecs())
+    defaults[spec.name] = spec.default_value;
   auto value = [&](const std::string& name) { return ParameterOr(a, name, defaults.at(name)); };
   const auto option = a.options.find("elastic");
   const std::string kind = option == a.options.end() ? "linear" : option->second;

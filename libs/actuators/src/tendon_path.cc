@@ -115,20 +115,27 @@ struct WrapFrame {
 
 // a plane normal's sign is fixed by a reference direction (first non-zero of z, y, x positive),
 // so that "counterclockwise" keeps its meaning when the points pass through the centre's line
-Vector3d OrientNormal(Vector3d n) {
+Vector3d OrientNormal(const Vector3d& n) {
   for (int i = 2; i >= 0; --i) {
     if (std::abs(n[i]) > 1e-12) return n[i] < 0 ? Vector3d(-n) : n;
   }
   return n;
 }
 
+// the plane through the sphere's centre and both points; when they are in line with the centre,
+// the plane through the side point, else the one normal to the obstacle's z axis (or x axis)
 WrapFrame SphereFrame(const Vector3d& q0, const Vector3d& q1, const std::optional<Vector3d>& s) {
+  const double scale = q0.norm();
   Vector3d n = q0.cross(q1);
-  if (n.norm() < 1e-12 * q0.norm() * q1.norm() && s) n = q0.cross(*s);
-  if (n.norm() < 1e-12 * q0.norm()) n = q0.unitOrthogonal();
+  if (n.norm() < 1e-12 * scale * q1.norm() && s) n = q0.cross(*s);
+  if (n.norm() < 1e-12 * scale * (s ? s->norm() : q1.norm())) {
+    const Vector3d e0 = q0 / scale;
+    n = Vector3d::UnitZ() - e0.z() * e0;
+    if (n.norm() < 1e-6) n = Vector3d::UnitX() - e0.x() * e0;
+  }
   n = OrientNormal(n.normalized());
   WrapFrame f;
-  f.e0 = q0.normalized();
+  f.e0 = q0 / scale;
   f.e1 = n.cross(f.e0).normalized();
   return f;
 }

@@ -407,6 +407,7 @@ void BulletScene::EvaluateTendons() {
         w.obstacle.pose = body_pose * o->pose.ToIsometry();
         w.obstacle.radius = o->radius;
         w.obstacle.length = o->length;
+        w.velocity = PointVelocity(w.body, w.obstacle.pose.translation());
         if (e.side) w.side = body_pose * (*e.side);
       }
       elements.push_back(w);

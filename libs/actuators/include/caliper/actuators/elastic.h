@@ -97,11 +97,11 @@ class LinearSpringDamper : public ElasticElement {
 
 /// Constants of the Zener (standard linear solid) element.
 struct ZenerParameters {
-  double e0 = 0.694e6;                       // E0, equilibrium modulus [Pa]
-  double e1 = 0.2116e6;                      // E1, Maxwell arm modulus [Pa]
-  double mu = 277788.48;                     // Maxwell arm viscosity [Pa s]
+  double e0 = 0.694e6;                               // E0, equilibrium modulus [Pa]
+  double e1 = 0.2116e6;                              // E1, Maxwell arm modulus [Pa]
+  double mu = 277788.48;                             // Maxwell arm viscosity [Pa s]
   double area = 3.14159265358979323846 * 25e-6 / 4;  // A_0, cross-section [m^2]
-  double rest_length = 0.01;                 // L_0 [m]
+  double rest_length = 0.01;                         // L_0 [m]
 };
 
 /// Zener / standard linear solid (TENDONS.md): strain e = l / L_0 - 1 clamped at 0, stress s with
@@ -137,13 +137,13 @@ class ZenerElement : public ElasticElement {
   };
   Next Advance(double length, double dt) const;
 
-  double e0_;                   // [Pa]
-  double e1_;                   // [Pa]
-  double mu_;                   // [Pa s]
-  double area_;                 // [m^2]
-  double strain_ = 0;           // [-]
-  double maxwell_stress_ = 0;   // q [Pa]
-  double stress_ = 0;           // s [Pa]
+  double e0_;                  // [Pa]
+  double e1_;                  // [Pa]
+  double mu_;                  // [Pa s]
+  double area_;                // [m^2]
+  double strain_ = 0;          // [-]
+  double maxwell_stress_ = 0;  // q [Pa]
+  double stress_ = 0;          // s [Pa]
 };
 
 /// F = sum_i c_i x^i + c dl/dt for the extension x = l - l_rest > 0, then F = max(F, 0); 0 when
@@ -192,7 +192,7 @@ class TableSpring : public ElasticElement {
   std::vector<Field> Fields() override;
 
  private:
-  double Static(double extension) const;          // [N]
+  double Static(double extension) const;           // [N]
   std::vector<std::pair<double, double>> points_;  // from (0, 0) [m], [N]
   double damping_;                                 // [N s/m]
 };

@@ -14,8 +14,6 @@
 // the activation (and, with an elastic tendon, the fibre length) to the end of the step and
 // returns the tension there, with the path at path_length + path_speed * dt.
 
-#include <cmath>
-
 namespace caliper::actuators {
 
 // ---------------------------------------------------------------------------------------------

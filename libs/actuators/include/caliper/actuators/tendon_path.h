@@ -25,7 +25,7 @@ struct WorldObstacle {
 struct WorldElement {
   sgal::PathElement::Kind kind = sgal::PathElement::Kind::kPoint;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  // kPoint: world position [m]
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // kPoint: world velocity [m/s]
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // kPoint: world velocity; kWrap: velocity of the obstacle's origin [m/s]
   int body = -1;           // body the point or obstacle is fixed to (-1: the world)
   double friction = 0;     // kPoint: capstan coefficient [-]
   WorldObstacle obstacle;  // kWrap

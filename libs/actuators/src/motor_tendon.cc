@@ -1,0 +1,384 @@
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "builtin_kinds.h"
+#include "caliper/actuators/actuator.h"
+#include "caliper/actuators/dc_motor.h"
+#include "caliper/actuators/elastic.h"
+
+namespace caliper::actuators {
+
+namespace {
+
+// a motor parameter as a kind parameter and a quantity
+struct MotorField {
+  const char* name;
+  const char* unit;
+  double DcMotorParameters::*member;
+  const char* help;
+};
+
+const MotorField kMotorFields[] = {
+    {"resistance", "ohm", &DcMotorParameters::resistance, "armature resistance R"},
+    {"inductance", "H", &DcMotorParameters::inductance, "armature inductance L"},
+    {"torque_constant", "N m/A", &DcMotorParameters::torque_constant, "torque constant k_t"},
+    {"back_emf_constant", "V s/rad", &DcMotorParameters::back_emf_constant,
+     "back-EMF constant k_e"},
+    {"rotor_inertia", "kg m^2", &DcMotorParameters::rotor_inertia, "rotor inertia J_rotor"},
+    {"gear_inertia", "kg m^2", &DcMotorParameters::gear_inertia,
+     "gearbox inertia reflected to the motor shaft J_gear"},
+    {"gear_ratio", "", &DcMotorParameters::gear_ratio, "gear ratio N (motor / spool speed)"},
+    {"efficiency", "", &DcMotorParameters::efficiency, "gearbox efficiency eta, in (0, 1]"},
+    {"bridge_resistance", "ohm", &DcMotorParameters::bridge_resistance,
+     "H-bridge resistance in series with the armature"},
+    {"current_limit", "A", &DcMotorParameters::current_limit, "driver current limit (0: none)"},
+    {"spool_radius", "m", &DcMotorParameters::spool_radius, "spool radius r_s"},
+    {"max_substep", "s", &DcMotorParameters::max_substep, "longest internal integration step"},
+};
+
+constexpr double kDefaultSupplyVoltage = 12;  // [V]
+
+std::string Number(double value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+std::string Prefix(const sgal::Actuator& a) {
+  return "actuator '" + a.name + "' (" + a.kind + "): ";
+}
+
+void RequireFinite(const std::string& prefix, const char* what, double value) {
+  if (!std::isfinite(value))
+    throw std::invalid_argument(prefix + what + " must be finite, got " + Number(value));
+}
+
+// the tendon seen from the spool: an inextensible line paid in by the spool, in series with the
+// elastic element, along a path of fixed length over one step
+class TendonSpoolLoad : public SpoolLoad {
+ public:
+  TendonSpoolLoad(ElasticElement* elastic, double path_length, double path_speed,
+                  double line_length, double spool_angle, double spool_radius)
+      : elastic_(elastic),
+        path_length_(path_length),
+        path_speed_(path_speed),
+        line_length_(line_length),
+        spool_angle_(spool_angle),
+        spool_radius_(spool_radius) {}
+
+  double LineLength(double spool_angle) const {
+    return line_length_ - spool_radius_ * (spool_angle - spool_angle_);
+  }
+  double ElasticLength(double spool_angle) const { return path_length_ - LineLength(spool_angle); }
+  double ElasticSpeed(double spool_speed) const {
+    return path_speed_ + spool_radius_ * spool_speed;
+  }
+  double TorqueAt(double spool_angle, double spool_speed, double h) const override {
+    return spool_radius_ * elastic_->Peek(ElasticLength(spool_angle), ElasticSpeed(spool_speed), h);
+  }
+  void Advance(double spool_angle, double spool_speed, double h) override {
+    force_ = elastic_->Force(ElasticLength(spool_angle), ElasticSpeed(spool_speed), h);
+  }
+  double force() const { return force_; }
+
+ private:
+  ElasticElement* elastic_;
+  double path_length_;   // [m]
+  double path_speed_;    // [m/s]
+  double line_length_;   // free line at the start of the step [m]
+  double spool_angle_;   // at the start of the step [rad]
+  double spool_radius_;  // [m]
+  double force_ = 0;     // [N]
+};
+
+class DcMotorTendon : public TendonActuator {
+ public:
+  explicit DcMotorTendon(const sgal::Actuator& a) : prefix_(Prefix(a)) {
+    DcMotorParameters p;
+    for (const MotorField& field : kMotorFields)
+      p.*field.member = ParameterOr(a, field.name, p.*field.member);
+    supply_voltage_ = ParameterOr(a, "supply_voltage", kDefaultSupplyVoltage);
+    pretension_ = ParameterOr(a, "pretension", 0);
+    const auto input = a.options.find("input");
+    if (input != a.options.end()) {
+      if (input->second == "duty")
+        duty_input_ = true;
+      else if (input->second != "voltage")
+        throw std::invalid_argument(prefix_ + "unknown input '" + input->second +
+                                    "' in options[\"input\"] (known: voltage, duty)");
+    }
+    try {
+      motor_.set_parameters(p);
+      CheckSupplyVoltage(supply_voltage_);
+      CheckPretension(pretension_);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
+    }
+    elastic_ = MakeElasticElement(a);
+    Reset(elastic_->RelaxedLength(pretension_));
+  }
+
+  void Reset(double path_length) override {
+    RequireFinite(prefix_, "path length", path_length);
+    motor_.Reset();
+    double length = 0;
+    try {
+      length = elastic_->RelaxedLength(pretension_);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + "pretension: " + e.what());
+    }
+    elastic_->Reset(length);
+    path_length_ = path_length;
+    path_speed_ = 0;
+    line_length_ = path_length - length;
+    elastic_length_ = length;
+    tension_ = elastic_->Peek(length, 0, 0);
+  }
+
+  double Step(double path_length, double path_speed, double dt) override {
+    RequireFinite(prefix_, "path length", path_length);
+    RequireFinite(prefix_, "path speed", path_speed);
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
+    const double angle = motor_.state().spool_angle;
+    TendonSpoolLoad load(elastic_.get(), path_length, path_speed, line_length_, angle,
+                         motor_.parameters().spool_radius);
+    motor_.Step(voltage(), dt, load);
+    path_length_ = path_length;
+    path_speed_ = path_speed;
+    line_length_ = load.LineLength(motor_.state().spool_angle);
+    elastic_length_ = load.ElasticLength(motor_.state().spool_angle);
+    tension_ = load.force();
+    return tension_;
+  }
+
+  double tension() const override { return tension_; }
+
+  void SetCommand(double value) override {
+    RequireFinite(prefix_, "command", value);
+    command_ = duty_input_ ? std::clamp(value, -1.0, 1.0) : value;
+  }
+  double command() const override { return command_; }
+  std::string command_unit() const override { return duty_input_ ? "" : "V"; }
+
+  std::vector<Quantity> Quantities() const override {
+    std::vector<Quantity> q;
+    for (const MotorField& field : kMotorFields) q.push_back({field.name, field.unit, true, true});
+    q.push_back({"supply_voltage", "V", true, true});
+    q.push_back({"pretension", "N", true, true});
+    for (const Quantity& e : elastic_->Quantities()) q.push_back(e);
+    for (const auto& [name, unit] : kStates) q.push_back({name, unit, false, false});
+    return q;
+  }
+
+  double Get(const std::string& name) const override {
+    const DcMotorParameters& p = motor_.parameters();
+    for (const MotorField& field : kMotorFields)
+      if (name == field.name) return p.*field.member;
+    if (name == "supply_voltage") return supply_voltage_;
+    if (name == "pretension") return pretension_;
+    const DcMotorState& s = motor_.state();
+    if (name == "current") return s.current;
+    if (name == "spool_speed") return s.spool_speed;
+    if (name == "spool_angle") return s.spool_angle;
+    if (name == "motor_speed") return motor_.motor_speed();
+    if (name == "line_length") return line_length_;
+    if (name == "elastic_length") return elastic_length_;
+    if (name == "tension") return tension_;
+    if (name == "voltage") return motor_.applied_voltage();
+    if (name == "power") return motor_.electrical_power();
+    if (HasElastic(name)) return elastic_->Get(name);
+    throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
+  }
+
+  void Set(const std::string& name, double value) override {
+    try {
+      for (const MotorField& field : kMotorFields) {
+        if (name != field.name) continue;
+        DcMotorParameters p = motor_.parameters();
+        p.*field.member = value;
+        motor_.set_parameters(p);
+        return;
+      }
+      if (name == "supply_voltage") {
+        CheckSupplyVoltage(value);
+        supply_voltage_ = value;
+        return;
+      }
+      if (name == "pretension") {
+        CheckPretension(value);
+        pretension_ = value;
+        return;
+      }
+      for (const auto& [state, unit] : kStates)
+        if (name == state)
+          throw std::invalid_argument("'" + name + "' [" + unit + "] is a state, not writable");
+      if (HasElastic(name)) return elastic_->Set(name, value);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
+    }
+    throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
+  }
+
+ private:
+  static constexpr std::pair<const char*, const char*> kStates[] = {
+      {"current", "A"},         {"spool_speed", "rad/s"}, {"spool_angle", "rad"},
+      {"motor_speed", "rad/s"}, {"line_length", "m"},     {"elastic_length", "m"},
+      {"tension", "N"},         {"voltage", "V"},         {"power", "W"}};
+
+  static void CheckSupplyVoltage(double value) {
+    if (!(value > 0) || !std::isfinite(value))
+      throw std::invalid_argument("parameter 'supply_voltage' must be > 0 [V], got " +
+                                  Number(value));
+  }
+  static void CheckPretension(double value) {
+    if (!(value >= 0) || !std::isfinite(value))
+      throw std::invalid_argument("parameter 'pretension' must be >= 0 [N], got " + Number(value));
+  }
+
+  bool HasElastic(const std::string& name) const {
+    for (const Quantity& q : elastic_->Quantities())
+      if (q.name == name) return true;
+    return false;
+  }
+
+  double voltage() const { return duty_input_ ? command_ * supply_voltage_ : command_; }
+
+  std::string prefix_;
+  DcMotor motor_;
+  std::unique_ptr<ElasticElement> elastic_;
+  bool duty_input_ = false;
+  double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
+  double pretension_ = 0;                          // at Reset [N]
+  double command_ = 0;                             // [V] or duty [-]
+  double path_length_ = 0;                         // [m]
+  double path_speed_ = 0;                          // [m/s]
+  double line_length_ = 0;                         // free kite line [m]
+  double elastic_length_ = 0;                      // [m]
+  double tension_ = 0;                             // [N]
+};
+
+// a passive tension-only spring-damper along the tendon
+class Ligament : public TendonActuator {
+ public:
+  explicit Ligament(const sgal::Actuator& a) : prefix_(Prefix(a)) {
+    const double rest = ParameterOr(a, "rest_length", 0);
+    rest_from_path_ = rest == 0;
+    try {
+      spring_ = std::make_unique<LinearSpringDamper>(ParameterOr(a, "stiffness", 0),
+                                                     ParameterOr(a, "damping", 0),
+                                                     rest_from_path_ ? 1.0 : rest);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
+    }
+  }
+
+  void Reset(double path_length) override {
+    RequireFinite(prefix_, "path length", path_length);
+    if (rest_from_path_) {
+      if (!(path_length > 0))
+        throw std::invalid_argument(prefix_ + "rest length from a path of length " +
+                                    Number(path_length) + " m: must be > 0");
+      spring_->Set("rest_length", path_length);
+    }
+    length_ = path_length;
+    speed_ = 0;
+    tension_ = spring_->Peek(length_, 0, 0);
+  }
+
+  double Step(double path_length, double path_speed, double dt) override {
+    RequireFinite(prefix_, "path length", path_length);
+    RequireFinite(prefix_, "path speed", path_speed);
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
+    length_ = path_length;
+    speed_ = path_speed;
+    tension_ = spring_->Force(path_length, path_speed, dt);
+    return tension_;
+  }
+
+  double tension() const override { return tension_; }
+
+  void SetCommand(double) override {
+    throw std::invalid_argument(prefix_ + "a ligament is passive and takes no command");
+  }
+  double command() const override { return 0; }
+  std::string command_unit() const override { return ""; }
+
+  std::vector<Quantity> Quantities() const override {
+    std::vector<Quantity> q = spring_->Quantities();
+    q.push_back({"tension", "N", false, false});
+    q.push_back({"length", "m", false, false});
+    q.push_back({"speed", "m/s", false, false});
+    return q;
+  }
+
+  double Get(const std::string& name) const override {
+    if (name == "tension") return tension_;
+    if (name == "length") return length_;
+    if (name == "speed") return speed_;
+    try {
+      return spring_->Get(name);
+    } catch (const std::out_of_range&) {
+      throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
+    }
+  }
+
+  void Set(const std::string& name, double value) override {
+    if (name == "tension" || name == "length" || name == "speed")
+      throw std::invalid_argument(prefix_ + "'" + name + "' is a state, not writable");
+    try {
+      spring_->Set(name, value);
+    } catch (const std::out_of_range&) {
+      throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
+    }
+    if (name == "rest_length") rest_from_path_ = false;
+  }
+
+ private:
+  std::string prefix_;
+  std::unique_ptr<LinearSpringDamper> spring_;
+  bool rest_from_path_ = false;  // rest length = path length at Reset
+  double tension_ = 0;           // [N]
+  double length_ = 0;            // [m]
+  double speed_ = 0;             // [m/s]
+};
+
+std::vector<ParameterSpec> DcMotorTendonParameters() {
+  const DcMotorParameters defaults;
+  std::vector<ParameterSpec> specs;
+  for (const MotorField& field : kMotorFields)
+    specs.push_back({field.name, field.unit, defaults.*field.member, false, field.help});
+  specs.push_back({"supply_voltage", "V", kDefaultSupplyVoltage, false,
+                   "supply voltage, scaled by the duty with options[\"input\"] = duty"});
+  specs.push_back({"pretension", "N", 0, false, "tension of the elastic element at Reset"});
+  for (const ParameterSpec& spec : ElasticParameterSpecs()) specs.push_back(spec);
+  return specs;
+}
+
+std::vector<ParameterSpec> LigamentParameters() {
+  return {{"stiffness", "N/m", 0, true, "ligament stiffness k"},
+          {"damping", "N s/m", 0, false, "ligament damping c, in tension only"},
+          {"rest_length", "m", 0, false, "slack length (0: the path length at Reset)"}};
+}
+
+}  // namespace
+
+void RegisterMotorKinds() {
+  RegisterKind("dc_motor_tendon", DcMotorTendonParameters(), [](const sgal::Actuator& a) {
+    return std::unique_ptr<TendonActuator>(std::make_unique<DcMotorTendon>(a));
+  });
+  RegisterKind("ligament", LigamentParameters(), [](const sgal::Actuator& a) {
+    return std::unique_ptr<TendonActuator>(std::make_unique<Ligament>(a));
+  });
+}
+
+}  // namespace caliper::actuators

@@ -1,0 +1,897 @@
+#include "caliper/actuators/muscle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "builtin_kinds.h"
+#include "caliper/actuators/actuator.h"
+
+namespace caliper::actuators {
+
+namespace {
+
+constexpr double kMinVal = 1e-15;     // MuJoCo's mjMINVAL
+constexpr double kMaxSubstep = 1e-3;  // [s]
+constexpr double kPi = 3.14159265358979323846;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+double Clamp(double x, double lo, double hi) { return std::min(std::max(x, lo), hi); }
+
+// shortening speed limit of Thelen's curve at activation a [normalised]
+double ThelenSpeedLimit(double activation) { return 0.25 + 0.75 * Clamp(activation, 0, 1); }
+
+double ThelenEccentricFactor(const ThelenCurveParameters& p) {
+  return (2 + 2 / p.af) / (p.flen - 1);
+}
+
+double ThelenPassiveSlope(double l, double kpe, double e0) {
+  if (l <= 1) return 0;
+  return kpe / e0 * std::exp(kpe * (l - 1) / e0) / (std::exp(kpe) - 1);
+}
+
+double ThelenActiveSlope(double l, double gamma) {
+  return -2 * (l - 1) / gamma * ThelenActiveForceLength(l, gamma);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Thelen curves
+
+double ThelenActiveForceLength(double l, double kshape_active) {
+  return std::exp(-(l - 1) * (l - 1) / kshape_active);
+}
+
+double ThelenPassiveForceLength(double l, double kshape_passive, double fmax_muscle_strain) {
+  if (l <= 1) return 0;
+  return (std::exp(kshape_passive * (l - 1) / fmax_muscle_strain) - 1) /
+         (std::exp(kshape_passive) - 1);
+}
+
+ThelenTendonConstants ThelenTendonToe(double e0) {
+  ThelenTendonConstants c;
+  const double e3 = std::exp(3.0);
+  c.toe_strain = 99 * e0 * e3 / (166 * e3 - 67);
+  c.linear_stiffness = 0.67 / (e0 - c.toe_strain);
+  return c;
+}
+
+double ThelenTendonForceStrain(double strain, double fmax_tendon_strain) {
+  const ThelenTendonConstants c = ThelenTendonToe(fmax_tendon_strain);
+  if (strain > c.toe_strain) return c.linear_stiffness * (strain - c.toe_strain) + c.toe_force;
+  if (strain > 0)
+    return c.toe_force / (std::exp(c.toe_shape) - 1) *
+           (std::exp(c.toe_shape * strain / c.toe_strain) - 1);
+  return 0;
+}
+
+double ThelenTendonStiffness(double strain, double fmax_tendon_strain) {
+  const ThelenTendonConstants c = ThelenTendonToe(fmax_tendon_strain);
+  if (strain > c.toe_strain) return c.linear_stiffness;
+  if (strain > 0)
+    return c.toe_force / (std::exp(c.toe_shape) - 1) * c.toe_shape / c.toe_strain *
+           std::exp(c.toe_shape * strain / c.toe_strain);
+  return 0;
+}
+
+double ThelenForceVelocityInverse(double fv, double activation, const ThelenCurveParameters& p) {
+  const double k = ThelenSpeedLimit(activation);
+  const double c = ThelenEccentricFactor(p);
+  const double fv_thr = p.fv_linear_extrap_threshold * p.flen;
+  // below zero force: the tangent at fv = 0
+  if (fv <= 0) return -k + k * (1 + 1 / p.af) * fv;
+  if (fv <= 1) return k * (fv - 1) / (1 + fv / p.af);
+  if (fv < fv_thr) return k * (fv - 1) / (c * (p.flen - fv));
+  // beyond the threshold: the tangent there
+  const double v_thr = k * (fv_thr - 1) / (c * (p.flen - fv_thr));
+  const double s_thr = k * (p.flen - 1) / (c * (p.flen - fv_thr) * (p.flen - fv_thr));
+  return v_thr + s_thr * (fv - fv_thr);
+}
+
+double ThelenForceVelocityInverseSlope(double fv, double activation,
+                                       const ThelenCurveParameters& p) {
+  const double k = ThelenSpeedLimit(activation);
+  const double c = ThelenEccentricFactor(p);
+  const double fv_thr = p.fv_linear_extrap_threshold * p.flen;
+  if (fv <= 0) return k * (1 + 1 / p.af);
+  if (fv <= 1) {
+    const double d = 1 + fv / p.af;
+    return k * (1 + 1 / p.af) / (d * d);
+  }
+  const double f = std::min(fv, fv_thr);
+  return k * (p.flen - 1) / (c * (p.flen - f) * (p.flen - f));
+}
+
+double ThelenForceVelocity(double v, double activation, const ThelenCurveParameters& p) {
+  const double k = ThelenSpeedLimit(activation);
+  if (v <= -k) return (v + k) / (k * (1 + 1 / p.af));
+  if (v <= 0) return (k + v) / (k - v / p.af);
+  const double c = ThelenEccentricFactor(p);
+  const double fv_thr = p.fv_linear_extrap_threshold * p.flen;
+  const double v_thr = k * (fv_thr - 1) / (c * (p.flen - fv_thr));
+  if (v < v_thr) return (k + v * c * p.flen) / (k + v * c);
+  const double s_thr = k * (p.flen - 1) / (c * (p.flen - fv_thr) * (p.flen - fv_thr));
+  return fv_thr + (v - v_thr) / s_thr;
+}
+
+double ActivationRate(double excitation, double activation, double activation_time_constant,
+                      double deactivation_time_constant, double minimum_activation) {
+  const double u = Clamp(excitation, minimum_activation, 1);
+  const double a = Clamp(activation, minimum_activation, 1);
+  const double tau = u > a ? activation_time_constant * (0.5 + 1.5 * a)
+                           : deactivation_time_constant / (0.5 + 1.5 * a);
+  return (u - a) / tau;
+}
+
+double PennatedFiberLength(double along, double optimal_fiber_length,
+                           double pennation_at_optimal) {
+  const double h = optimal_fiber_length * std::sin(pennation_at_optimal);
+  return std::sqrt(h * h + along * along);
+}
+
+double PennationAngle(double fiber_length, double optimal_fiber_length,
+                      double pennation_at_optimal) {
+  const double h = optimal_fiber_length * std::sin(pennation_at_optimal);
+  if (h <= 0) return 0;
+  if (fiber_length <= h) return kPi / 2;
+  return std::asin(h / fiber_length);
+}
+
+// ---------------------------------------------------------------------------------------------
+// MuJoCo curves
+
+double MujocoActiveForceLength(double L, double lmin, double lmax) {
+  if (L < lmin || L > lmax) return 0;
+  const double a = 0.5 * (lmin + 1);
+  const double b = 0.5 * (1 + lmax);
+  if (L <= a) {
+    const double x = (L - lmin) / std::max(kMinVal, a - lmin);
+    return 0.5 * x * x;
+  }
+  if (L <= 1) {
+    const double x = (1 - L) / std::max(kMinVal, 1 - a);
+    return 1 - 0.5 * x * x;
+  }
+  if (L <= b) {
+    const double x = (L - 1) / std::max(kMinVal, b - 1);
+    return 1 - 0.5 * x * x;
+  }
+  const double x = (lmax - L) / std::max(kMinVal, lmax - b);
+  return 0.5 * x * x;
+}
+
+double MujocoForceVelocity(double V, double fvmax) {
+  const double y = fvmax - 1;
+  if (V <= -1) return 0;
+  if (V <= 0) return (V + 1) * (V + 1);
+  if (V <= y) return fvmax - (y - V) * (y - V) / std::max(kMinVal, y);
+  return fvmax;
+}
+
+double MujocoPassiveForceLength(double L, double lmax, double fpmax) {
+  const double b = 0.5 * (1 + lmax);
+  if (L <= 1) return 0;
+  if (L <= b) {
+    const double x = (L - 1) / std::max(kMinVal, b - 1);
+    return fpmax * 0.5 * x * x;
+  }
+  const double x = (L - b) / std::max(kMinVal, b - 1);
+  return fpmax * (0.5 + x);
+}
+
+double MujocoActivationRate(double ctrl, double act, double tau_act, double tau_deact) {
+  const double u = Clamp(ctrl, 0, 1);
+  const double a = Clamp(act, 0, 1);
+  const double tau = u > act ? tau_act * (0.5 + 1.5 * a) : tau_deact / (0.5 + 1.5 * a);
+  return (u - act) / std::max(kMinVal, tau);
+}
+
+double MujocoOptimalLength(double lengthrange_lo, double lengthrange_hi, double range0,
+                           double range1) {
+  return (lengthrange_hi - lengthrange_lo) / std::max(kMinVal, range1 - range0);
+}
+
+double MujocoNormalizedLength(double length, double lengthrange_lo, double lengthrange_hi,
+                              double range0, double range1) {
+  const double L0 = MujocoOptimalLength(lengthrange_lo, lengthrange_hi, range0, range1);
+  return range0 + (length - lengthrange_lo) / std::max(kMinVal, L0);
+}
+
+double MujocoForceScale(double force, double scale, double acc0) {
+  return force < 0 ? scale / std::max(kMinVal, acc0) : force;
+}
+
+// ---------------------------------------------------------------------------------------------
+// parameter validation
+
+namespace {
+
+void Require(bool ok, const std::string& name, double value, const std::string& rule) {
+  if (!ok || !std::isfinite(value))
+    throw std::invalid_argument("parameter '" + name + "' = " + Num(value) + ": " + rule);
+}
+
+}  // namespace
+
+void Validate(const ThelenMuscleParameters& p, bool elastic_tendon) {
+  const ThelenCurveParameters& c = p.curves;
+  Require(p.max_isometric_force >= 0, "max_isometric_force", p.max_isometric_force,
+          "must be >= 0 N");
+  Require(p.optimal_fiber_length > 0, "optimal_fiber_length", p.optimal_fiber_length,
+          "must be > 0 m");
+  if (elastic_tendon)
+    Require(p.tendon_slack_length > 0, "tendon_slack_length", p.tendon_slack_length,
+            "must be > 0 m with an elastic tendon");
+  else
+    Require(p.tendon_slack_length >= 0, "tendon_slack_length", p.tendon_slack_length,
+            "must be >= 0 m");
+  Require(p.maximum_pennation_angle > 0 && p.maximum_pennation_angle < kPi / 2,
+          "maximum_pennation_angle", p.maximum_pennation_angle, "must be in (0, pi/2) rad");
+  Require(p.pennation_angle >= 0 && p.pennation_angle < p.maximum_pennation_angle,
+          "pennation_angle", p.pennation_angle,
+          "must be in [0, maximum_pennation_angle = " + Num(p.maximum_pennation_angle) +
+              ") rad");
+  Require(p.max_contraction_velocity > 0, "max_contraction_velocity",
+          p.max_contraction_velocity, "must be > 0 optimal fibre lengths/s");
+  Require(p.activation_time_constant > 0, "activation_time_constant",
+          p.activation_time_constant, "must be > 0 s");
+  Require(p.deactivation_time_constant > 0, "deactivation_time_constant",
+          p.deactivation_time_constant, "must be > 0 s");
+  if (elastic_tendon)
+    Require(p.minimum_activation > 0 && p.minimum_activation < 1, "minimum_activation",
+            p.minimum_activation,
+            "must be in (0, 1) with an elastic tendon (the fibre velocity is singular at 0)");
+  else
+    Require(p.minimum_activation >= 0 && p.minimum_activation < 1, "minimum_activation",
+            p.minimum_activation, "must be in [0, 1)");
+  Require(c.kshape_active > 0, "kshape_active", c.kshape_active, "must be > 0");
+  Require(c.kshape_passive > 0, "kshape_passive", c.kshape_passive, "must be > 0");
+  Require(c.fmax_muscle_strain > 0, "fmax_muscle_strain", c.fmax_muscle_strain, "must be > 0");
+  Require(c.fmax_tendon_strain > 0, "fmax_tendon_strain", c.fmax_tendon_strain, "must be > 0");
+  Require(c.af > 0, "af", c.af, "must be > 0");
+  Require(c.flen > 1, "flen", c.flen, "must be > 1");
+  Require(c.fv_linear_extrap_threshold > 1 / c.flen && c.fv_linear_extrap_threshold < 1,
+          "fv_linear_extrap_threshold", c.fv_linear_extrap_threshold,
+          "must be in (1/flen = " + Num(1 / c.flen) + ", 1)");
+}
+
+void Validate(const MujocoMuscleParameters& p) {
+  Require(std::isfinite(p.range1) && p.range0 < p.range1, "range0", p.range0,
+          "must be < range1 = " + Num(p.range1));
+  Require(p.lmin > 0 && p.lmin < 1, "lmin", p.lmin, "must be in (0, 1)");
+  Require(p.lmax > 1, "lmax", p.lmax, "must be > 1");
+  Require(p.vmax > 0, "vmax", p.vmax, "must be > 0 L0/s");
+  Require(p.fpmax >= 0, "fpmax", p.fpmax, "must be >= 0");
+  Require(p.fvmax >= 1, "fvmax", p.fvmax, "must be >= 1");
+  Require(std::isfinite(p.lengthrange_lo) && p.lengthrange_lo < p.lengthrange_hi,
+          "lengthrange_hi", p.lengthrange_hi,
+          "must be > lengthrange_lo = " + Num(p.lengthrange_lo) + " m");
+  Require(std::isfinite(p.force), "force", p.force, "must be finite");
+  if (p.force < 0) {
+    Require(p.scale >= 0, "scale", p.scale, "must be >= 0 (force < 0 uses scale / acc0)");
+    Require(p.acc0 > 0, "acc0", p.acc0, "must be > 0 when force < 0 (F0 = scale / acc0)");
+  }
+  Require(p.tau_act > 0, "tau_act", p.tau_act, "must be > 0 s");
+  Require(p.tau_deact > 0, "tau_deact", p.tau_deact, "must be > 0 s");
+}
+
+// ---------------------------------------------------------------------------------------------
+// the kind hill_muscle
+
+namespace {
+
+enum class Curves { kThelen, kMujoco };
+
+struct AllParameters {
+  ThelenMuscleParameters thelen;
+  MujocoMuscleParameters mujoco;
+  double default_activation = 0;  // [-]
+};
+
+enum class Applies { kBoth, kThelen, kMujoco };
+
+struct ParameterEntry {
+  const char* name;
+  const char* unit;
+  Applies applies;
+  bool required;
+  double& (*ref)(AllParameters&);
+  const char* help;
+};
+
+const std::vector<ParameterEntry>& ParameterTable() {
+  using P = AllParameters;
+  static const std::vector<ParameterEntry> table = {
+      {"default_activation", "", Applies::kBoth, false,
+       [](P& p) -> double& { return p.default_activation; },
+       "activation at Reset, in [0, 1] (raised to minimum_activation)"},
+      // thelen2003
+      {"max_isometric_force", "N", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.max_isometric_force; }, "F0 (thelen2003)"},
+      {"optimal_fiber_length", "m", Applies::kThelen, true,
+       [](P& p) -> double& { return p.thelen.optimal_fiber_length; },
+       "fibre length of maximum active force (thelen2003, required)"},
+      {"tendon_slack_length", "m", Applies::kThelen, true,
+       [](P& p) -> double& { return p.thelen.tendon_slack_length; },
+       "tendon length below which it carries no force (thelen2003, required)"},
+      {"pennation_angle", "rad", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.pennation_angle; },
+       "pennation at optimal fibre length; constant muscle thickness (thelen2003)"},
+      {"max_contraction_velocity", "1/s", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.max_contraction_velocity; },
+       "in optimal fibre lengths per second (thelen2003)"},
+      {"activation_time_constant", "s", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.activation_time_constant; }, "(thelen2003)"},
+      {"deactivation_time_constant", "s", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.deactivation_time_constant; }, "(thelen2003)"},
+      {"minimum_activation", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.minimum_activation; },
+       "lower bound of the activation (thelen2003; > 0 with an elastic tendon)"},
+      {"maximum_pennation_angle", "rad", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.maximum_pennation_angle; },
+       "sets the shortest fibre, height / sin(maximum) (thelen2003)"},
+      {"kshape_active", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.kshape_active; },
+       "gamma of the active force-length Gaussian (thelen2003)"},
+      {"kshape_passive", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.kshape_passive; },
+       "passive force-length exponent (thelen2003)"},
+      {"fmax_muscle_strain", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.fmax_muscle_strain; },
+       "fibre strain of passive force F0 (thelen2003)"},
+      {"fmax_tendon_strain", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.fmax_tendon_strain; },
+       "tendon strain of force F0 (thelen2003)"},
+      {"af", "", Applies::kThelen, false, [](P& p) -> double& { return p.thelen.curves.af; },
+       "force-velocity shape factor (thelen2003)"},
+      {"flen", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.flen; },
+       "maximum lengthening force / F0 (thelen2003)"},
+      {"fv_linear_extrap_threshold", "", Applies::kThelen, false,
+       [](P& p) -> double& { return p.thelen.curves.fv_linear_extrap_threshold; },
+       "force-velocity linear beyond this * flen (thelen2003)"},
+      // mujoco
+      {"range0", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.range0; },
+       "normalised length at lengthrange_lo (mujoco)"},
+      {"range1", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.range1; },
+       "normalised length at lengthrange_hi (mujoco)"},
+      {"force", "N", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.force; },
+       "F0; < 0: scale / acc0 (mujoco)"},
+      {"scale", "rad/s^2", Applies::kMujoco, false,
+       [](P& p) -> double& { return p.mujoco.scale; }, "F0 = scale / acc0 when force < 0 (mujoco)"},
+      {"acc0", "rad/s^2/N", Applies::kMujoco, false,
+       [](P& p) -> double& { return p.mujoco.acc0; },
+       "joint acceleration norm of a unit actuator force, from MuJoCo's compiler (mujoco)"},
+      {"lmin", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.lmin; },
+       "shortest normalised length with active force (mujoco)"},
+      {"lmax", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.lmax; },
+       "longest normalised length with active force (mujoco)"},
+      {"vmax", "1/s", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.vmax; },
+       "shortening speed of zero force, in L0 per second (mujoco)"},
+      {"fpmax", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.fpmax; },
+       "passive force / F0 at lmax (mujoco)"},
+      {"fvmax", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.fvmax; },
+       "lengthening force limit / F0 (mujoco)"},
+      {"lengthrange_lo", "m", Applies::kMujoco, true,
+       [](P& p) -> double& { return p.mujoco.lengthrange_lo; },
+       "actuator length mapped to range0 (mujoco, required)"},
+      {"lengthrange_hi", "m", Applies::kMujoco, true,
+       [](P& p) -> double& { return p.mujoco.lengthrange_hi; },
+       "actuator length mapped to range1 (mujoco, required)"},
+      {"tau_act", "s", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.tau_act; },
+       "activation time constant (mujoco)"},
+      {"tau_deact", "s", Applies::kMujoco, false,
+       [](P& p) -> double& { return p.mujoco.tau_deact; }, "deactivation time constant (mujoco)"},
+  };
+  return table;
+}
+
+bool AppliesTo(Applies applies, Curves curves) {
+  return applies == Applies::kBoth || (applies == Applies::kThelen && curves == Curves::kThelen) ||
+         (applies == Applies::kMujoco && curves == Curves::kMujoco);
+}
+
+const char* CurvesName(Curves c) { return c == Curves::kThelen ? "thelen2003" : "mujoco"; }
+
+// root of f on [lo, hi] with f(lo) <= 0 <= f(hi); f returns (value, derivative); Newton steps,
+// bisection when a step leaves the bracket or does not halve the error
+template <class F>
+double SafeNewton(const F& f, double lo, double hi, double x, double tol) {
+  x = Clamp(x, lo, hi);
+  double dx_old = hi - lo;
+  double dx = dx_old;
+  auto [fx, dfx] = f(x);
+  for (int i = 0; i < 200; ++i) {
+    if (fx == 0) return x;
+    if (fx < 0)
+      lo = x;
+    else
+      hi = x;
+    const double newton = x - fx / dfx;
+    if (dfx > 0 && newton > lo && newton < hi && std::abs(2 * fx) <= std::abs(dx_old * dfx)) {
+      dx_old = dx;
+      dx = x - newton;
+      x = newton;
+    } else {
+      dx_old = dx;
+      dx = 0.5 * (hi - lo);
+      x = lo + dx;
+    }
+    if (std::abs(dx) < tol || hi - lo < tol) return x;
+    std::tie(fx, dfx) = f(x);
+  }
+  return x;
+}
+
+struct Outputs {
+  double fiber_length = 0;         // [m]
+  double fiber_velocity = 0;       // [m/s]
+  double norm_fiber_length = 0;    // [-]
+  double norm_fiber_velocity = 0;  // [-]
+  double pennation = 0;            // [rad]
+  double tendon_length = 0;        // [m]
+  double tendon_strain = 0;        // [-]
+  double active_force_length = 0;  // [-]
+  double force_velocity = 1;       // [-]
+  double passive_force_length = 0; // [-]
+  double active_fiber_force = 0;   // [N]
+  double passive_force = 0;        // [N]
+  double tension = 0;              // [N]
+};
+
+class HillMuscle : public TendonActuator {
+ public:
+  HillMuscle(std::string name, Curves curves, bool elastic, const AllParameters& p)
+      : name_(std::move(name)), curves_(curves), elastic_(elastic), p_(p) {
+    activation_ = InitialActivation();
+    fiber_length_ = p_.thelen.optimal_fiber_length;
+  }
+
+  void Reset(double path_length) override {
+    CheckFinite("path length", path_length);
+    activation_ = InitialActivation();
+    if (elastic_) fiber_length_ = EquilibriumFiberLength(path_length, activation_);
+    Evaluate(path_length, 0);
+  }
+
+  double Step(double path_length, double path_speed, double dt) override {
+    CheckFinite("path length", path_length);
+    CheckFinite("path speed", path_speed);
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
+    const int n = static_cast<int>(std::ceil(dt / MaxSubstep() - 1e-9));
+    const double h = dt / std::max(n, 1);
+    for (int i = 0; i < std::max(n, 1); ++i) {
+      const double a0 = activation_;
+      activation_ = IntegrateActivation(a0, h);
+      if (elastic_) {
+        const double l0 = path_length + path_speed * i * h;
+        fiber_length_ = FiberStep(fiber_length_, l0, l0 + path_speed * h, a0, activation_, h);
+      }
+    }
+    Evaluate(path_length + path_speed * dt, path_speed);
+    return out_.tension;
+  }
+
+  double tension() const override { return out_.tension; }
+
+  void SetCommand(double value) override {
+    CheckFinite("excitation", value);
+    excitation_ = Clamp(value, 0, 1);
+  }
+  double command() const override { return excitation_; }
+  std::string command_unit() const override { return ""; }
+
+  std::vector<Quantity> Quantities() const override {
+    std::vector<Quantity> q;
+    for (const auto& e : ParameterTable())
+      if (AppliesTo(e.applies, curves_)) q.push_back({e.name, e.unit, true, true});
+    if (curves_ == Curves::kMujoco) {
+      q.push_back({"max_isometric_force", "N", false, true});
+      q.push_back({"optimal_fiber_length", "m", false, true});
+    }
+    q.push_back({"excitation", "", true, false});
+    q.push_back({"activation", "", true, false});
+    q.push_back({"fiber_length", "m", elastic_, false});
+    for (const auto& [name, unit] : OutputNames()) q.push_back({name, unit, false, false});
+    if (curves_ == Curves::kThelen) {
+      q.push_back({"pennation", "rad", false, false});
+      q.push_back({"tendon_length", "m", false, false});
+      q.push_back({"tendon_strain", "", false, false});
+    }
+    return q;
+  }
+
+  double Get(const std::string& name) const override {
+    for (const auto& e : ParameterTable())
+      if (e.name == name && AppliesTo(e.applies, curves_)) {
+        AllParameters copy = p_;
+        return e.ref(copy);
+      }
+    if (curves_ == Curves::kMujoco && name == "max_isometric_force") return MujocoF0();
+    if (curves_ == Curves::kMujoco && name == "optimal_fiber_length") return MujocoL0();
+    if (name == "excitation") return excitation_;
+    if (name == "activation") return activation_;
+    if (name == "fiber_length") return elastic_ ? fiber_length_ : out_.fiber_length;
+    if (name == "fiber_velocity") return out_.fiber_velocity;
+    if (name == "normalized_fiber_length") return out_.norm_fiber_length;
+    if (name == "normalized_fiber_velocity") return out_.norm_fiber_velocity;
+    if (name == "active_force_length") return out_.active_force_length;
+    if (name == "force_velocity") return out_.force_velocity;
+    if (name == "passive_force_length") return out_.passive_force_length;
+    if (name == "active_fiber_force") return out_.active_fiber_force;
+    if (name == "passive_force") return out_.passive_force;
+    if (name == "tension") return out_.tension;
+    if (curves_ == Curves::kThelen) {
+      if (name == "pennation") return out_.pennation;
+      if (name == "tendon_length") return out_.tendon_length;
+      if (name == "tendon_strain") return out_.tendon_strain;
+    }
+    throw std::out_of_range(Prefix() + "no quantity '" + name + "'");
+  }
+
+  void Set(const std::string& name, double value) override {
+    for (const auto& e : ParameterTable())
+      if (e.name == name && AppliesTo(e.applies, curves_)) {
+        AllParameters candidate = p_;
+        e.ref(candidate) = value;
+        try {
+          ValidateAll(candidate, curves_, elastic_);
+        } catch (const std::invalid_argument& error) {
+          throw std::invalid_argument(Prefix() + error.what());
+        }
+        p_ = candidate;
+        activation_ = Clamp(activation_, MinimumActivation(), 1);
+        return;
+      }
+    if (name == "excitation") {
+      SetCommand(value);
+      return;
+    }
+    if (name == "activation") {
+      if (!(value >= MinimumActivation() && value <= 1))
+        throw std::invalid_argument(Prefix() + "activation " + Num(value) + " must be in [" +
+                                    Num(MinimumActivation()) + ", 1]");
+      activation_ = value;
+      return;
+    }
+    if (name == "fiber_length" && elastic_) {
+      if (!(value >= MinimumFiberLength()) || !std::isfinite(value))
+        throw std::invalid_argument(Prefix() + "fiber_length " + Num(value) +
+                                    " m must be >= the shortest fibre " +
+                                    Num(MinimumFiberLength()) + " m");
+      fiber_length_ = value;
+      return;
+    }
+    (void)Get(name);  // throws std::out_of_range for an unknown name
+    throw std::invalid_argument(Prefix() + "'" + name + "' is read-only");
+  }
+
+  static void ValidateAll(const AllParameters& p, Curves curves, bool elastic) {
+    Require(p.default_activation >= 0 && p.default_activation <= 1, "default_activation",
+            p.default_activation, "must be in [0, 1]");
+    if (curves == Curves::kThelen)
+      Validate(p.thelen, elastic);
+    else
+      Validate(p.mujoco);
+  }
+
+ private:
+  static const std::vector<std::pair<const char*, const char*>>& OutputNames() {
+    static const std::vector<std::pair<const char*, const char*>> names = {
+        {"fiber_velocity", "m/s"},
+        {"normalized_fiber_length", ""},
+        {"normalized_fiber_velocity", ""},
+        {"active_force_length", ""},
+        {"force_velocity", ""},
+        {"passive_force_length", ""},
+        {"active_fiber_force", "N"},
+        {"passive_force", "N"},
+        {"tension", "N"}};
+    return names;
+  }
+
+  std::string Prefix() const {
+    return "hill_muscle '" + name_ + "' (curves=" + CurvesName(curves_) + "): ";
+  }
+
+  void CheckFinite(const char* what, double v) const {
+    if (!std::isfinite(v))
+      throw std::invalid_argument(Prefix() + what + " is not finite (" + Num(v) + ")");
+  }
+
+  double MinimumActivation() const {
+    return curves_ == Curves::kThelen ? p_.thelen.minimum_activation : 0.0;
+  }
+  double InitialActivation() const { return Clamp(p_.default_activation, MinimumActivation(), 1); }
+
+  double MujocoF0() const {
+    return MujocoForceScale(p_.mujoco.force, p_.mujoco.scale, p_.mujoco.acc0);
+  }
+  double MujocoL0() const {
+    return MujocoOptimalLength(p_.mujoco.lengthrange_lo, p_.mujoco.lengthrange_hi,
+                               p_.mujoco.range0, p_.mujoco.range1);
+  }
+
+  double MaxSubstep() const {
+    double tau_min;
+    if (curves_ == Curves::kThelen)
+      tau_min = std::min(0.5 * p_.thelen.activation_time_constant,
+                         0.5 * p_.thelen.deactivation_time_constant);
+    else
+      tau_min = std::min(0.5 * p_.mujoco.tau_act, 0.5 * p_.mujoco.tau_deact);
+    return std::min(kMaxSubstep, 0.5 * tau_min);
+  }
+
+  double ActivationRateOf(double a) const {
+    if (curves_ == Curves::kThelen)
+      return ActivationRate(excitation_, a, p_.thelen.activation_time_constant,
+                            p_.thelen.deactivation_time_constant, p_.thelen.minimum_activation);
+    return MujocoActivationRate(excitation_, a, p_.mujoco.tau_act, p_.mujoco.tau_deact);
+  }
+
+  // classical RK4 over h (h <= tau_min / 2), clamped to [minimum, 1]
+  double IntegrateActivation(double a, double h) const {
+    const double k1 = ActivationRateOf(a);
+    const double k2 = ActivationRateOf(a + 0.5 * h * k1);
+    const double k3 = ActivationRateOf(a + 0.5 * h * k2);
+    const double k4 = ActivationRateOf(a + h * k3);
+    return Clamp(a + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), MinimumActivation(), 1);
+  }
+
+  // --- Thelen with an elastic tendon: fibre length state
+
+  double Height() const {
+    return p_.thelen.optimal_fiber_length * std::sin(p_.thelen.pennation_angle);
+  }
+
+  double MinimumFiberLength() const {
+    return std::max(Height() / std::sin(p_.thelen.maximum_pennation_angle),
+                    0.01 * p_.thelen.optimal_fiber_length);
+  }
+
+  // normalised fibre force along the fibre needed by the tendon, and its derivative by lm
+  struct Balance {
+    double fse = 0, cos = 1, fal = 0, fpe = 0;  // [-]
+    double num = 0, den = 1;    // fv = num / den: fse / cos - fpe over a fal [-]
+    double dnum = 0, dden = 0;  // their derivatives by lm [1/m]
+    double fv = 1;              // [-]
+    double dfv = 0;             // [1/m]
+  };
+
+  Balance BalanceAt(double lm, double path_length, double a) const {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const double h = Height();
+    const double along = std::sqrt(std::max(lm * lm - h * h, 0.0));
+    Balance b;
+    b.cos = along / lm;
+    const double strain = (path_length - along) / t.tendon_slack_length - 1;
+    const double l = lm / t.optimal_fiber_length;
+    b.fse = ThelenTendonForceStrain(strain, t.curves.fmax_tendon_strain);
+    b.fal = ThelenActiveForceLength(l, t.curves.kshape_active);
+    b.fpe = ThelenPassiveForceLength(l, t.curves.kshape_passive, t.curves.fmax_muscle_strain);
+    const double cos = std::max(b.cos, 1e-12);
+    b.num = b.fse / cos - b.fpe;
+    b.den = std::max(a * b.fal, 1e-12);
+    b.fv = b.num / b.den;
+    const double dfse = ThelenTendonStiffness(strain, t.curves.fmax_tendon_strain) /
+                        t.tendon_slack_length * (-1 / cos);
+    const double dcos = h * h / (lm * lm * lm * cos);
+    b.dnum = dfse / cos - b.fse * dcos / (cos * cos) -
+             ThelenPassiveSlope(l, t.curves.kshape_passive, t.curves.fmax_muscle_strain) /
+                 t.optimal_fiber_length;
+    b.dden = a * ThelenActiveSlope(l, t.curves.kshape_active) / t.optimal_fiber_length;
+    b.dfv = (b.dnum * b.den - b.num * b.dden) / (b.den * b.den);
+    return b;
+  }
+
+  // fibre velocity [m/s] from the force balance, and its derivative by lm [1/s]
+  std::pair<double, double> FiberVelocity(double lm, double path_length, double a) const {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const Balance b = BalanceAt(lm, path_length, a);
+    const double scale = t.max_contraction_velocity * t.optimal_fiber_length;
+    return {ThelenForceVelocityInverse(b.fv, a, t.curves) * scale,
+            ThelenForceVelocityInverseSlope(b.fv, a, t.curves) * b.dfv * scale};
+  }
+
+  // x with x = base + c g(x): root of R(x) = x - base - c g(x) above the shortest fibre
+  double SolveStage(double base, double c, double path_length, double a) const {
+    const double lo = MinimumFiberLength();
+    auto residual = [&](double x) {
+      const auto [g, dg] = FiberVelocity(x, path_length, a);
+      return std::make_pair(x - base - c * g, 1 - c * dg);
+    };
+    if (residual(lo).first >= 0) return lo;
+    double hi = std::max(base, lo * 1.001);
+    for (int i = 0; i < 80 && residual(hi).first < 0; ++i) hi = lo + 2 * (hi - lo);
+    return SafeNewton(residual, lo, hi, std::max(base, lo),
+                      1e-13 * p_.thelen.optimal_fiber_length);
+  }
+
+  // two-stage L-stable SDIRK (second order, stiffly accurate) over h; the path moves linearly
+  // from l0 to l1 and the activation from a0 to a1
+  double FiberStep(double lm, double l0, double l1, double a0, double a1, double h) const {
+    const double gamma = 1 - 1 / std::sqrt(2.0);
+    const double x1 = SolveStage(lm, gamma * h, l0 + gamma * (l1 - l0), a0 + gamma * (a1 - a0));
+    const double k1 = (x1 - lm) / (gamma * h);
+    return SolveStage(lm + (1 - gamma) * h * k1, gamma * h, l1, a1);
+  }
+
+  // the fibre length of zero fibre velocity (fv = 1): tendon force = (a fal + fpe) cos
+  double EquilibriumFiberLength(double path_length, double a) const {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const double lo = MinimumFiberLength();
+    const double h = Height();
+    auto excess = [&](double x) {
+      // isometric fibre force minus what the tendon pulls, normalised, along the fibre
+      const Balance b = BalanceAt(x, path_length, a);
+      return std::make_pair(b.den - b.num, b.dden - b.dnum);
+    };
+    if (excess(lo).first >= 0) return lo;
+    const double slack = path_length - t.tendon_slack_length;
+    double hi = std::sqrt(h * h + slack * slack);
+    if (!(hi > lo)) return lo;
+    for (int i = 0; i < 80 && excess(hi).first < 0; ++i) hi = lo + 2 * (hi - lo);
+    return SafeNewton(excess, lo, hi, 0.5 * (lo + hi), 1e-14 * t.optimal_fiber_length);
+  }
+
+  // --- outputs at the end of a step
+
+  void Evaluate(double path_length, double path_speed) {
+    if (curves_ == Curves::kMujoco)
+      EvaluateMujoco(path_length, path_speed);
+    else if (elastic_)
+      EvaluateThelenElastic(path_length);
+    else
+      EvaluateThelenRigid(path_length, path_speed);
+  }
+
+  void EvaluateMujoco(double length, double speed) {
+    const MujocoMuscleParameters& m = p_.mujoco;
+    const double L0 = MujocoL0();
+    const double F0 = MujocoF0();
+    Outputs o;
+    o.norm_fiber_length = MujocoNormalizedLength(length, m.lengthrange_lo, m.lengthrange_hi,
+                                                 m.range0, m.range1);
+    o.fiber_length = o.norm_fiber_length * L0;
+    o.fiber_velocity = speed;
+    o.norm_fiber_velocity = speed / std::max(kMinVal, L0 * m.vmax);
+    o.active_force_length = MujocoActiveForceLength(o.norm_fiber_length, m.lmin, m.lmax);
+    o.force_velocity = MujocoForceVelocity(o.norm_fiber_velocity, m.fvmax);
+    o.passive_force_length = MujocoPassiveForceLength(o.norm_fiber_length, m.lmax, m.fpmax);
+    o.active_fiber_force = F0 * activation_ * o.active_force_length * o.force_velocity;
+    o.passive_force = F0 * o.passive_force_length;
+    o.tension = std::max(0.0, o.active_fiber_force + o.passive_force);
+    out_ = o;
+  }
+
+  void EvaluateThelenRigid(double length, double speed) {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const double along = length - t.tendon_slack_length;
+    Outputs o;
+    o.tendon_length = t.tendon_slack_length;
+    o.fiber_length =
+        PennatedFiberLength(std::max(along, 0.0), t.optimal_fiber_length, t.pennation_angle);
+    const double cos = along > 0 && o.fiber_length > 0 ? along / o.fiber_length : 0.0;
+    o.pennation = along > 0 ? std::acos(cos) : kPi / 2;
+    o.fiber_velocity = cos * speed;
+    FillThelenForces(&o, t.max_isometric_force, cos);
+    out_ = o;
+  }
+
+  void EvaluateThelenElastic(double length) {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const double lm = std::max(fiber_length_, MinimumFiberLength());
+    const Balance b = BalanceAt(lm, length, activation_);
+    Outputs o;
+    o.fiber_length = lm;
+    o.pennation = std::acos(Clamp(b.cos, 0, 1));
+    o.tendon_length = length - lm * b.cos;
+    o.tendon_strain = o.tendon_length / t.tendon_slack_length - 1;
+    o.fiber_velocity = FiberVelocity(lm, length, activation_).first;
+    o.norm_fiber_length = lm / t.optimal_fiber_length;
+    o.norm_fiber_velocity =
+        o.fiber_velocity / (t.max_contraction_velocity * t.optimal_fiber_length);
+    o.active_force_length = b.fal;
+    o.force_velocity = b.fv;
+    o.passive_force_length = b.fpe;
+    o.active_fiber_force = t.max_isometric_force * activation_ * b.fal * b.fv;
+    o.passive_force = t.max_isometric_force * b.fpe;
+    o.tension = t.max_isometric_force * b.fse;
+    out_ = o;
+  }
+
+  void FillThelenForces(Outputs* o, double f0, double cos) const {
+    const ThelenMuscleParameters& t = p_.thelen;
+    o->norm_fiber_length = o->fiber_length / t.optimal_fiber_length;
+    o->norm_fiber_velocity =
+        o->fiber_velocity / (t.max_contraction_velocity * t.optimal_fiber_length);
+    o->active_force_length = ThelenActiveForceLength(o->norm_fiber_length, t.curves.kshape_active);
+    o->passive_force_length = ThelenPassiveForceLength(
+        o->norm_fiber_length, t.curves.kshape_passive, t.curves.fmax_muscle_strain);
+    o->force_velocity = ThelenForceVelocity(o->norm_fiber_velocity, activation_, t.curves);
+    o->active_fiber_force = f0 * activation_ * o->active_force_length * o->force_velocity;
+    o->passive_force = f0 * o->passive_force_length;
+    o->tension = std::max(0.0, (o->active_fiber_force + o->passive_force) * cos);
+  }
+
+  std::string name_;
+  Curves curves_;
+  bool elastic_;
+  AllParameters p_;
+  double excitation_ = 0;    // command u [-], in [0, 1]
+  double activation_ = 0;    // [-]
+  double fiber_length_ = 0;  // elastic tendon state [m]
+  Outputs out_;
+};
+
+std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
+  const std::string where = "actuator '" + a.name + "' (hill_muscle): ";
+  for (const auto& [key, value] : a.options)
+    if (key != "curves" && key != "tendon")
+      throw std::invalid_argument(where + "unknown option '" + key +
+                                  "' (known: curves, tendon)");
+  Curves curves = Curves::kThelen;
+  if (const auto it = a.options.find("curves"); it != a.options.end()) {
+    if (it->second == "mujoco")
+      curves = Curves::kMujoco;
+    else if (it->second != "thelen2003")
+      throw std::invalid_argument(where + "unknown curves '" + it->second +
+                                  "' (known: thelen2003, mujoco)");
+  }
+  bool elastic = false;
+  if (const auto it = a.options.find("tendon"); it != a.options.end()) {
+    if (it->second == "elastic")
+      elastic = true;
+    else if (it->second != "rigid")
+      throw std::invalid_argument(where + "unknown tendon '" + it->second +
+                                  "' (known: rigid, elastic)");
+  }
+  if (elastic && curves == Curves::kMujoco)
+    throw std::invalid_argument(where + "tendon=elastic needs curves=thelen2003 (MuJoCo's "
+                                        "muscle has a rigid tendon)");
+  AllParameters p;
+  std::set<std::string> given;
+  for (const auto& [name, value] : a.parameters) given.insert(name);
+  for (const auto& e : ParameterTable()) {
+    const bool applies = AppliesTo(e.applies, curves);
+    if (given.count(e.name) && !applies)
+      throw std::invalid_argument(where + "parameter '" + e.name + "' does not apply to curves=" +
+                                  CurvesName(curves));
+    if (applies && e.required && !given.count(e.name))
+      throw std::invalid_argument(where + "missing parameter '" + e.name + "' [" + e.unit +
+                                  "] needed by curves=" + CurvesName(curves) + ": " + e.help);
+    if (given.count(e.name)) e.ref(p) = a.parameters.at(e.name);
+  }
+  try {
+    HillMuscle::ValidateAll(p, curves, elastic);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(where + error.what());
+  }
+  return std::make_unique<HillMuscle>(a.name, curves, elastic, p);
+}
+
+}  // namespace
+
+void RegisterMuscleKinds() {
+  std::vector<ParameterSpec> specs;
+  AllParameters defaults;
+  for (const auto& e : ParameterTable())
+    specs.push_back({e.name, e.unit, e.ref(defaults), false, e.help});
+  RegisterKind("hill_muscle", std::move(specs), MakeHillMuscle);
+}
+
+}  // namespace caliper::actuators

@@ -1,0 +1,316 @@
+// The dc_motor_tendon and ligament kinds through the registry: errors that name the actuator,
+// the stall tension against a fixed path, quantities, the ligament law.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "caliper/actuators/actuator.h"
+#include "caliper/actuators/dc_motor.h"
+#include "caliper/sgal/scene.h"
+
+namespace caliper::actuators {
+namespace {
+
+constexpr double kVoltage = 3;                      // [V]
+constexpr double kStallCurrent = kVoltage / 0.516;  // U / R [A]
+
+sgal::Actuator Motor() {
+  sgal::Actuator a;
+  a.name = "biceps_motor";
+  a.kind = "dc_motor_tendon";
+  a.tendon = "biceps";
+  return a;
+}
+
+sgal::Actuator Ligament() {
+  sgal::Actuator a;
+  a.name = "knee_ligament";
+  a.kind = "ligament";
+  a.tendon = "acl";
+  a.parameters["stiffness"] = 500;
+  return a;
+}
+
+// At stall w = 0, so i = U / R and rho = rho(i, 0) (eta + 4.5e-5 (1/eta - eta)); the spool torque
+// balances the motor torque through the gear: r_s F / (rho N) = k_t i.
+double StallTension(double spool_radius, double voltage = kVoltage, double resistance = 0.516) {
+  const double current = voltage / resistance;
+  return 11.5e-3 * current * 128 * GearEfficiencyFactor(0.59, current, 0) / spool_radius;
+}
+
+std::string MessageOf(const sgal::Actuator& a) {
+  try {
+    Make(a);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+void RunFor(TendonActuator& actuator, double path_length, double duration, double dt = 1e-3) {
+  const long steps = std::lround(duration / dt);
+  for (long i = 0; i < steps; ++i) actuator.Step(path_length, 0, dt);
+}
+
+TEST(MotorKinds, AreRegisteredWithTheirParameters) {
+  const auto kinds = Kinds();
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), "dc_motor_tendon"), kinds.end());
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), "ligament"), kinds.end());
+  bool stiffness_required = false;
+  for (const auto& spec : KindParameters("ligament"))
+    if (spec.name == "stiffness") stiffness_required = spec.required;
+  EXPECT_TRUE(stiffness_required);
+  double resistance = 0;
+  int count = 0;
+  for (const auto& spec : KindParameters("dc_motor_tendon")) {
+    if (spec.name == "resistance") resistance = spec.default_value;
+    EXPECT_FALSE(spec.required) << spec.name;
+    ++count;
+  }
+  EXPECT_EQ(resistance, 0.516);
+  EXPECT_EQ(count, 12 + 2 + 12);
+}
+
+TEST(MotorKinds, RejectUnknownKindsParametersAndOptionsNamingTheActuator) {
+  sgal::Actuator a = Motor();
+  a.kind = "dc_motor_tendonn";
+  std::string message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "biceps_motor")) << message;
+  EXPECT_TRUE(Contains(message, "dc_motor_tendonn")) << message;
+
+  a = Motor();
+  a.parameters["resistence"] = 1;
+  message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "biceps_motor")) << message;
+  EXPECT_TRUE(Contains(message, "unknown parameter 'resistence'")) << message;
+
+  a = Ligament();
+  a.parameters.erase("stiffness");
+  message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "knee_ligament")) << message;
+  EXPECT_TRUE(Contains(message, "missing parameter 'stiffness'")) << message;
+
+  a = Motor();
+  a.options["input"] = "current";
+  message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "biceps_motor")) << message;
+  EXPECT_TRUE(Contains(message, "input")) << message;
+
+  a = Motor();
+  a.options["elastic"] = "rubber";
+  message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "biceps_motor")) << message;
+  EXPECT_TRUE(Contains(message, "rubber")) << message;
+}
+
+TEST(MotorKinds, RejectParameterValuesOutOfRangeNamingTheParameter) {
+  for (const auto& [name, value] : {std::pair<std::string, double>{"resistance", -1},
+                                    {"efficiency", 1.5},
+                                    {"spool_radius", 0},
+                                    {"supply_voltage", 0},
+                                    {"pretension", -1},
+                                    {"stiffness", 0},
+                                    {"inductance", NAN}}) {
+    sgal::Actuator a = Motor();
+    a.parameters[name] = value;
+    const std::string message = MessageOf(a);
+    EXPECT_TRUE(Contains(message, "biceps_motor")) << message;
+    EXPECT_TRUE(Contains(message, "'" + name + "'")) << message;
+  }
+  sgal::Actuator a = Ligament();
+  a.parameters["damping"] = -2;
+  const std::string message = MessageOf(a);
+  EXPECT_TRUE(Contains(message, "knee_ligament")) << message;
+  EXPECT_TRUE(Contains(message, "damping")) << message;
+}
+
+TEST(DcMotorTendon, PullsAFixedPathToTheStallTension) {
+  sgal::Actuator a = Motor();
+  a.parameters["stiffness"] = 2e5;
+  a.parameters["rest_length"] = 0.05;
+  auto motor = Make(a);
+  motor->Reset(0.3);
+  EXPECT_EQ(motor->tension(), 0);
+  EXPECT_NEAR(motor->Get("line_length"), 0.25, 1e-12);
+  motor->SetCommand(kVoltage);
+  RunFor(*motor, 0.3, 0.5);
+  const double early = motor->tension();
+  RunFor(*motor, 0.3, 9.5);
+  const double stall = StallTension(0.0045);  // 1122 N
+  EXPECT_NEAR(stall, 1122.2, 0.1);
+  EXPECT_GT(early, 0.3 * stall);
+  EXPECT_LT(early, 0.9 * stall);
+  EXPECT_NEAR(motor->tension(), stall, 0.002 * stall);
+  EXPECT_EQ(motor->Get("tension"), motor->tension());
+  EXPECT_NEAR(motor->Get("current"), kStallCurrent, 0.001 * kStallCurrent);
+  EXPECT_LT(std::abs(motor->Get("spool_speed")), 1e-4);
+  EXPECT_NEAR(motor->Get("elastic_length"), 0.05 + motor->tension() / 2e5, 1e-9);
+  EXPECT_NEAR(motor->Get("line_length") + motor->Get("elastic_length"), 0.3, 1e-12);
+  EXPECT_NEAR(motor->Get("spool_angle"), (0.25 - motor->Get("line_length")) / 0.0045, 1e-9);
+  EXPECT_NEAR(motor->Get("voltage"), kVoltage, 1e-12);
+  EXPECT_NEAR(motor->Get("power"), kVoltage * motor->Get("current"), 1e-9);
+}
+
+TEST(DcMotorTendon, WithAZenerElementStallsAtTheSameTension) {
+  sgal::Actuator a = Motor();
+  a.options["elastic"] = "zener";
+  a.parameters["zener_area"] = 1e-3;
+  a.parameters["rest_length"] = 0.05;
+  a.parameters["spool_radius"] = 0.02;
+  auto motor = Make(a);
+  motor->Reset(0.3);
+  motor->SetCommand(kVoltage);
+  RunFor(*motor, 0.3, 25);
+  const double stall = StallTension(0.02);  // 252 N
+  EXPECT_NEAR(motor->tension(), stall, 0.005 * stall);
+  // relaxed: s = E0 e
+  EXPECT_NEAR(motor->Get("elastic_length"), 0.05 * (1 + stall / (0.694e6 * 1e-3)), 0.005 * 0.05);
+  EXPECT_NEAR(motor->Get("stress"), stall / 1e-3, 0.005 * stall / 1e-3);
+}
+
+TEST(DcMotorTendon, DutyInputScalesTheSupplyVoltage) {
+  sgal::Actuator a = Motor();
+  a.options["input"] = "duty";
+  a.parameters["supply_voltage"] = 12;
+  auto motor = Make(a);
+  EXPECT_EQ(motor->command_unit(), "");
+  motor->Reset(0.3);
+  motor->SetCommand(0.25);
+  // the path shortened: the line is slack, the motor runs free
+  RunFor(*motor, 0.25, 0.3);
+  EXPECT_NEAR(motor->Get("voltage"), 3, 1e-12);
+  EXPECT_NEAR(motor->Get("spool_speed"), 3 / (11.5e-3 * 128), 0.01 * 2.038);
+  EXPECT_NEAR(motor->Get("motor_speed"), 128 * motor->Get("spool_speed"), 1e-9);
+  EXPECT_EQ(motor->tension(), 0);
+  EXPECT_LT(motor->Get("line_length"), 0.25);
+  motor->SetCommand(2);
+  EXPECT_EQ(motor->command(), 1);
+  EXPECT_THROW(motor->SetCommand(NAN), std::invalid_argument);
+}
+
+TEST(DcMotorTendon, ReverseVoltagePaysOutLineAndSlackens) {
+  sgal::Actuator a = Motor();
+  a.parameters["pretension"] = 10;
+  auto motor = Make(a);
+  EXPECT_EQ(motor->command_unit(), "V");
+  motor->Reset(0.3);
+  EXPECT_NEAR(motor->tension(), 10, 1e-9);
+  motor->SetCommand(-kVoltage);
+  RunFor(*motor, 0.3, 2);
+  EXPECT_EQ(motor->tension(), 0);
+  EXPECT_NEAR(motor->Get("spool_speed"), -2.038, 0.01 * 2.038);
+  // the elastic element (1000 N/m) started 10 mm long, the spool paid out 18 mm
+  EXPECT_NEAR(motor->Get("line_length"), 0.3 - 0.06 + 0.0045 * 2.038 * (2 - 0.006), 3e-4);
+  EXPECT_LT(motor->Get("elastic_length"), 0.05);
+}
+
+TEST(DcMotorTendon, PretensionSetsTheElasticLengthAtReset) {
+  sgal::Actuator a = Motor();
+  a.parameters["pretension"] = 20;
+  a.parameters["stiffness"] = 1000;
+  a.parameters["rest_length"] = 0.05;
+  auto motor = Make(a);
+  motor->Reset(0.4);
+  EXPECT_NEAR(motor->Get("elastic_length"), 0.07, 1e-12);
+  EXPECT_NEAR(motor->Get("line_length"), 0.33, 1e-12);
+  EXPECT_NEAR(motor->tension(), 20, 1e-9);
+  // unpowered, the gear gives way only slowly (back-driven through eta)
+  EXPECT_NEAR(motor->Step(0.4, 0, 1e-3), 20, 0.01);
+  EXPECT_LT(motor->Get("spool_speed"), 0);
+}
+
+TEST(DcMotorTendon, QuantitiesCanBeReadAndEdited) {
+  sgal::Actuator a = Motor();
+  a.parameters["stiffness"] = 2e5;
+  auto motor = Make(a);
+  bool found_current = false;
+  bool found_resistance = false;
+  for (const Quantity& q : motor->Quantities()) {
+    if (q.name == "current") {
+      found_current = true;
+      EXPECT_EQ(q.unit, "A");
+      EXPECT_FALSE(q.writable);
+      EXPECT_FALSE(q.is_static);
+    }
+    if (q.name == "resistance") {
+      found_resistance = true;
+      EXPECT_EQ(q.unit, "ohm");
+      EXPECT_TRUE(q.writable);
+      EXPECT_TRUE(q.is_static);
+    }
+  }
+  EXPECT_TRUE(found_current);
+  EXPECT_TRUE(found_resistance);
+  EXPECT_EQ(motor->Quantities().size(), 12u + 2u + 3u + 9u);
+  EXPECT_EQ(motor->Get("gear_ratio"), 128);
+  EXPECT_EQ(motor->Get("stiffness"), 2e5);
+
+  try {
+    motor->Set("resistance", 0);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(Contains(e.what(), "biceps_motor")) << e.what();
+    EXPECT_TRUE(Contains(e.what(), "resistance")) << e.what();
+  }
+  EXPECT_THROW(motor->Set("resistance", NAN), std::invalid_argument);
+  EXPECT_THROW(motor->Set("tension", 5), std::invalid_argument);
+  EXPECT_THROW(motor->Set("stiffness", -5), std::invalid_argument);
+  EXPECT_THROW(motor->Set("torque", 1), std::out_of_range);
+  EXPECT_THROW(motor->Get("torque"), std::out_of_range);
+  EXPECT_THROW(motor->Get("zener_E0"), std::out_of_range);
+  EXPECT_EQ(motor->Get("resistance"), 0.516);
+
+  // doubling R halves the stall current and the stall tension
+  motor->Set("resistance", 2 * 0.516);
+  EXPECT_EQ(motor->Get("resistance"), 2 * 0.516);
+  motor->Reset(0.3);
+  motor->SetCommand(kVoltage);
+  RunFor(*motor, 0.3, 10);
+  EXPECT_NEAR(motor->Get("current"), kStallCurrent / 2, 0.001 * kStallCurrent);
+  const double stall = StallTension(0.0045, kVoltage, 2 * 0.516);
+  EXPECT_NEAR(motor->tension(), stall, 0.002 * stall);
+  EXPECT_THROW(motor->Step(0.3, 0, 0), std::invalid_argument);
+}
+
+TEST(LigamentKind, IsASpringDamperInTensionOnly) {
+  sgal::Actuator a = Ligament();
+  a.parameters["damping"] = 2;
+  a.parameters["rest_length"] = 0.1;
+  auto ligament = Make(a);
+  ligament->Reset(0.1);
+  EXPECT_EQ(ligament->tension(), 0);
+  EXPECT_NEAR(ligament->Step(0.12, 0.05, 1e-3), 500 * 0.02 + 2 * 0.05, 1e-12);
+  EXPECT_NEAR(ligament->tension(), 10.1, 1e-12);
+  EXPECT_NEAR(ligament->Step(0.12, -0.5, 1e-3), 500 * 0.02 - 2 * 0.5, 1e-12);
+  EXPECT_EQ(ligament->Step(0.09, 0.5, 1e-3), 0);
+  EXPECT_EQ(ligament->Step(0.101, -1.0, 1e-3), 0);
+  EXPECT_EQ(ligament->Get("length"), 0.101);
+  EXPECT_EQ(ligament->Get("speed"), -1.0);
+  EXPECT_THROW(ligament->SetCommand(1), std::invalid_argument);
+  EXPECT_THROW(ligament->Set("tension", 1), std::invalid_argument);
+  EXPECT_THROW(ligament->Get("current"), std::out_of_range);
+  ligament->Set("stiffness", 1000);
+  EXPECT_NEAR(ligament->Step(0.12, 0, 1e-3), 20, 1e-12);
+}
+
+TEST(LigamentKind, RestLengthDefaultsToThePathLengthAtReset) {
+  auto ligament = Make(Ligament());
+  ligament->Reset(0.25);
+  EXPECT_EQ(ligament->Get("rest_length"), 0.25);
+  EXPECT_EQ(ligament->tension(), 0);
+  EXPECT_NEAR(ligament->Step(0.26, 0, 1e-3), 5, 1e-9);
+  ligament->Set("rest_length", 0.2);
+  ligament->Reset(0.3);
+  EXPECT_EQ(ligament->Get("rest_length"), 0.2);
+  EXPECT_NEAR(ligament->tension(), 50, 1e-9);
+}
+
+}  // namespace
+}  // namespace caliper::actuators
