@@ -3,7 +3,7 @@
 
 namespace caliper::actuators {
 
-void RegisterMotorKinds();   // dc_motor_tendon, ligament (motor_tendon.cc, ligament.cc)
+void RegisterMotorKinds();   // dc_motor_tendon, ligament (motor_tendon.cc)
 void RegisterMuscleKinds();  // hill_muscle (muscle.cc)
 
 inline void RegisterBuiltinKinds() {

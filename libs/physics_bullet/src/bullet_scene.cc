@@ -452,18 +452,18 @@ void BulletScene::UpdateJoints() {
     if (c.kind != sgal::ConstraintKind::kHinge && c.kind != sgal::ConstraintKind::kSlider) continue;
     const Isometry3d fa = JointFrame(j.body_a, c.frame_a);
     const Isometry3d fb = JointFrame(j.body_b, c.frame_b);
-    const Vector3d axis = fa.linear().col(2);
+    const Vector3d axis = fb.linear().col(2);
     if (c.kind == sgal::ConstraintKind::kHinge) {
-      // rotation of the frame of b relative to that of a, about a's z axis
-      const Eigen::Matrix3d rel = fa.linear().transpose() * fb.linear();
+      // rotation of body_a's joint frame relative to body_b's (the parent's), about z
+      const Eigen::Matrix3d rel = fb.linear().transpose() * fa.linear();
       j.position = std::atan2(rel(1, 0), rel(0, 0));
-      const Vector3d wa = j.body_a < 0 ? Vector3d::Zero() : FromBt(bodies_[j.body_a].rigid->getAngularVelocity());
+      const Vector3d wa = FromBt(bodies_[j.body_a].rigid->getAngularVelocity());
       const Vector3d wb = j.body_b < 0 ? Vector3d::Zero() : FromBt(bodies_[j.body_b].rigid->getAngularVelocity());
-      j.velocity = axis.dot(wb - wa);
+      j.velocity = axis.dot(wa - wb);
     } else {
-      j.position = axis.dot(fb.translation() - fa.translation());
-      j.velocity = axis.dot(PointVelocity(j.body_b, fb.translation()) -
-                            PointVelocity(j.body_a, fb.translation()));
+      j.position = axis.dot(fa.translation() - fb.translation());
+      j.velocity = axis.dot(PointVelocity(j.body_a, fa.translation()) -
+                            PointVelocity(j.body_b, fa.translation()));
     }
   }
 }
@@ -475,7 +475,7 @@ void BulletScene::ApplyJointSprings() {
     const sgal::JointSpring& sp = c.springs[0];
     if (sp.stiffness == 0 && sp.damping == 0) continue;
     const double load = -(sp.stiffness * (j.position - sp.rest) + sp.damping * j.velocity);
-    const Vector3d axis = JointFrame(j.body_a, c.frame_a).linear().col(2);
+    const Vector3d axis = JointFrame(j.body_b, c.frame_b).linear().col(2);
     auto push = [&](int body, double sign) {
       if (body < 0 || scene_.bodies[body].type != sgal::BodyType::kDynamic) return;
       btRigidBody& rb = *bodies_[body].rigid;
@@ -484,8 +484,8 @@ void BulletScene::ApplyJointSprings() {
       else
         rb.applyCentralForce(ToBt(axis * (sign * load), scale_));
     };
-    push(j.body_b, 1.0);
-    push(j.body_a, -1.0);
+    push(j.body_a, 1.0);
+    push(j.body_b, -1.0);
   }
 }
 

@@ -134,7 +134,9 @@ struct JointSpring {
 };
 
 /// A joint between body_a and body_b (or the world when body_b is empty). Each side's frame is
-/// given in that body's frame; hinges turn and sliders slide about/along the frame's z axis.
+/// given in that body's frame; hinges turn and sliders slide about/along the frames' z axis. The
+/// joint position is the rotation (or displacement) of body_a's frame relative to body_b's, so
+/// body_b is the parent: positive angles turn body_a counter-clockwise about z.
 struct Constraint {
   std::string name;
   ConstraintKind kind = ConstraintKind::kHinge;
