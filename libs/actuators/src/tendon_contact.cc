@@ -162,7 +162,9 @@ void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
   scratch->clear();
   query(a.position, b.position, scratch);
   const std::vector<WorldShape> shapes = *scratch;
-  const Crossing c = FirstCrossing(a.position, b.position, shapes, a.body, b.body, options.margin);
+  // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
+  const Crossing c = FirstCrossing(a.position, b.position, shapes, a.contact ? -2 : a.body,
+                                   b.contact ? -2 : b.body, options.margin);
   if (c.shape == nullptr) return;
   const Eigen::Vector3d ab = b.position - a.position;
   const double len = ab.norm();
@@ -180,7 +182,7 @@ void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
   PathPoint q;
   q.position = ExitPoint(*c.shape, mid, away, options.margin, 10 * len + 1.0);
   q.body = c.shape->body;
-  q.on_wrap = true;
+  q.contact = true;
   Refine(a, q, query, options, depth - 1, scratch, out);
   out->push_back(q);
   Refine(q, b, query, options, depth - 1, scratch, out);

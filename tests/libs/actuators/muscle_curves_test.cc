@@ -138,7 +138,9 @@ TEST(ThelenCurves, InverseForceVelocityUndoesTheForwardCurve) {
       for (double v = -1.5; v <= 1.5; v += 0.01) {
         const double fv = ThelenForceVelocity(v, a, p);
         EXPECT_NEAR(ThelenForceVelocityInverse(fv, a, p), v, 1e-12) << "a " << a << " v " << v;
-        // the slope is the derivative of the inverse
+        // the slope is the derivative of the inverse (away from the kink at fv = 1, where
+        // Thelen's lengthening slope is twice the shortening one)
+        if (std::abs(fv - 1) < 1e-5) continue;
         const double h = 1e-7;
         const double fd = (ThelenForceVelocityInverse(fv + h, a, p) -
                            ThelenForceVelocityInverse(fv - h, a, p)) /

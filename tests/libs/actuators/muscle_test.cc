@@ -114,12 +114,11 @@ Storage ReadStorage(const std::string& path) {
   return s;
 }
 
-// fine-step RK4 solution of an activation law from a0 under constant u, at t
+// the fine-step (1 us) RK4 solution of an activation law under constant u, advanced from a by t
 template <class Rate>
-double ReferenceActivation(const Rate& rate, double a0, double t) {
+double ReferenceActivation(const Rate& rate, double a, double t) {
   const int n = static_cast<int>(std::lround(t / 1e-6));
   const double h = t / std::max(n, 1);
-  double a = a0;
   for (int i = 0; i < n; ++i) {
     const double k1 = rate(a), k2 = rate(a + 0.5 * h * k1), k3 = rate(a + 0.5 * h * k2),
                  k4 = rate(a + h * k3);
@@ -268,7 +267,9 @@ TEST(HillMuscle, ListsQuantitiesWithUnits) {
   for (TendonActuator* m : {rigid.get(), elastic.get(), mujoco.get()}) {
     for (const auto& q : m->Quantities()) {
       EXPECT_NO_THROW(m->Get(q.name)) << q.name;
-      if (q.writable) EXPECT_NO_THROW(m->Set(q.name, m->Get(q.name))) << q.name;
+      if (q.writable) {
+        EXPECT_NO_THROW(m->Set(q.name, m->Get(q.name))) << q.name;
+      }
     }
   }
 }
@@ -287,10 +288,10 @@ TEST(HillMuscle, IsometricMuscleAtOptimalLengthReachesF0AsActivationFollowsItsOd
   EXPECT_NEAR(m->tension(), 0.01 * f0, 1e-9);
   m->SetCommand(1.0);
   auto rising = [](double a) { return ActivationRate(1.0, a, 0.015, 0.05, 0.01); };
-  double worst = 0;
+  double worst = 0, expected = 0.01;
   for (int i = 1; i <= 300; ++i) {
     const double tension = m->Step(lts + lopt, 0, dt);
-    const double expected = ReferenceActivation(rising, 0.01, i * dt);
+    expected = ReferenceActivation(rising, expected, dt);
     worst = std::max(worst, std::abs(m->Get("activation") - expected));
     ASSERT_NEAR(tension, f0 * m->Get("activation"), 1e-9 * f0) << i;
     if (i == 15) {
@@ -300,22 +301,28 @@ TEST(HillMuscle, IsometricMuscleAtOptimalLengthReachesF0AsActivationFollowsItsOd
     }
   }
   EXPECT_LT(worst, 1e-6);  // reached: ~1e-8 with 1 ms steps
+  RecordProperty("max_activation_error_rising", std::to_string(worst));
   EXPECT_NEAR(m->tension(), f0, 1e-3 * f0);
   EXPECT_DOUBLE_EQ(m->Get("active_force_length"), 1.0);
   EXPECT_DOUBLE_EQ(m->Get("force_velocity"), 1.0);
-  EXPECT_DOUBLE_EQ(m->Get("passive_force"), 0.0);
+  EXPECT_NEAR(m->Get("passive_force"), 0.0, 1e-9);
 
   // and back down with the slower, activation-dependent deactivation
   const double a1 = m->Get("activation");
   m->SetCommand(0.0);
   auto falling = [](double a) { return ActivationRate(0.0, a, 0.015, 0.05, 0.01); };
   worst = 0;
+  expected = a1;
   for (int i = 1; i <= 300; ++i) {
     m->Step(lts + lopt, 0, dt);
-    worst = std::max(worst, std::abs(m->Get("activation") - ReferenceActivation(falling, a1, i * dt)));
+    expected = ReferenceActivation(falling, expected, dt);
+    worst = std::max(worst, std::abs(m->Get("activation") - expected));
   }
   EXPECT_LT(worst, 1e-6);
-  EXPECT_NEAR(m->Get("activation"), 0.01, 1e-3);
+  RecordProperty("max_activation_error_falling", std::to_string(worst));
+  // deactivation slows down as activation falls: tau_deact / 0.5 = 0.1 s near zero
+  EXPECT_GT(m->Get("activation"), 0.015);
+  EXPECT_LT(m->Get("activation"), 0.03);
 }
 
 TEST(HillMuscle, MujocoMuscleActivationFollowsMujocosOde) {
@@ -328,10 +335,10 @@ TEST(HillMuscle, MujocoMuscleActivationFollowsMujocosOde) {
   EXPECT_DOUBLE_EQ(m->tension(), 0.0);
   m->SetCommand(0.7);
   auto rate = [](double a) { return MujocoActivationRate(0.7, a, 0.01, 0.04); };
+  double expected = 0;
   for (int i = 1; i <= 100; ++i) {
-    // a 2 ms engine step is taken as two 1 ms RK4 sub-steps
     const double tension = m->Step(length, 0, 2e-3);
-    const double expected = ReferenceActivation(rate, 0.0, i * 2e-3);
+    expected = ReferenceActivation(rate, expected, 2e-3);
     ASSERT_NEAR(m->Get("activation"), expected, 1e-6) << i;
     ASSERT_NEAR(tension, 400 * m->Get("activation"), 1e-9) << i;
   }

@@ -223,7 +223,7 @@ TEST(BulletScene, RejectsAnInvalidSceneWithEveryProblem) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("broken.dae: 2 problem(s)"), std::string::npos) << m;
+    EXPECT_NE(m.find("broken.dae: 3 problem(s)"), std::string::npos) << m;
     EXPECT_NE(m.find("body 'a': mass"), std::string::npos) << m;
     EXPECT_NE(m.find("constraint 'j': no body 'nobody'"), std::string::npos) << m;
   }

@@ -62,7 +62,7 @@ TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
   EXPECT_GT(inserted, 3);
   for (const auto& p : path.points) {
     EXPECT_GE((p.position - shape.pose.translation()).norm(), r - 1e-9) << "inside the sphere";
-    if (p.on_wrap) {
+    if (p.contact) {
       EXPECT_EQ(p.body, 0);
     }
   }

@@ -40,9 +40,10 @@ struct ContactOptions {
   int max_depth = 3;      ///< bisections per crossing: up to 2^depth - 1 points per body
 };
 
-/// Bends a path around every body it would pass through, except the bodies the segment's own end
-/// points are fixed to. Inserted points carry the body they press on. Returns the number of
-/// inserted points; `path` (points and length) is updated in place.
+/// Bends a path around every body it would pass through, except the bodies the segment's own
+/// routed end points (attachments, via points, declared wraps) sit on. Inserted points are marked
+/// `contact` and carry the body they press on. Returns the number of inserted points; `path`
+/// (points and length) is updated in place.
 int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options);
 
 }  // namespace caliper::actuators

@@ -38,6 +38,7 @@ struct PathPoint {
   int body = -1;          // body that takes the force at this point (-1: the world)
   double friction = 0;    // capstan coefficient at this point [-]
   bool on_wrap = false;   // tangent or arc point on a wrap obstacle
+  bool contact = false;   // inserted where the tendon presses on a body it is not routed over
 };
 
 struct PathGeometry {
