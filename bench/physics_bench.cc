@@ -47,7 +47,7 @@ double TimeCaliper(const TreeOptions& tree, bool contact) {
   return Time(
       [&] {
         scene = physics_bullet::MakeScene(description, options);
-        for (const auto& a : description.actuators) scene->SetCommand(a.name, 1.0);
+        for (const auto& a : description.actuators) scene->SetCommand(a.name, 0.05);  // [V]
       },
       [&] { scene->Step(); });
 }

@@ -136,8 +136,7 @@ double ActivationRate(double excitation, double activation, double activation_ti
   return (u - a) / tau;
 }
 
-double PennatedFiberLength(double along, double optimal_fiber_length,
-                           double pennation_at_optimal) {
+double PennatedFiberLength(double along, double optimal_fiber_length, double pennation_at_optimal) {
   const double h = optimal_fiber_length * std::sin(pennation_at_optimal);
   return std::sqrt(h * h + along * along);
 }
@@ -242,12 +241,11 @@ void Validate(const ThelenMuscleParameters& p, bool elastic_tendon) {
           "maximum_pennation_angle", p.maximum_pennation_angle, "must be in (0, pi/2) rad");
   Require(p.pennation_angle >= 0 && p.pennation_angle < p.maximum_pennation_angle,
           "pennation_angle", p.pennation_angle,
-          "must be in [0, maximum_pennation_angle = " + Num(p.maximum_pennation_angle) +
-              ") rad");
-  Require(p.max_contraction_velocity > 0, "max_contraction_velocity",
-          p.max_contraction_velocity, "must be > 0 optimal fibre lengths/s");
-  Require(p.activation_time_constant > 0, "activation_time_constant",
-          p.activation_time_constant, "must be > 0 s");
+          "must be in [0, maximum_pennation_angle = " + Num(p.maximum_pennation_angle) + ") rad");
+  Require(p.max_contraction_velocity > 0, "max_contraction_velocity", p.max_contraction_velocity,
+          "must be > 0 optimal fibre lengths/s");
+  Require(p.activation_time_constant > 0, "activation_time_constant", p.activation_time_constant,
+          "must be > 0 s");
   Require(p.deactivation_time_constant > 0, "deactivation_time_constant",
           p.deactivation_time_constant, "must be > 0 s");
   if (elastic_tendon)
@@ -276,9 +274,8 @@ void Validate(const MujocoMuscleParameters& p) {
   Require(p.vmax > 0, "vmax", p.vmax, "must be > 0 L0/s");
   Require(p.fpmax >= 0, "fpmax", p.fpmax, "must be >= 0");
   Require(p.fvmax >= 1, "fvmax", p.fvmax, "must be >= 1");
-  Require(std::isfinite(p.lengthrange_lo) && p.lengthrange_lo < p.lengthrange_hi,
-          "lengthrange_hi", p.lengthrange_hi,
-          "must be > lengthrange_lo = " + Num(p.lengthrange_lo) + " m");
+  Require(std::isfinite(p.lengthrange_lo) && p.lengthrange_lo < p.lengthrange_hi, "lengthrange_hi",
+          p.lengthrange_hi, "must be > lengthrange_lo = " + Num(p.lengthrange_lo) + " m");
   Require(std::isfinite(p.force), "force", p.force, "must be finite");
   if (p.force < 0) {
     Require(p.scale >= 0, "scale", p.scale, "must be >= 0 (force < 0 uses scale / acc0)");
@@ -357,8 +354,7 @@ const std::vector<ParameterEntry>& ParameterTable() {
        "tendon strain of force F0 (thelen2003)"},
       {"af", "", Applies::kThelen, false, [](P& p) -> double& { return p.thelen.curves.af; },
        "force-velocity shape factor (thelen2003)"},
-      {"flen", "", Applies::kThelen, false,
-       [](P& p) -> double& { return p.thelen.curves.flen; },
+      {"flen", "", Applies::kThelen, false, [](P& p) -> double& { return p.thelen.curves.flen; },
        "maximum lengthening force / F0 (thelen2003)"},
       {"fv_linear_extrap_threshold", "", Applies::kThelen, false,
        [](P& p) -> double& { return p.thelen.curves.fv_linear_extrap_threshold; },
@@ -370,10 +366,9 @@ const std::vector<ParameterEntry>& ParameterTable() {
        "normalised length at lengthrange_hi (mujoco)"},
       {"force", "N", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.force; },
        "F0; < 0: scale / acc0 (mujoco)"},
-      {"scale", "rad/s^2", Applies::kMujoco, false,
-       [](P& p) -> double& { return p.mujoco.scale; }, "F0 = scale / acc0 when force < 0 (mujoco)"},
-      {"acc0", "rad/s^2/N", Applies::kMujoco, false,
-       [](P& p) -> double& { return p.mujoco.acc0; },
+      {"scale", "rad/s^2", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.scale; },
+       "F0 = scale / acc0 when force < 0 (mujoco)"},
+      {"acc0", "rad/s^2/N", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.acc0; },
        "joint acceleration norm of a unit actuator force, from MuJoCo's compiler (mujoco)"},
       {"lmin", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.lmin; },
        "shortest normalised length with active force (mujoco)"},
@@ -382,7 +377,7 @@ const std::vector<ParameterEntry>& ParameterTable() {
       {"vmax", "1/s", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.vmax; },
        "shortening speed of zero force, in L0 per second (mujoco)"},
       {"fpmax", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.fpmax; },
-       "passive force / F0 at lmax (mujoco)"},
+       "passive force / F0 is fpmax / 2 at (1 + lmax) / 2, linear beyond (mujoco)"},
       {"fvmax", "", Applies::kMujoco, false, [](P& p) -> double& { return p.mujoco.fvmax; },
        "lengthening force limit / F0 (mujoco)"},
       {"lengthrange_lo", "m", Applies::kMujoco, true,
@@ -437,19 +432,19 @@ double SafeNewton(const F& f, double lo, double hi, double x, double tol) {
 }
 
 struct Outputs {
-  double fiber_length = 0;         // [m]
-  double fiber_velocity = 0;       // [m/s]
-  double norm_fiber_length = 0;    // [-]
-  double norm_fiber_velocity = 0;  // [-]
-  double pennation = 0;            // [rad]
-  double tendon_length = 0;        // [m]
-  double tendon_strain = 0;        // [-]
-  double active_force_length = 0;  // [-]
-  double force_velocity = 1;       // [-]
-  double passive_force_length = 0; // [-]
-  double active_fiber_force = 0;   // [N]
-  double passive_force = 0;        // [N]
-  double tension = 0;              // [N]
+  double fiber_length = 0;          // [m]
+  double fiber_velocity = 0;        // [m/s]
+  double norm_fiber_length = 0;     // [-]
+  double norm_fiber_velocity = 0;   // [-]
+  double pennation = 0;             // [rad]
+  double tendon_length = 0;         // [m]
+  double tendon_strain = 0;         // [-]
+  double active_force_length = 0;   // [-]
+  double force_velocity = 1;        // [-]
+  double passive_force_length = 0;  // [-]
+  double active_fiber_force = 0;    // [N]
+  double passive_force = 0;         // [N]
+  double tension = 0;               // [N]
 };
 
 class HillMuscle : public TendonActuator {
@@ -623,8 +618,8 @@ class HillMuscle : public TendonActuator {
     return MujocoForceScale(p_.mujoco.force, p_.mujoco.scale, p_.mujoco.acc0);
   }
   double MujocoL0() const {
-    return MujocoOptimalLength(p_.mujoco.lengthrange_lo, p_.mujoco.lengthrange_hi,
-                               p_.mujoco.range0, p_.mujoco.range1);
+    return MujocoOptimalLength(p_.mujoco.lengthrange_lo, p_.mujoco.lengthrange_hi, p_.mujoco.range0,
+                               p_.mujoco.range1);
   }
 
   // RK4 steps of h |d(da/dt)/da| <= 0.05; that derivative is at most 8 / tau_act while rising
@@ -671,10 +666,10 @@ class HillMuscle : public TendonActuator {
   // normalised fibre force along the fibre needed by the tendon, and its derivative by lm
   struct Balance {
     double fse = 0, cos = 1, fal = 0, fpe = 0;  // [-]
-    double num = 0, den = 1;    // fv = num / den: fse / cos - fpe over a fal [-]
-    double dnum = 0, dden = 0;  // their derivatives by lm [1/m]
-    double fv = 1;              // [-]
-    double dfv = 0;             // [1/m]
+    double num = 0, den = 1;                    // fv = num / den: fse / cos - fpe over a fal [-]
+    double dnum = 0, dden = 0;                  // their derivatives by lm [1/m]
+    double fv = 1;                              // [-]
+    double dfv = 0;                             // [1/m]
   };
 
   Balance BalanceAt(double lm, double path_length, double a) const {
@@ -722,8 +717,7 @@ class HillMuscle : public TendonActuator {
     if (residual(lo).first >= 0) return lo;
     double hi = std::max(base, lo * 1.001);
     for (int i = 0; i < 80 && residual(hi).first < 0; ++i) hi = lo + 2 * (hi - lo);
-    return SafeNewton(residual, lo, hi, std::max(base, lo),
-                      1e-13 * p_.thelen.optimal_fiber_length);
+    return SafeNewton(residual, lo, hi, std::max(base, lo), 1e-13 * p_.thelen.optimal_fiber_length);
   }
 
   // two-stage L-stable SDIRK (second order, stiffly accurate) over h; the path moves linearly
@@ -769,8 +763,8 @@ class HillMuscle : public TendonActuator {
     const double L0 = MujocoL0();
     const double F0 = MujocoF0();
     Outputs o;
-    o.norm_fiber_length = MujocoNormalizedLength(length, m.lengthrange_lo, m.lengthrange_hi,
-                                                 m.range0, m.range1);
+    o.norm_fiber_length =
+        MujocoNormalizedLength(length, m.lengthrange_lo, m.lengthrange_hi, m.range0, m.range1);
     o.fiber_length = o.norm_fiber_length * L0;
     o.fiber_velocity = speed;
     o.norm_fiber_velocity = speed / std::max(kMinVal, L0 * m.vmax);
@@ -847,8 +841,7 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
   const std::string where = "actuator '" + a.name + "' (hill_muscle): ";
   for (const auto& [key, value] : a.options)
     if (key != "curves" && key != "tendon")
-      throw std::invalid_argument(where + "unknown option '" + key +
-                                  "' (known: curves, tendon)");
+      throw std::invalid_argument(where + "unknown option '" + key + "' (known: curves, tendon)");
   Curves curves = Curves::kThelen;
   if (const auto it = a.options.find("curves"); it != a.options.end()) {
     if (it->second == "mujoco")
@@ -866,16 +859,17 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
                                   "' (known: rigid, elastic)");
   }
   if (elastic && curves == Curves::kMujoco)
-    throw std::invalid_argument(where + "tendon=elastic needs curves=thelen2003 (MuJoCo's "
-                                        "muscle has a rigid tendon)");
+    throw std::invalid_argument(where +
+                                "tendon=elastic needs curves=thelen2003 (MuJoCo's "
+                                "muscle has a rigid tendon)");
   AllParameters p;
   std::set<std::string> given;
   for (const auto& [name, value] : a.parameters) given.insert(name);
   for (const auto& e : ParameterTable()) {
     const bool applies = AppliesTo(e.applies, curves);
     if (given.count(e.name) && !applies)
-      throw std::invalid_argument(where + "parameter '" + e.name + "' does not apply to curves=" +
-                                  CurvesName(curves));
+      throw std::invalid_argument(where + "parameter '" + e.name +
+                                  "' does not apply to curves=" + CurvesName(curves));
     if (applies && e.required && !given.count(e.name))
       throw std::invalid_argument(where + "missing parameter '" + e.name + "' [" + e.unit +
                                   "] needed by curves=" + CurvesName(curves) + ": " + e.help);

@@ -170,17 +170,23 @@ void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
   const double len = ab.norm();
   if (len < 1e-12) return;
   const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
-  // push out perpendicular to the segment, away from the shape's centre
-  const Eigen::Vector3d centre = c.shape->pose.translation();
   const Eigen::Vector3d u = ab / len;
-  Eigen::Vector3d away = (mid - centre) - u * u.dot(mid - centre);
-  if (away.norm() < 1e-9) {
-    // the segment runs through the centre: any perpendicular, chosen deterministically
-    away = u.unitOrthogonal();
+  Eigen::Vector3d away;
+  if (const auto* plane = std::get_if<sgal::Plane>(c.shape->geometry)) {
+    // out of a half-space along its normal
+    away = c.shape->pose.linear() * plane->normal;
+  } else {
+    // perpendicular to the segment, away from the shape's centre
+    const Eigen::Vector3d centre = c.shape->pose.translation();
+    away = (mid - centre) - u * u.dot(mid - centre);
+    if (away.norm() < 1e-9) away = u.unitOrthogonal();  // through the centre: any perpendicular
   }
   away.normalize();
+  const double reach = 10 * len + 1.0;
+  const auto exit = SegmentInside(*c.shape, mid, mid + away * reach, options.margin);
+  if (exit && exit->second >= 1.0) return;  // no way out along that direction: leave it straight
   PathPoint q;
-  q.position = ExitPoint(*c.shape, mid, away, options.margin, 10 * len + 1.0);
+  q.position = ExitPoint(*c.shape, mid, away, options.margin, reach);
   q.body = c.shape->body;
   q.contact = true;
   Refine(a, q, query, options, depth - 1, scratch, out);

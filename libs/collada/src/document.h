@@ -3,7 +3,6 @@
 // readers (dom141.cc, dom150.cc) produce and the writer (dom150.cc) consumes. The importer and
 // exporter work on this tree only, so that no Collada-DOM type leaks out of those two sources.
 
-#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -98,12 +97,12 @@ class Document {
   std::unordered_map<std::string_view, const Element*> ids_;
   std::string text_;
   mutable bool lines_indexed_ = false;
-  mutable std::map<std::vector<std::pair<std::string, int>>, int> lines_;
+  mutable std::unordered_map<const Element*, int> lines_;
 };
 
-/// The version attribute of a COLLADA file's root element, from its first bytes (UTF-8 or UTF-16
-/// with a byte order mark); "" when it cannot be found (a .zae, a file that is not XML).
-std::string SniffVersion(const std::string& path);
+/// The version attribute of the <COLLADA> element in a document's text; "" when it cannot be
+/// found (a file that is not XML).
+std::string SniffVersion(const std::string& text);
 
 /// Reads a file's text as UTF-8 ("" when it cannot be read); UTF-16 with a byte order mark is
 /// converted.

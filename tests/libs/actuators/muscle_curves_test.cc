@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <string>
 
 #include "caliper/actuators/muscle.h"
@@ -15,6 +17,12 @@ namespace {
 
 using caliper::testing::CorpusDir;
 using caliper::testing::ReadCsv;
+
+std::string Sci(double v) {
+  std::ostringstream s;
+  s << std::scientific << std::setprecision(2) << v;
+  return s.str();
+}
 
 std::string Generated(const std::string& file) {
   return CorpusDir() + "/reference/mujoco222_generated/" + file;
@@ -142,9 +150,9 @@ TEST(ThelenCurves, InverseForceVelocityUndoesTheForwardCurve) {
         // Thelen's lengthening slope is twice the shortening one)
         if (std::abs(fv - 1) < 1e-5) continue;
         const double h = 1e-7;
-        const double fd = (ThelenForceVelocityInverse(fv + h, a, p) -
-                           ThelenForceVelocityInverse(fv - h, a, p)) /
-                          (2 * h);
+        const double fd =
+            (ThelenForceVelocityInverse(fv + h, a, p) - ThelenForceVelocityInverse(fv - h, a, p)) /
+            (2 * h);
         const double slope = ThelenForceVelocityInverseSlope(fv, a, p);
         EXPECT_NEAR(slope, fd, 1e-5 * std::max(1.0, slope)) << "a " << a << " v " << v;
       }
@@ -224,7 +232,7 @@ TEST(MujocoCurves, ActiveAndPassiveForceLengthMatchMuJoCo222Table) {
     worst = std::max({worst, std::abs(MujocoActiveForceLength(Ln, 0.5, 1.6) - row[fl]),
                       std::abs(MujocoPassiveForceLength(Ln, 1.6, 1.3) - row[fp])});
   }
-  RecordProperty("max_abs_error", std::to_string(worst));
+  RecordProperty("max_abs_error", Sci(worst));
 }
 
 TEST(MujocoCurves, ForceVelocityMatchesMuJoCo222Table) {
@@ -239,7 +247,7 @@ TEST(MujocoCurves, ForceVelocityMatchesMuJoCo222Table) {
     EXPECT_NEAR(MujocoForceVelocity(row[V], 1.2), row[fv], 1e-10) << "V " << row[V];
     worst = std::max(worst, std::abs(MujocoForceVelocity(row[V], 1.2) - row[fv]));
   }
-  RecordProperty("max_abs_error", std::to_string(worst));
+  RecordProperty("max_abs_error", Sci(worst));
 }
 
 TEST(MujocoCurves, ActivationDynamicsMatchMuJoCo222Table) {

@@ -92,6 +92,26 @@ TEST(WrapAroundBodies, LeavesSegmentsAloneThatMissOrEndOnTheBody) {
   EXPECT_EQ(path.length, 2);
 }
 
+TEST(WrapAroundBodies, LiftsAStringOutOfTheFloorAlongItsNormal) {
+  const sgal::Geometry floor = sgal::Plane{};
+  PathGeometry path;
+  path.points = {{Vector3d(-1, 0, 0.1), -1}, {Vector3d(1, 0, 0.1), -1}};
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, std::vector<WorldShape>* out) {
+    WorldShape s = At(floor, Vector3d(0, 0, 0.3), 7);  // the ground 0.2 m above both ends
+    out->push_back(s);
+  };
+  path.length = 2;
+  ContactOptions options;
+  options.margin = 0;
+  EXPECT_GT(WrapAroundBodies(&path, query, options), 0);
+  for (const auto& p : path.points)
+    if (p.contact) {
+      EXPECT_NEAR(p.position.z(), 0.3, 1e-6) << "on the surface, not pushed sideways";
+      EXPECT_EQ(p.body, 7);
+    }
+  EXPECT_LT(path.length, 3.0) << "a detour of sensible length, not off to infinity";
+}
+
 sgal::Scene StringOverBall(bool dynamic_ball) {
   sgal::Scene s;
   s.gravity = Vector3d::Zero();

@@ -12,7 +12,20 @@
 //   default_activation; a parameter of the other curve set is rejected.
 // Step(path_length, path_speed, dt) lets the path move at path_speed during the step, advances
 // the activation (and, with an elastic tendon, the fibre length) to the end of the step and
-// returns the tension there, with the path at path_length + path_speed * dt.
+// returns the tension there, with the path at path_length + path_speed * dt. Tension only:
+//   rigid tendon:   F0 (a fal fv + fpe) cos(pennation), fibre length and speed from the path;
+//   elastic tendon: F0 fse(tendon strain), the fibre speed from the force balance through the
+//                   inverse force-velocity curve (as OpenSim's Thelen2003Muscle);
+//   mujoco:         F0 (a FL FV + FP) on MuJoCo's normalised length and speed.
+// Numerics: activation by RK4 in sub-steps of h |d(da/dt)/da| <= 0.05 (1/16 ms for tau_act 10 ms);
+// the fibre length by a two-stage L-stable SDIRK (second order) in sub-steps of <= 1 ms, each stage
+// solved by safeguarded Newton; Reset() puts the fibre at its zero-speed equilibrium.
+// Quantities: the parameters (writable, validated), excitation, activation, fiber_length
+// (writable with an elastic tendon), fiber_velocity, normalized_fiber_length,
+// normalized_fiber_velocity, active_force_length, force_velocity, passive_force_length,
+// active_fiber_force [N], passive_force [N], tension [N]; thelen2003 adds pennation,
+// tendon_length, tendon_strain; mujoco adds max_isometric_force and optimal_fiber_length (L0),
+// read-only.
 
 namespace caliper::actuators {
 
@@ -42,11 +55,12 @@ double ThelenPassiveForceLength(double norm_fiber_length, double kshape_passive 
 /// exponential toe F_toe (exp(k_toe e / e_toe) - 1) / (exp(k_toe) - 1) up to e_toe, then linear
 /// k_lin (e - e_toe) + F_toe, continuous in value and slope and equal to 1 at e0T.
 struct ThelenTendonConstants {
-  double toe_strain = 0;       // e_toe = 99 e0T e^3 / (166 e^3 - 67) (0.6086 e0T) [-]
-  double linear_stiffness = 0; // k_lin = 0.67 / (e0T - e_toe) (42.80 for e0T = 0.04) [-]
-  double toe_force = 0.33;     // F_toe [-]
-  double toe_shape = 3.0;      // k_toe [-]
+  double toe_strain = 0;        // e_toe = 99 e0T e^3 / (166 e^3 - 67) (0.6086 e0T) [-]
+  double linear_stiffness = 0;  // k_lin = 0.67 / (e0T - e_toe) (42.80 for e0T = 0.04) [-]
+  double toe_force = 0.33;      // F_toe [-]
+  double toe_shape = 3.0;       // k_toe [-]
 };
+/// The constants for a tendon strain e0T [-] at F0.
 ThelenTendonConstants ThelenTendonToe(double fmax_tendon_strain = 0.04);
 
 /// Normalised tendon force at a tendon strain (length / slack length - 1); 0 when slack.
@@ -80,6 +94,8 @@ double ActivationRate(double excitation, double activation, double activation_ti
 /// optimal_fiber_length * sin(pennation_at_optimal); and the pennation angle [rad] of a fibre.
 double PennatedFiberLength(double length_along_tendon, double optimal_fiber_length,
                            double pennation_at_optimal);
+/// The pennation angle [rad] of a fibre of this length [m] (pi/2 when it is not longer than the
+/// height, 0 without pennation).
 double PennationAngle(double fiber_length, double optimal_fiber_length,
                       double pennation_at_optimal);
 
@@ -121,36 +137,36 @@ double MujocoForceScale(double force, double scale, double acc0);
 
 /// options["curves"] = "thelen2003". Names in the actuator description are the field names.
 struct ThelenMuscleParameters {
-  double max_isometric_force = 1000;       // F0 [N]
-  double optimal_fiber_length = 0.1;       // [m] (required in a description)
-  double tendon_slack_length = 0.2;        // [m] (required in a description)
-  double pennation_angle = 0;              // at optimal fibre length [rad], in [0, pi/2)
-  double max_contraction_velocity = 10;    // [optimal fibre lengths / s]
-  double activation_time_constant = 0.015;   // [s]
-  double deactivation_time_constant = 0.050; // [s]
-  double minimum_activation = 0.01;        // [-], > 0 with an elastic tendon
+  double max_isometric_force = 1000;                    // F0 [N]
+  double optimal_fiber_length = 0.1;                    // [m] (required in a description)
+  double tendon_slack_length = 0.2;                     // [m] (required in a description)
+  double pennation_angle = 0;                           // at optimal fibre length [rad], < maximum
+  double max_contraction_velocity = 10;                 // [optimal fibre lengths / s]
+  double activation_time_constant = 0.015;              // [s]
+  double deactivation_time_constant = 0.050;            // [s]
+  double minimum_activation = 0.01;                     // [-], > 0 with an elastic tendon
   double maximum_pennation_angle = 1.4706289056333368;  // acos(0.1) [rad]
-  ThelenCurveParameters curves;            // by the field names of ThelenCurveParameters
+  ThelenCurveParameters curves;  // by the field names of ThelenCurveParameters
 };
 
 /// options["curves"] = "mujoco": MuJoCo's gainprm/biasprm (range0, range1, force, scale, lmin,
 /// lmax, vmax, fpmax, fvmax), the compiled actuator length range and acc0, dynprm (tau_act,
 /// tau_deact). The tendon is rigid and unpennated; L is the normalised path length.
 struct MujocoMuscleParameters {
-  double range0 = 0.75;          // normalised length at lengthrange_lo [-]
-  double range1 = 1.05;          // normalised length at lengthrange_hi [-]
-  double force = -1;             // F0 [N]; < 0: scale / acc0
-  double scale = 200;            // [(rad/s^2) or (m/s^2)], MuJoCo's force scale
-  double acc0 = 0;               // [(rad/s^2)/N], needed when force < 0
-  double lmin = 0.5;             // [-]
-  double lmax = 1.6;             // [-]
-  double vmax = 1.5;             // [L0/s]
-  double fpmax = 1.3;            // passive force at lmax [-]
-  double fvmax = 1.2;            // lengthening force limit [-]
-  double lengthrange_lo = 0;     // [m] (required in a description)
-  double lengthrange_hi = 0;     // [m] (required in a description)
-  double tau_act = 0.01;         // [s]
-  double tau_deact = 0.04;       // [s]
+  double range0 = 0.75;       // normalised length at lengthrange_lo [-]
+  double range1 = 1.05;       // normalised length at lengthrange_hi [-]
+  double force = -1;          // F0 [N]; < 0: scale / acc0
+  double scale = 200;         // [(rad/s^2) or (m/s^2)], MuJoCo's force scale
+  double acc0 = 0;            // [(rad/s^2)/N], needed when force < 0
+  double lmin = 0.5;          // [-]
+  double lmax = 1.6;          // [-]
+  double vmax = 1.5;          // [L0/s]
+  double fpmax = 1.3;         // passive scale: FP = fpmax / 2 at (1 + lmax) / 2 [-]
+  double fvmax = 1.2;         // lengthening force limit [-]
+  double lengthrange_lo = 0;  // [m] (required in a description)
+  double lengthrange_hi = 0;  // [m] (required in a description)
+  double tau_act = 0.01;      // [s]
+  double tau_deact = 0.04;    // [s]
 };
 
 /// Throws std::invalid_argument naming the first parameter out of range (and the one it
