@@ -137,6 +137,30 @@ struct Crossing {
   const WorldShape* shape = nullptr;
 };
 
+/// Radius of a sphere about the shape's origin that holds it (infinite for planes and meshes).
+double BoundingRadius(const sgal::Geometry& geometry) {
+  return std::visit(
+      [](const auto& g) -> double {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, sgal::Box>) return g.size.norm() / 2;
+        else if constexpr (std::is_same_v<T, sgal::Sphere>) return g.radius;
+        else if constexpr (std::is_same_v<T, sgal::Capsule>) return g.radius + g.length / 2;
+        else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>)
+          return std::hypot(g.radius, g.length / 2);
+        else return kInf;
+      },
+      geometry);
+}
+
+/// Whether the segment a-b passes within `reach` of point c.
+bool Near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double reach) {
+  if (!std::isfinite(reach)) return true;
+  const Eigen::Vector3d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0 ? std::clamp((c - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - c).squaredNorm() <= reach * reach;
+}
+
 /// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body.
 Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                        const std::vector<WorldShape>& shapes, int exclude_a, int exclude_b,
@@ -145,6 +169,7 @@ Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   double best_len = 0;
   for (const auto& s : shapes) {
     if (s.body == exclude_a || s.body == exclude_b) continue;
+    if (!Near(a, b, s.pose.translation(), BoundingRadius(*s.geometry) + margin)) continue;
     const auto i = SegmentInside(s, a, b, margin);
     if (!i || i->second - i->first <= 1e-9) continue;
     if (i->second - i->first > best_len) {
@@ -166,28 +191,29 @@ void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
   const Crossing c = FirstCrossing(a.position, b.position, shapes, a.contact ? -2 : a.body,
                                    b.contact ? -2 : b.body, options.margin);
   if (c.shape == nullptr) return;
+  const WorldShape shape = *c.shape;  // the recursion below reuses the scratch list
   const Eigen::Vector3d ab = b.position - a.position;
   const double len = ab.norm();
   if (len < 1e-12) return;
   const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
   const Eigen::Vector3d u = ab / len;
   Eigen::Vector3d away;
-  if (const auto* plane = std::get_if<sgal::Plane>(c.shape->geometry)) {
+  if (const auto* plane = std::get_if<sgal::Plane>(shape.geometry)) {
     // out of a half-space along its normal
-    away = c.shape->pose.linear() * plane->normal;
+    away = shape.pose.linear() * plane->normal;
   } else {
     // perpendicular to the segment, away from the shape's centre
-    const Eigen::Vector3d centre = c.shape->pose.translation();
+    const Eigen::Vector3d centre = shape.pose.translation();
     away = (mid - centre) - u * u.dot(mid - centre);
     if (away.norm() < 1e-9) away = u.unitOrthogonal();  // through the centre: any perpendicular
   }
   away.normalize();
   const double reach = 10 * len + 1.0;
-  const auto exit = SegmentInside(*c.shape, mid, mid + away * reach, options.margin);
+  const auto exit = SegmentInside(shape, mid, mid + away * reach, options.margin);
   if (exit && exit->second >= 1.0) return;  // no way out along that direction: leave it straight
   PathPoint q;
-  q.position = ExitPoint(*c.shape, mid, away, options.margin, reach);
-  q.body = c.shape->body;
+  q.position = ExitPoint(shape, mid, away, options.margin, reach);
+  q.body = shape.body;
   q.contact = true;
   Refine(a, q, query, options, depth - 1, scratch, out);
   out->push_back(q);

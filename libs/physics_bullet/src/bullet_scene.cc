@@ -50,18 +50,31 @@ struct BodyData {
   std::unique_ptr<btRigidBody> rigid;
   Isometry3d com_in_body = Isometry3d::Identity();  // principal-axes frame at the com
   std::vector<actuators::WorldShape> world_shapes;  // refreshed each step when contact is on
+  std::vector<Isometry3d> shape_poses;               // shapes in the body frame
 };
 
 struct JointData {
   const sgal::Constraint* desc = nullptr;
+  Isometry3d frame_a = Isometry3d::Identity();  // joint frames in the body frames
+  Isometry3d frame_b = Isometry3d::Identity();
   std::unique_ptr<btTypedConstraint> constraint;
   int body_a = -1, body_b = -1;
   double position = 0;  // [rad] or [m]
   double velocity = 0;  // [rad/s] or [m/s]
+  Vector3d axis = Vector3d::UnitZ();  // world, this step
+};
+
+/// A path element with its names resolved once.
+struct ElementRef {
+  const sgal::PathElement* desc = nullptr;
+  int body = -1;
+  const sgal::WrapObstacle* obstacle = nullptr;
 };
 
 struct TendonData {
   const sgal::Tendon* desc = nullptr;
+  std::vector<ElementRef> elements;
+  std::vector<actuators::WorldElement> world;  // reused every step
   actuators::TendonPath path;
   actuators::PathGeometry geometry;
   double previous_length = -1;
@@ -102,7 +115,7 @@ class BulletScene : public sgal::PhysicsScene {
   void BuildConstraint(size_t index);
   void BuildTendons();
   Isometry3d BodyPose(int body) const;  // world pose of a body frame [m]
-  Isometry3d JointFrame(int body, const sgal::Pose& frame) const;
+  void CacheBodyPoses();
   Vector3d PointVelocity(int body, const Vector3d& world_point) const;
   void UpdateJoints();
   void RefreshWorldShapes();
@@ -128,6 +141,11 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<JointData> joints_;
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
+  std::vector<Isometry3d> poses_;        // body frames this step [m]
+  std::vector<Vector3d> coms_;           // centres of mass this step [m]
+  std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
+  std::vector<Vector3d> spins_;          // angular velocities [rad/s]
+  std::vector<Snapshot> snapshot_;
 };
 
 std::unique_ptr<btCollisionShape> MakeShape(const sgal::Geometry& geometry, double s, bool dynamic,
@@ -268,9 +286,22 @@ Isometry3d BulletScene::BodyPose(int body) const {
   return FromBt(b.rigid->getCenterOfMassTransform(), scale_) * b.com_in_body.inverse();
 }
 
-Isometry3d BulletScene::JointFrame(int body, const sgal::Pose& frame) const {
-  return BodyPose(body) * frame.ToIsometry();
+void BulletScene::CacheBodyPoses() {
+  const size_t n = bodies_.size();
+  poses_.resize(n);
+  coms_.resize(n);
+  velocities_.resize(n);
+  spins_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const btRigidBody& rb = *bodies_[i].rigid;
+    const Isometry3d com = FromBt(rb.getCenterOfMassTransform(), scale_);
+    poses_[i] = com * bodies_[i].com_in_body.inverse();
+    coms_[i] = com.translation();
+    velocities_[i] = FromBt(rb.getLinearVelocity(), scale_);
+    spins_[i] = FromBt(rb.getAngularVelocity());
+  }
 }
+
 
 Vector3d BulletScene::PointVelocity(int body, const Vector3d& p) const {
   if (body < 0) return Vector3d::Zero();
@@ -283,6 +314,8 @@ void BulletScene::BuildConstraint(size_t index) {
   const sgal::Constraint& c = scene_.constraints[index];
   JointData& j = joints_[index];
   j.desc = &c;
+  j.frame_a = c.frame_a.ToIsometry();
+  j.frame_b = c.frame_b.ToIsometry();
   j.body_a = scene_.BodyIndex(c.body_a);
   j.body_b = c.body_b.empty() ? -1 : scene_.BodyIndex(c.body_b);
   btRigidBody& a = *bodies_[j.body_a].rigid;
@@ -348,7 +381,21 @@ void BulletScene::BuildConstraint(size_t index) {
 
 void BulletScene::BuildTendons() {
   tendons_.resize(scene_.tendons.size());
-  for (size_t i = 0; i < scene_.tendons.size(); ++i) tendons_[i].desc = &scene_.tendons[i];
+  for (size_t i = 0; i < scene_.tendons.size(); ++i) {
+    TendonData& t = tendons_[i];
+    t.desc = &scene_.tendons[i];
+    for (const auto& e : t.desc->path) {
+      ElementRef ref;
+      ref.desc = &e;
+      if (e.kind == sgal::PathElement::Kind::kPoint) {
+        ref.body = e.body.empty() ? -1 : scene_.BodyIndex(e.body);
+      } else {
+        ref.obstacle = scene_.FindObstacle(e.obstacle);
+        ref.body = ref.obstacle->body.empty() ? -1 : scene_.BodyIndex(ref.obstacle->body);
+      }
+      t.elements.push_back(ref);
+    }
+  }
   actuators_.resize(scene_.actuators.size());
   for (size_t i = 0; i < scene_.actuators.size(); ++i) {
     ActuatorData& a = actuators_[i];
@@ -358,6 +405,7 @@ void BulletScene::BuildTendons() {
       if (scene_.tendons[t].name == a.desc->tendon) a.tendon = static_cast<int>(t);
     tendons_[a.tendon].actuators.push_back(static_cast<int>(i));
   }
+  CacheBodyPoses();
   RefreshWorldShapes();
   EvaluateTendons();
   for (auto& a : actuators_) a.model->Reset(tendons_[a.tendon].geometry.length);
@@ -368,11 +416,15 @@ void BulletScene::RefreshWorldShapes() {
   if (!options_.tendon_body_contact) return;
   for (size_t i = 0; i < bodies_.size(); ++i) {
     BodyData& b = bodies_[i];
-    const Isometry3d pose = BodyPose(static_cast<int>(i));
+    const Isometry3d& pose = poses_[i];
+    if (b.shape_poses.size() != b.desc->shapes.size()) {
+      b.shape_poses.clear();
+      for (const auto& shape : b.desc->shapes) b.shape_poses.push_back(shape.pose.ToIsometry());
+    }
     b.world_shapes.resize(b.desc->shapes.size());
     for (size_t s = 0; s < b.desc->shapes.size(); ++s) {
       b.world_shapes[s].geometry = &b.desc->shapes[s].geometry;
-      b.world_shapes[s].pose = pose * b.desc->shapes[s].pose.ToIsometry();
+      b.world_shapes[s].pose = pose * b.shape_poses[s];
       b.world_shapes[s].body = static_cast<int>(i);
     }
   }
@@ -388,31 +440,35 @@ struct AabbCollector : public btBroadphaseAabbCallback {
 };
 
 void BulletScene::EvaluateTendons() {
-  std::vector<actuators::WorldElement> elements;
+  auto pose = [&](int body) { return body < 0 ? Isometry3d::Identity() : poses_[body]; };
+  auto velocity = [&](int body, const Vector3d& p) -> Vector3d {
+    if (body < 0) return Vector3d::Zero();
+    return velocities_[body] + spins_[body].cross(p - coms_[body]);
+  };
   for (auto& t : tendons_) {
-    elements.clear();
-    for (const auto& e : t.desc->path) {
-      actuators::WorldElement w;
+    t.world.resize(t.elements.size());
+    for (size_t k = 0; k < t.elements.size(); ++k) {
+      const ElementRef& ref = t.elements[k];
+      const sgal::PathElement& e = *ref.desc;
+      actuators::WorldElement& w = t.world[k];
       w.kind = e.kind;
+      w.body = ref.body;
       if (e.kind == sgal::PathElement::Kind::kPoint) {
-        w.body = e.body.empty() ? -1 : scene_.BodyIndex(e.body);
-        w.point = BodyPose(w.body) * e.position;
-        w.velocity = PointVelocity(w.body, w.point);
+        w.point = pose(ref.body) * e.position;
+        w.velocity = velocity(ref.body, w.point);
         w.friction = e.friction;
       } else {
-        const sgal::WrapObstacle* o = scene_.FindObstacle(e.obstacle);
-        w.body = o->body.empty() ? -1 : scene_.BodyIndex(o->body);
-        const Isometry3d body_pose = BodyPose(w.body);
+        const sgal::WrapObstacle* o = ref.obstacle;
+        const Isometry3d body_pose = pose(ref.body);
         w.obstacle.kind = o->kind;
         w.obstacle.pose = body_pose * o->pose.ToIsometry();
         w.obstacle.radius = o->radius;
         w.obstacle.length = o->length;
-        w.velocity = PointVelocity(w.body, w.obstacle.pose.translation());
+        w.velocity = velocity(ref.body, w.obstacle.pose.translation());
         if (e.side) w.side = body_pose * (*e.side);
       }
-      elements.push_back(w);
     }
-    t.geometry = t.path.Evaluate(elements);
+    t.geometry = t.path.Evaluate(t.world);
     t.contacts = 0;
     if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
       AabbCollector collector;
@@ -439,31 +495,34 @@ void BulletScene::ApplyTendonForces() {
     if (t.tension <= 0) continue;
     for (const auto& f : actuators::PathForces(t.geometry, t.tension)) {
       if (f.body < 0 || scene_.bodies[f.body].type != sgal::BodyType::kDynamic) continue;
-      btRigidBody& rb = *bodies_[f.body].rigid;
-      const Vector3d com = FromBt(rb.getCenterOfMassPosition(), scale_);
-      rb.applyForce(ToBt(f.force, scale_), ToBt(f.position - com, scale_));
+      bodies_[f.body].rigid->applyForce(ToBt(f.force, scale_), ToBt(f.position - coms_[f.body], scale_));
     }
   }
 }
 
 void BulletScene::UpdateJoints() {
+  auto pose = [&](int body) { return body < 0 ? Isometry3d::Identity() : poses_[body]; };
+  auto spin = [&](int body) { return body < 0 ? Vector3d::Zero() : spins_[body]; };
+  auto velocity = [&](int body, const Vector3d& p) -> Vector3d {
+    if (body < 0) return Vector3d::Zero();
+    return velocities_[body] + spins_[body].cross(p - coms_[body]);
+  };
   for (auto& j : joints_) {
     const sgal::Constraint& c = *j.desc;
     if (c.kind != sgal::ConstraintKind::kHinge && c.kind != sgal::ConstraintKind::kSlider) continue;
-    const Isometry3d fa = JointFrame(j.body_a, c.frame_a);
-    const Isometry3d fb = JointFrame(j.body_b, c.frame_b);
+    const Isometry3d fa = pose(j.body_a) * j.frame_a;
+    const Isometry3d fb = pose(j.body_b) * j.frame_b;
     const Vector3d axis = fb.linear().col(2);
+    j.axis = axis;
     if (c.kind == sgal::ConstraintKind::kHinge) {
       // rotation of body_a's joint frame relative to body_b's (the parent's), about z
       const Eigen::Matrix3d rel = fb.linear().transpose() * fa.linear();
       j.position = std::atan2(rel(1, 0), rel(0, 0));
-      const Vector3d wa = FromBt(bodies_[j.body_a].rigid->getAngularVelocity());
-      const Vector3d wb = j.body_b < 0 ? Vector3d::Zero() : FromBt(bodies_[j.body_b].rigid->getAngularVelocity());
-      j.velocity = axis.dot(wa - wb);
+      j.velocity = axis.dot(spin(j.body_a) - spin(j.body_b));
     } else {
       j.position = axis.dot(fa.translation() - fb.translation());
-      j.velocity = axis.dot(PointVelocity(j.body_a, fa.translation()) -
-                            PointVelocity(j.body_b, fa.translation()));
+      j.velocity = axis.dot(velocity(j.body_a, fa.translation()) -
+                            velocity(j.body_b, fa.translation()));
     }
   }
 }
@@ -475,7 +534,7 @@ void BulletScene::ApplyJointSprings() {
     const sgal::JointSpring& sp = c.springs[0];
     if (sp.stiffness == 0 && sp.damping == 0) continue;
     const double load = -(sp.stiffness * (j.position - sp.rest) + sp.damping * j.velocity);
-    const Vector3d axis = JointFrame(j.body_b, c.frame_b).linear().col(2);
+    const Vector3d axis = j.axis;
     auto push = [&](int body, double sign) {
       if (body < 0 || scene_.bodies[body].type != sgal::BodyType::kDynamic) return;
       btRigidBody& rb = *bodies_[body].rigid;
@@ -514,7 +573,8 @@ void BulletScene::CheckState() {
 
 void BulletScene::Step() {
   // keep the last good state: a failing step leaves the scene as it was
-  std::vector<Snapshot> snapshot(bodies_.size());
+  std::vector<Snapshot>& snapshot = snapshot_;
+  snapshot.resize(bodies_.size());
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
     snapshot[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
@@ -529,6 +589,7 @@ void BulletScene::Step() {
     }
   };
 
+  CacheBodyPoses();
   RefreshWorldShapes();
   EvaluateTendons();
   UpdateJoints();
