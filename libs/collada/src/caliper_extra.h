@@ -22,6 +22,19 @@ inline std::vector<const Element*> CaliperTechniques(const Element& owner) {
   return out;
 }
 
+/// The exact name a Caliper technique of `owner` keeps in <name> (Collada-DOM cuts name
+/// attributes at the first blank); "" when there is none.
+inline std::string CaliperName(const Element& owner) {
+  for (const Element* technique : CaliperTechniques(owner))
+    if (const Element* name = technique->Child("name"); name != nullptr) return name->text;
+  return "";
+}
+
+/// Whether Collada-DOM keeps a name attribute as it is (it cuts at white space).
+inline bool DomKeepsName(const std::string& name) {
+  return name.find_first_of(" \t\r\n") == std::string::npos;
+}
+
 /// Adds <extra type="caliper"><technique profile="CALIPER"> to `owner`; returns the technique.
 inline Element* AddCaliperTechnique(Element* owner) {
   Element* extra = owner->Add("extra");

@@ -36,7 +36,8 @@ bool EndsWithNoCase(const std::string& s, const std::string& suffix) {
 struct Tag {
   std::string_view name;  // local name
   int line = 0;
-  size_t end = 0;  // index of the first tag after this element's subtree
+  size_t offset = 0;  // of the '<' in the text
+  size_t end = 0;     // index of the first tag after this element's subtree
 };
 
 // Scans an XML text for its start tags (comments, CDATA, processing instructions and the
@@ -114,7 +115,8 @@ bool ScanTags(const std::string& text, std::vector<Tag>* tags, int* bad_line, st
       *what = "unterminated tag";
       return false;
     }
-    const std::string_view name = LocalName(std::string_view(text).substr(name_begin, name_end - name_begin));
+    const std::string_view name =
+        LocalName(std::string_view(text).substr(name_begin, name_end - name_begin));
     const bool self_closing = !closing && k > lt && text[k - 1] == '/';
     if (closing) {
       if (open.empty() || (*tags)[open.back()].name != name) {
@@ -135,7 +137,7 @@ bool ScanTags(const std::string& text, std::vector<Tag>* tags, int* bad_line, st
         *what = "a second root element <" + std::string(name) + ">";
         return false;
       }
-      tags->push_back({name, line, 0});
+      tags->push_back({name, line, lt, 0});
       if (self_closing) {
         tags->back().end = tags->size();
         if (open.empty()) root_closed = true;
@@ -153,21 +155,89 @@ bool ScanTags(const std::string& text, std::vector<Tag>* tags, int* bad_line, st
   return true;
 }
 
-// Gives each element the line of its start tag; elements the scan does not find (dropped by the
-// DOM or made up) keep none.
-void AssignLines(const Element& e, const std::vector<Tag>& tags, size_t at,
-                 std::unordered_map<const Element*, int>* lines) {
-  (*lines)[&e] = tags[at].line;
-  size_t cursor = at + 1;
-  const size_t end = tags[at].end;
+// Gives each element the index of its start tag; elements the scan does not find (dropped by
+// the DOM or made up) get none. Children are matched by name in order, not by position: the DOM
+// keeps typed children in schema order, which need not be the file's.
+void AssignTags(const Element& e, const std::vector<Tag>& tags, size_t at,
+                std::unordered_map<const Element*, size_t>* index) {
+  (*index)[&e] = at;
+  std::unordered_map<std::string_view, std::vector<size_t>> by_name;
+  for (size_t j = at + 1; j < tags[at].end; j = tags[j].end) by_name[tags[j].name].push_back(j);
+  std::unordered_map<std::string_view, size_t> used;
   for (const auto& child : e.children) {
-    const std::string_view want = child->local_name();
-    size_t j = cursor;
-    while (j < end && tags[j].name != want) j = tags[j].end;
-    if (j >= end) continue;
-    AssignLines(*child, tags, j, lines);
-    cursor = tags[j].end;
+    const std::string_view name = child->local_name();
+    const auto it = by_name.find(name);
+    if (it == by_name.end()) continue;
+    size_t& next = used[name];
+    if (next >= it->second.size()) continue;
+    AssignTags(*child, tags, it->second[next++], index);
   }
+}
+
+// Replaces the five predefined entities and character references.
+std::string Unescape(std::string_view v) {
+  std::string out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (v[i] != '&') {
+      out += v[i];
+      continue;
+    }
+    const size_t semi = v.find(';', i);
+    if (semi == std::string_view::npos) {
+      out += v.substr(i);
+      break;
+    }
+    const std::string_view entity = v.substr(i + 1, semi - i - 1);
+    if (entity == "amp")
+      out += '&';
+    else if (entity == "lt")
+      out += '<';
+    else if (entity == "gt")
+      out += '>';
+    else if (entity == "quot")
+      out += '"';
+    else if (entity == "apos")
+      out += '\'';
+    else if (!entity.empty() && entity[0] == '#') {
+      const long code = std::strtol(
+          std::string(entity.substr(1)).c_str() + (entity.size() > 1 && entity[1] == 'x'), nullptr,
+          entity.size() > 1 && entity[1] == 'x' ? 16 : 10);
+      if (code < 0x80)
+        out += static_cast<char>(code);
+      else
+        out += '?';
+    } else {
+      out += v.substr(i, semi - i + 1);
+    }
+    i = semi;
+  }
+  return out;
+}
+
+// The attributes of the start tag at `offset`.
+std::vector<std::pair<std::string, std::string>> TagAttributes(const std::string& text,
+                                                               size_t offset) {
+  std::vector<std::pair<std::string, std::string>> out;
+  size_t i = offset + 1;
+  while (i < text.size() && !IsSpace(text[i]) && text[i] != '>' && text[i] != '/') ++i;
+  while (i < text.size()) {
+    while (i < text.size() && IsSpace(text[i])) ++i;
+    if (i >= text.size() || text[i] == '>' || text[i] == '/') break;
+    const size_t name_begin = i;
+    while (i < text.size() && !IsSpace(text[i]) && text[i] != '=' && text[i] != '>') ++i;
+    const std::string name = text.substr(name_begin, i - name_begin);
+    while (i < text.size() && IsSpace(text[i])) ++i;
+    if (i >= text.size() || text[i] != '=') break;
+    ++i;
+    while (i < text.size() && IsSpace(text[i])) ++i;
+    if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) break;
+    const char quote = text[i++];
+    const size_t close = text.find(quote, i);
+    if (close == std::string::npos) break;
+    out.emplace_back(name, Unescape(std::string_view(text).substr(i, close - i)));
+    i = close + 1;
+  }
+  return out;
 }
 
 }  // namespace
@@ -203,15 +273,6 @@ std::string Element::Trimmed() const {
   while (b < e && IsSpace(text[b])) ++b;
   while (e > b && IsSpace(text[e - 1])) --e;
   return text.substr(b, e - b);
-}
-
-std::vector<double> Element::Numbers() const {
-  if (numeric) return numbers;
-  std::vector<double> out;
-  std::string bad;
-  if (!ParseNumbers(text, &out, &bad))
-    throw std::invalid_argument("'" + bad + "' is not a number");
-  return out;
 }
 
 std::string Element::Describe() const {
@@ -302,21 +363,67 @@ const Element* Document::FindId(std::string_view id) const {
   return it == ids_.end() ? nullptr : it->second;
 }
 
+void Document::IndexTags() const {
+  if (tags_indexed_) return;
+  tags_indexed_ = true;
+  std::vector<Tag> tags;
+  int bad_line = 0;
+  std::string what;
+  ScanTags(text_, &tags, &bad_line, &what);
+  // subtrees a failed scan left open end at the last tag found
+  for (auto& t : tags)
+    if (t.end == 0) t.end = tags.size();
+  std::unordered_map<const Element*, size_t> index;
+  if (root && !tags.empty() && tags[0].name == root->local_name())
+    AssignTags(*root, tags, 0, &index);
+  for (const auto& [e, i] : index) tags_[e] = {tags[i].line, tags[i].offset};
+}
+
 int Document::LineOf(const Element& element) const {
-  if (!lines_indexed_) {
-    lines_indexed_ = true;
-    std::vector<Tag> tags;
-    int bad_line = 0;
-    std::string what;
-    ScanTags(text_, &tags, &bad_line, &what);
-    // subtrees a failed scan left open end at the last tag found
-    for (auto& t : tags)
-      if (t.end == 0) t.end = tags.size();
-    if (root && !tags.empty() && tags[0].name == root->local_name())
-      AssignLines(*root, tags, 0, &lines_);
+  IndexTags();
+  const auto it = tags_.find(&element);
+  return it == tags_.end() ? 0 : it->second.first;
+}
+
+std::vector<std::string> Document::RestoreAttributes(Element* subtree) {
+  IndexTags();
+  std::vector<std::string> restored;
+  std::vector<Element*> stack{subtree};
+  while (!stack.empty()) {
+    Element* e = stack.back();
+    stack.pop_back();
+    for (auto& c : e->children) stack.push_back(c.get());
+    const auto it = tags_.find(e);
+    if (it == tags_.end()) continue;
+    for (auto& [name, value] : TagAttributes(text_, it->second.second)) {
+      if (e->HasAttribute(name)) continue;
+      restored.push_back(name + " = " + value);
+      e->attributes.emplace_back(name, value);
+    }
   }
-  const auto it = lines_.find(&element);
-  return it == lines_.end() ? 0 : it->second;
+  return restored;
+}
+
+void Document::RestoreNames() {
+  // cheap test first: a name attribute with a blank in its value
+  bool blanks = false;
+  for (size_t at = text_.find(" name=\""); at != std::string::npos && !blanks;
+       at = text_.find(" name=\"", at + 7)) {
+    const size_t close = text_.find('"', at + 7);
+    blanks = close != std::string::npos && text_.find_first_of(" \t", at + 7) < close;
+  }
+  if (!blanks || !root) return;
+  IndexTags();
+  std::vector<Element*> stack{root.get()};
+  while (!stack.empty()) {
+    Element* e = stack.back();
+    stack.pop_back();
+    for (auto& c : e->children) stack.push_back(c.get());
+    const auto it = tags_.find(e);
+    if (it == tags_.end() || !e->HasAttribute("name")) continue;
+    for (const auto& [name, value] : TagAttributes(text_, it->second.second))
+      if (name == "name") e->Set("name", value);
+  }
 }
 
 std::string ReadText(const std::string& path) {
@@ -346,7 +453,8 @@ std::string SniffVersion(const std::string& text) {
   const size_t root = text.find("<COLLADA");
   if (root == std::string::npos) return "";
   const size_t end = text.find('>', root);
-  const std::string tag = text.substr(root, end == std::string::npos ? std::string::npos : end - root);
+  const std::string tag =
+      text.substr(root, end == std::string::npos ? std::string::npos : end - root);
   size_t at = 0;
   while ((at = tag.find("version", at)) != std::string::npos) {
     // the attribute itself, not xmlns or another name ending in "version"
@@ -400,6 +508,12 @@ Document ReadDocument(const std::string& path) {
   } else {
     attempts = {150, 141};
   }
+  // malformed XML never reaches the DOM: its reader can loop forever on some (a start tag left
+  // open inside character data, found by fuzzing)
+  if (!doc.zipped) {
+    const auto [line, what] = FindXmlProblem(text);
+    if (line > 0) throw ReadError("malformed XML: " + what, line);
+  }
   std::lock_guard<std::mutex> lock(DomMutex());
   DomLoad load;
   for (int attempt : attempts) {
@@ -430,13 +544,41 @@ Document ReadDocument(const std::string& path) {
   }
   for (const auto& w : load.warnings) {
     // the schema location attributes of XML Schema instances are harmless
-    if (w.find("attribute xmlns:") != std::string::npos || w.find("attribute xsi:") != std::string::npos)
+    if (w.find("attribute xmlns:") != std::string::npos ||
+        w.find("attribute xsi:") != std::string::npos)
       continue;
     doc.dom_warnings.push_back(w);
   }
   doc.root = std::move(load.root);
   if (doc.declared_version.empty()) doc.declared_version = doc.root->Attribute("version");
   doc.SetText(doc.zipped ? std::move(load.text) : std::move(text));
+  doc.RestoreNames();
+  // Collada-DOM types elements inside a technique by their name where COLLADA has a global
+  // element of that name (param, translate, ...), and drops the attributes that type lacks:
+  // inside Caliper's techniques they come back from the file's text
+  std::vector<std::string> restored;
+  std::vector<Element*> stack{doc.root.get()};
+  while (!stack.empty()) {
+    Element* e = stack.back();
+    stack.pop_back();
+    if (e->local_name() == "technique" && e->Attribute("profile") == "CALIPER" &&
+        e->parent != nullptr && e->parent->local_name() == "extra" &&
+        e->parent->Attribute("type") == "caliper") {
+      for (auto& r : doc.RestoreAttributes(e)) restored.push_back(std::move(r));
+      continue;
+    }
+    for (auto& c : e->children) stack.push_back(c.get());
+  }
+  if (!restored.empty()) {
+    std::vector<std::string> kept;
+    for (auto& w : doc.dom_warnings) {
+      const bool fixed = std::any_of(restored.begin(), restored.end(), [&](const std::string& r) {
+        return w.find("unable to create an attribute " + r + " ") != std::string::npos;
+      });
+      if (!fixed) kept.push_back(std::move(w));
+    }
+    doc.dom_warnings = std::move(kept);
+  }
   doc.IndexIds();
   return doc;
 }

@@ -20,9 +20,9 @@ class Element {
 
   std::string name;  // as written, with a namespace prefix if it had one (math:apply)
   std::vector<std::pair<std::string, std::string>> attributes;
-  std::string text;              // character data; empty when `numbers` holds it
-  std::vector<double> numbers;   // values of numeric lists (float_array, p, vcount, ...)
-  bool numeric = false;          // whether `numbers` holds the character data
+  std::string text;             // character data; empty when `numbers` holds it
+  std::vector<double> numbers;  // values of numeric lists (float_array, p, vcount, ...)
+  bool numeric = false;         // whether `numbers` holds the character data
   std::vector<std::unique_ptr<Element>> children;
   Element* parent = nullptr;
 
@@ -32,16 +32,15 @@ class Element {
   const std::string* FindAttribute(std::string_view attribute) const;
   /// The value of an attribute, `fallback` when absent.
   std::string Attribute(std::string_view attribute, const std::string& fallback = "") const;
-  bool HasAttribute(std::string_view attribute) const { return FindAttribute(attribute) != nullptr; }
+  bool HasAttribute(std::string_view attribute) const {
+    return FindAttribute(attribute) != nullptr;
+  }
   /// The first child with this local name, nullptr when there is none.
   const Element* Child(std::string_view child_name) const;
   /// All children with this local name.
   std::vector<const Element*> Children(std::string_view child_name) const;
   /// The character data with surrounding white space removed.
   std::string Trimmed() const;
-  /// The numbers of the character data; throws std::invalid_argument naming the first token
-  /// that is not a number ("nan" and "inf" are numbers).
-  std::vector<double> Numbers() const;
   /// `rigid_body 'forearm'`: the local name and the id, sid or name, for messages.
   std::string Describe() const;
 
@@ -74,11 +73,11 @@ class ReadError : public std::runtime_error {
 /// A COLLADA document loaded through Collada-DOM.
 class Document {
  public:
-  std::string path;               // the file as given
-  std::string version;            // the schema the DOM loaded it with: "1.4.1" or "1.5.0"
-  std::string declared_version;   // the version attribute of <COLLADA>
-  bool zipped = false;            // a .zae archive
-  std::unique_ptr<Element> root;  // <COLLADA>
+  std::string path;                       // the file as given
+  std::string version;                    // the schema the DOM loaded it with: "1.4.1" or "1.5.0"
+  std::string declared_version;           // the version attribute of <COLLADA>
+  bool zipped = false;                    // a .zae archive
+  std::unique_ptr<Element> root;          // <COLLADA>
   std::vector<std::string> dom_warnings;  // what the DOM reported without failing
 
   /// Indexes the id attributes (call once the tree is complete).
@@ -92,12 +91,21 @@ class Document {
   int LineOf(const Element& element) const;
   /// The text the lines refer to (the .dae itself, or the .dae inside a .zae).
   void SetText(std::string text) { text_ = std::move(text); }
+  /// Adds to the elements of a subtree the attributes their start tags in the text have and the
+  /// DOM dropped; returns them as "name = value".
+  std::vector<std::string> RestoreAttributes(Element* subtree);
+  /// Collada-DOM cuts name attributes at the first blank: puts back the whole names from the
+  /// text, where it has any with blanks.
+  void RestoreNames();
 
  private:
+  // finds each element's start tag in the text: its line and offset
+  void IndexTags() const;
+
   std::unordered_map<std::string_view, const Element*> ids_;
   std::string text_;
-  mutable bool lines_indexed_ = false;
-  mutable std::unordered_map<const Element*, int> lines_;
+  mutable bool tags_indexed_ = false;
+  mutable std::unordered_map<const Element*, std::pair<int, size_t>> tags_;
 };
 
 /// The version attribute of the <COLLADA> element in a document's text; "" when it cannot be

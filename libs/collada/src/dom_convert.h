@@ -111,19 +111,26 @@ DomLoad LoadWithDom(const std::string& path) {
   return result;
 }
 
-/// Copies a tree into the DOM under `out` (already created with the same name).
-inline void BuildDomElement(const Element& in, daeElement* out) {
+/// Copies a tree into the DOM under `out` (already created with the same name). Inside an
+/// `opaque` element (a Caliper technique) every element is created untyped: the DOM would
+/// otherwise make a <param> or <translate> there its COLLADA type and drop attributes that type
+/// does not have.
+inline void BuildDomElement(const Element& in, daeElement* out, bool opaque) {
   for (const auto& [name, value] : in.attributes) out->setAttribute(name.c_str(), value.c_str());
   if (in.numeric)
     out->setCharData(FormatNumbers(in.numbers.data(), in.numbers.size()));
   else if (!in.text.empty())
     out->setCharData(in.text);
+  const bool inner_opaque =
+      opaque || (in.local_name() == "technique" && in.Attribute("profile") == "CALIPER");
   for (const auto& child : in.children) {
-    daeElement* c = out->add(child->name.c_str());
+    // a name COLLADA does not have gives an untyped element, which is then renamed
+    daeElement* c = out->add(inner_opaque ? "caliper-untyped" : child->name.c_str());
     if (c == nullptr)
       throw std::runtime_error("the COLLADA " + std::string(out->getElementName()) +
                                " element takes no <" + child->name + ">");
-    BuildDomElement(*child, c);
+    if (inner_opaque) c->setElementName(child->name.c_str());
+    BuildDomElement(*child, c, inner_opaque);
   }
 }
 
@@ -135,8 +142,9 @@ void WriteWithDom(const Element& root, const std::string& path) {
   {
     DAE dae(nullptr, nullptr, Dom::kVersion);
     daeElement* dom_root = dae.add(path);
-    if (dom_root == nullptr) throw std::runtime_error("the DOM cannot create a document for " + path);
-    BuildDomElement(root, dom_root);
+    if (dom_root == nullptr)
+      throw std::runtime_error("the DOM cannot create a document for " + path);
+    BuildDomElement(root, dom_root, false);
     ok = dae.writeTo(path, path);
   }
   if (!ok || !handler.errors.empty()) {

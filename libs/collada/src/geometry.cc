@@ -4,6 +4,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "caliper_extra.h"
+
 namespace caliper::collada::internal {
 
 namespace {
@@ -34,7 +36,9 @@ struct Input {
   const Element* source = nullptr;
 };
 
-double Cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double Cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 bool InTriangle(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                 const Eigen::Vector2d& c) {
@@ -53,7 +57,8 @@ bool Triangulate(const std::vector<Corner>& poly, const std::vector<Eigen::Vecto
     return true;
   }
   auto fan = [&](const std::vector<size_t>& idx) {
-    for (size_t i = 1; i + 1 < idx.size(); ++i) out->push_back({poly[idx[0]], poly[idx[i]], poly[idx[i + 1]]});
+    for (size_t i = 1; i + 1 < idx.size(); ++i)
+      out->push_back({poly[idx[0]], poly[idx[i]], poly[idx[i + 1]]});
   };
   std::vector<size_t> idx(n);
   for (size_t i = 0; i < n; ++i) idx[i] = i;
@@ -88,11 +93,14 @@ bool Triangulate(const std::vector<Corner>& poly, const std::vector<Eigen::Vecto
   while (idx.size() > 3) {
     bool clipped = false;
     for (size_t k = 0; k < idx.size(); ++k) {
-      const size_t a = idx[(k + idx.size() - 1) % idx.size()], b = idx[k], c = idx[(k + 1) % idx.size()];
+      const size_t a = idx[(k + idx.size() - 1) % idx.size()], b = idx[k],
+                   c = idx[(k + 1) % idx.size()];
       if (Cross2(p[b] - p[a], p[c] - p[b]) <= 1e-15) continue;  // reflex or flat corner
       bool empty = true;
+      // a polygon with a hole bridged in repeats the bridge's corners: those do not block
+      auto corner = [&](size_t m) { return p[m] == p[a] || p[m] == p[b] || p[m] == p[c]; };
       for (size_t m : idx)
-        if (m != a && m != b && m != c && InTriangle(p[m], p[a], p[b], p[c])) {
+        if (m != a && m != b && m != c && !corner(m) && InTriangle(p[m], p[a], p[b], p[c])) {
           empty = false;
           break;
         }
@@ -111,7 +119,9 @@ bool Triangulate(const std::vector<Corner>& poly, const std::vector<Eigen::Vecto
   return true;
 }
 
-std::string Fragment(const std::string& url) { return url.empty() || url[0] != '#' ? url : url.substr(1); }
+std::string Fragment(const std::string& url) {
+  return url.empty() || url[0] != '#' ? url : url.substr(1);
+}
 
 }  // namespace
 
@@ -127,38 +137,41 @@ const GeometryData& GeometryLibrary::Get(const Element& geometry) {
 GeometryData GeometryLibrary::Read(const Element& geometry) {
   GeometryData data;
   // what a Caliper exporter noted about a tessellated primitive
-  for (const Element* extra : geometry.Children("extra")) {
-    if (extra->Attribute("type") != "caliper") continue;
-    for (const Element* technique : extra->Children("technique")) {
-      if (technique->Attribute("profile") != "CALIPER") continue;
-      for (const auto& c : technique->children) {
-        const std::string_view kind = c->local_name();
-        const auto v = ctx_.Numbers(*c);
-        auto need = [&](size_t k) {
-          if (v.size() != k) ctx_.Fail(c.get(), "needs " + std::to_string(k) + " numbers");
-        };
-        const double s = ctx_.meter;
-        if (kind == "box") {
-          need(3);
-          data.primitive = sgal::Box{Eigen::Vector3d(v[0], v[1], v[2]) * s};
-        } else if (kind == "sphere") {
-          need(1);
-          data.primitive = sgal::Sphere{v[0] * s};
-        } else if (kind == "capsule") {
-          need(2);
-          data.primitive = sgal::Capsule{v[0] * s, v[1] * s};
-        } else if (kind == "cylinder") {
-          need(2);
-          data.primitive = sgal::Cylinder{v[0] * s, v[1] * s};
-        } else if (kind == "cone") {
-          need(2);
-          data.primitive = sgal::Cone{v[0] * s, v[1] * s};
-        } else if (kind == "plane") {
-          need(4);
-          data.primitive = sgal::Plane{Eigen::Vector3d(v[0], v[1], v[2]).normalized(), v[3] * s};
-        } else {
-          ctx_.Warn(c.get(), "unknown element <" + std::string(kind) + "> in a geometry's Caliper technique");
-        }
+  for (const Element* technique : CaliperTechniques(geometry)) {
+    for (const auto& c : technique->children) {
+      if (c->local_name() != "primitive") {
+        ctx_.Warn(c.get(), "unknown element <" + std::string(c->local_name()) +
+                               "> in a geometry's Caliper technique");
+        continue;
+      }
+      const std::string kind = c->Attribute("kind");
+      const auto v = ctx_.Numbers(*c);
+      auto need = [&](size_t k) {
+        if (v.size() != k)
+          ctx_.Fail(c.get(), "a " + kind + " needs " + std::to_string(k) + " numbers");
+      };
+      const double s = ctx_.meter;
+      if (kind == "box") {
+        need(3);
+        data.primitive = sgal::Box{Eigen::Vector3d(v[0], v[1], v[2]) * s};
+      } else if (kind == "sphere") {
+        need(1);
+        data.primitive = sgal::Sphere{v[0] * s};
+      } else if (kind == "capsule") {
+        need(2);
+        data.primitive = sgal::Capsule{v[0] * s, v[1] * s};
+      } else if (kind == "cylinder") {
+        need(2);
+        data.primitive = sgal::Cylinder{v[0] * s, v[1] * s};
+      } else if (kind == "cone") {
+        need(2);
+        data.primitive = sgal::Cone{v[0] * s, v[1] * s};
+      } else if (kind == "plane") {
+        need(4);
+        data.primitive = sgal::Plane{Eigen::Vector3d(v[0], v[1], v[2]).normalized(), v[3] * s};
+      } else {
+        ctx_.Fail(c.get(), "unknown primitive kind '" + kind +
+                               "' (box, sphere, capsule, cylinder, cone, plane)");
       }
     }
   }
@@ -175,8 +188,11 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
   }
   if (mesh == nullptr) mesh = convex;
   if (mesh == nullptr) {
-    std::string kind = geometry.children.empty() ? "nothing" : "<" + std::string(geometry.children[0]->local_name()) + ">";
-    ctx_.Warn(&geometry, "holds " + kind + "; only <mesh> and <convex_mesh> are read, so it is not shown");
+    std::string kind = geometry.children.empty()
+                           ? "nothing"
+                           : "<" + std::string(geometry.children[0]->local_name()) + ">";
+    ctx_.Warn(&geometry,
+              "holds " + kind + "; only <mesh> and <convex_mesh> are read, so it is not shown");
     return data;
   }
   data.convex = mesh == convex;
@@ -199,14 +215,17 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
     d.count = array->numbers.size();
     if (const Element* tc = s.Child("technique_common"); tc != nullptr) {
       if (const Element* acc = tc->Child("accessor"); acc != nullptr) {
-        d.stride = static_cast<size_t>(std::stoul(acc->Attribute("stride", "1")));
-        d.offset = static_cast<size_t>(std::stoul(acc->Attribute("offset", "0")));
-        d.count = static_cast<size_t>(std::stoul(acc->Attribute("count", "0")));
+        d.stride = ctx_.Count(*acc, "stride", 1);
+        d.offset = ctx_.Count(*acc, "offset", 0);
+        d.count = ctx_.Count(*acc, "count", 0);
         if (d.stride == 0) d.stride = 1;
       }
     }
-    if (d.stride < 3 && d.count > 0) ctx_.Fail(&s, "an accessor of stride " + std::to_string(d.stride) + " cannot hold 3D vectors");
-    if (d.count > 0 && d.offset + (d.count - 1) * d.stride + 3 > d.values->size())
+    if (d.stride < 3 && d.count > 0)
+      ctx_.Fail(&s,
+                "an accessor of stride " + std::to_string(d.stride) + " cannot hold 3D vectors");
+    if (d.count > d.values->size() || d.offset > d.values->size() ||
+        (d.count > 0 && d.offset + (d.count - 1) * d.stride + 3 > d.values->size()))
       ctx_.Fail(&s, "its accessor reads " + std::to_string(d.count) + " vectors past the end of " +
                         std::to_string(d.values->size()) + " values");
     return sources[&s] = d;
@@ -253,7 +272,7 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
     for (const Element* in : prim.Children("input")) {
       Input input;
       input.semantic = in->Attribute("semantic");
-      input.offset = static_cast<size_t>(std::stoul(in->Attribute("offset", "0")));
+      input.offset = ctx_.Count(*in, "offset", 0);
       input.source = in;
       stride = std::max(stride, input.offset + 1);
       inputs.push_back(input);
@@ -267,10 +286,15 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
       ctx_.Resolve(*vertex_input->source, vertex_input->source->Attribute("source"));
     std::vector<Eigen::Vector3d>* normals = nullptr;
     if (normal_input != nullptr) {
-      const Element& s = ctx_.Resolve(*normal_input->source, normal_input->source->Attribute("source"));
+      const Element& s =
+          ctx_.Resolve(*normal_input->source, normal_input->source->Attribute("source"));
       auto found = normal_sources.find(&s);
       if (found == normal_sources.end())
-        found = normal_sources.emplace(&s, vectors(source(*normal_input->source, normal_input->source->Attribute("source")), 1.0)).first;
+        found = normal_sources
+                    .emplace(&s, vectors(source(*normal_input->source,
+                                                normal_input->source->Attribute("source")),
+                                         1.0))
+                    .first;
       normals = &found->second;
     }
     Group group;
@@ -278,13 +302,15 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
     auto corner = [&](const std::vector<double>& p, size_t k) {
       Corner c;
       const size_t base = k * stride;
-      c.position = static_cast<int64_t>(p[base + vertex_input->offset]);
-      if (c.position < 0 || c.position >= static_cast<int64_t>(positions.size()))
-        ctx_.Fail(&prim, "vertex index " + std::to_string(c.position) + " out of range (" +
+      const double vi = p[base + vertex_input->offset];
+      if (!(vi >= 0) || vi >= static_cast<double>(positions.size()))
+        ctx_.Fail(&prim, "vertex index " + FormatNumber(vi) + " out of range (" +
                              std::to_string(positions.size()) + " positions)");
+      c.position = static_cast<int64_t>(vi);
       if (normals != nullptr) {
-        c.normal = static_cast<int64_t>(p[base + normal_input->offset]);
-        if (c.normal < 0 || c.normal >= static_cast<int64_t>(normals->size())) c.normal = -1;
+        const double ni = p[base + normal_input->offset];
+        c.normal =
+            ni >= 0 && ni < static_cast<double>(normals->size()) ? static_cast<int64_t>(ni) : -1;
       } else if (!vertex_normals.empty()) {
         c.normal = c.position;
       }
@@ -314,12 +340,16 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
       const Element* vcount = prim.Child("vcount");
       if (p != nullptr && vcount != nullptr) {
         const auto corners = corners_of(*p);
-        const std::vector<double> counts = vcount->numeric ? vcount->numbers : ctx_.Numbers(*vcount);
+        const std::vector<double> counts =
+            vcount->numeric ? vcount->numbers : ctx_.Numbers(*vcount);
         size_t at = 0;
         for (double c : counts) {
+          if (!(c >= 0) || c > static_cast<double>(corners.size()))
+            ctx_.Fail(vcount, "corner count " + FormatNumber(c) + " is out of range");
           const size_t k = static_cast<size_t>(c);
           if (at + k > corners.size())
-            ctx_.Fail(vcount, "counts " + std::to_string(at + k) + " corners, <p> has " + std::to_string(corners.size()));
+            ctx_.Fail(vcount, "counts " + std::to_string(at + k) + " corners, <p> has " +
+                                  std::to_string(corners.size()));
           add_polygon(std::vector<Corner>(corners.begin() + static_cast<std::ptrdiff_t>(at),
                                           corners.begin() + static_cast<std::ptrdiff_t>(at + k)));
           at += k;
@@ -352,9 +382,12 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
     group_normals.push_back(normals);
   }
   if (failed_polygons > 0)
-    ctx_.Warn(mesh, std::to_string(failed_polygons) +
-                        " polygon(s) could not be ear-clipped (self-intersecting?) and were fanned");
-  if (holes > 0) ctx_.Warn(mesh, std::to_string(holes) + " polygon hole(s) ignored: the outer outlines are filled");
+    ctx_.Warn(mesh,
+              std::to_string(failed_polygons) +
+                  " polygon(s) could not be ear-clipped (self-intersecting?) and were fanned");
+  if (holes > 0)
+    ctx_.Warn(mesh,
+              std::to_string(holes) + " polygon hole(s) ignored: the outer outlines are filled");
 
   // positions that are not finite take their triangles with them
   size_t dropped = 0;
@@ -374,23 +407,26 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
         ++dropped;
         continue;
       }
-      if (t[0].position == t[1].position || t[1].position == t[2].position || t[0].position == t[2].position)
+      if (t[0].position == t[1].position || t[1].position == t[2].position ||
+          t[0].position == t[2].position)
         continue;  // degenerate
       kept.push_back(t);
-      all->triangles.push_back({static_cast<uint32_t>(t[0].position), static_cast<uint32_t>(t[1].position),
+      all->triangles.push_back({static_cast<uint32_t>(t[0].position),
+                                static_cast<uint32_t>(t[1].position),
                                 static_cast<uint32_t>(t[2].position)});
     }
     g.triangles = std::move(kept);
   }
-  if (dropped > 0) ctx_.Warn(mesh, std::to_string(dropped) + " triangle(s) with non-finite positions dropped");
+  if (dropped > 0)
+    ctx_.Warn(mesh, std::to_string(dropped) + " triangle(s) with non-finite positions dropped");
   data.all = all;
   data.usable = !all->vertices.empty() && (data.convex || !all->triangles.empty());
   for (size_t gi = 0; gi < groups.size(); ++gi) {
     const Group& g = groups[gi];
     if (g.triangles.empty()) continue;
     const std::vector<Eigen::Vector3d>* normals = group_normals[gi] != nullptr ? group_normals[gi]
-                                                  : vertex_normals.empty()    ? nullptr
-                                                                              : &vertex_normals;
+                                                  : vertex_normals.empty()     ? nullptr
+                                                                               : &vertex_normals;
     if (normals == nullptr && groups.size() == 1) {
       data.parts.push_back({g.material, all});
       continue;
@@ -448,7 +484,8 @@ Eigen::Vector4f BoundColor(Context& ctx, const Element& instance, const std::str
       std::vector<double> v;
       std::string bad;
       if (!ParseNumbers(color->text, &v, &bad) || v.size() < 3) continue;
-      Eigen::Vector4f rgba(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
+      Eigen::Vector4f rgba(static_cast<float>(v[0]), static_cast<float>(v[1]),
+                           static_cast<float>(v[2]),
                            v.size() > 3 ? static_cast<float>(v[3]) : 1.0f);
       return rgba.cwiseMax(0.0f).cwiseMin(1.0f);
     }

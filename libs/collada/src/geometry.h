@@ -4,7 +4,6 @@
 // that bound materials give them.
 
 #include <Eigen/Core>
-
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,10 +24,10 @@ struct MeshPart {
 
 /// A geometry as the scene uses it. Positions are in metres (the document's unit applied).
 struct GeometryData {
-  bool usable = false;   // false for what we do not read (splines, B-reps, empty meshes)
-  bool convex = false;   // a <convex_mesh>
-  std::shared_ptr<const sgal::Mesh> all;  // every triangle over the positions (collision)
-  std::vector<MeshPart> parts;            // by material (drawing)
+  bool usable = false;  // false for what we do not read (splines, B-reps, empty meshes)
+  bool convex = false;  // a <convex_mesh>
+  std::shared_ptr<const sgal::Mesh> all;    // every triangle over the positions (collision)
+  std::vector<MeshPart> parts;              // by material (drawing)
   std::optional<sgal::Geometry> primitive;  // the exact primitive a Caliper exporter noted
 };
 

@@ -16,6 +16,15 @@ void Context::Warn(const Element* e, const std::string& message) const {
   if (warnings_ != nullptr) warnings_->push_back(Where(e) + ": " + message);
 }
 
+void Context::WarnRepeated(const std::string& kind, const Element* e, const std::string& message) {
+  if (repeated_[kind]++ == 0) Warn(e, message);
+}
+
+void Context::ReportRepeated() {
+  for (const auto& [kind, times] : repeated_)
+    if (times > 1) Warn(nullptr, std::to_string(times - 1) + " more: " + kind);
+}
+
 void Context::Fail(const Element* e, const std::string& message) const {
   throw ImportError(Where(e) + ": " + message);
 }
@@ -69,6 +78,22 @@ bool Context::Bool(const Element* e, bool fallback) const {
   Fail(e, "'" + t + "' is not a boolean (true or false)");
 }
 
+size_t Context::Count(const Element& e, const char* attribute, size_t fallback) const {
+  const std::string* v = e.FindAttribute(attribute);
+  if (v == nullptr) return fallback;
+  size_t n = 0;
+  bool digits = !v->empty();
+  for (char c : *v) {
+    if (c < '0' || c > '9') {
+      digits = false;
+      break;
+    }
+    n = n * 10 + static_cast<size_t>(c - '0');
+  }
+  if (!digits) Fail(&e, std::string("attribute ") + attribute + "=\"" + *v + "\" is not a count");
+  return n;
+}
+
 std::string Context::UniqueBodyName(const std::string& preferred) const {
   const std::string base = preferred.empty() ? "body" : preferred;
   if (body_source.count(base) == 0) return base;
@@ -78,7 +103,8 @@ std::string Context::UniqueBodyName(const std::string& preferred) const {
   }
 }
 
-size_t Context::AddBody(sgal::Body body, const Element* source, const std::vector<std::string>& aliases) {
+size_t Context::AddBody(sgal::Body body, const Element* source,
+                        const std::vector<std::string>& aliases) {
   body_source[body.name] = source;
   for (const auto& a : aliases)
     if (!a.empty()) body_alias.emplace(a, body.name);

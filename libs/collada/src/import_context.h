@@ -4,7 +4,6 @@
 // file, line and element.
 
 #include <Eigen/Core>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -20,8 +19,8 @@ class Context {
       : doc(document), warnings_(warnings) {}
 
   const Document& doc;
-  double meter = 1;                                       // metres per document unit
-  Eigen::Matrix3d up = Eigen::Matrix3d::Identity();       // document axes -> Z up
+  double meter = 1;                                  // metres per document unit
+  Eigen::Matrix3d up = Eigen::Matrix3d::Identity();  // document axes -> Z up
   bool openrave = false;  // written by OpenRAVE (rigid bodies in the physics model's frame)
   sgal::Scene scene;
 
@@ -48,6 +47,10 @@ class Context {
   std::string Where(const Element* e) const;
   /// Appends `Where(e): message` to the warnings.
   void Warn(const Element* e, const std::string& message) const;
+  /// Warns the first time for `kind`, counts the later times (see ReportRepeated).
+  void WarnRepeated(const std::string& kind, const Element* e, const std::string& message);
+  /// Adds "N more: kind" for each kind warned about more than once.
+  void ReportRepeated();
   /// Throws ImportError with `Where(e): message`.
   [[noreturn]] void Fail(const Element* e, const std::string& message) const;
 
@@ -66,12 +69,15 @@ class Context {
   Eigen::Vector3d Vector3(const Element& e) const;
   /// A boolean (true/false/1/0) of an element; `fallback` when `e` is null.
   bool Bool(const Element* e, bool fallback) const;
+  /// A non-negative integer attribute; `fallback` when absent. Throws ImportError naming `e`.
+  size_t Count(const Element& e, const char* attribute, size_t fallback) const;
 
   /// A length in the document's unit to metres.
   double Length(double document_value) const { return document_value * meter; }
 
  private:
   std::vector<std::string>* warnings_;
+  std::map<std::string, int> repeated_;  // kind -> times warned
 };
 
 }  // namespace caliper::collada::internal

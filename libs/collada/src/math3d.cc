@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-
 #include <cmath>
 
 namespace caliper::collada::internal {
@@ -59,8 +58,7 @@ Eigen::Quaterniond RotationZTo(const Eigen::Vector3d& axis) {
   return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis / n);
 }
 
-void PrincipalAxes(const Eigen::Matrix3d& tensor, Eigen::Vector3d* moments,
-                   Eigen::Matrix3d* axes) {
+void PrincipalAxes(const Eigen::Matrix3d& tensor, Eigen::Vector3d* moments, Eigen::Matrix3d* axes) {
   const Eigen::Matrix3d sym = 0.5 * (tensor + tensor.transpose());
   // a diagonal tensor keeps its axes (and the order of its moments)
   const Eigen::Matrix3d off = sym - Eigen::Matrix3d(sym.diagonal().asDiagonal());

@@ -4,7 +4,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <utility>
 
 #include "caliper/sgal/scene.h"
@@ -32,7 +31,6 @@ Eigen::Quaterniond RotationZTo(const Eigen::Vector3d& axis);
 
 /// Symmetric positive semi-definite tensor -> principal moments and the rotation whose columns are
 /// the principal axes (a proper rotation: det = +1).
-void PrincipalAxes(const Eigen::Matrix3d& tensor, Eigen::Vector3d* moments,
-                   Eigen::Matrix3d* axes);
+void PrincipalAxes(const Eigen::Matrix3d& tensor, Eigen::Vector3d* moments, Eigen::Matrix3d* axes);
 
 }  // namespace caliper::collada::internal

@@ -20,7 +20,8 @@ std::shared_ptr<sgal::Mesh> BoxMesh(const Eigen::Vector3d& size) {
   auto m = std::make_shared<sgal::Mesh>();
   const Eigen::Vector3f h = (size / 2).cast<float>();
   for (int i = 0; i < 8; ++i)
-    m->vertices.emplace_back((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
+    m->vertices.emplace_back((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                             (i & 4) ? h.z() : -h.z());
   AddQuad(m.get(), 0, 2, 3, 1);  // -z
   AddQuad(m.get(), 4, 5, 7, 6);  // +z
   AddQuad(m.get(), 0, 1, 5, 4);  // -y
@@ -40,8 +41,8 @@ std::shared_ptr<sgal::Mesh> Revolve(const std::vector<std::pair<double, double>>
     const int n = r > 0 ? kSegments : 1;
     for (int i = 0; i < n; ++i) {
       const double a = 2 * kPi * i / kSegments;
-      m->vertices.emplace_back(static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
-                               static_cast<float>(z));
+      m->vertices.emplace_back(static_cast<float>(r * std::cos(a)),
+                               static_cast<float>(r * std::sin(a)), static_cast<float>(z));
     }
   }
   auto ring_size = [&](size_t k) { return rings[k].first > 0 ? kSegments : 1; };
@@ -120,7 +121,9 @@ bool IsDiagonal(const Eigen::Matrix3d& m) {
 
 std::shared_ptr<const sgal::Mesh> Tessellate(const sgal::Geometry& geometry) {
   struct Visitor {
-    std::shared_ptr<const sgal::Mesh> operator()(const sgal::Box& b) const { return BoxMesh(b.size); }
+    std::shared_ptr<const sgal::Mesh> operator()(const sgal::Box& b) const {
+      return BoxMesh(b.size);
+    }
     std::shared_ptr<const sgal::Mesh> operator()(const sgal::Sphere& s) const {
       return SphereRings(s.radius, 0);
     }
@@ -136,7 +139,8 @@ std::shared_ptr<const sgal::Mesh> Tessellate(const sgal::Geometry& geometry) {
     std::shared_ptr<const sgal::Mesh> operator()(const sgal::Plane& p) const {
       auto m = BoxMesh(Eigen::Vector3d(10, 10, 0));
       m->triangles.resize(4);  // the two faces of the square
-      const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), p.normal.normalized());
+      const Eigen::Quaterniond q =
+          Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), p.normal.normalized());
       const Eigen::Vector3f shift = (p.normal.normalized() * p.offset).cast<float>();
       for (auto& v : m->vertices) v = q.cast<float>() * v + shift;
       return m;
@@ -156,7 +160,9 @@ sgal::Geometry ApplyLinear(const sgal::Geometry& geometry, const Eigen::Matrix3d
   if ((m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-12) return geometry;
   const bool diagonal = IsDiagonal(m);
   const Eigen::Vector3d d = m.diagonal().cwiseAbs();
-  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
+  auto near = [](double a, double b) {
+    return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
+  };
   auto hull = [&]() -> sgal::Geometry {
     *approximated = true;
     return sgal::ConvexHull{TransformMesh(*Tessellate(geometry), m)};
@@ -166,7 +172,8 @@ sgal::Geometry ApplyLinear(const sgal::Geometry& geometry, const Eigen::Matrix3d
     return sgal::ConvexHull{TransformMesh(*Tessellate(geometry), m)};  // exact: a box's hull
   }
   if (const auto* s = std::get_if<sgal::Sphere>(&geometry)) {
-    if (diagonal && near(d.x(), d.y()) && near(d.y(), d.z())) return sgal::Sphere{s->radius * d.x()};
+    if (diagonal && near(d.x(), d.y()) && near(d.y(), d.z()))
+      return sgal::Sphere{s->radius * d.x()};
     return hull();
   }
   if (const auto* c = std::get_if<sgal::Capsule>(&geometry)) {
@@ -179,7 +186,8 @@ sgal::Geometry ApplyLinear(const sgal::Geometry& geometry, const Eigen::Matrix3d
     return hull();
   }
   if (const auto* c = std::get_if<sgal::Cone>(&geometry)) {
-    if (diagonal && near(d.x(), d.y()) && m(2, 2) > 0) return sgal::Cone{c->radius * d.x(), c->length * d.z()};
+    if (diagonal && near(d.x(), d.y()) && m(2, 2) > 0)
+      return sgal::Cone{c->radius * d.x(), c->length * d.z()};
     return hull();
   }
   if (const auto* p = std::get_if<sgal::Plane>(&geometry)) {
@@ -194,7 +202,8 @@ sgal::Geometry ApplyLinear(const sgal::Geometry& geometry, const Eigen::Matrix3d
   return sgal::TriangleMesh{t.mesh ? TransformMesh(*t.mesh, m) : t.mesh};
 }
 
-bool ExtendBounds(const sgal::Geometry& geometry, const sgal::Pose& pose, Eigen::AlignedBox3d* box) {
+bool ExtendBounds(const sgal::Geometry& geometry, const sgal::Pose& pose,
+                  Eigen::AlignedBox3d* box) {
   if (std::holds_alternative<sgal::Plane>(geometry)) return false;
   const auto mesh = Tessellate(geometry);
   for (const auto& v : mesh->vertices) box->extend(pose.Apply(v.cast<double>()));

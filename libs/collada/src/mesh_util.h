@@ -4,7 +4,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <memory>
 
 #include "caliper/sgal/scene.h"
@@ -23,7 +22,6 @@ sgal::Geometry ApplyLinear(const sgal::Geometry& geometry, const Eigen::Matrix3d
                            bool* approximated);
 
 /// Grows `box` by a geometry placed at `pose`; false for a plane (unbounded).
-bool ExtendBounds(const sgal::Geometry& geometry, const sgal::Pose& pose,
-                  Eigen::AlignedBox3d* box);
+bool ExtendBounds(const sgal::Geometry& geometry, const sgal::Pose& pose, Eigen::AlignedBox3d* box);
 
 }  // namespace caliper::collada::internal

@@ -50,9 +50,9 @@ struct Prefix {
   const char* name;
   double scale;
 };
-const Prefix kPrefixes[] = {{"G", 1e9},  {"M", 1e6},  {"k", 1e3},       {"d", 1e-1},
-                            {"c", 1e-2}, {"m", 1e-3}, {"u", 1e-6},      {"\xc2\xb5", 1e-6},
-                            {"\xce\xbc", 1e-6},       {"n", 1e-9},      {"p", 1e-12}};
+const Prefix kPrefixes[] = {{"G", 1e9},         {"M", 1e6},  {"k", 1e3},  {"d", 1e-1},
+                            {"c", 1e-2},        {"m", 1e-3}, {"u", 1e-6}, {"\xc2\xb5", 1e-6},
+                            {"\xce\xbc", 1e-6}, {"n", 1e-9}, {"p", 1e-12}};
 
 bool LookUp(const std::string& token, Unit* out) {
   for (const auto& s : kSymbols)
@@ -85,7 +85,8 @@ Unit Power(const Unit& u, int exponent) {
 Unit Product(const Unit& a, const Unit& b, int sign) {
   Unit r;
   r.scale = sign > 0 ? a.scale * b.scale : a.scale / b.scale;
-  for (size_t i = 0; i < r.dimension.size(); ++i) r.dimension[i] = a.dimension[i] + sign * b.dimension[i];
+  for (size_t i = 0; i < r.dimension.size(); ++i)
+    r.dimension[i] = a.dimension[i] + sign * b.dimension[i];
   return r;
 }
 
@@ -158,7 +159,8 @@ class Parser {
       const size_t begin = pos_;
       while (pos_ < text_.size()) {
         const char c = text_[pos_];
-        if (c == ' ' || c == '\t' || c == '/' || c == '*' || c == '^' || c == '(' || c == ')') break;
+        if (c == ' ' || c == '\t' || c == '/' || c == '*' || c == '^' || c == '(' || c == ')')
+          break;
         if (c == '.' && pos_ > begin) break;
         if (text_.compare(pos_, 2, "\xc2\xb7") == 0) break;
         ++pos_;

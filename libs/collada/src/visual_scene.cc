@@ -93,7 +93,8 @@ void VisualScene::Visit(const Element& node, int parent, const Eigen::Affine3d& 
                         std::vector<const Element*>* path) {
   if (std::find(path->begin(), path->end(), &node) != path->end())
     ctx_.Fail(&node, "instantiates itself (an <instance_node> cycle)");
-  if (path->size() > kMaxDepth) ctx_.Fail(&node, "nodes nested deeper than " + std::to_string(kMaxDepth));
+  if (path->size() > kMaxDepth)
+    ctx_.Fail(&node, "nodes nested deeper than " + std::to_string(kMaxDepth));
   path->push_back(&node);
   NodeInstance inst;
   inst.node = &node;
@@ -107,7 +108,8 @@ void VisualScene::Visit(const Element& node, int parent, const Eigen::Affine3d& 
     } else if (n == "instance_controller") {
       // a skin or morph: drawn as its source geometry in the bind pose
       const Element* target = &ctx_.Resolve(*c, c->Attribute("url"));
-      for (int hops = 0; hops < 8 && target != nullptr && target->local_name() == "controller"; ++hops) {
+      for (int hops = 0; hops < 8 && target != nullptr && target->local_name() == "controller";
+           ++hops) {
         const Element* inner = target->Child("skin");
         if (inner == nullptr) inner = target->Child("morph");
         target = inner == nullptr ? nullptr : &ctx_.Resolve(*inner, inner->Attribute("source"));
@@ -118,7 +120,9 @@ void VisualScene::Visit(const Element& node, int parent, const Eigen::Affine3d& 
       }
       if (!warned_controller_) {
         warned_controller_ = true;
-        ctx_.Warn(c.get(), "skinned or morphed geometry is shown in its bind pose (controllers are not animated)");
+        ctx_.Warn(
+            c.get(),
+            "skinned or morphed geometry is shown in its bind pose (controllers are not animated)");
       }
       inst.geometry.push_back({c.get(), target});
     }
@@ -133,7 +137,8 @@ void VisualScene::Visit(const Element& node, int parent, const Eigen::Affine3d& 
     } else if (c->local_name() == "instance_node") {
       const Element& target = ctx_.Resolve(*c, c->Attribute("url"));
       if (target.local_name() != "node")
-        ctx_.Fail(c.get(), "url '" + c->Attribute("url") + "' is a <" + std::string(target.local_name()) + ">, not a <node>");
+        ctx_.Fail(c.get(), "url '" + c->Attribute("url") + "' is a <" +
+                               std::string(target.local_name()) + ">, not a <node>");
       Visit(target, index, world, path);
     }
   }

@@ -3,7 +3,6 @@
 // instance) with its world transform in metres and Z up, and the geometry it draws.
 
 #include <Eigen/Geometry>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -23,7 +22,7 @@ struct NodeGeometry {
 /// One instance of a <node>.
 struct NodeInstance {
   const Element* node = nullptr;
-  int parent = -1;                    // index of the parent instance, -1 at the top
+  int parent = -1;  // index of the parent instance, -1 at the top
   Eigen::Affine3d parent_world = Eigen::Affine3d::Identity();  // [m], Z up
   Eigen::Affine3d world = Eigen::Affine3d::Identity();         // parent_world * local
   std::vector<NodeGeometry> geometry;
