@@ -16,8 +16,25 @@ constexpr double kSwitchSharpness = 500;
 constexpr double kSwitchOffset = 5;
 // the SDIRK2 coefficient gamma = 1 - 1/sqrt(2) (L-stable, stiffly accurate)
 const double kGamma = 1.0 - 1.0 / std::sqrt(2.0);
-// absolute tolerance of the spool speed in each implicit stage [rad/s]
+// absolute tolerance of the spool speed in each implicit stage of the fallback solver [rad/s]
 constexpr double kSpeedTolerance = 1e-12;
+// Newton's iteration stops when the speed after its step is within this times the speed scale
+// |w| + 1 V / (k_e N) of the stage's solution (1e-12 rad/s as the bracketing solver's tolerance
+// for the reference motor, 0.68 rad/s/V); steps below kRoundingStep of that are always taken
+constexpr double kNewtonTolerance = 1.5e-12;
+constexpr double kRoundingStep = 1e-3;
+constexpr int kNewtonIterations = 50;
+// beyond |1000 i w + 10| > 40 the switch is exactly 0 or 1 in rho (tanh is +-1 to the last bit
+// from |500 i w + 5| > 19.1): no exp needed
+constexpr double kSwitchSaturation = 40;
+
+// (tanh(-500 i w - 5) + 1) / 2 written as 1 / (1 + exp(1000 i w + 10))
+inline double SwitchBlend(double current_times_speed) {
+  const double x = 2 * (kSwitchSharpness * current_times_speed + kSwitchOffset);
+  if (x > kSwitchSaturation) return 0;
+  if (x < -kSwitchSaturation) return 1;
+  return 1 / (1 + std::exp(x));
+}
 
 enum class Range { kPositive, kNonNegative, kFraction };
 
@@ -144,9 +161,28 @@ void DcMotorParameters::Validate() const {
 }
 
 double GearEfficiencyFactor(double efficiency, double current, double spool_speed) {
-  const double blend =
-      (std::tanh(-kSwitchSharpness * current * spool_speed - kSwitchOffset) + 1) / 2;
+  const double blend = SwitchBlend(current * spool_speed);
   return efficiency + (1 / efficiency - efficiency) * blend;
+}
+
+double SpoolLoad::TorqueAlong(double spool_angle, double spool_speed, double h,
+                              double angle_per_speed, double* slope, double* low,
+                              double* high) const {
+  const double dw = 1e-7 * std::max(1.0, std::abs(spool_speed));
+  const double da = angle_per_speed * dw;
+  *slope = (TorqueAt(spool_angle + da, spool_speed + dw, h) -
+            TorqueAt(spool_angle - da, spool_speed - dw, h)) /
+           (2 * dw);
+  *low = *high = 0;
+  return TorqueAt(spool_angle, spool_speed, h);
+}
+
+double ConstantSpoolLoad::TorqueAlong(double, double, double, double, double* slope, double* low,
+                                      double* high) const {
+  *slope = 0;
+  *low = -std::numeric_limits<double>::infinity();
+  *high = std::numeric_limits<double>::infinity();
+  return torque_;
 }
 
 DcMotor::DcMotor(const DcMotorParameters& parameters) { set_parameters(parameters); }
@@ -154,69 +190,318 @@ DcMotor::DcMotor(const DcMotorParameters& parameters) { set_parameters(parameter
 void DcMotor::set_parameters(const DcMotorParameters& parameters) {
   parameters.Validate();
   parameters_ = parameters;
+  constants_ = StageConstants{};  // recomputed at the next step
 }
 
 void DcMotor::Reset() {
   state_ = DcMotorState{};
   applied_voltage_ = 0;
   load_torque_ = 0;
+  last_acceleration_ = 0;
 }
 
 void DcMotor::set_locked(bool locked) {
   locked_ = locked;
   if (locked_) state_.spool_speed = 0;
+  last_acceleration_ = 0;
 }
 
-DcMotor::Stage DcMotor::SolveStage(const DcMotorState& a, double c, double voltage, double h,
-                                   const SpoolLoad& load) const {
+void DcMotor::UpdateConstants(double dt) {
   const DcMotorParameters& p = parameters_;
+  StageConstants& k = constants_;
   const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
   const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
-  const double inertia = p.gear_ratio * this->inertia();         // N J [kg m^2]
-
-  // the current at the end of the stage for a spool speed w: linear, then limited
-  auto solve = [&](double w, Stage* s) {
-    s->spool_speed = w;
-    s->spool_angle = a.spool_angle + c * w;
-    s->current =
-        (a.current + c * (voltage - emf * w) / p.inductance) / (1 + c * resistance / p.inductance);
-    s->voltage = voltage;
-    if (p.current_limit > 0 && std::abs(s->current) > p.current_limit) {
-      s->current = std::copysign(p.current_limit, s->current);
-      s->voltage = p.inductance * (s->current - a.current) / c + resistance * s->current + emf * w;
-    }
-    s->torque = load.TorqueAt(s->spool_angle, w, h);
-  };
-  auto residual = [&](double w) {
-    Stage s;
-    solve(w, &s);
-    const double rho = GearEfficiencyFactor(p.efficiency, s.current, w);
-    const double acceleration =
-        (p.torque_constant * s.current - s.torque / (rho * p.gear_ratio)) / inertia;
-    return w - a.spool_speed - c * acceleration;
-  };
-
-  Stage stage;
-  const double w = locked_ ? 0.0 : FindRoot(residual, a.spool_speed, kSpeedTolerance);
-  solve(w, &stage);
-  return stage;
+  k.dt = dt;
+  k.substeps = std::max(1, static_cast<int>(std::ceil(dt / p.max_substep - 1e-9)));
+  k.h = dt / k.substeps;
+  k.c = kGamma * k.h;
+  k.inverse_c = 1 / k.c;
+  // the current at the end of a stage, L (i - i_a) / c = U - R i - emf w, solved for i
+  const double denominator = 1 + k.c * resistance / p.inductance;
+  k.current_base = 1 / denominator;
+  k.current_drive = k.c / p.inductance / denominator;
+  k.current_slope = -k.c * emf / p.inductance / denominator;
+  const double c_over_inertia = k.c / (p.gear_ratio * inertia());  // C = c / (N J)
+  k.c_torque = c_over_inertia * p.torque_constant;
+  k.c_ratio = c_over_inertia / p.gear_ratio;
+  k.spread = 1 / p.efficiency - p.efficiency;
+  k.inverse_rho_driving = 1 / p.efficiency;
+  k.inverse_rho_driven = 1 / (p.efficiency + k.spread);
+  k.tolerance = kNewtonTolerance / emf;  // of the no-load speed at 1 V [rad/s]
 }
 
-void DcMotor::Substep(double voltage, double h, SpoolLoad& load) {
-  const double c = kGamma * h;
-  const Stage first = SolveStage(state_, c, voltage, c, load);
-  // second stage: y + (1 - gamma) h f(Y1) with f(Y1) = (Y1 - y) / (gamma h)
+double DcMotor::Exp(double x) const {
+  // exp(x) = exp(x_last) exp(x - x_last), the latter by 1 + d + d^2/2 while |d| < 2^-20
+  // (relative error below d^3/6 < 2e-19): a motor at rest or holding reuses the last value
+  const double d = x - exp_argument_;
+  if (std::abs(d) < 1.0 / (1 << 20)) return exp_value_ * (1 + d * (1 + 0.5 * d));
+  exp_argument_ = x;
+  exp_value_ = std::exp(x);
+  return exp_value_;
+}
+
+DcMotor::Stage DcMotor::StageAt(const DcMotorState& a, double voltage, double w) const {
+  const DcMotorParameters& p = parameters_;
+  const StageConstants& k = constants_;
+  Stage s;
+  s.spool_speed = w;
+  s.spool_angle = a.spool_angle + k.c * w;
+  s.current = k.current_base * a.current + k.current_drive * voltage + k.current_slope * w;
+  s.voltage = voltage;
+  if (p.current_limit > 0 && std::abs(s.current) > p.current_limit) {
+    s.current = std::copysign(p.current_limit, s.current);
+    s.voltage = p.inductance * (s.current - a.current) / k.c +
+                (p.resistance + p.bridge_resistance) * s.current +
+                p.back_emf_constant * p.gear_ratio * w;
+  }
+  return s;
+}
+
+double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load, double w0,
+                           const SpoolLoad& load) const {
+  const StageConstants& k = constants_;
+  const double current0 = k.current_base * a.current + k.current_drive * voltage;  // at w = 0
+  const double limit = parameters_.current_limit;
+  const double efficiency = parameters_.efficiency;
+  const double angle0 = a.spool_angle;
+  const double speed0 = a.spool_speed;
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  // The residual R(w) = w - a.w - C k_t i + (C / N) tau / rho, C = c / (N J), with
+  // 1 / rho = (1 + e) / D, D = eta (1 + e) + 1/eta - eta, e = exp(x), x = 1000 i w + 10; with
+  // its slope, both times D^2 > 0 (1 where the switch is saturated) so that a Newton step costs
+  // one division; and what bounds its curvature.
+  struct Value {
+    double residual, slope;          // R D^2, dR/dw D^2
+    double scale;                    // D^2
+    double torque, d_torque;         // tau [N m] and d(tau)/dw
+    double affine_low, affine_high;  // changes of w over which tau stays on its tangent
+    double d_inverse_x;              // d(1 / rho)/dx D^2 = (1/eta - eta) e
+    double x_slope;                  // dx/dw
+    double d_current;                // di/dw (0 while the current is limited)
+    int regime;  // -1, +1: saturated (rho = eta + (1/eta - eta), eta exactly); 0; kUnloaded
+  };
+  constexpr int kUnloaded = 2;  // no torque, no slope: the switch does not matter
+  // the current at the end of the stage and the switch regime at a spool speed w
+  auto state_at = [&](double w, double* current, double* x) {
+    double i = current0 + k.current_slope * w;
+    bool limited = limit > 0 && std::abs(i) > limit;
+    if (limited) i = std::copysign(limit, i);
+    *current = i;
+    *x = 2 * (kSwitchSharpness * (i * w) + kSwitchOffset);
+    const int regime = *x > kSwitchSaturation ? 1 : (*x < -kSwitchSaturation ? -1 : 0);
+    return limited ? regime + 4 : regime;  // both in one number
+  };
+  auto evaluate = [&](double w, Value* v) {
+    double current;
+    double x;
+    const int state = state_at(w, &current, &x);
+    v->regime = state > 2 ? state - 4 : state;
+    v->d_current = state > 2 ? 0.0 : k.current_slope;
+    v->torque = load.TorqueAlong(angle0 + k.c * w, w, h_load, k.c, &v->d_torque, &v->affine_low,
+                                 &v->affine_high);
+    v->x_slope = 2 * kSwitchSharpness * (v->d_current * w + current);
+    const double linear = w - speed0 - k.c_torque * current;
+    const double d_linear = 1 - k.c_torque * v->d_current;
+    if (v->torque == 0 && v->d_torque == 0) {
+      // unloaded (a slack line): rho does not matter
+      v->regime = kUnloaded;
+      v->scale = 1;
+      v->d_inverse_x = 0;
+      v->residual = linear;
+      v->slope = d_linear;
+    } else if (v->regime == 0) {
+      const double e = Exp(x);
+      const double d = efficiency * (1 + e) + k.spread;
+      const double rho_d = (1 + e) * d;  // D^2 / rho
+      v->scale = d * d;
+      v->d_inverse_x = k.spread * e;
+      v->residual = linear * v->scale + k.c_ratio * v->torque * rho_d;
+      v->slope = d_linear * v->scale +
+                 k.c_ratio * (v->d_torque * rho_d + v->torque * v->d_inverse_x * v->x_slope);
+    } else {
+      const double inverse_rho = v->regime > 0 ? k.inverse_rho_driving : k.inverse_rho_driven;
+      v->scale = 1;
+      v->d_inverse_x = 0;
+      v->residual = linear + k.c_ratio * v->torque * inverse_rho;
+      v->slope = d_linear + k.c_ratio * v->d_torque * inverse_rho;
+    }
+    return state;
+  };
+  // A bound of |R(w + step)| D^2 [rad/s] from the value at w, where R is linear in the step but
+  // for the switch (bounded through |d^n(1/rho)/dx^n| <= |d(1/rho)/dx|, which grows at most as
+  // e^|dx|; x is quadratic in w) and the load (evaluated at w + step and compared with its
+  // tangent); infinite when the current limit or the switch's saturation changes over the step.
+  auto bound_after = [&](const Value& v, int state, double w, double step) {
+    const double next = w + step;
+    double current;
+    double x;
+    const int next_state = state_at(next, &current, &x);
+    if (v.regime == kUnloaded ? (next_state > 2) != (state > 2) : next_state != state)
+      return kInfinity;
+    // the load off its tangent, seen through 1/rho <= 1/eta
+    double bound = 0;
+    if (!(step >= v.affine_low && step <= v.affine_high)) {
+      const double torque = load.TorqueAt(angle0 + k.c * next, next, h_load);
+      bound = k.c_ratio * k.inverse_rho_driving * std::abs(torque - v.torque - v.d_torque * step) *
+              v.scale;
+    }
+    if (v.regime == 0) {
+      const double ds = std::abs(step);
+      const double x_curvature = 4 * kSwitchSharpness * std::abs(v.d_current);
+      const double x_slope = std::abs(v.x_slope) + x_curvature * ds;  // max |dx/dw|
+      const double dx = x_slope * ds;                                 // max |x - x_w|
+      if (dx > 0.5) return kInfinity;
+      const double sigma = v.d_inverse_x * (1 + 2 * dx);  // >= |d^n(1/rho)/dx^n| D^2
+      const double tau = std::abs(v.torque) + std::abs(v.d_torque) * ds;
+      // max |d2(tau / rho)/dw2| D^2 with d2(tau)/dw2 = 0
+      const double curvature =
+          sigma * (tau * (x_slope * x_slope + x_curvature) + 2 * std::abs(v.d_torque) * x_slope);
+      bound += 0.5 * k.c_ratio * curvature * ds * ds;
+    }
+    return bound;
+  };
+
+  // Whether a solution w* is the first from the base speed a.w, as the bracketing search finds
+  // it: R increases between them. The only term of dR/dw that can be negative is
+  // (C/N) tau d(1/rho)/dw, d(1/rho)/dw = s_x x' with 0 <= s_x <= (1/eta - eta)/4 (dR/dw >= 1
+  // without it): it cannot when the switch is saturated over the interval or tau x' >= 0 there,
+  // and is too small when (C/N) max|tau| (1/eta - eta)/4 max|x'| < 1/2 (|tau| taken at the ends).
+  // Otherwise the stage may have several solutions (a current against the load while the speed
+  // crosses zero) and the bracketing search decides.
+  auto first_from_base = [&](const Value& v, double w_eval, double step) {
+    const double w_star = w_eval + step;
+    const int sign = load_sign_;
+    double tau = -1;  // max |tau| at the ends, once known
+    auto max_torque = [&] {
+      if (tau < 0) {
+        const double back = speed0 - w_eval;  // to the base speed
+        const double torque0 = back >= v.affine_low && back <= v.affine_high
+                                   ? v.torque + v.d_torque * back
+                                   : load.TorqueAt(angle0 + k.c * speed0, speed0, h_load);
+        tau = std::max(std::abs(v.torque) + std::abs(v.d_torque * step), std::abs(torque0));
+      }
+      return tau;
+    };
+    if (limit == 0) {
+      // x' = 1000 (i0 + 2 s w) is affine: its values at the ends bound it
+      const double x_slope0 = 2 * kSwitchSharpness * (current0 + 2 * k.current_slope * speed0);
+      const double x_slope1 = 2 * kSwitchSharpness * (current0 + 2 * k.current_slope * w_star);
+      if (sign > 0 ? (x_slope0 >= 0 && x_slope1 >= 0)
+                   : (sign < 0 && x_slope0 <= 0 && x_slope1 <= 0))
+        return true;
+      const double x_slope = std::max(std::abs(x_slope0), std::abs(x_slope1));
+      if (k.c_ratio * max_torque() * 0.25 * k.spread * x_slope < 0.5) return true;
+    }
+    const double lo = std::min(speed0, w_star);
+    const double hi = std::max(speed0, w_star);
+    double x_min = kInfinity;
+    double x_max = -kInfinity;
+    double x_slope_min = kInfinity;
+    double x_slope_max = -kInfinity;
+    auto x_slope_at = [&](double current, double d_current, double w) {
+      const double x_slope = 2 * kSwitchSharpness * (current + d_current * w);
+      x_slope_min = std::min(x_slope_min, x_slope);
+      x_slope_max = std::max(x_slope_max, x_slope);
+    };
+    auto visit = [&](double w) {
+      double current;
+      double x;
+      const int state = state_at(w, &current, &x);
+      x_min = std::min(x_min, x);
+      x_max = std::max(x_max, x);
+      x_slope_at(current, state > 2 ? 0.0 : k.current_slope, w);
+    };
+    visit(lo);
+    visit(hi);
+    // x = 1000 i w + 10 is quadratic in w where the current is not limited: its vertex
+    const double vertex = -current0 / (2 * k.current_slope);
+    if (vertex > lo && vertex < hi) visit(vertex);
+    // where the limit starts, both sides
+    if (limit > 0) {
+      for (const double bound : {limit, -limit}) {
+        const double w = (bound - current0) / k.current_slope;
+        if (!(w > lo && w < hi)) continue;
+        const double x = 2 * (kSwitchSharpness * (bound * w) + kSwitchOffset);
+        x_min = std::min(x_min, x);
+        x_max = std::max(x_max, x);
+        x_slope_at(bound, 0.0, w);
+        x_slope_at(bound, k.current_slope, w);
+      }
+    }
+    if (x_min > kSwitchSaturation || x_max < -kSwitchSaturation) return true;
+    if ((sign > 0 && x_slope_min >= 0) || (sign < 0 && x_slope_max <= 0)) return true;
+    const double x_slope = std::max(std::abs(x_slope_min), std::abs(x_slope_max));
+    return k.c_ratio * max_torque() * 0.25 * k.spread * x_slope < 0.5;
+  };
+
+  // Safeguarded Newton: the residual increases with w, so each value narrows a bracket. It stops
+  // when the bound of the residual after the step puts the speed within the tolerance of the
+  // stage's solution, usually after the first step from the guess.
+  double low = -kInfinity;
+  double high = kInfinity;
+  double w = w0;
+  for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
+    Value v;
+    const int state = evaluate(w, &v);
+    if (!std::isfinite(v.residual) || !(v.slope > 0) || !std::isfinite(v.slope)) break;
+    const double step = v.residual == 0 ? 0.0 : -v.residual / v.slope;
+    const double tolerance = k.tolerance + kNewtonTolerance * std::abs(w);  // [rad/s]
+    if (std::abs(step) <= kRoundingStep * tolerance ||
+        bound_after(v, state, w, step) <= tolerance * v.slope) {
+      if (!first_from_base(v, w, step)) break;
+      return w + step;
+    }
+    (v.residual < 0 ? low : high) = w;
+    w += step;
+    if (!(w > low && w < high)) {
+      if (!std::isfinite(low) || !std::isfinite(high)) break;
+      w = 0.5 * (low + high);  // bisection when Newton leaves the bracket
+    }
+  }
+  return SolveStageBracketing(a, voltage, h_load, load);
+}
+
+double DcMotor::SolveStageBracketing(const DcMotorState& a, double voltage, double h_load,
+                                     const SpoolLoad& load) const {
+  const DcMotorParameters& p = parameters_;
+  const StageConstants& k = constants_;
+  const double inertia = p.gear_ratio * this->inertia();  // N J [kg m^2]
+  auto residual = [&](double w) {
+    const Stage s = StageAt(a, voltage, w);
+    const double torque = load.TorqueAt(s.spool_angle, w, h_load);
+    const double rho = GearEfficiencyFactor(p.efficiency, s.current, w);
+    const double acceleration =
+        (p.torque_constant * s.current - torque / (rho * p.gear_ratio)) / inertia;
+    return w - a.spool_speed - k.c * acceleration;
+  };
+  return FindRoot(residual, a.spool_speed, kSpeedTolerance);
+}
+
+void DcMotor::Substep(double voltage, SpoolLoad& load, bool last) {
+  const double h = constants_.h;
+  const double c = constants_.c;
+  const DcMotorState y = state_;
+  // first stage, Y1 = y + c f(Y1), its speed guessed from the slope at the end of the last
+  // sub-step
+  const double w1 =
+      locked_ ? 0.0 : SolveStage(y, voltage, c, y.spool_speed + c * last_acceleration_, load);
+  const Stage first = StageAt(y, voltage, w1);
+  // second stage: y + (1 - gamma) h f(Y1) + c f(Y2) with f(Y1) = (Y1 - y) / c, its speed guessed
+  // from y + h f(Y1)
   const double k = (1 - kGamma) / kGamma;
-  DcMotorState a = state_;
-  a.current += k * (first.current - state_.current);
-  a.spool_speed += k * (first.spool_speed - state_.spool_speed);
-  a.spool_angle += k * (first.spool_angle - state_.spool_angle);
-  const Stage second = SolveStage(a, c, voltage, h, load);
+  DcMotorState a = y;
+  a.current += k * (first.current - y.current);
+  a.spool_speed += k * (first.spool_speed - y.spool_speed);
+  a.spool_angle += k * (first.spool_angle - y.spool_angle);
+  const double slope1 = (w1 - y.spool_speed) * constants_.inverse_c;
+  const double w2 = locked_ ? 0.0 : SolveStage(a, voltage, h, y.spool_speed + h * slope1, load);
+  const Stage second = StageAt(a, voltage, w2);
+  last_acceleration_ = (w2 - a.spool_speed) * constants_.inverse_c;
   state_.current = second.current;
   state_.spool_speed = second.spool_speed;
   state_.spool_angle = second.spool_angle;
   applied_voltage_ = second.voltage;
-  load_torque_ = second.torque;
+  if (last) load_torque_ = load.TorqueAt(second.spool_angle, w2, h);
   load.Advance(state_.spool_angle, state_.spool_speed, h);
 }
 
@@ -225,9 +510,10 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
     throw std::invalid_argument("dc motor: voltage must be finite, got " + std::to_string(voltage));
   if (!(dt > 0) || !std::isfinite(dt))
     throw std::invalid_argument("dc motor: time step must be > 0 [s], got " + std::to_string(dt));
-  const int n = std::max(1, static_cast<int>(std::ceil(dt / parameters_.max_substep - 1e-9)));
-  const double h = dt / n;
-  for (int i = 0; i < n; ++i) Substep(voltage, h, load);
+  if (dt != constants_.dt) UpdateConstants(dt);
+  load_sign_ = load.TorqueSign();
+  const int n = constants_.substeps;
+  for (int i = 0; i < n; ++i) Substep(voltage, load, i + 1 == n);
 }
 
 void DcMotor::Step(double voltage, double dt, double load_torque) {

@@ -69,6 +69,25 @@ void ElasticElement::CheckValue(const Field& field, double value) {
                                 "], got " + Number(value));
 }
 
+double ElasticElement::PeekWithSlopes(double length, double rate, double dt, double* d_length,
+                                      double* d_rate) const {
+  const double dl = 1e-9 * std::max(1.0, std::abs(length));
+  const double dv = 1e-9 * std::max(1.0, std::abs(rate));
+  *d_length = (Peek(length + dl, rate, dt) - Peek(length - dl, rate, dt)) / (2 * dl);
+  *d_rate = (Peek(length, rate + dv, dt) - Peek(length, rate - dv, dt)) / (2 * dv);
+  return Peek(length, rate, dt);
+}
+
+double ElasticElement::PeekAlong(double length, double rate, double dt, double d_length,
+                                 double d_rate, double* slope, double* low, double* high) const {
+  double by_length;
+  double by_rate;
+  const double force = PeekWithSlopes(length, rate, dt, &by_length, &by_rate);
+  *slope = by_length * d_length + by_rate * d_rate;
+  *low = *high = 0;
+  return force;
+}
+
 ElasticElement::Field ElasticElement::Parameter(const std::string& name, const std::string& unit,
                                                 double* value, Range range) {
   return Field{Quantity{name, unit, true, true}, value, range};
@@ -83,12 +102,6 @@ LinearSpringDamper::LinearSpringDamper(double stiffness, double damping, double 
     : stiffness_(stiffness), damping_(damping) {
   rest_length_ = rest_length;
   for (const Field& field : Fields()) CheckValue(field, *field.value);
-}
-
-double LinearSpringDamper::Peek(double length, double rate, double) const {
-  const double extension = length - rest_length_;
-  if (extension <= 0) return 0;
-  return std::max(stiffness_ * extension + damping_ * rate, 0.0);
 }
 
 double LinearSpringDamper::RelaxedLength(double force) const {
@@ -109,13 +122,25 @@ ZenerElement::ZenerElement(const ZenerParameters& p)
   Reset(rest_length_);
 }
 
+const ZenerElement::Factors& ZenerElement::FactorsFor(double dt) const {
+  dt = std::max(dt, 0.0);
+  for (const Factors& f : factors_)
+    if (f.dt == dt) return f;
+  Factors& f = factors_[factors_next_];
+  factors_next_ = 1 - factors_next_;
+  const double x = dt * e1_ / mu_;
+  f.dt = dt;
+  f.decay = std::exp(-x);
+  f.ramp = x > 0 ? -std::expm1(-x) / x : 1.0;
+  return f;
+}
+
 ZenerElement::Next ZenerElement::Advance(double length, double dt) const {
   Next next;
   next.strain = std::max(length / rest_length_ - 1, 0.0);
   // exact for a strain moving linearly: q decays, the ramp adds E1 de (1 - e^-x) / x
-  const double x = std::max(dt, 0.0) * e1_ / mu_;
-  const double ramp = x > 0 ? -std::expm1(-x) / x : 1.0;
-  next.maxwell_stress = maxwell_stress_ * std::exp(-x) + e1_ * (next.strain - strain_) * ramp;
+  const Factors& f = FactorsFor(dt);
+  next.maxwell_stress = maxwell_stress_ * f.decay + e1_ * (next.strain - strain_) * f.ramp;
   next.stress = e0_ * next.strain + next.maxwell_stress;
   return next;
 }
@@ -128,6 +153,44 @@ void ZenerElement::Reset(double length) {
 
 double ZenerElement::Peek(double length, double, double dt) const {
   return std::max(Advance(length, dt).stress * area_, 0.0);
+}
+
+double ZenerElement::PeekWithSlopes(double length, double, double dt, double* d_length,
+                                    double* d_rate) const {
+  const Factors& f = FactorsFor(dt);
+  const double strain = std::max(length / rest_length_ - 1, 0.0);
+  const double stress =
+      e0_ * strain + (maxwell_stress_ * f.decay + e1_ * (strain - strain_) * f.ramp);  // Advance()
+  *d_rate = 0;
+  const double force = stress * area_;
+  if (!(force > 0)) {
+    *d_length = 0;
+    return 0;
+  }
+  *d_length = strain > 0 ? area_ * (e0_ + e1_ * f.ramp) / rest_length_ : 0.0;
+  return force;
+}
+
+double ZenerElement::PeekAlong(double length, double, double dt, double d_length, double,
+                               double* slope, double* low, double* high) const {
+  const Factors& f = FactorsFor(dt);
+  const double raw = length / rest_length_ - 1;  // the strain before clamping at 0
+  const double strain = std::max(raw, 0.0);
+  const double stress =
+      e0_ * strain + (maxwell_stress_ * f.decay + e1_ * (strain - strain_) * f.ramp);  // Advance()
+  // stress is affine in the length while the strain is positive, constant while it is clamped
+  const double d_stress = raw > 0 ? (e0_ + e1_ * f.ramp) * d_length / rest_length_ : 0.0;
+  *low = -kUnbounded;
+  *high = kUnbounded;
+  KeepSign(raw, d_length / rest_length_, low, high);
+  KeepSign(stress, d_stress, low, high);
+  const double force = stress * area_;
+  if (!(force > 0)) {
+    *slope = 0;
+    return 0;
+  }
+  *slope = area_ * d_stress;
+  return force;
 }
 
 double ZenerElement::Force(double length, double, double dt) {
@@ -152,7 +215,10 @@ std::vector<ElasticElement::Field> ZenerElement::Fields() {
           State("stress", "Pa", &stress_)};
 }
 
-void ZenerElement::Changed() { stress_ = e0_ * strain_ + maxwell_stress_; }
+void ZenerElement::Changed() {
+  stress_ = e0_ * strain_ + maxwell_stress_;
+  factors_[0] = factors_[1] = Factors{};  // E1 or mu may have changed
+}
 
 PolynomialSpring::PolynomialSpring(std::vector<double> coefficients, double damping,
                                    double rest_length)
@@ -176,6 +242,27 @@ double PolynomialSpring::Peek(double length, double rate, double) const {
   const double extension = length - rest_length_;
   if (extension <= 0) return 0;
   return std::max(Static(extension) + damping_ * rate, 0.0);
+}
+
+double PolynomialSpring::PeekWithSlopes(double length, double rate, double, double* d_length,
+                                        double* d_rate) const {
+  const double extension = length - rest_length_;
+  double force = 0;
+  double slope = 0;
+  if (extension > 0) {
+    for (auto c = coefficients_.rbegin(); c != coefficients_.rend(); ++c) {
+      slope = slope * extension + (force + *c);
+      force = (force + *c) * extension;
+    }
+    force += damping_ * rate;
+  }
+  if (extension <= 0 || !(force > 0)) {
+    *d_length = *d_rate = 0;
+    return 0;
+  }
+  *d_length = slope;
+  *d_rate = damping_;
+  return force;
 }
 
 double PolynomialSpring::RelaxedLength(double force) const {
@@ -255,12 +342,27 @@ std::vector<std::pair<double, double>> TableSpring::Parse(const std::string& tex
   return points;
 }
 
-double TableSpring::Static(double extension) const {
+double TableSpring::Static(double extension, double* slope) const {
   std::size_t i = 1;
   while (i + 1 < points_.size() && points_[i].first < extension) ++i;
   const auto& [x0, f0] = points_[i - 1];
   const auto& [x1, f1] = points_[i];
+  if (slope) *slope = (f1 - f0) / (x1 - x0);
   return f0 + (f1 - f0) * (extension - x0) / (x1 - x0);
+}
+
+double TableSpring::PeekWithSlopes(double length, double rate, double, double* d_length,
+                                   double* d_rate) const {
+  const double extension = length - rest_length_;
+  double slope = 0;
+  const double force = extension > 0 ? Static(extension, &slope) + damping_ * rate : 0.0;
+  if (!(force > 0)) {
+    *d_length = *d_rate = 0;
+    return 0;
+  }
+  *d_length = slope;
+  *d_rate = damping_;
+  return force;
 }
 
 double TableSpring::Peek(double length, double rate, double) const {

@@ -4,6 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -63,9 +64,10 @@ void RequireFinite(const std::string& prefix, const char* what, double value) {
 // elastic element, along a path of fixed length over one step
 class TendonSpoolLoad : public SpoolLoad {
  public:
-  TendonSpoolLoad(ElasticElement* elastic, double path_length, double path_speed,
-                  double line_length, double spool_angle, double spool_radius)
+  TendonSpoolLoad(ElasticElement* elastic, const LinearSpringDamper* linear, double path_length,
+                  double path_speed, double line_length, double spool_angle, double spool_radius)
       : elastic_(elastic),
+        linear_(linear),
         path_length_(path_length),
         path_speed_(path_speed),
         line_length_(line_length),
@@ -80,21 +82,42 @@ class TendonSpoolLoad : public SpoolLoad {
     return path_speed_ + spool_radius_ * spool_speed;
   }
   double TorqueAt(double spool_angle, double spool_speed, double h) const override {
-    return spool_radius_ * elastic_->Peek(ElasticLength(spool_angle), ElasticSpeed(spool_speed), h);
+    const double length = ElasticLength(spool_angle);
+    const double speed = ElasticSpeed(spool_speed);
+    // the default element without a second virtual call
+    return spool_radius_ * (linear_ ? linear_->LinearSpringDamper::Peek(length, speed, h)
+                                    : elastic_->Peek(length, speed, h));
+  }
+  double TorqueAlong(double spool_angle, double spool_speed, double h, double angle_per_speed,
+                     double* slope, double* low, double* high) const override {
+    // the elastic length and speed grow by r_s per radian and per rad/s
+    const double length = ElasticLength(spool_angle);
+    const double speed = ElasticSpeed(spool_speed);
+    const double d_length = spool_radius_ * angle_per_speed;
+    double d_force;
+    const double force =
+        linear_
+            ? linear_->LinearSpringDamper::PeekAlong(length, speed, h, d_length, spool_radius_,
+                                                     &d_force, low, high)
+            : elastic_->PeekAlong(length, speed, h, d_length, spool_radius_, &d_force, low, high);
+    *slope = spool_radius_ * d_force;
+    return spool_radius_ * force;
   }
   void Advance(double spool_angle, double spool_speed, double h) override {
     force_ = elastic_->Force(ElasticLength(spool_angle), ElasticSpeed(spool_speed), h);
   }
+  int TorqueSign() const override { return 1; }  // tension only
   double force() const { return force_; }
 
  private:
   ElasticElement* elastic_;
-  double path_length_;   // [m]
-  double path_speed_;    // [m/s]
-  double line_length_;   // free line at the start of the step [m]
-  double spool_angle_;   // at the start of the step [rad]
-  double spool_radius_;  // [m]
-  double force_ = 0;     // [N]
+  const LinearSpringDamper* linear_;  // elastic_ when it is the linear element, else null
+  double path_length_;                // [m]
+  double path_speed_;                 // [m/s]
+  double line_length_;                // free line at the start of the step [m]
+  double spool_angle_;                // at the start of the step [rad]
+  double spool_radius_;               // [m]
+  double force_ = 0;                  // [N]
 };
 
 class DcMotorTendon : public TendonActuator {
@@ -121,6 +144,8 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + e.what());
     }
     elastic_ = MakeElasticElement(a);
+    if (typeid(*elastic_) == typeid(LinearSpringDamper))
+      linear_ = static_cast<const LinearSpringDamper*>(elastic_.get());
     Reset(elastic_->RelaxedLength(pretension_));
   }
 
@@ -147,7 +172,7 @@ class DcMotorTendon : public TendonActuator {
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     const double angle = motor_.state().spool_angle;
-    TendonSpoolLoad load(elastic_.get(), path_length, path_speed, line_length_, angle,
+    TendonSpoolLoad load(elastic_.get(), linear_, path_length, path_speed, line_length_, angle,
                          motor_.parameters().spool_radius);
     motor_.Step(voltage(), dt, load);
     path_length_ = path_length;
@@ -253,6 +278,7 @@ class DcMotorTendon : public TendonActuator {
   std::string prefix_;
   DcMotor motor_;
   std::unique_ptr<ElasticElement> elastic_;
+  const LinearSpringDamper* linear_ = nullptr;  // elastic_ when it is linear (no virtual calls)
   bool duty_input_ = false;
   double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
   double pretension_ = 0;                          // at Reset [N]

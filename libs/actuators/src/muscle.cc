@@ -46,6 +46,41 @@ double ThelenActiveSlope(double l, double gamma) {
   return -2 * (l - 1) / gamma * ThelenActiveForceLength(l, gamma);
 }
 
+// The activation a(h) of da/dt = (u - a) / tau with tau = tau_act (0.5 + 1.5 a) while u > a and
+// tau_deact / (0.5 + 1.5 a) while u < a (the law of ActivationRate for a, u in [0, 1]; a never
+// crosses u), solved exactly, P = 0.5 + 1.5 u:
+//   rising, v = u - a:  P ln(v / v0) - 1.5 (v - v0) = -h / tau_act, solved for ln v by Halley's
+//                       method from the tangent at v0 (left of the root of a concave, increasing
+//                       function);
+//   falling, w = a - u: w / (P + 1.5 w) = w0 / (P + 1.5 w0) exp(-P h / tau_deact).
+double ExactActivation(double u, double a, double h, double tau_act, double tau_deact) {
+  const double p = 0.5 + 1.5 * u;
+  if (u > a) {
+    const double v0 = u - a;
+    const double y0 = std::log(v0);
+    const double rhs = h / tau_act;
+    double y = y0 - rhs / (0.5 + 1.5 * a);
+    for (int i = 0; i < 20; ++i) {
+      const double v = std::exp(y);
+      const double g = p * (y - y0) - 1.5 * (v - v0) + rhs;
+      const double slope = p - 1.5 * v;  // >= 0.5: v <= v0 <= u, p = 0.5 + 1.5 u
+      const double curvature = -1.5 * v;
+      const double step = -2 * g * slope / (2 * slope * slope - g * curvature);
+      // converging cubically with a constant below 3 (|g'''| = |g''| <= 1.5, g' >= 0.5): after a
+      // step below 1e-6 the error in y (relative in v) is below 3e-18
+      if (std::abs(step) < 1e-6) return u - v * (1 + step * (1 + 0.5 * step));  // v e^step
+      y += step;
+    }
+    return u - std::exp(y);
+  }
+  if (u < a) {
+    const double w0 = a - u;
+    const double q = w0 / (p + 1.5 * w0) * std::exp(-p * h / tau_deact);
+    return u + q * p / (1 - 1.5 * q);
+  }
+  return a;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -436,7 +471,7 @@ struct Outputs {
   double fiber_velocity = 0;        // [m/s]
   double norm_fiber_length = 0;     // [-]
   double norm_fiber_velocity = 0;   // [-]
-  double pennation = 0;             // [rad]
+  double pennation_cos = 1;         // cos(pennation) [-]; < 0: pi/2 (no fibre along the path)
   double tendon_length = 0;         // [m]
   double tendon_strain = 0;         // [-]
   double active_force_length = 0;   // [-]
@@ -453,6 +488,7 @@ class HillMuscle : public TendonActuator {
       : name_(std::move(name)), curves_(curves), elastic_(elastic), p_(p) {
     activation_ = InitialActivation();
     fiber_length_ = p_.thelen.optimal_fiber_length;
+    UpdateDerived();
   }
 
   void Reset(double path_length) override {
@@ -532,7 +568,8 @@ class HillMuscle : public TendonActuator {
     if (name == "passive_force") return out_.passive_force;
     if (name == "tension") return out_.tension;
     if (curves_ == Curves::kThelen) {
-      if (name == "pennation") return out_.pennation;
+      if (name == "pennation")
+        return out_.pennation_cos < 0 ? kPi / 2 : std::acos(out_.pennation_cos);
       if (name == "tendon_length") return out_.tendon_length;
       if (name == "tendon_strain") return out_.tendon_strain;
     }
@@ -550,6 +587,7 @@ class HillMuscle : public TendonActuator {
           throw std::invalid_argument(Prefix() + error.what());
         }
         p_ = candidate;
+        UpdateDerived();
         activation_ = Clamp(activation_, MinimumActivation(), 1);
         return;
       }
@@ -622,45 +660,39 @@ class HillMuscle : public TendonActuator {
                                p_.mujoco.range1);
   }
 
-  // RK4 steps of h |d(da/dt)/da| <= 0.05; that derivative is at most 8 / tau_act while rising
-  // (at a = 0, u = 1) and 3.5 / tau_deact while falling (at a = 1, u = 0)
-  double ActivationSubstep() const {
+  // The activation after h [s] with the excitation held: the exact solution of
+  // da/dt = (u - a) / tau(a) (ActivationRate, MujocoActivationRate), clamped to [minimum, 1].
+  double IntegrateActivation(double a, double h) const {
     const bool thelen = curves_ == Curves::kThelen;
+    const double minimum = MinimumActivation();
+    const double u = Clamp(excitation_, minimum, 1);
+    a = Clamp(a, minimum, 1);
     const double tau_act = thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act;
     const double tau_deact = thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact;
-    return 0.05 / std::max(8 / tau_act, 3.5 / tau_deact);
-  }
-
-  double ActivationRateOf(double a) const {
-    if (curves_ == Curves::kThelen)
-      return ActivationRate(excitation_, a, p_.thelen.activation_time_constant,
-                            p_.thelen.deactivation_time_constant, p_.thelen.minimum_activation);
-    return MujocoActivationRate(excitation_, a, p_.mujoco.tau_act, p_.mujoco.tau_deact);
-  }
-
-  // classical RK4 over h in sub-steps, clamped to [minimum, 1]
-  double IntegrateActivation(double a, double h) const {
-    const int n = std::max(1, static_cast<int>(std::ceil(h / ActivationSubstep() - 1e-9)));
-    const double k = h / n;
-    for (int i = 0; i < n; ++i) {
-      const double k1 = ActivationRateOf(a);
-      const double k2 = ActivationRateOf(a + 0.5 * k * k1);
-      const double k3 = ActivationRateOf(a + 0.5 * k * k2);
-      const double k4 = ActivationRateOf(a + k * k3);
-      a = Clamp(a + k / 6 * (k1 + 2 * k2 + 2 * k3 + k4), MinimumActivation(), 1);
-    }
-    return a;
+    return Clamp(ExactActivation(u, a, h, tau_act, tau_deact), minimum, 1);
   }
 
   // --- Thelen with an elastic tendon: fibre length state
 
-  double Height() const {
-    return p_.thelen.optimal_fiber_length * std::sin(p_.thelen.pennation_angle);
+  // what the parameters give, once per change: the fibres' height, the shortest fibre, the
+  // passive curve's denominator
+  void UpdateDerived() {
+    const ThelenMuscleParameters& t = p_.thelen;
+    height_ = t.optimal_fiber_length * std::sin(t.pennation_angle);
+    minimum_fiber_length_ =
+        std::max(height_ / std::sin(t.maximum_pennation_angle), 0.01 * t.optimal_fiber_length);
+    passive_denominator_ = std::exp(t.curves.kshape_passive) - 1;
   }
 
-  double MinimumFiberLength() const {
-    return std::max(Height() / std::sin(p_.thelen.maximum_pennation_angle),
-                    0.01 * p_.thelen.optimal_fiber_length);
+  double Height() const { return height_; }  // optimal_fiber_length sin(pennation_angle) [m]
+
+  double MinimumFiberLength() const { return minimum_fiber_length_; }  // [m]
+
+  // ThelenPassiveForceLength with the parameters' denominator
+  double PassiveForceLength(double l) const {
+    if (l <= 1) return 0;
+    const ThelenCurveParameters& c = p_.thelen.curves;
+    return (std::exp(c.kshape_passive * (l - 1) / c.fmax_muscle_strain) - 1) / passive_denominator_;
   }
 
   // normalised fibre force along the fibre needed by the tendon, and its derivative by lm
@@ -682,7 +714,7 @@ class HillMuscle : public TendonActuator {
     const double l = lm / t.optimal_fiber_length;
     b.fse = ThelenTendonForceStrain(strain, t.curves.fmax_tendon_strain);
     b.fal = ThelenActiveForceLength(l, t.curves.kshape_active);
-    b.fpe = ThelenPassiveForceLength(l, t.curves.kshape_passive, t.curves.fmax_muscle_strain);
+    b.fpe = PassiveForceLength(l);
     const double cos = std::max(b.cos, 1e-12);
     b.num = b.fse / cos - b.fpe;
     b.den = std::max(a * b.fal, 1e-12);
@@ -782,10 +814,10 @@ class HillMuscle : public TendonActuator {
     const double along = length - t.tendon_slack_length;
     Outputs o;
     o.tendon_length = t.tendon_slack_length;
-    o.fiber_length =
-        PennatedFiberLength(std::max(along, 0.0), t.optimal_fiber_length, t.pennation_angle);
+    const double straight = std::max(along, 0.0);
+    o.fiber_length = std::sqrt(height_ * height_ + straight * straight);  // PennatedFiberLength
     const double cos = along > 0 && o.fiber_length > 0 ? along / o.fiber_length : 0.0;
-    o.pennation = along > 0 ? std::acos(cos) : kPi / 2;
+    o.pennation_cos = along > 0 ? cos : -1;
     o.fiber_velocity = cos * speed;
     FillThelenForces(&o, t.max_isometric_force, cos);
     out_ = o;
@@ -797,7 +829,7 @@ class HillMuscle : public TendonActuator {
     const Balance b = BalanceAt(lm, length, activation_);
     Outputs o;
     o.fiber_length = lm;
-    o.pennation = std::acos(Clamp(b.cos, 0, 1));
+    o.pennation_cos = Clamp(b.cos, 0, 1);
     o.tendon_length = length - lm * b.cos;
     o.tendon_strain = o.tendon_length / t.tendon_slack_length - 1;
     o.fiber_velocity = FiberVelocity(lm, length, activation_).first;
@@ -819,8 +851,7 @@ class HillMuscle : public TendonActuator {
     o->norm_fiber_velocity =
         o->fiber_velocity / (t.max_contraction_velocity * t.optimal_fiber_length);
     o->active_force_length = ThelenActiveForceLength(o->norm_fiber_length, t.curves.kshape_active);
-    o->passive_force_length = ThelenPassiveForceLength(
-        o->norm_fiber_length, t.curves.kshape_passive, t.curves.fmax_muscle_strain);
+    o->passive_force_length = PassiveForceLength(o->norm_fiber_length);
     o->force_velocity = ThelenForceVelocity(o->norm_fiber_velocity, activation_, t.curves);
     o->active_fiber_force = f0 * activation_ * o->active_force_length * o->force_velocity;
     o->passive_force = f0 * o->passive_force_length;
@@ -831,9 +862,12 @@ class HillMuscle : public TendonActuator {
   Curves curves_;
   bool elastic_;
   AllParameters p_;
-  double excitation_ = 0;    // command u [-], in [0, 1]
-  double activation_ = 0;    // [-]
-  double fiber_length_ = 0;  // elastic tendon state [m]
+  double height_ = 0;                // optimal_fiber_length sin(pennation_angle) [m]
+  double minimum_fiber_length_ = 0;  // [m]
+  double passive_denominator_ = 1;   // exp(kshape_passive) - 1 [-]
+  double excitation_ = 0;            // command u [-], in [0, 1]
+  double activation_ = 0;            // [-]
+  double fiber_length_ = 0;          // elastic tendon state [m]
   Outputs out_;
 };
 

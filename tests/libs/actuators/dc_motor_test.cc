@@ -222,6 +222,94 @@ TEST(DcMotor, RoboyMotorRunsAtItsNoLoadSpeed) {
   EXPECT_NEAR(motor.state().spool_speed, 3.986, 0.001);
 }
 
+TEST(DcMotor, GearEfficiencyFactorIsTheTanhBlendOfTendonsMd) {
+  for (double iw = -0.1; iw <= 0.1; iw += 1e-4) {
+    const double blend = (std::tanh(-500 * iw - 5) + 1) / 2;
+    EXPECT_NEAR(GearEfficiencyFactor(0.59, 1, iw), 0.59 + (1 / 0.59 - 0.59) * blend, 1e-15)
+        << "i w " << iw;
+  }
+}
+
+TEST(DcMotor, TheDefaultSubstepsMatchTheFineReferenceCloselyAndShorterOnesCloser) {
+  // the fine-reference comparison of the test above, for the default sub-steps (1/3 ms) and for
+  // the earlier default 0.1 ms: errors reached 1.4e-4 and 1.3e-5 rad/s
+  DcMotor fine(Reference());
+  const std::vector<double> w_fine = CaliperEraSpeeds(1e-5, fine);
+  DcMotorParameters p = Reference();
+  EXPECT_EQ(p.max_substep, 3.4e-4);
+  for (double max_substep : {3.4e-4, 1e-4}) {
+    p.max_substep = max_substep;
+    DcMotor coarse(p);
+    const std::vector<double> w_coarse = CaliperEraSpeeds(1e-3, coarse);
+    double worst = 0;
+    for (double t : {1.002, 1.005, 1.01, 1.02, 1.05, 3.002, 3.005, 3.01, 3.5, 4.002, 4.005, 4.02})
+      worst = std::max(worst, std::abs(SpeedAt(w_coarse, 1e-3, t) - SpeedAt(w_fine, 1e-5, t)));
+    EXPECT_LT(worst, max_substep > 2e-4 ? 3e-4 : 3e-5) << "max_substep " << max_substep;
+    EXPECT_NEAR(coarse.state().spool_angle, fine.state().spool_angle, 1e-4);
+  }
+}
+
+// a load known only through TorqueAt(): the motor differentiates it numerically and knows no
+// affine range or sign
+class OpaqueLoad : public SpoolLoad {
+ public:
+  explicit OpaqueLoad(double torque) : torque_(torque) {}
+  double TorqueAt(double, double, double) const override { return torque_; }
+  void Advance(double, double, double) override {}
+
+ private:
+  double torque_;
+};
+
+TEST(DcMotor, AnOpaqueLoadGivesWhatTheConstantLoadGives) {
+  DcMotor known(Reference());
+  DcMotor opaque(Reference());
+  for (int i = 0; i < 3000; ++i) {
+    const double t = i * 1e-3;
+    const double voltage = t < 2 ? kVoltage : -kVoltage;
+    const double load = t >= 1 && t < 1.5 ? 11.6 : (t >= 2.2 && t < 2.4 ? 20.0 : 0.0);
+    known.Step(voltage, 1e-3, load);
+    OpaqueLoad same(load);
+    opaque.Step(voltage, 1e-3, same);
+    ASSERT_NEAR(opaque.state().spool_speed, known.state().spool_speed, 1e-9) << "t " << t;
+    ASSERT_NEAR(opaque.state().current, known.state().current, 1e-8) << "t " << t;
+  }
+}
+
+TEST(DcMotor, AStageWithSeveralSolutionsTakesTheFirstFromItsBase) {
+  // back-driven at 2.9 rad/s by 28 N m with the current reversing: an implicit stage of this step
+  // has three solutions (near 2.68, 2.70 and 2.72 rad/s); the first from the stage's base speed,
+  // which the bracketing search finds, gives 1.4333 rad/s at the end of the step (another
+  // gives 1.3613; the fine-step solution is 1.4032)
+  DcMotorParameters p = Reference();
+  p.max_substep = 1e-4;
+  DcMotor motor(p);
+  DcMotorState s;
+  s.current = 17.861130985985536;
+  s.spool_speed = 2.8777802982414546;
+  s.spool_angle = -3.7918841563628174;
+  motor.set_state(s);
+  motor.Step(-0.33577714971295014, 0.0013503518161756592, 28.283453493587231);
+  EXPECT_NEAR(motor.state().spool_speed, 1.43332763, 1e-7);
+  EXPECT_NEAR(motor.state().current, -5.058883524, 1e-7);
+}
+
+TEST(DcMotor, ChangingTheStepLengthRecomputesTheSubsteps) {
+  // a motor that keeps its step constants against one that recomputes them for every step
+  DcMotor kept(Reference());
+  DcMotor fresh(Reference());
+  const double steps[] = {1e-3, 2.5e-4, 1e-3, 5e-3, 7e-5, 1e-3};
+  for (int round = 0; round < 50; ++round) {
+    for (double dt : steps) {
+      kept.Step(kVoltage, dt, 5.0);
+      fresh.set_parameters(fresh.parameters());
+      fresh.Step(kVoltage, dt, 5.0);
+      ASSERT_NEAR(kept.state().spool_speed, fresh.state().spool_speed, 1e-12) << dt;
+      ASSERT_NEAR(kept.state().current, fresh.state().current, 1e-12) << dt;
+    }
+  }
+}
+
 TEST(DcMotor, RejectsParametersOutOfRangeAndBadSteps) {
   DcMotorParameters p = Reference();
   p.resistance = -1;

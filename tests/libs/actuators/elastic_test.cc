@@ -4,9 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace caliper::actuators {
 namespace {
@@ -214,6 +217,134 @@ TEST(ElasticElement, FactoryReadsTheOptionsAndParameters) {
     EXPECT_TRUE(Contains(e.what(), "shin")) << e.what();
     EXPECT_TRUE(Contains(e.what(), "stiffness")) << e.what();
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// the slopes and affine ranges a motor's Newton iteration uses
+
+// the elements of this file in a state where each has its kinks within reach
+std::vector<std::unique_ptr<ElasticElement>> Elements() {
+  std::vector<std::unique_ptr<ElasticElement>> elements;
+  elements.push_back(std::make_unique<LinearSpringDamper>(200, 5, 0.1));
+  auto zener = std::make_unique<ZenerElement>(Reference());
+  zener->Reset(kL0 * 1.2);
+  zener->Force(kL0 * 1.3, 0, 1e-3);  // the Maxwell arm loaded
+  elements.push_back(std::move(zener));
+  elements.push_back(
+      std::make_unique<PolynomialSpring>(std::vector<double>{100, 1e4, 1e6}, 2, 0.1));
+  elements.push_back(std::make_unique<TableSpring>(TableSpring::Parse("0.01 1; 0.02 5"), 3, 0.1));
+  return elements;
+}
+
+TEST(ElasticElement, SlopesAreTheDerivativesOfPeek) {
+  for (const auto& element : Elements()) {
+    const double rest = element->rest_length();
+    for (double extension : {0.13 * rest, 0.27 * rest, 0.6 * rest}) {
+      for (double rate : {-0.01, 0.0, 0.3}) {
+        const double length = rest + extension;
+        double d_length;
+        double d_rate;
+        const double force = element->PeekWithSlopes(length, rate, 1e-3, &d_length, &d_rate);
+        EXPECT_EQ(force, element->Peek(length, rate, 1e-3)) << element->kind();
+        const double dl = 1e-7 * rest;
+        const double numeric_length =
+            (element->Peek(length + dl, rate, 1e-3) - element->Peek(length - dl, rate, 1e-3)) /
+            (2 * dl);
+        const double numeric_rate =
+            (element->Peek(length, rate + 1e-6, 1e-3) - element->Peek(length, rate - 1e-6, 1e-3)) /
+            2e-6;
+        EXPECT_NEAR(d_length, numeric_length, 1e-6 * (1 + std::abs(numeric_length)))
+            << element->kind() << " extension " << extension << " rate " << rate;
+        EXPECT_NEAR(d_rate, numeric_rate, 1e-6 * (1 + std::abs(numeric_rate)))
+            << element->kind() << " extension " << extension << " rate " << rate;
+      }
+    }
+  }
+}
+
+TEST(ElasticElement, PeekAlongALineIsAffineWithinItsRange) {
+  // lines through taut and slack states, some crossing the rest length or a vanishing force
+  for (const auto& element : Elements()) {
+    const double rest = element->rest_length();
+    for (double start : {-0.2, 0.01, 0.3}) {
+      for (double d_length : {-0.5 * rest, 0.2 * rest}) {
+        for (double d_rate : {-3.0, 0.0, 2.0}) {
+          const double length = rest * (1 + start);
+          const double rate = 0.05;
+          double slope;
+          double low;
+          double high;
+          const double force =
+              element->PeekAlong(length, rate, 1e-3, d_length, d_rate, &slope, &low, &high);
+          const std::string where = element->kind() + " start " + std::to_string(start) +
+                                    " d_length " + std::to_string(d_length) + " d_rate " +
+                                    std::to_string(d_rate);
+          EXPECT_EQ(force, element->Peek(length, rate, 1e-3)) << where;
+          ASSERT_LE(low, 0) << where;
+          ASSERT_GE(high, 0) << where;
+          // the slope is the derivative along the line
+          double d_l;
+          double d_r;
+          element->PeekWithSlopes(length, rate, 1e-3, &d_l, &d_r);
+          EXPECT_NEAR(slope, d_l * d_length + d_r * d_rate, 1e-9 * (1 + std::abs(slope))) << where;
+          // and holds exactly over the range it claims (up to 2 units of the line)
+          for (double t : {0.0, 0.25, 0.5, 0.999, 1.0}) {
+            for (double x : {t * std::max(low, -2.0), t * std::min(high, 2.0)}) {
+              const double peeked = element->Peek(length + d_length * x, rate + d_rate * x, 1e-3);
+              EXPECT_NEAR(peeked, force + slope * x, 1e-9 * (1 + std::abs(peeked)))
+                  << where << " x " << x;
+            }
+          }
+        }
+      }
+    }
+  }
+  // the linear and Zener elements know their ranges: up to the kink, not beyond
+  LinearSpringDamper spring(200, 0, 0.1);
+  double slope;
+  double low;
+  double high;
+  EXPECT_NEAR(spring.PeekAlong(0.12, 0, 1e-3, -0.01, 0, &slope, &low, &high), 4, 1e-12);
+  EXPECT_EQ(slope, -2);
+  EXPECT_NEAR(high, 2, 1e-8);  // slack from x = 2 on
+  EXPECT_LT(high, 2);
+  EXPECT_LT(low, -1e299);
+  ZenerElement zener(Reference());
+  zener.Reset(kL0 * 1.5);
+  EXPECT_GT(zener.PeekAlong(kL0 * 1.5, 0, 1e-3, -kL0, 0, &slope, &low, &high), 0);
+  EXPECT_GT(high, 0.1);
+  EXPECT_LT(high, 0.5);  // the stress reaches zero before the strain does
+}
+
+TEST(ZenerElement, FactorsForSeveralStepLengthsGiveTheSameForcesAsAFreshElement) {
+  // a motor peeks at two step lengths in turn; a third and a change of E1 must not mix them up
+  ZenerElement zener(Reference());
+  zener.Reset(kL0);
+  zener.Force(kL0 * 1.4, 0, 1e-3);
+  for (int round = 0; round < 3; ++round) {
+    for (double dt : {2.9e-5, 1e-4, 3e-3, 1e-4, 0.0, 2.9e-5}) {
+      ZenerElement fresh(Reference());
+      fresh.Reset(kL0);
+      fresh.Force(kL0 * 1.4, 0, 1e-3);
+      for (int i = 0; i < round; ++i) {
+        zener.Force(kL0 * (1.4 + 0.01 * i), 0, 1e-3);
+        fresh.Force(kL0 * (1.4 + 0.01 * i), 0, 1e-3);
+      }
+      EXPECT_EQ(zener.Peek(kL0 * 1.45, 0, dt), fresh.Peek(kL0 * 1.45, 0, dt)) << dt;
+      zener.Reset(kL0);
+      zener.Force(kL0 * 1.4, 0, 1e-3);
+    }
+  }
+  zener.Peek(kL0 * 1.45, 0, 1e-3);  // cached for E1
+  zener.Set("zener_E1", 2 * kE1);
+  zener.Reset(kL0);
+  zener.Force(kL0 * 1.4, 0, 1e-3);
+  ZenerParameters p = Reference();
+  p.e1 = 2 * kE1;
+  ZenerElement changed(p);
+  changed.Reset(kL0);
+  changed.Force(kL0 * 1.4, 0, 1e-3);
+  EXPECT_EQ(zener.Peek(kL0 * 1.45, 0, 1e-3), changed.Peek(kL0 * 1.45, 0, 1e-3));
 }
 
 }  // namespace

@@ -30,6 +30,19 @@ class ElasticElement {
   /// [m/s] at the end. Does not change the state.
   virtual double Peek(double length, double rate, double dt) const = 0;
 
+  /// Peek() and its derivatives by the length [N/m] and by the rate [N s/m] (one-sided at a
+  /// kink: those of the branch that gave the force), for a motor's Newton iteration. The default
+  /// differentiates Peek() numerically; the elements here give them exactly.
+  virtual double PeekWithSlopes(double length, double rate, double dt, double* d_length,
+                                double* d_rate) const;
+
+  /// Peek() on the line (length + d_length x, rate + d_rate x): returns the tension at x = 0 and
+  /// sets *slope to its derivative by x and [*low, *high] (*low <= 0 <= *high) to the x over
+  /// which it is exactly affine with that slope (both 0 when not known). The default uses
+  /// PeekWithSlopes() and knows no range; the linear and Zener elements give it.
+  virtual double PeekAlong(double length, double rate, double dt, double d_length, double d_rate,
+                           double* slope, double* low, double* high) const;
+
   /// As Peek(), and accepts the step: the element's state moves on.
   virtual double Force(double length, double rate, double dt) = 0;
 
@@ -68,6 +81,18 @@ class ElasticElement {
                          Range range);
   /// A state field: read-only.
   static Field State(const std::string& name, const std::string& unit, double* value);
+  /// For PeekAlong(): narrows [*low, *high] to the x over which g0 + g1 x keeps the side of zero
+  /// g0 is on (> 0, or <= 0), with a margin of 1e-9 of the distance to the crossing.
+  static void KeepSign(double g0, double g1, double* low, double* high) {
+    if (g1 == 0) return;
+    const double crossing = -g0 / g1 * (1 - 1e-9);
+    if ((g0 > 0) == (g1 > 0)) {
+      if (crossing > *low) *low = crossing;
+    } else if (crossing < *high) {
+      *high = crossing;
+    }
+  }
+  static constexpr double kUnbounded = 1e300;
 
   double rest_length_ = 0;  // [m]
 };
@@ -80,7 +105,40 @@ class LinearSpringDamper : public ElasticElement {
   LinearSpringDamper(double stiffness, double damping, double rest_length);
   std::string kind() const override { return "linear"; }
   void Reset(double) override {}
-  double Peek(double length, double rate, double dt) const override;
+  double Peek(double length, double rate, double) const override {
+    const double extension = length - rest_length_;
+    if (extension <= 0) return 0;
+    const double force = stiffness_ * extension + damping_ * rate;
+    return force < 0 ? 0.0 : force;  // std::max(force, 0.0)
+  }
+  double PeekWithSlopes(double length, double rate, double, double* d_length,
+                        double* d_rate) const override {
+    const double extension = length - rest_length_;
+    const double force = stiffness_ * extension + damping_ * rate;
+    if (extension <= 0 || !(force > 0)) {
+      *d_length = *d_rate = 0;
+      return 0;
+    }
+    *d_length = stiffness_;
+    *d_rate = damping_;
+    return force;
+  }
+  double PeekAlong(double length, double rate, double, double d_length, double d_rate,
+                   double* slope, double* low, double* high) const override {
+    const double extension = length - rest_length_;
+    const double force = stiffness_ * extension + damping_ * rate;
+    const double d_force = stiffness_ * d_length + damping_ * d_rate;
+    *low = -kUnbounded;
+    *high = kUnbounded;
+    KeepSign(extension, d_length, low, high);  // taut or slack
+    if (extension <= 0) {
+      *slope = 0;
+      return 0;
+    }
+    KeepSign(force, d_force, low, high);  // pulling or not
+    *slope = force > 0 ? d_force : 0.0;
+    return force < 0 ? 0.0 : force;
+  }
   double Force(double length, double rate, double dt) override { return Peek(length, rate, dt); }
   double RelaxedLength(double force) const override;
 
@@ -108,7 +166,9 @@ struct ZenerParameters {
 /// ds/dt + (E1/mu) s = (E0 + E1) de/dt + (E0 E1 / mu) e, F = max(s A_0, 0). Written as
 /// s = E0 e + q with the Maxwell arm's stress dq/dt = -(E1/mu) q + E1 de/dt, and q updated exactly
 /// for a strain moving linearly over each step (stable and exact for any dt). The strain rate
-/// comes from the change of length over the step; the `rate` argument is not used.
+/// comes from the change of length over the step; the `rate` argument is not used. The exp()
+/// factors of the last two step lengths are cached (a motor peeks at two in turn), so the const
+/// members must not run concurrently on one element.
 class ZenerElement : public ElasticElement {
  public:
   /// Throws std::invalid_argument naming a parameter that is not positive.
@@ -116,6 +176,10 @@ class ZenerElement : public ElasticElement {
   std::string kind() const override { return "zener"; }
   void Reset(double length) override;
   double Peek(double length, double rate, double dt) const override;
+  double PeekWithSlopes(double length, double rate, double dt, double* d_length,
+                        double* d_rate) const override;
+  double PeekAlong(double length, double rate, double dt, double d_length, double d_rate,
+                   double* slope, double* low, double* high) const override;
   double Force(double length, double rate, double dt) override;
   double RelaxedLength(double force) const override;
 
@@ -135,15 +199,25 @@ class ZenerElement : public ElasticElement {
     double maxwell_stress;  // q [Pa]
     double stress;          // s [Pa]
   };
+  // the Maxwell arm's factors over a step of dt: decay e^-x and ramp (1 - e^-x) / x,
+  // x = dt E1 / mu; cached for the last two step lengths (a motor alternates two)
+  struct Factors {
+    double dt = -1;    // [s]; < 0: empty
+    double decay = 1;  // [-]
+    double ramp = 1;   // [-]
+  };
+  const Factors& FactorsFor(double dt) const;
   Next Advance(double length, double dt) const;
 
-  double e0_;                  // [Pa]
-  double e1_;                  // [Pa]
-  double mu_;                  // [Pa s]
-  double area_;                // [m^2]
-  double strain_ = 0;          // [-]
-  double maxwell_stress_ = 0;  // q [Pa]
-  double stress_ = 0;          // s [Pa]
+  mutable Factors factors_[2];
+  mutable int factors_next_ = 0;  // the entry replaced next
+  double e0_;                     // [Pa]
+  double e1_;                     // [Pa]
+  double mu_;                     // [Pa s]
+  double area_;                   // [m^2]
+  double strain_ = 0;             // [-]
+  double maxwell_stress_ = 0;     // q [Pa]
+  double stress_ = 0;             // s [Pa]
 };
 
 /// F = sum_i c_i x^i + c dl/dt for the extension x = l - l_rest > 0, then F = max(F, 0); 0 when
@@ -158,6 +232,8 @@ class PolynomialSpring : public ElasticElement {
   std::string kind() const override { return "polynomial"; }
   void Reset(double) override {}
   double Peek(double length, double rate, double dt) const override;
+  double PeekWithSlopes(double length, double rate, double dt, double* d_length,
+                        double* d_rate) const override;
   double Force(double length, double rate, double dt) override { return Peek(length, rate, dt); }
   /// Solved by bisection for the first extension reaching the force.
   double RelaxedLength(double force) const override;
@@ -185,6 +261,8 @@ class TableSpring : public ElasticElement {
   std::string kind() const override { return "table"; }
   void Reset(double) override {}
   double Peek(double length, double rate, double dt) const override;
+  double PeekWithSlopes(double length, double rate, double dt, double* d_length,
+                        double* d_rate) const override;
   double Force(double length, double rate, double dt) override { return Peek(length, rate, dt); }
   double RelaxedLength(double force) const override;
 
@@ -192,7 +270,8 @@ class TableSpring : public ElasticElement {
   std::vector<Field> Fields() override;
 
  private:
-  double Static(double extension) const;           // [N]
+  // the force [N] at an extension [m] > 0, and the slope of the segment used [N/m]
+  double Static(double extension, double* slope = nullptr) const;
   std::vector<std::pair<double, double>> points_;  // from (0, 0) [m], [N]
   double damping_;                                 // [N s/m]
 };

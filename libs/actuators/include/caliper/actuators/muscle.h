@@ -17,9 +17,10 @@
 //   elastic tendon: F0 fse(tendon strain), the fibre speed from the force balance through the
 //                   inverse force-velocity curve (as OpenSim's Thelen2003Muscle);
 //   mujoco:         F0 (a FL FV + FP) on MuJoCo's normalised length and speed.
-// Numerics: activation by RK4 in sub-steps of h |d(da/dt)/da| <= 0.05 (1/16 ms for tau_act 10 ms);
-// the fibre length by a two-stage L-stable SDIRK (second order) in sub-steps of <= 1 ms, each stage
-// solved by safeguarded Newton; Reset() puts the fibre at its zero-speed equilibrium.
+// Numerics: the activation ODE solved exactly over each step (the excitation held; closed form
+// while falling, Halley's method on the implicit closed form while rising); the fibre length by a
+// two-stage L-stable SDIRK (second order) in sub-steps of <= 1 ms, each stage solved by
+// safeguarded Newton; Reset() puts the fibre at its zero-speed equilibrium.
 // Quantities: the parameters (writable, validated), excitation, activation, fiber_length
 // (writable with an elastic tendon), fiber_velocity, normalized_fiber_length,
 // normalized_fiber_velocity, active_force_length, force_velocity, passive_force_length,

@@ -1,0 +1,191 @@
+// Per-step cost of the engine-free actuator kinds, built through actuators::Make with their
+// default parameters and options (plus what a kind requires), each driven along a plausible path
+// for 100,000 steps of 1 ms. Prints one line per figure:
+//   RATIO <name> <ns per step> (target <target>)
+// measured in this run (the median of several repetitions; a comment line before it gives the
+// fastest repetition too, the better figure on a shared machine), never compared with stored
+// times. Options: --steps N, --repeats N.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "caliper/actuators/actuator.h"
+#include "caliper/sgal/scene.h"
+
+namespace caliper::bench {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDt = 1e-3;  // [s]
+int steps = 100000;
+int repeats = 5;
+
+struct Case {
+  std::string name;  // figure name
+  std::string kind;  // actuator kind
+  std::map<std::string, std::string> options;
+  std::map<std::string, double> parameters;
+  double length0 = 0;                     // mean path length [m]
+  double amplitude = 0;                   // path length amplitude [m]
+  double frequency = 1;                   // path motion [Hz]
+  std::function<double(double)> command;  // command at time t [s]; none: passive
+  double target_ns = 0;                   // 0: no target
+};
+
+volatile double sink = 0;  // keeps the tensions alive
+
+struct Timing {
+  double median;  // [ns]
+  double best;    // [ns]
+};
+
+/// Time of one 1 ms step [ns] over `repeats` runs of `steps` steps from Reset(). The command is
+/// updated every step (SetCommand is part of what an adapter does per step).
+Timing TimeCase(const Case& c) {
+  sgal::Actuator a;
+  a.name = c.name;
+  a.kind = c.kind;
+  a.tendon = "t";
+  a.options = c.options;
+  a.parameters = c.parameters;
+  std::vector<double> runs;
+  for (int r = 0; r < repeats; ++r) {
+    std::unique_ptr<actuators::TendonActuator> actuator = actuators::Make(a);
+    actuator->Reset(c.length0);
+    // the path and the command, precomputed so that only the actuator is timed
+    std::vector<double> length(steps), speed(steps), command(steps);
+    for (int i = 0; i < steps; ++i) {
+      const double t = i * kDt;
+      const double w = 2 * kPi * c.frequency;
+      length[i] = c.length0 + c.amplitude * std::sin(w * t);
+      speed[i] = c.amplitude * w * std::cos(w * t);
+      command[i] = c.command ? c.command(t) : 0.0;
+    }
+    double sum = 0;
+    const auto begin = std::chrono::steady_clock::now();
+    const bool commanded = static_cast<bool>(c.command);
+    for (int i = 0; i < steps; ++i) {
+      if (commanded) actuator->SetCommand(command[i]);
+      sum += actuator->Step(length[i], speed[i], kDt);
+    }
+    const double ns =
+        std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - begin).count();
+    sink = sink + sum;
+    if (!std::isfinite(sum)) {
+      std::fprintf(stderr, "%s: non-finite tension\n", c.name.c_str());
+      std::exit(1);
+    }
+    runs.push_back(ns / steps);
+  }
+  std::sort(runs.begin(), runs.end());
+  return {runs[runs.size() / 2], runs.front()};
+}
+
+std::vector<Case> Cases() {
+  std::vector<Case> cases;
+  const auto constant = [](double v) { return [v](double) { return v; }; };
+  // [V]: forward, held, backward, so that the motor drives, holds, is back-driven and slackens
+  const auto driven = [](double t) { return 3 * std::sin(2 * kPi * 0.5 * t); };
+  // [-]: excitation swinging between 0.1 and 0.9 (activation always moving)
+  const auto excitation = [](double t) { return 0.5 + 0.4 * std::sin(2 * kPi * 2 * t); };
+
+  // the benchmark tree's actuator (bench/tree_model.cc): default parameters and options (the
+  // elastic element is then linear), 0.05 V as in physics_bench
+  cases.push_back(
+      {"dc_motor_step_ns_per_1ms", "dc_motor_tendon", {}, {}, 0.3, 0.002, 1, constant(0.05), 300});
+  // the same, driven by a voltage swinging +-3 V against a moving path
+  cases.push_back(
+      {"dc_motor_driven_step_ns_per_1ms", "dc_motor_tendon", {}, {}, 0.3, 0.01, 1, driven, 300});
+  cases.push_back({"dc_motor_linear_step_ns_per_1ms",
+                   "dc_motor_tendon",
+                   {{"elastic", "linear"}},
+                   {},
+                   0.3,
+                   0.01,
+                   1,
+                   driven,
+                   300});
+  cases.push_back({"dc_motor_zener_step_ns_per_1ms",
+                   "dc_motor_tendon",
+                   {{"elastic", "zener"}},
+                   {},
+                   0.3,
+                   0.01,
+                   1,
+                   driven,
+                   300});
+  cases.push_back({"ligament_step_ns_per_1ms",
+                   "ligament",
+                   {},
+                   {{"stiffness", 1000}, {"damping", 2}},
+                   0.3,
+                   0.01,
+                   1,
+                   nullptr,  // passive: takes no command
+                   0});
+  // OpenSim's defaults with the two required lengths; path around slack + optimal
+  cases.push_back({"hill_thelen_rigid_step_ns_per_1ms",
+                   "hill_muscle",
+                   {{"curves", "thelen2003"}, {"tendon", "rigid"}},
+                   {{"optimal_fiber_length", 0.1}, {"tendon_slack_length", 0.2}},
+                   0.3,
+                   0.02,
+                   1,
+                   excitation,
+                   0});
+  // arm26's SF muscle as MuJoCo 2.2.2 compiles it; path swinging through its length range
+  cases.push_back({"hill_mujoco_step_ns_per_1ms",
+                   "hill_muscle",
+                   {{"curves", "mujoco"}},
+                   {{"lengthrange_lo", 0.10242022997},
+                    {"lengthrange_hi", 0.340386464984},
+                    {"acc0", 0.558692074634}},
+                   0.22,
+                   0.1,
+                   1,
+                   excitation,
+                   0});
+  // for information: the elastic tendon (fibre length integrated, 1 ms sub-steps)
+  cases.push_back({"hill_thelen_elastic_step_ns_per_1ms",
+                   "hill_muscle",
+                   {{"curves", "thelen2003"}, {"tendon", "elastic"}},
+                   {{"optimal_fiber_length", 0.1}, {"tendon_slack_length", 0.2}},
+                   0.3,
+                   0.02,
+                   1,
+                   excitation,
+                   0});
+  return cases;
+}
+
+}  // namespace
+}  // namespace caliper::bench
+
+int main(int argc, char** argv) {
+  using namespace caliper::bench;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::string(argv[i]) == "--steps")
+      steps = std::max(1, std::atoi(argv[++i]));
+    else if (std::string(argv[i]) == "--repeats")
+      repeats = std::max(1, std::atoi(argv[++i]));
+  }
+  std::printf("# actuator step cost, %d steps of 1 ms, median of %d runs\n", steps, repeats);
+  for (const Case& c : Cases()) {
+    const Timing t = TimeCase(c);
+    std::printf("# %s: %s, best %.1f ns, median %.1f ns\n", c.name.c_str(), c.kind.c_str(), t.best,
+                t.median);
+    if (c.target_ns > 0)
+      std::printf("RATIO %s %.1f (target %.0f)\n", c.name.c_str(), t.median, c.target_ns);
+    else
+      std::printf("RATIO %s %.1f\n", c.name.c_str(), t.median);
+    std::fflush(stdout);
+  }
+  return 0;
+}
