@@ -503,6 +503,18 @@ class HillMuscle : public TendonActuator {
     CheckFinite("path speed", path_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
+    if (mujoco_integrator_) {
+      // MuJoCo's order: the force of the current state, then act += dt * act_dot
+      Evaluate(path_length, path_speed);
+      const bool thelen = curves_ == Curves::kThelen;
+      const double rate =
+          ActivationRate(excitation_, activation_,
+                         thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act,
+                         thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact,
+                         MinimumActivation());
+      activation_ = Clamp(activation_ + dt * rate, MinimumActivation(), 1);
+      return out_.tension;
+    }
     // fibre sub-steps of at most 1 ms (activation takes finer ones inside)
     const int n = elastic_ ? std::max(1, static_cast<int>(std::ceil(dt / kMaxSubstep - 1e-9))) : 1;
     const double h = dt / n;
@@ -869,13 +881,17 @@ class HillMuscle : public TendonActuator {
   double activation_ = 0;            // [-]
   double fiber_length_ = 0;          // elastic tendon state [m]
   Outputs out_;
+
+ public:
+  bool mujoco_integrator_ = false;   // options["integrator"] = "mujoco"
 };
 
 std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
   const std::string where = "actuator '" + a.name + "' (hill_muscle): ";
   for (const auto& [key, value] : a.options)
-    if (key != "curves" && key != "tendon")
-      throw std::invalid_argument(where + "unknown option '" + key + "' (known: curves, tendon)");
+    if (key != "curves" && key != "tendon" && key != "integrator")
+      throw std::invalid_argument(where + "unknown option '" + key +
+                                  "' (known: curves, tendon, integrator)");
   Curves curves = Curves::kThelen;
   if (const auto it = a.options.find("curves"); it != a.options.end()) {
     if (it->second == "mujoco")
@@ -914,7 +930,18 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
   } catch (const std::invalid_argument& error) {
     throw std::invalid_argument(where + error.what());
   }
-  return std::make_unique<HillMuscle>(a.name, curves, elastic, p);
+  auto muscle = std::make_unique<HillMuscle>(a.name, curves, elastic, p);
+  if (const auto it = a.options.find("integrator"); it != a.options.end()) {
+    if (it->second == "mujoco") {
+      if (elastic)
+        throw std::invalid_argument(where + "integrator=mujoco needs a rigid tendon");
+      muscle->mujoco_integrator_ = true;
+    } else if (it->second != "exact") {
+      throw std::invalid_argument(where + "unknown integrator '" + it->second +
+                                  "' (known: exact, mujoco)");
+    }
+  }
+  return muscle;
 }
 
 }  // namespace

@@ -8,6 +8,10 @@
 // Kind `hill_muscle` (sgal::Actuator, command = excitation u in [0, 1], clamped):
 //   options["curves"] = "thelen2003" (default) | "mujoco"
 //   options["tendon"] = "rigid" (default) | "elastic" (thelen2003 only)
+//   options["integrator"] = "exact" (default) | "mujoco" (rigid tendon only): as MuJoCo's
+//                   mj_step, the force from the activation at the start of the step at the path
+//                   length at its start, then one explicit Euler step of the activation (so that
+//                   MuJoCo models are reproduced step by step)
 //   parameters: ThelenMuscleParameters or MujocoMuscleParameters by their snake_case names, plus
 //   default_activation; a parameter of the other curve set is rejected.
 // Step(path_length, path_speed, dt) lets the path move at path_speed during the step, advances
