@@ -180,18 +180,14 @@ Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return best;
 }
 
-void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
-            const ContactOptions& options, int depth, std::vector<WorldShape>* scratch,
-            std::vector<PathPoint>* out) {
+void Refine(const PathPoint& a, const PathPoint& b, const std::vector<WorldShape>& candidates,
+            const ContactOptions& options, int depth, std::vector<PathPoint>* out) {
   if (depth <= 0) return;
-  scratch->clear();
-  query(a.position, b.position, scratch);
-  const std::vector<WorldShape> shapes = *scratch;
   // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
-  const Crossing c = FirstCrossing(a.position, b.position, shapes, a.contact ? -2 : a.body,
+  const Crossing c = FirstCrossing(a.position, b.position, candidates, a.contact ? -2 : a.body,
                                    b.contact ? -2 : b.body, options.margin);
   if (c.shape == nullptr) return;
-  const WorldShape shape = *c.shape;  // the recursion below reuses the scratch list
+  const WorldShape& shape = *c.shape;
   const Eigen::Vector3d ab = b.position - a.position;
   const double len = ab.norm();
   if (len < 1e-12) return;
@@ -215,9 +211,9 @@ void Refine(const PathPoint& a, const PathPoint& b, const ShapeQuery& query,
   q.position = ExitPoint(shape, mid, away, options.margin, reach);
   q.body = shape.body;
   q.contact = true;
-  Refine(a, q, query, options, depth - 1, scratch, out);
+  Refine(a, q, candidates, options, depth - 1, out);
   out->push_back(q);
-  Refine(q, b, query, options, depth - 1, scratch, out);
+  Refine(q, b, candidates, options, depth - 1, out);
 }
 
 }  // namespace
@@ -233,7 +229,9 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
     const PathPoint& b = path->points[i + 1];
     out.push_back(a);
     const size_t before = out.size();
-    Refine(a, b, query, options, options.max_depth, &scratch, &out);
+    scratch.clear();
+    query(a.position, b.position, options.margin + options.detour_reach, &scratch);
+    Refine(a, b, scratch, options, options.max_depth, &out);
     inserted += static_cast<int>(out.size() - before);
   }
   out.push_back(path->points.back());

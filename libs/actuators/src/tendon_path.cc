@@ -268,9 +268,13 @@ PathGeometry TendonPath::Evaluate(const std::vector<WorldElement>& elements) {
   if (wrap_side_.size() != elements.size()) wrap_side_.assign(elements.size(), 0);
 
   PathGeometry path;
+  path.points.reserve(elements.size() + 16);
   // velocity of every path point, and whether the piece after it runs along an obstacle surface
-  std::vector<Vector3d> velocity;
-  std::vector<bool> on_surface_after;
+  // (scratch kept between calls: this runs for every tendon in every step)
+  thread_local std::vector<Vector3d> velocity;
+  thread_local std::vector<bool> on_surface_after;
+  velocity.clear();
+  on_surface_after.clear();
   auto add = [&](const Vector3d& p, const Vector3d& v, int body, double friction, bool on_wrap) {
     path.points.push_back(PathPoint{p, body, friction, on_wrap});
     velocity.push_back(v);
@@ -319,7 +323,8 @@ std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {
   }
   if (n < 2) return forces;
 
-  std::vector<Vector3d> unit(n - 1, Vector3d::Zero());
+  thread_local std::vector<Vector3d> unit;
+  unit.assign(n - 1, Vector3d::Zero());
   for (size_t k = 0; k + 1 < n; ++k) {
     const Vector3d d = path.points[k + 1].position - path.points[k].position;
     if (d.norm() > kTiny) unit[k] = d.normalized();

@@ -146,6 +146,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
   std::vector<Snapshot> snapshot_;
+  double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
 };
 
 std::unique_ptr<btCollisionShape> MakeShape(const sgal::Geometry& geometry, double s, bool dynamic,
@@ -405,6 +406,29 @@ void BulletScene::BuildTendons() {
       if (scene_.tendons[t].name == a.desc->tendon) a.tendon = static_cast<int>(t);
     tendons_[a.tendon].actuators.push_back(static_cast<int>(i));
   }
+  double largest = 0;
+  for (const auto& b : scene_.bodies)
+    for (const auto& shape : b.shapes) {
+      const double r = std::visit(
+          [](const auto& g) -> double {
+            using T = std::decay_t<decltype(g)>;
+            if constexpr (std::is_same_v<T, sgal::Box>) return g.size.norm() / 2;
+            else if constexpr (std::is_same_v<T, sgal::Sphere>) return g.radius;
+            else if constexpr (std::is_same_v<T, sgal::Capsule>) return g.radius + g.length / 2;
+            else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>)
+              return std::hypot(g.radius, g.length / 2);
+            else if constexpr (std::is_same_v<T, sgal::Plane>) return 0.0;
+            else {
+              double m = 0;
+              if (g.mesh)
+                for (const auto& v : g.mesh->vertices) m = std::max(m, static_cast<double>(v.norm()));
+              return m;
+            }
+          },
+          shape.geometry);
+      largest = std::max(largest, r + shape.pose.position.norm());
+    }
+  detour_reach_ = 2 * largest;
   CacheBodyPoses();
   RefreshWorldShapes();
   EvaluateTendons();
@@ -472,9 +496,8 @@ void BulletScene::EvaluateTendons() {
     t.contacts = 0;
     if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
       AabbCollector collector;
-      const actuators::ShapeQuery query = [&](const Vector3d& a, const Vector3d& b,
+      const actuators::ShapeQuery query = [&](const Vector3d& a, const Vector3d& b, double pad,
                                               std::vector<actuators::WorldShape>* out) {
-        const double pad = t.desc->radius;
         collector.bodies.clear();
         broadphase_->aabbTest(ToBt(a.cwiseMin(b) - Vector3d::Constant(pad), scale_),
                               ToBt(a.cwiseMax(b) + Vector3d::Constant(pad), scale_), collector);
@@ -483,6 +506,7 @@ void BulletScene::EvaluateTendons() {
       };
       actuators::ContactOptions contact;
       contact.margin = t.desc->radius;
+      contact.detour_reach = detour_reach_;
       t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact);
       if (t.contacts > 0 && t.previous_length >= 0)
         t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;

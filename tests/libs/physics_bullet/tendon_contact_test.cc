@@ -52,7 +52,7 @@ TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
   PathGeometry path;
   path.points = {{Vector3d(-d, 0, 0), -1}, {Vector3d(d, 0, 0), -1}};
   path.length = 2 * d;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, std::vector<WorldShape>* out) {
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
     out->push_back(shape);
   };
   ContactOptions options;
@@ -84,7 +84,7 @@ TEST(WrapAroundBodies, LeavesSegmentsAloneThatMissOrEndOnTheBody) {
   PathGeometry path;
   path.points = {{Vector3d(-1, 0, 0), 3}, {Vector3d(1, 0, 0), -1}};
   path.length = 2;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, std::vector<WorldShape>* out) {
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
     out->push_back(At(box, Vector3d::Zero(), 3));  // the tendon is fixed to this very body
     out->push_back(At(box, Vector3d(0, 1, 0), 4));  // beside the path
   };
@@ -96,7 +96,7 @@ TEST(WrapAroundBodies, LiftsAStringOutOfTheFloorAlongItsNormal) {
   const sgal::Geometry floor = sgal::Plane{};
   PathGeometry path;
   path.points = {{Vector3d(-1, 0, 0.1), -1}, {Vector3d(1, 0, 0.1), -1}};
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, std::vector<WorldShape>* out) {
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
     WorldShape s = At(floor, Vector3d(0, 0, 0.3), 7);  // the ground 0.2 m above both ends
     out->push_back(s);
   };

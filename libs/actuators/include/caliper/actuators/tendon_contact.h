@@ -30,14 +30,18 @@ std::optional<std::pair<double, double>> SegmentInside(const WorldShape& shape,
                                                       const Eigen::Vector3d& a,
                                                       const Eigen::Vector3d& b, double margin);
 
-/// Gives the shapes that may touch the segment a-b (an engine's broadphase query).
+/// Gives the shapes whose bounds come within `pad` of the box around a-b (an engine's
+/// broadphase query).
 using ShapeQuery =
-    std::function<void(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+    std::function<void(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double pad,
                        std::vector<WorldShape>* out)>;
 
 struct ContactOptions {
   double margin = 0.001;  ///< tendon radius: how far the path stays from surfaces [m]
   int max_depth = 3;      ///< bisections per crossing: up to 2^depth - 1 points per body
+  /// Reach of the detour points beyond a segment: twice the largest shape's bounding radius [m].
+  /// One query per routed segment with this padding serves the whole refinement.
+  double detour_reach = 0.1;
 };
 
 /// Bends a path around every body it would pass through, except the bodies the segment's own
