@@ -29,4 +29,30 @@ std::vector<int> ChangeFilter::Changed(const std::vector<BodyState>& states) {
   return changed;
 }
 
+int ObserverHub::Add(SceneObserver* observer) {
+  entries_.push_back({next_id_, observer, ChangeFilter(position_tolerance_, angle_tolerance_)});
+  return next_id_++;
+}
+
+void ObserverHub::Remove(int id) {
+  for (auto it = entries_.begin(); it != entries_.end(); ++it)
+    if (it->id == id) {
+      entries_.erase(it);
+      return;
+    }
+}
+
+void ObserverHub::Notify(const PhysicsScene& scene) {
+  if (entries_.empty()) return;
+  const std::vector<BodyState> states = scene.BodyStates();
+  for (auto& e : entries_) {
+    const std::vector<int> changed = e.filter.Changed(states);
+    if (changed.empty()) continue;
+    std::vector<BodyState> subset;
+    subset.reserve(changed.size());
+    for (int i : changed) subset.push_back(states[i]);
+    e.observer->OnTransforms(scene.steps(), scene.time(), changed, subset);
+  }
+}
+
 }  // namespace caliper::sgal

@@ -270,3 +270,50 @@ TEST(BulletScene, ParametersAreListedReadAndWritten) {
 
 }  // namespace
 }  // namespace caliper::physics_bullet
+
+namespace caliper::physics_bullet {
+namespace {
+
+struct Recorder : sgal::SceneObserver {
+  std::vector<std::vector<int>> calls;
+  void OnTransforms(uint64_t, double, const std::vector<int>& bodies,
+                    const std::vector<sgal::BodyState>& states) override {
+    EXPECT_EQ(bodies.size(), states.size());
+    calls.push_back(bodies);
+  }
+};
+
+TEST(ObserverHub, ReportsOnlyTheBodiesThatMoved) {
+  sgal::Scene s = Pendulum(0.5, 0.3);
+  sgal::Body wall;
+  wall.name = "wall";
+  wall.type = sgal::BodyType::kStatic;
+  wall.pose.position = Vector3d(2, 0, 0);
+  wall.shapes.push_back({"w", sgal::Box{}, {}});
+  s.bodies.push_back(wall);
+  auto scene = MakeScene(s);
+  sgal::ObserverHub hub(1e-4, 1e-4);
+  Recorder first, late;
+  hub.Add(&first);
+  scene->Step();
+  hub.Notify(*scene);
+  ASSERT_EQ(first.calls.size(), 1u);
+  EXPECT_EQ(first.calls[0], (std::vector<int>{0, 1})) << "everything the first time";
+  const int id = hub.Add(&late);
+  for (int i = 0; i < 20; ++i) {
+    scene->Step();
+    hub.Notify(*scene);
+  }
+  for (size_t i = 1; i < first.calls.size(); ++i)
+    EXPECT_EQ(first.calls[i], (std::vector<int>{0})) << "the static wall never moves";
+  ASSERT_FALSE(late.calls.empty());
+  EXPECT_EQ(late.calls[0], (std::vector<int>{0, 1}));
+  hub.Remove(id);
+  const size_t before = late.calls.size();
+  scene->Step();
+  hub.Notify(*scene);
+  EXPECT_EQ(late.calls.size(), before);
+}
+
+}  // namespace
+}  // namespace caliper::physics_bullet

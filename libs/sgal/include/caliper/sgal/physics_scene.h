@@ -76,6 +76,7 @@ class PhysicsScene {
 class SceneObserver {
  public:
   virtual ~SceneObserver() = default;
+  /// `bodies` are indices into the description's bodies; `states[i]` belongs to `bodies[i]`.
   virtual void OnTransforms(uint64_t step, double time, const std::vector<int>& bodies,
                             const std::vector<BodyState>& states) = 0;
 };
@@ -91,6 +92,32 @@ class ChangeFilter {
   double position_tolerance_;  // [m]
   double angle_tolerance_;     // [rad]
   std::vector<Pose> last_;
+};
+
+/// In-process observers of a running scene: after each step, Notify() tells every observer the
+/// bodies that moved beyond the tolerances since it was last told (each observer has its own
+/// filter, so one added late first receives every body).
+class ObserverHub {
+ public:
+  explicit ObserverHub(double position_tolerance = 1e-6, double angle_tolerance = 1e-5)
+      : position_tolerance_(position_tolerance), angle_tolerance_(angle_tolerance) {}
+  /// Adds an observer (not owned; it must outlive the hub or be removed) and returns its id.
+  int Add(SceneObserver* observer);
+  void Remove(int id);
+  /// Reports the changed bodies of `scene` to each observer; observers with nothing new are not
+  /// called.
+  void Notify(const PhysicsScene& scene);
+
+ private:
+  struct Entry {
+    int id;
+    SceneObserver* observer;
+    ChangeFilter filter;
+  };
+  double position_tolerance_;
+  double angle_tolerance_;
+  int next_id_ = 1;
+  std::vector<Entry> entries_;
 };
 
 }  // namespace caliper::sgal
