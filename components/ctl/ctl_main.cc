@@ -12,12 +12,15 @@
 #include <string>
 #include <vector>
 
+#include "caliper/collada/exporter.h"
+#include "caliper/collada/importer.h"
 #include "caliper/core/system.h"
 #include "caliper/logging.hh"
 #include "caliper/logging/record.h"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
+#include "inspect.h"
 
 namespace caliper::ctl {
 namespace {
@@ -39,20 +42,13 @@ struct Options {
   double timeout_s = 5.0;
 };
 
+/// The connection to a session: the ORB is started by the first verb that needs it, so that
+/// verbs working on files alone (inspect) run without a naming service.
 class Client {
  public:
-  explicit Client(const Options& options) : options_(options) {
-    const std::string ms = std::to_string(static_cast<int>(options.timeout_s * 1000));
-    std::vector<std::string> args = {"caliper-ctl", "-ORBendPoint", "giop:tcp:127.0.0.1:",
-                                     "-ORBclientCallTimeOutPeriod", ms,
-                                     "-ORBclientConnectTimeOutPeriod", ms};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    int argc = static_cast<int>(argv.size());
-    orb_ = CORBA::ORB_init(argc, argv.data());
-    address_ = rtc::NamingAddress(options.nameservice);
-  }
+  explicit Client(const Options& options) : options_(options) {}
   ~Client() {
+    if (CORBA::is_nil(orb_)) return;
     try {
       orb_->destroy();
     } catch (...) {
@@ -60,6 +56,7 @@ class Client {
   }
 
   CosNaming::NamingContext_ptr Root() {
+    Connect();
     try {
       return rtc::ResolveRoot(orb_, address_);
     } catch (const rtc::Unreachable& e) {
@@ -95,10 +92,29 @@ class Client {
            " (the process may have died; its name is stale)";
   }
 
-  CORBA::ORB_ptr orb() { return orb_.in(); }
-  const std::string& address() const { return address_; }
+  CORBA::ORB_ptr orb() {
+    Connect();
+    return orb_.in();
+  }
+  const std::string& address() {
+    Connect();
+    return address_;
+  }
 
  private:
+  void Connect() {
+    if (!CORBA::is_nil(orb_)) return;
+    const std::string ms = std::to_string(static_cast<int>(options_.timeout_s * 1000));
+    std::vector<std::string> args = {"caliper-ctl", "-ORBendPoint", "giop:tcp:127.0.0.1:",
+                                     "-ORBclientCallTimeOutPeriod", ms,
+                                     "-ORBclientConnectTimeOutPeriod", ms};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    int argc = static_cast<int>(argv.size());
+    orb_ = CORBA::ORB_init(argc, argv.data());
+    address_ = rtc::NamingAddress(options_.nameservice);
+  }
+
   Options options_;
   CORBA::ORB_var orb_;
   std::string address_;
@@ -356,6 +372,37 @@ int Log(Client& client, std::vector<std::string>& args) {
   }
 }
 
+// Reads a scene file with no session: the ORB is never started.
+int Inspect(Client&, std::vector<std::string>& args) {
+  std::string out_path;
+  const bool export_scene = TakeOption(args, "--export", &out_path);
+  for (const auto& a : args)
+    if (a.size() > 1 && a[0] == '-') throw UsageError("unknown option '" + a + "'");
+  if (args.size() != 1)
+    throw UsageError(args.empty() ? "expected a file" : "expected one file, got " +
+                                                            std::to_string(args.size()));
+  const std::string& path = args[0];
+  std::vector<std::string> warnings;
+  collada::FileInfo info;
+  sgal::Scene scene;
+  try {
+    scene = collada::Import(path, &warnings, &info);
+  } catch (const collada::ImportError& e) {
+    for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+    throw Failure(std::string("not imported: ") + e.what());
+  }
+  PrintSceneReport(path, scene, info, warnings, std::cout);
+  if (export_scene) {
+    try {
+      collada::Export(scene, out_path);
+    } catch (const collada::ExportError& e) {
+      throw Failure(e.what());
+    }
+    std::cout << "exported to " << out_path << "\n";
+  }
+  return 0;
+}
+
 std::map<std::string, Verb> Verbs() {
   std::map<std::string, Verb> verbs;
   verbs["ls"] = {"ls", "list the components in the naming service with their states", List};
@@ -371,6 +418,10 @@ std::map<std::string, Verb> Verbs() {
                   "print the session log (the newest N records, 50 by default); --follow keeps "
                   "printing new ones until Ctrl-C",
                   Log};
+  verbs["inspect"] = {"inspect FILE [--export OUT.dae]",
+                      "report what a COLLADA file (.dae, .zae) holds, or why it does not import "
+                      "(no session needed); --export writes the imported scene back out",
+                      Inspect};
   return verbs;
 }
 
@@ -378,7 +429,8 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
   std::cout << "Usage: caliper-ctl [--nameservice corbaname::HOST:PORT] [--timeout S] VERB ...\n\n"
             << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
             << "$CALIPER_NAMESERVICE, else corbaname::127.0.0.1:2809. NAME is an instance name\n"
-            << "(model0), host/model0, or host.host_cxt/model0.rtc.\n\nVerbs:\n";
+            << "(model0), host/model0, or host.host_cxt/model0.rtc. `inspect` reads a file\n"
+            << "and needs no session.\n\nVerbs:\n";
   for (const auto& [name, verb] : verbs)
     std::cout << "  " << std::left << std::setw(12) << name << verb.summary << "\n";
   std::cout << "\n`caliper-ctl VERB --help` describes one verb. Exit status: 0 done, 1 failed, "

@@ -21,10 +21,11 @@ using internal::Element;
 constexpr double kPi = 3.14159265358979323846;
 
 // <asset>: the unit, the up axis, and who wrote the file.
-void ReadAsset(Context& ctx) {
+void ReadAsset(Context& ctx, FileInfo* info) {
   const Element* asset = ctx.doc.root->Child("asset");
   if (asset == nullptr) return;
   if (const Element* unit = asset->Child("unit"); unit != nullptr) {
+    info->unit_name = unit->Attribute("name");
     // trust meter, not name: files say name="centimeter" with meter="1"
     const std::string meter = unit->Attribute("meter", "1");
     std::vector<double> v;
@@ -36,6 +37,8 @@ void ReadAsset(Context& ctx) {
   }
   const Element* up = asset->Child("up_axis");
   const std::string axis = up == nullptr ? "Y_UP" : up->Trimmed();
+  info->meter = ctx.meter;
+  info->up_axis = axis;
   if (axis == "Y_UP") {
     ctx.up = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
   } else if (axis == "X_UP") {
@@ -47,6 +50,7 @@ void ReadAsset(Context& ctx) {
   ctx.up = ctx.up.unaryExpr([](double x) { return std::abs(x) < 1e-15 ? 0.0 : x; });
   for (const Element* contributor : asset->Children("contributor")) {
     const Element* tool = contributor->Child("authoring_tool");
+    if (tool != nullptr && info->authoring_tool.empty()) info->authoring_tool = tool->Trimmed();
     if (tool != nullptr && tool->text.find("OpenRAVE") != std::string::npos) ctx.openrave = true;
   }
 }
@@ -107,6 +111,14 @@ std::string Stem(const std::string& path) {
 }  // namespace
 
 sgal::Scene Import(const std::string& path, std::vector<std::string>* warnings) {
+  return Import(path, warnings, nullptr);
+}
+
+sgal::Scene Import(const std::string& path, std::vector<std::string>* warnings, FileInfo* info) {
+  FileInfo ignored;
+  if (info == nullptr) info = &ignored;
+  *info = FileInfo{};
+  info->up_axis = "Y_UP";
   internal::Document doc;
   try {
     doc = internal::ReadDocument(path);
@@ -116,10 +128,12 @@ sgal::Scene Import(const std::string& path, std::vector<std::string>* warnings) 
   } catch (const std::exception& e) {
     throw ImportError(path + ": " + e.what());
   }
+  info->version = doc.declared_version.empty() ? doc.version : doc.declared_version;
+  info->zipped = doc.zipped;
   Context ctx(doc, warnings);
   try {
     for (const auto& w : doc.dom_warnings) ctx.Warn(nullptr, "Collada-DOM: " + w);
-    ReadAsset(ctx);
+    ReadAsset(ctx, info);
     ctx.scene.source = path;
     ctx.scene.name = Stem(path);
     internal::VisualScene visual(&ctx);

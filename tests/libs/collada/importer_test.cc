@@ -152,6 +152,28 @@ TEST(ColladaImportTest, ScalesByUnitMeterNotByName) {
   EXPECT_GT(ShapeBounds(seymour).sizes().maxCoeff(), 10.0);
 }
 
+TEST(ColladaImportTest, ReportsTheFilesVersionUnitAndUpAxis) {
+  FileInfo info;
+  Import(Data("caliper_arm.dae"), nullptr, &info);
+  EXPECT_EQ(info.version, "1.5.0");
+  EXPECT_FALSE(info.zipped);
+  EXPECT_EQ(info.meter, 1.0);
+  EXPECT_EQ(info.unit_name, "meter");
+  EXPECT_EQ(info.up_axis, "Z_UP");
+  EXPECT_EQ(info.authoring_tool, "hand written");
+  // filled as far as it was read when the import fails
+  EXPECT_THROW(Import(Data("malformed_negative_mass.dae"), nullptr, &info), ImportError);
+  EXPECT_EQ(info.up_axis, "Z_UP");
+  CALIPER_REQUIRE_CORPUS();
+  Import(Corpus("khronos_cts_1.4.1/asset_unit_foot.dae"), nullptr, &info);
+  EXPECT_EQ(info.version, "1.4.1");
+  EXPECT_EQ(info.meter, 0.3048);
+  EXPECT_EQ(info.unit_name, "foot");
+  EXPECT_EQ(info.up_axis, "Y_UP");
+  Import(Corpus("collada_robots/willowgarage-pr2.zae"), nullptr, &info);
+  EXPECT_TRUE(info.zipped);
+}
+
 TEST(ColladaImportTest, TurnsXUpToZUp) {
   CALIPER_REQUIRE_CORPUS();
   // a cone with its apex at x = 150 in and its base at x = -75 in
