@@ -1,0 +1,55 @@
+#include "model_component.h"
+
+#include "caliper/logging/log.h"
+
+namespace caliper::model {
+
+std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
+  using Type = core::ConfigKey::Type;
+  return {
+      {"model.scene", Type::kString, "", "COLLADA scene loaded at start ('' = none)"},
+      {"model.real_time_factor", Type::kDouble, "1", "1 = real time, 0 = as fast as possible", 0,
+       1e6},
+      {"model.autostart", Type::kBool, "false", "start simulating once loaded and active"},
+      {"model.tendon_contact", Type::kBool, "true",
+       "bend tendons around bodies they would cut through"},
+  };
+}
+
+ModelComponent::ModelComponent(rtc::Runtime& runtime)
+    : runtime_(runtime), autostart_(runtime.config().GetBool("model.autostart")) {
+  physics_bullet::Options options;
+  options.tendon_body_contact = runtime.config().GetBool("model.tendon_contact");
+  core_ = std::make_unique<ModelCore>(options);
+  core_->SetRealTimeFactor(runtime.config().GetDouble("model.real_time_factor"));
+}
+
+rtc::ReturnCode ModelComponent::OnInitialize() {
+  const std::string scene = runtime_.config().GetString("model.scene");
+  if (!scene.empty()) core_->Load(scene);  // a bad file fails initialisation with its message
+  return rtc::ReturnCode::kOk;
+}
+
+rtc::ReturnCode ModelComponent::OnActivated() {
+  if (autostart_ && core_->status().state == RunState::kStopped) core_->Start();
+  return rtc::ReturnCode::kOk;
+}
+
+rtc::ReturnCode ModelComponent::OnDeactivated() {
+  if (core_->status().state == RunState::kRunning) core_->Pause();
+  return rtc::ReturnCode::kOk;
+}
+
+rtc::ReturnCode ModelComponent::OnExecute() {
+  if (runtime_.context().kind() == rtc::ContextKind::kExternal) {
+    core_->Tick();
+  } else {
+    // leave a fifth of each period to CORBA calls
+    const double period = 1.0 / runtime_.context().rate();
+    core_->Advance(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(0.8 * period)));
+  }
+  return rtc::ReturnCode::kOk;
+}
+
+}  // namespace caliper::model

@@ -1,0 +1,37 @@
+#pragma once
+// The Model component (caliper-model): owns the physics of one scene and serves it.
+//
+// Configuration (config/model.conf):
+//   model.scene             COLLADA file loaded at start ("" = none)
+//   model.real_time_factor  1 = real time, 0 = as fast as possible
+//   model.autostart         start simulating once loaded and active
+//   model.tendon_contact    bend tendons around bodies they would cut through
+// The execution context drives stepping: PERIODIC ticks advance the simulation by what the
+// real-time factor makes due; an EXTERNAL context steps once per tick (lock-step).
+
+#include <memory>
+
+#include "caliper/rtc/runtime.h"
+#include "model_core.h"
+
+namespace caliper::model {
+
+class ModelComponent : public rtc::Component {
+ public:
+  explicit ModelComponent(rtc::Runtime& runtime);
+
+  rtc::ReturnCode OnInitialize() override;
+  rtc::ReturnCode OnActivated() override;
+  rtc::ReturnCode OnDeactivated() override;
+  rtc::ReturnCode OnExecute() override;
+
+  ModelCore& core() { return *core_; }
+  static std::vector<core::ConfigKey> ConfigKeys();
+
+ private:
+  rtc::Runtime& runtime_;
+  std::unique_ptr<ModelCore> core_;
+  bool autostart_;
+};
+
+}  // namespace caliper::model

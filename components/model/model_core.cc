@@ -1,0 +1,445 @@
+#include "model_core.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+
+#include "caliper/collada/exporter.h"
+#include "caliper/collada/importer.h"
+#include "caliper/logging/log.h"
+
+namespace caliper::model {
+
+using Clock = std::chrono::steady_clock;
+
+const char* ToString(RunState state) {
+  switch (state) {
+    case RunState::kEmpty: return "EMPTY";
+    case RunState::kStopped: return "STOPPED";
+    case RunState::kRunning: return "RUNNING";
+    case RunState::kPaused: return "PAUSED";
+    case RunState::kFaulted: return "FAULTED";
+  }
+  return "?";
+}
+
+std::string IdSafe(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (std::isalnum(u))
+      out += static_cast<char>(std::tolower(u));
+    else if (!out.empty() && out.back() != '_')
+      out += '_';
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  return out.empty() ? "model" : out;
+}
+
+/// Everything that belongs to one loaded scene.
+struct ModelCore::Loaded {
+  std::shared_ptr<const sgal::Scene> description;  // as loaded (rewind rebuilds from it)
+  std::string source;
+  std::string name;                                 // id prefix
+  std::unique_ptr<sgal::PhysicsScene> physics;
+  std::shared_ptr<daq::SceneSampler> sampler;
+  std::map<std::string, double> commands;           // last command per actuator
+};
+
+ModelCore::ModelCore(physics_bullet::Options options) : options_(options) {}
+
+ModelCore::~ModelCore() {
+  // the channels refer to the scene: remove them first
+  std::lock_guard<std::mutex> lock(mutex_);
+  registry_.Clear();
+}
+
+void ModelCore::Require(bool scene_needed) const {
+  if (scene_needed && !loaded_) throw NotAvailable("no scene is loaded (load one first)");
+}
+
+void ModelCore::Load(const std::string& path) {
+  std::vector<std::string> warnings;
+  sgal::Scene scene = collada::Import(path, &warnings);  // throws collada::ImportError
+  for (const auto& w : warnings) logging::Get("model").warn("%s: %s", path.c_str(), w.c_str());
+  LoadScene(scene, path);
+}
+
+void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
+  // build everything outside the lock: a bad scene throws here and changes nothing
+  auto loaded = std::make_unique<Loaded>();
+  loaded->description = std::make_shared<const sgal::Scene>(scene);
+  loaded->source = source;
+  loaded->name = IdSafe(scene.name.empty() ? "model" : scene.name);
+  loaded->physics = physics_bullet::MakeScene(scene, options_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  BuildLocked(std::move(loaded));
+  state_ = RunState::kStopped;
+  last_error_.clear();
+  logging::Get("model").notice("loaded %s: %zu bodies, %zu tendons, %zu actuators", source.c_str(),
+                               scene.bodies.size(), scene.tendons.size(), scene.actuators.size());
+}
+
+void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded) {
+  const bool had_scene = loaded_ != nullptr;
+  // the old scene's channels go first (they refer to its physics); subscriptions stay and
+  // re-resolve their ids at the next step
+  registry_.Clear();
+  const daq::SceneChannels channels = daq::RegisterScene(registry_, loaded->name, *loaded->physics);
+  loaded->sampler = channels.sampler;
+  for (const auto& id : channels.skipped)
+    logging::Get("model").warn("channel %s not registered: the id is taken", id.c_str());
+  if (had_scene)
+    for (const auto& [name, value] : loaded_->commands)
+      if (std::any_of(loaded->description->actuators.begin(), loaded->description->actuators.end(),
+                      [&](const sgal::Actuator& a) { return a.name == name; })) {
+        loaded->physics->SetCommand(name, value);
+        loaded->commands[name] = value;
+      }
+  loaded_ = std::move(loaded);
+  ++generation_;
+  pending_commands_.clear();
+  pending_sets_.clear();
+  if (had_scene)
+    for (auto* l : listeners_) l->OnCleared();
+  for (auto* l : listeners_) l->OnScene(loaded_->description, generation_);
+  loaded_->sampler->Refresh();
+  PublishLocked();
+}
+
+void ModelCore::RewindLocked() {
+  auto fresh = std::make_unique<Loaded>();
+  fresh->description = loaded_->description;
+  fresh->source = loaded_->source;
+  fresh->name = loaded_->name;
+  fresh->physics = physics_bullet::MakeScene(*fresh->description, options_);
+  BuildLocked(std::move(fresh));
+  last_error_.clear();
+}
+
+void ModelCore::Start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  if (state_ == RunState::kFaulted)
+    throw NotAvailable("the simulation stopped on a fault (" + last_error_ +
+                       "); reset or stop it first");
+  if (state_ == RunState::kRunning) return;
+  state_ = RunState::kRunning;
+  run_wall_start_ = Clock::now();
+  run_sim_start_ = loaded_->physics->time();
+  rate_wall_ = run_wall_start_;
+  rate_sim_ = run_sim_start_;
+}
+
+void ModelCore::Pause() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  if (state_ == RunState::kRunning) state_ = RunState::kPaused;
+}
+
+void ModelCore::Stop() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  RewindLocked();
+  state_ = RunState::kStopped;
+}
+
+void ModelCore::Reset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
+  RewindLocked();
+  state_ = keep;
+  run_wall_start_ = Clock::now();
+  run_sim_start_ = 0;
+}
+
+void ModelCore::StepNow(uint64_t n) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
+  if (state_ == RunState::kFaulted)
+    throw NotAvailable("the simulation stopped on a fault (" + last_error_ + "); reset it first");
+  for (uint64_t i = 0; i < n && state_ != RunState::kFaulted; ++i) StepLocked();
+  if (state_ != RunState::kFaulted) state_ = RunState::kPaused;
+}
+
+void ModelCore::SetTimeStep(double seconds) {
+  if (!(seconds > 0 && seconds <= 0.1) || !std::isfinite(seconds))
+    throw InvalidValue("time step " + std::to_string(seconds) + " s: must be in (0, 0.1] s");
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  loaded_->physics->SetParameter("simulation.time_step", seconds);
+}
+
+void ModelCore::SetRealTimeFactor(double factor) {
+  if (!(factor >= 0) || !std::isfinite(factor))
+    throw InvalidValue("real-time factor " + std::to_string(factor) +
+                       ": must be >= 0 (1 real time, 0 as fast as possible)");
+  std::lock_guard<std::mutex> lock(mutex_);
+  real_time_factor_ = factor;
+  if (loaded_) {
+    run_wall_start_ = Clock::now();
+    run_sim_start_ = loaded_->physics->time();
+  }
+}
+
+Status ModelCore::status() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Status s;
+  s.state = state_;
+  s.real_time_factor = real_time_factor_;
+  s.achieved_real_time_factor = state_ == RunState::kRunning ? achieved_rtf_ : 0;
+  s.last_error = last_error_;
+  if (loaded_) {
+    s.scene = loaded_->source;
+    s.sim_time = loaded_->physics->time();
+    s.steps = loaded_->physics->steps();
+    s.time_step = loaded_->physics->description().settings.time_step;
+  }
+  return s;
+}
+
+void ModelCore::StepLocked() {
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  // commands and parameter writes take effect at this step boundary, in the order they came
+  for (const auto& [name, value] : pending_commands_) {
+    physics.SetCommand(name, value);
+    loaded_->commands[name] = value;
+  }
+  pending_commands_.clear();
+  for (const auto& [id, values] : pending_sets_) {
+    try {
+      registry_.Set(id, values);
+    } catch (const std::exception& e) {
+      logging::Get("model").warn("parameter %s not applied: %s", id.c_str(), e.what());
+    }
+  }
+  pending_sets_.clear();
+  try {
+    physics.Step();
+  } catch (const sgal::SimulationFault& fault) {
+    state_ = RunState::kFaulted;
+    last_error_ = fault.what();
+    logging::Get("model").error("%s", fault.what());
+    return;
+  }
+  loaded_->sampler->Refresh();
+  recorder_.OnStep(physics.steps(), physics.time());
+  PublishLocked();
+}
+
+void ModelCore::PublishLocked() {
+  if (listeners_.empty() || !loaded_) return;
+  auto snapshot = std::make_shared<Snapshot>();
+  snapshot->generation = generation_;
+  snapshot->step = loaded_->physics->steps();
+  snapshot->time = loaded_->physics->time();
+  snapshot->bodies = loaded_->physics->BodyStates();
+  snapshot->tendons = loaded_->physics->TendonStates();
+  for (auto* l : listeners_) l->OnSnapshot(snapshot);
+}
+
+void ModelCore::Advance(Clock::duration budget) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!loaded_ || state_ != RunState::kRunning) return;
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  const auto begin = Clock::now();
+  if (real_time_factor_ > 0) {
+    // the simulated time that is due now; never more than the budget's worth in one call
+    const double wall = std::chrono::duration<double>(begin - run_wall_start_).count();
+    const double due = run_sim_start_ + wall * real_time_factor_;
+    while (physics.time() + 1e-12 < due && state_ == RunState::kRunning) {
+      StepLocked();
+      if (Clock::now() - begin > budget) {
+        // cannot keep up: do not build a backlog, let the achieved factor show it
+        run_wall_start_ = Clock::now();
+        run_sim_start_ = physics.time();
+        break;
+      }
+    }
+  } else {
+    do {
+      StepLocked();
+    } while (Clock::now() - begin < budget && state_ == RunState::kRunning);
+  }
+  const auto now = Clock::now();
+  const double span = std::chrono::duration<double>(now - rate_wall_).count();
+  if (span >= 1.0) {
+    achieved_rtf_ = (physics.time() - rate_sim_) / span;
+    rate_wall_ = now;
+    rate_sim_ = physics.time();
+  }
+}
+
+void ModelCore::Tick() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (loaded_ && state_ == RunState::kRunning) StepLocked();
+}
+
+std::shared_ptr<const sgal::Scene> ModelCore::description() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return loaded_ ? loaded_->description : nullptr;
+}
+
+void ModelCore::Save(const std::string& path) {
+  sgal::Scene current;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Require(true);
+    // the engine's copy holds the parameters tuned while running
+    current = loaded_->physics->description();
+  }
+  collada::Export(current, path);
+  logging::Get("model").notice("saved the scene with its current parameters to %s", path.c_str());
+}
+
+std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  std::vector<ActuatorInfo> out;
+  const auto parameters = loaded_->physics->Parameters();
+  for (const auto& a : loaded_->description->actuators) {
+    std::string unit;
+    for (const auto& p : parameters)
+      if (p.id == a.name + ".command") unit = p.unit;
+    out.push_back({a.name, a.kind, a.tendon, unit});
+  }
+  return out;
+}
+
+void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& commands) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  for (const auto& [name, value] : commands) {
+    const auto& actuators = loaded_->description->actuators;
+    if (std::none_of(actuators.begin(), actuators.end(),
+                     [&](const sgal::Actuator& a) { return a.name == name; }))
+      throw UnknownId("no actuator '" + name + "' in " + loaded_->source, name);
+    if (!std::isfinite(value))
+      throw InvalidValue("command for '" + name + "' is not finite");
+  }
+  pending_commands_.insert(pending_commands_.end(), commands.begin(), commands.end());
+  // while not running, the next step may be far away: keep the command visible now
+  for (const auto& [name, value] : commands) loaded_->commands[name] = value;
+}
+
+std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  std::vector<ActuatorState> out;
+  for (const auto& a : loaded_->description->actuators) {
+    ActuatorState s;
+    s.name = a.name;
+    const auto it = loaded_->commands.find(a.name);
+    s.command = it == loaded_->commands.end() ? 0.0 : it->second;
+    s.tension = loaded_->physics->GetParameter(a.tendon + ".tension");
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return registry_.List(pattern.empty() ? "*" : pattern);
+}
+
+std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  try {
+    return registry_.Sample(ids);
+  } catch (const daq::UnknownId& e) {
+    throw UnknownId(e.what(), e.id());
+  }
+}
+
+void ModelCore::SetChannel(const std::string& id, const std::vector<double>& values) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
+  const daq::ChannelInfo& info = registry_.Info(id);
+  if (!info.writable) throw InvalidValue(id + ": read-only (a state of the simulation)");
+  if (values.size() != info.shape.size())
+    throw InvalidValue(id + ": expected " + std::to_string(info.shape.size()) + " values (shape " +
+                       info.shape.ToString() + "), got " + std::to_string(values.size()));
+  for (double v : values)
+    if (!std::isfinite(v)) throw InvalidValue(id + ": value is not finite");
+  if (state_ == RunState::kRunning) {
+    pending_sets_.emplace_back(id, values);
+    return;
+  }
+  // nothing steps soon: apply now, between steps, and let the engine's refusal reach the caller
+  try {
+    registry_.Set(id, values);
+  } catch (const daq::InvalidValue& e) {
+    throw InvalidValue(e.what());
+  }
+  loaded_->sampler->Refresh();
+}
+
+uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
+                              size_t batch_steps) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Require(true);
+  if (every_n_steps == 0) throw InvalidValue("every_n_steps must be at least 1");
+  if (ids.empty()) throw InvalidValue("subscribe to at least one id");
+  daq::SubscriptionOptions options;
+  options.ids = ids;
+  options.every_n_steps = every_n_steps;
+  options.batch_steps = std::max<size_t>(1, batch_steps);
+  try {
+    return recorder_.Subscribe(options);
+  } catch (const daq::UnknownId& e) {
+    throw UnknownId(e.what(), e.id());
+  } catch (const std::invalid_argument& e) {
+    throw InvalidValue(e.what());
+  }
+}
+
+void ModelCore::Unsubscribe(uint64_t subscription) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    recorder_.Unsubscribe(subscription);
+  } catch (const daq::UnknownId&) {
+    // already gone
+  }
+}
+
+std::vector<daq::Batch> ModelCore::TakeBatches(uint64_t subscription) {
+  try {
+    return recorder_.TakeBatches(subscription);
+  } catch (const daq::UnknownId&) {
+    return {};
+  }
+}
+
+bool ModelCore::WaitForBatches(uint64_t subscription, std::chrono::milliseconds timeout) {
+  try {
+    return recorder_.WaitForBatches(subscription, timeout);
+  } catch (const daq::UnknownId&) {
+    return false;
+  }
+}
+
+void ModelCore::AddListener(CoreListener* listener) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  listeners_.push_back(listener);
+  if (loaded_) {
+    listener->OnScene(loaded_->description, generation_);
+    PublishLocked();
+  }
+}
+
+void ModelCore::RemoveListener(CoreListener* listener) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  listeners_.erase(std::remove(listeners_.begin(), listeners_.end(), listener), listeners_.end());
+}
+
+std::string ModelCore::model_name() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return loaded_ ? loaded_->name : "";
+}
+
+}  // namespace caliper::model

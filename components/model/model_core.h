@@ -1,0 +1,173 @@
+#pragma once
+// The Model's data and simulation loop, without CORBA: the loaded scene, its physics, commands
+// and parameter writes queued for the next step boundary, run control with a real-time factor,
+// and snapshots for observers. Every public method is thread-safe; a step never overlaps a call.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "caliper/daq/daq_scene.h"
+#include "caliper/daq/recorder.h"
+#include "caliper/daq/registry.h"
+#include "caliper/physics_bullet/bullet_scene.h"
+#include "caliper/sgal/physics_scene.h"
+
+namespace caliper::model {
+
+enum class RunState { kEmpty, kStopped, kRunning, kPaused, kFaulted };
+const char* ToString(RunState state);
+
+/// The operation is not possible now (no scene, faulted, running); the message says why.
+class NotAvailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A bad value (NaN, out of range, wrong shape); the message says which and why.
+class InvalidValue : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// An id (actuator, channel) that does not exist; `id()` names it.
+class UnknownId : public std::out_of_range {
+ public:
+  UnknownId(const std::string& what, std::string id) : std::out_of_range(what), id_(std::move(id)) {}
+  const std::string& id() const { return id_; }
+
+ private:
+  std::string id_;
+};
+
+struct Status {
+  RunState state = RunState::kEmpty;
+  std::string scene;
+  double sim_time = 0;          // [s]
+  uint64_t steps = 0;
+  double time_step = 0;         // [s]
+  double real_time_factor = 1;  // requested; 0 = as fast as possible
+  double achieved_real_time_factor = 0;
+  std::string last_error;
+};
+
+/// All body states and tendon states after one step, shared with observers' senders.
+struct Snapshot {
+  uint64_t generation = 0;  // which loaded scene
+  uint64_t step = 0;
+  double time = 0;          // [s]
+  std::vector<sgal::BodyState> bodies;
+  std::vector<sgal::TendonState> tendons;
+};
+
+/// Told about scenes and steps; implemented by the servant's observer senders. Called with the
+/// core's lock held: must only post and return.
+class CoreListener {
+ public:
+  virtual ~CoreListener() = default;
+  virtual void OnScene(std::shared_ptr<const sgal::Scene> scene, uint64_t generation) = 0;
+  virtual void OnSnapshot(std::shared_ptr<const Snapshot> snapshot) = 0;
+  virtual void OnCleared() = 0;
+};
+
+class ModelCore {
+ public:
+  explicit ModelCore(physics_bullet::Options options = {});
+  ~ModelCore();
+
+  /// Imports and builds a scene outside the lock, then swaps it in. On failure throws
+  /// std::runtime_error with the importer's or the engine's message and keeps the old scene.
+  void Load(const std::string& path);
+  /// The same for a description built in memory (tests, generators).
+  void LoadScene(const sgal::Scene& scene, const std::string& source);
+
+  void Start();
+  void Pause();
+  void Stop();   // pause and rewind
+  void Reset();  // rewind, keep the run state
+  /// Runs n steps now; NotAvailable while running.
+  void StepNow(uint64_t n);
+  void SetTimeStep(double seconds);
+  void SetRealTimeFactor(double factor);
+  Status status() const;
+
+  /// Advances a RUNNING simulation by what is due at the real-time factor, or by at most
+  /// `budget` of wall time when running as fast as possible. Called by the execution context.
+  void Advance(std::chrono::steady_clock::duration budget);
+  /// One step if RUNNING (lock-step with an external execution context).
+  void Tick();
+
+  // scene and actuators
+  std::shared_ptr<const sgal::Scene> description() const;  // nullptr when empty
+  void Save(const std::string& path);
+  struct ActuatorInfo {
+    std::string name, kind, tendon, command_unit;
+  };
+  std::vector<ActuatorInfo> Actuators() const;
+  /// Queued for the next step boundary; UnknownId / InvalidValue checked now.
+  void SetCommands(const std::vector<std::pair<std::string, double>>& commands);
+  struct ActuatorState {
+    std::string name;
+    double command = 0, tension = 0;
+  };
+  std::vector<ActuatorState> ActuatorStates() const;
+
+  // channels (parameters and states) through the DAQ registry
+  std::vector<daq::ChannelInfo> Channels(const std::string& pattern) const;
+  std::vector<daq::Reading> Sample(const std::vector<std::string>& ids) const;
+  /// Shape and finiteness checked now; applied at the next step boundary while running, at once
+  /// otherwise (then the engine's own refusal, e.g. a negative mass, is raised too).
+  void SetChannel(const std::string& id, const std::vector<double>& values);
+  /// Subscriptions outlive scene reloads: ids that vanish are reported stale.
+  uint64_t Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
+                     size_t batch_steps);
+  void Unsubscribe(uint64_t subscription);
+  /// Thread-safe without the model's lock: for the subscribers' sender threads.
+  std::vector<daq::Batch> TakeBatches(uint64_t subscription);
+  bool WaitForBatches(uint64_t subscription, std::chrono::milliseconds timeout);
+
+  void AddListener(CoreListener* listener);
+  void RemoveListener(CoreListener* listener);
+
+  /// Model name used as the prefix of channel ids (the scene's name, made id-safe).
+  std::string model_name() const;
+
+ private:
+  struct Loaded;
+  void BuildLocked(std::unique_ptr<Loaded> loaded);
+  void StepLocked();
+  void PublishLocked();
+  void RewindLocked();
+  void Require(bool scene_needed) const;
+
+  physics_bullet::Options options_;
+  mutable std::mutex mutex_;
+  daq::Registry registry_;
+  daq::Recorder recorder_{registry_};
+  std::unique_ptr<Loaded> loaded_;
+  uint64_t generation_ = 0;
+  RunState state_ = RunState::kEmpty;
+  double real_time_factor_ = 1.0;
+  std::string last_error_;
+  std::vector<std::pair<std::string, double>> pending_commands_;
+  std::vector<std::pair<std::string, std::vector<double>>> pending_sets_;
+  std::vector<CoreListener*> listeners_;
+  // real-time pacing: wall clock and sim time when the current run began
+  std::chrono::steady_clock::time_point run_wall_start_;
+  double run_sim_start_ = 0;
+  // achieved real-time factor over the last second
+  std::chrono::steady_clock::time_point rate_wall_;
+  double rate_sim_ = 0;
+  double achieved_rtf_ = 0;
+};
+
+/// `arm.v2` from `Arm V2!`: lower case, letters, digits, underscores.
+std::string IdSafe(const std::string& name);
+
+}  // namespace caliper::model

@@ -1,0 +1,19 @@
+// caliper-model: the Model component.
+#include "caliper/rtc/runtime.h"
+#include "model_component.h"
+#include "model_servant.h"
+
+int main(int argc, char** argv) {
+  using namespace caliper;
+  rtc::ComponentType type;
+  type.name = "model";
+  type.description = "Model: the physics of one tendon-driven robot scene, served over CORBA.";
+  type.category = "simulation";
+  type.config_keys = model::ModelComponent::ConfigKeys();
+  return rtc::RunComponent(
+      argc, argv, type,
+      [](rtc::Runtime& rt) { return std::make_unique<model::ModelComponent>(rt); },
+      [](rtc::Runtime& rt, rtc::Component& c) -> PortableServer::Servant {
+        return new model::ModelServant(rt, static_cast<model::ModelComponent&>(c).core());
+      });
+}

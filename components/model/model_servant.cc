@@ -1,0 +1,542 @@
+#include "model_servant.h"
+
+#include <algorithm>
+#include <map>
+
+#include "caliper/logging/log.h"
+#include "caliper/rtc/naming.h"
+
+namespace caliper::model {
+
+namespace S = ::Caliper::Scene;
+namespace D = ::Caliper::Daq;
+namespace M = ::Caliper::Simulation;
+
+namespace {
+
+S::Frame ToFrame(const sgal::Pose& p) {
+  S::Frame f;
+  f.px = p.position.x();
+  f.py = p.position.y();
+  f.pz = p.position.z();
+  f.qw = p.orientation.w();
+  f.qx = p.orientation.x();
+  f.qy = p.orientation.y();
+  f.qz = p.orientation.z();
+  return f;
+}
+
+S::ShapeGeometry ToGeometry(const sgal::Geometry& g,
+                            std::map<const sgal::Mesh*, CORBA::Long>* meshes) {
+  S::ShapeGeometry out;
+  out.mesh = -1;
+  auto dims = [&](std::initializer_list<double> values) {
+    out.dims.length(static_cast<CORBA::ULong>(values.size()));
+    CORBA::ULong i = 0;
+    for (double v : values) out.dims[i++] = v;
+  };
+  std::visit(
+      [&](const auto& s) {
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, sgal::Box>) {
+          out.kind = S::BOX;
+          dims({s.size.x(), s.size.y(), s.size.z()});
+        } else if constexpr (std::is_same_v<T, sgal::Sphere>) {
+          out.kind = S::SPHERE;
+          dims({s.radius});
+        } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
+          out.kind = S::CAPSULE;
+          dims({s.radius, s.length});
+        } else if constexpr (std::is_same_v<T, sgal::Cylinder>) {
+          out.kind = S::CYLINDER;
+          dims({s.radius, s.length});
+        } else if constexpr (std::is_same_v<T, sgal::Cone>) {
+          out.kind = S::CONE;
+          dims({s.radius, s.length});
+        } else if constexpr (std::is_same_v<T, sgal::Plane>) {
+          out.kind = S::PLANE;
+          dims({s.normal.x(), s.normal.y(), s.normal.z(), s.offset});
+        } else {
+          out.kind = std::is_same_v<T, sgal::ConvexHull> ? S::CONVEX_HULL : S::TRIANGLE_MESH;
+          if (s.mesh) {
+            const auto it = meshes->find(s.mesh.get());
+            if (it != meshes->end()) {
+              out.mesh = it->second;
+            } else {
+              const CORBA::Long index = static_cast<CORBA::Long>(meshes->size());
+              (*meshes)[s.mesh.get()] = index;
+              out.mesh = index;
+            }
+          }
+        }
+      },
+      g);
+  return out;
+}
+
+S::TendonStateSeq ToIdl(const std::vector<sgal::TendonState>& tendons) {
+  S::TendonStateSeq out;
+  out.length(static_cast<CORBA::ULong>(tendons.size()));
+  for (CORBA::ULong i = 0; i < tendons.size(); ++i) {
+    const auto& t = tendons[i];
+    out[i].tendon_index = i;
+    out[i].length = t.length;
+    out[i].tension = t.tension;
+    out[i].points.length(static_cast<CORBA::ULong>(3 * t.points.size()));
+    for (CORBA::ULong k = 0; k < t.points.size(); ++k)
+      for (int c = 0; c < 3; ++c) out[i].points[3 * k + c] = t.points[k][c];
+  }
+  return out;
+}
+
+bool PeerGone(const CORBA::Exception& e) {
+  return CORBA::TRANSIENT::_downcast(&e) || CORBA::COMM_FAILURE::_downcast(&e) ||
+         CORBA::OBJECT_NOT_EXIST::_downcast(&e) || CORBA::TIMEOUT::_downcast(&e);
+}
+
+D::Value ToIdl(const daq::Reading& v) {
+  D::Value out;
+  out.rows = v.shape.rows;
+  out.cols = v.shape.cols;
+  out.data.length(static_cast<CORBA::ULong>(v.values.size()));
+  for (CORBA::ULong i = 0; i < v.values.size(); ++i) out.data[i] = v.values[i];
+  return out;
+}
+
+D::ChannelInfoSeq* ToIdl(const std::vector<daq::ChannelInfo>& channels) {
+  auto* out = new D::ChannelInfoSeq;
+  out->length(static_cast<CORBA::ULong>(channels.size()));
+  for (CORBA::ULong i = 0; i < channels.size(); ++i) {
+    const auto& c = channels[i];
+    (*out)[i].id = c.id.c_str();
+    (*out)[i].unit = c.unit.c_str();
+    (*out)[i].rows = c.shape.rows;
+    (*out)[i].cols = c.shape.cols;
+    (*out)[i].writable = c.writable;
+    (*out)[i].is_static = c.is_static;
+    (*out)[i].description = c.description.c_str();
+  }
+  return out;
+}
+
+std::vector<std::string> FromIdl(const S::StringSeq& ids) {
+  std::vector<std::string> out;
+  for (CORBA::ULong i = 0; i < ids.length(); ++i) out.emplace_back(ids[i].in());
+  return out;
+}
+
+/// Runs a core call and turns its C++ exceptions into the IDL's user exceptions.
+template <class F>
+auto Guard(F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const UnknownId& e) {
+    throw D::UnknownId(e.what(), e.id().c_str());
+  } catch (const InvalidValue& e) {
+    throw D::InvalidParameter(e.what());
+  } catch (const NotAvailable& e) {
+    throw M::NotAvailable(e.what());
+  } catch (const CORBA::UserException&) {
+    throw;
+  } catch (const std::exception& e) {
+    logging::Get("model").error("internal error: %s", e.what());
+    throw M::NotAvailable((std::string("internal error: ") + e.what()).c_str());
+  }
+}
+
+}  // namespace
+
+S::Description* ToIdl(const sgal::Scene& scene) {
+  auto* d = new S::Description;
+  d->name = scene.name.c_str();
+  d->source = scene.source.c_str();
+  d->time_step = scene.settings.time_step;
+  std::map<const sgal::Mesh*, CORBA::Long> meshes;
+  d->bodies.length(static_cast<CORBA::ULong>(scene.bodies.size()));
+  for (CORBA::ULong i = 0; i < scene.bodies.size(); ++i) {
+    const auto& b = scene.bodies[i];
+    S::Body& out = d->bodies[i];
+    out.name = b.name.c_str();
+    out.pose = ToFrame(b.pose);
+    out.moving = b.type != sgal::BodyType::kStatic;
+    // what to draw: the visuals, or the collision shapes of a body that has none
+    std::vector<sgal::Visual> visuals = b.visuals;
+    if (visuals.empty())
+      for (const auto& s : b.shapes) visuals.push_back({s.name, s.geometry, s.pose, {0.7f, 0.7f, 0.7f, 1}});
+    out.visuals.length(static_cast<CORBA::ULong>(visuals.size()));
+    for (CORBA::ULong k = 0; k < visuals.size(); ++k) {
+      out.visuals[k].name = visuals[k].name.c_str();
+      out.visuals[k].geometry = ToGeometry(visuals[k].geometry, &meshes);
+      out.visuals[k].pose = ToFrame(visuals[k].pose);
+      out.visuals[k].r = visuals[k].color[0];
+      out.visuals[k].g = visuals[k].color[1];
+      out.visuals[k].b = visuals[k].color[2];
+      out.visuals[k].a = visuals[k].color[3];
+    }
+  }
+  d->meshes.length(static_cast<CORBA::ULong>(meshes.size()));
+  for (const auto& [mesh, index] : meshes) {
+    S::MeshData& m = d->meshes[index];
+    m.vertices.length(static_cast<CORBA::ULong>(3 * mesh->vertices.size()));
+    for (CORBA::ULong k = 0; k < mesh->vertices.size(); ++k)
+      for (int c = 0; c < 3; ++c) m.vertices[3 * k + c] = mesh->vertices[k][c];
+    m.triangles.length(static_cast<CORBA::ULong>(3 * mesh->triangles.size()));
+    for (CORBA::ULong k = 0; k < mesh->triangles.size(); ++k)
+      for (int c = 0; c < 3; ++c) m.triangles[3 * k + c] = mesh->triangles[k][c];
+    m.normals.length(static_cast<CORBA::ULong>(3 * mesh->normals.size()));
+    for (CORBA::ULong k = 0; k < mesh->normals.size(); ++k)
+      for (int c = 0; c < 3; ++c) m.normals[3 * k + c] = mesh->normals[k][c];
+  }
+  static const char* const kKinds[] = {"hinge", "slider", "ball", "fixed", "generic_6dof"};
+  d->constraints.length(static_cast<CORBA::ULong>(scene.constraints.size()));
+  for (CORBA::ULong i = 0; i < scene.constraints.size(); ++i) {
+    const auto& c = scene.constraints[i];
+    d->constraints[i].name = c.name.c_str();
+    d->constraints[i].kind = kKinds[static_cast<int>(c.kind)];
+    d->constraints[i].body_a = c.body_a.c_str();
+    d->constraints[i].body_b = c.body_b.c_str();
+    d->constraints[i].frame_a = ToFrame(c.frame_a);
+    d->constraints[i].frame_b = ToFrame(c.frame_b);
+  }
+  d->obstacles.length(static_cast<CORBA::ULong>(scene.obstacles.size()));
+  for (CORBA::ULong i = 0; i < scene.obstacles.size(); ++i) {
+    const auto& o = scene.obstacles[i];
+    d->obstacles[i].name = o.name.c_str();
+    d->obstacles[i].body = o.body.c_str();
+    d->obstacles[i].kind = o.kind == sgal::ObstacleKind::kSphere ? "sphere" : "cylinder";
+    d->obstacles[i].pose = ToFrame(o.pose);
+    d->obstacles[i].radius = o.radius;
+    d->obstacles[i].length = o.length;
+  }
+  d->tendons.length(static_cast<CORBA::ULong>(scene.tendons.size()));
+  for (CORBA::ULong i = 0; i < scene.tendons.size(); ++i) {
+    const auto& t = scene.tendons[i];
+    d->tendons[i].name = t.name.c_str();
+    d->tendons[i].radius = t.radius;
+    CORBA::ULong n = 0;
+    for (const auto& e : t.path)
+      if (e.kind == sgal::PathElement::Kind::kWrap) {
+        d->tendons[i].obstacles.length(n + 1);
+        d->tendons[i].obstacles[n++] = e.obstacle.c_str();
+      }
+  }
+  return d;
+}
+
+// ------------------------------------------------------------------------ observers
+
+ObserverSender::ObserverSender(S::SceneObserver_ptr observer)
+    : observer_(S::SceneObserver::_duplicate(observer)) {
+  thread_ = std::thread([this] { Run(); });
+}
+
+ObserverSender::~ObserverSender() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void ObserverSender::OnScene(std::shared_ptr<const sgal::Scene> scene, uint64_t generation) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  scene_ = std::move(scene);
+  scene_generation_ = generation;
+  snapshot_.reset();
+  wake_.notify_all();
+}
+
+void ObserverSender::OnSnapshot(std::shared_ptr<const Snapshot> snapshot) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (snapshot_) ++coalesced_;
+  snapshot_ = std::move(snapshot);
+  wake_.notify_all();
+}
+
+void ObserverSender::OnCleared() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  cleared_ = true;
+  wake_.notify_all();
+}
+
+void ObserverSender::Run() {
+  sgal::ChangeFilter filter;
+  uint64_t generation = 0;
+  uint64_t update = 0;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [&] { return stop_ || cleared_ || scene_ || snapshot_; });
+    if (stop_) return;
+    const bool cleared = cleared_;
+    cleared_ = false;
+    auto scene = std::move(scene_);
+    scene_.reset();
+    const uint64_t scene_generation = scene_generation_;
+    auto snapshot = std::move(snapshot_);
+    snapshot_.reset();
+    lock.unlock();
+    try {
+      if (cleared) observer_->on_scene_cleared();
+      if (scene) {
+        std::unique_ptr<S::Description> description(ToIdl(*scene));
+        observer_->on_scene(*description);
+        generation = scene_generation;
+        filter = sgal::ChangeFilter();
+      }
+      if (snapshot && snapshot->generation == generation) {
+        const std::vector<int> changed = filter.Changed(snapshot->bodies);
+        S::BodyTransformSeq transforms;
+        transforms.length(static_cast<CORBA::ULong>(changed.size()));
+        for (CORBA::ULong i = 0; i < changed.size(); ++i) {
+          transforms[i].body_index = static_cast<CORBA::ULong>(changed[i]);
+          transforms[i].pose = ToFrame(snapshot->bodies[changed[i]].pose);
+        }
+        observer_->on_transforms(++update, snapshot->time, transforms, ToIdl(snapshot->tendons));
+        ++sent_;
+      }
+    } catch (const CORBA::Exception& e) {
+      if (PeerGone(e)) {
+        logging::Get("observers").info("dropping an observer: %s", rtc::Describe(e).c_str());
+        dead_ = true;
+        lock.lock();
+        wake_.wait(lock, [&] { return stop_; });
+        return;
+      }
+      logging::Get("observers").warn("observer call failed: %s", rtc::Describe(e).c_str());
+    }
+    lock.lock();
+  }
+}
+
+ConsumerSender::ConsumerSender(ModelCore& core, uint64_t subscription, D::DataConsumer_ptr consumer)
+    : core_(core), subscription_(subscription), consumer_(D::DataConsumer::_duplicate(consumer)) {
+  thread_ = std::thread([this] { Run(); });
+}
+
+ConsumerSender::~ConsumerSender() {
+  stop_ = true;
+  thread_.join();
+}
+
+void ConsumerSender::Run() {
+  while (!stop_) {
+    auto batches = core_.TakeBatches(subscription_);
+    if (batches.empty()) {
+      core_.WaitForBatches(subscription_, std::chrono::milliseconds(50));
+      continue;
+    }
+    for (const auto& b : batches) {
+      D::SampleBatch out;
+      out.subscription = subscription_;
+      out.batch = b.sequence;
+      out.first_step = b.first_step;
+      out.times.length(static_cast<CORBA::ULong>(b.times.size()));
+      for (CORBA::ULong i = 0; i < b.times.size(); ++i) out.times[i] = b.times[i];
+      out.values_per_sample = static_cast<CORBA::ULong>(b.values_per_sample);
+      out.data.length(static_cast<CORBA::ULong>(b.data.size()));
+      for (CORBA::ULong i = 0; i < b.data.size(); ++i) out.data[i] = b.data[i];
+      const std::vector<std::string> stale = b.StaleIds();
+      out.stale_ids.length(static_cast<CORBA::ULong>(stale.size()));
+      for (CORBA::ULong i = 0; i < stale.size(); ++i) out.stale_ids[i] = stale[i].c_str();
+      try {
+        consumer_->on_samples(out);
+      } catch (const CORBA::Exception& e) {
+        if (PeerGone(e)) {
+          logging::Get("daq").info("dropping subscription %llu: %s",
+                                   static_cast<unsigned long long>(subscription_),
+                                   rtc::Describe(e).c_str());
+          core_.Unsubscribe(subscription_);
+          dead_ = true;
+          return;
+        }
+      }
+    }
+  }
+}
+
+// ------------------------------------------------------------------------ servant
+
+ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core)
+    : rtc::RTObjectServant(runtime), core_(core) {}
+
+ModelServant::~ModelServant() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto& [id, o] : observers_) core_.RemoveListener(o.get());
+  observers_.clear();
+  consumers_.clear();
+}
+
+void ModelServant::DropDead() {
+  for (auto it = observers_.begin(); it != observers_.end();) {
+    if (it->second->dead()) {
+      core_.RemoveListener(it->second.get());
+      it = observers_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto it = consumers_.begin(); it != consumers_.end();)
+    it = it->second->dead() ? consumers_.erase(it) : std::next(it);
+}
+
+void ModelServant::load_scene(const char* path) {
+  try {
+    core_.Load(path);
+  } catch (const std::exception& e) {
+    logging::Get("model").error("load %s failed: %s", path, e.what());
+    throw M::LoadFailed(e.what());
+  }
+}
+
+void ModelServant::start() { Guard([&] { core_.Start(); }); }
+void ModelServant::pause() { Guard([&] { core_.Pause(); }); }
+void ModelServant::stop() { Guard([&] { core_.Stop(); }); }
+void ModelServant::reset() { Guard([&] { core_.Reset(); }); }
+void ModelServant::step(CORBA::ULong n) { Guard([&] { core_.StepNow(n); }); }
+void ModelServant::set_time_step(CORBA::Double s) { Guard([&] { core_.SetTimeStep(s); }); }
+
+void ModelServant::set_real_time_factor(CORBA::Double f) {
+  Guard([&] { core_.SetRealTimeFactor(f); });
+}
+
+M::SimulationStatus* ModelServant::status() {
+  const Status s = core_.status();
+  auto* result = new M::SimulationStatus;
+  M::SimulationStatus& out = *result;
+  out.state = static_cast<M::SimulationState>(static_cast<int>(s.state));
+  out.scene = s.scene.c_str();
+  out.sim_time = s.sim_time;
+  out.steps = s.steps;
+  out.time_step = s.time_step;
+  out.real_time_factor = s.real_time_factor;
+  out.achieved_real_time_factor = s.achieved_real_time_factor;
+  out.last_error = s.last_error.c_str();
+  return result;
+}
+
+S::Description* ModelServant::scene_description() {
+  return Guard([&] {
+    auto scene = core_.description();
+    if (!scene) throw NotAvailable("no scene is loaded");
+    return ToIdl(*scene);
+  });
+}
+
+void ModelServant::save_scene(const char* path) {
+  Guard([&] {
+    try {
+      core_.Save(path);
+    } catch (const NotAvailable&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw InvalidValue(std::string("cannot save ") + path + ": " + e.what());
+    }
+  });
+}
+
+M::ActuatorInfoSeq* ModelServant::actuators() {
+  return Guard([&] {
+    const auto list = core_.Actuators();
+    auto* out = new M::ActuatorInfoSeq;
+    out->length(static_cast<CORBA::ULong>(list.size()));
+    for (CORBA::ULong i = 0; i < list.size(); ++i) {
+      (*out)[i].name = list[i].name.c_str();
+      (*out)[i].kind = list[i].kind.c_str();
+      (*out)[i].tendon = list[i].tendon.c_str();
+      (*out)[i].command_unit = list[i].command_unit.c_str();
+    }
+    return out;
+  });
+}
+
+void ModelServant::set_command(const char* actuator, CORBA::Double value) {
+  Guard([&] { core_.SetCommands({{actuator, value}}); });
+}
+
+void ModelServant::set_commands(const M::CommandSeq& commands) {
+  std::vector<std::pair<std::string, double>> list;
+  for (CORBA::ULong i = 0; i < commands.length(); ++i)
+    list.emplace_back(commands[i].actuator.in(), commands[i].value);
+  Guard([&] { core_.SetCommands(list); });
+}
+
+M::ActuatorStateSeq* ModelServant::actuator_states() {
+  return Guard([&] {
+    const auto states = core_.ActuatorStates();
+    auto* out = new M::ActuatorStateSeq;
+    out->length(static_cast<CORBA::ULong>(states.size()));
+    for (CORBA::ULong i = 0; i < states.size(); ++i) {
+      (*out)[i].name = states[i].name.c_str();
+      (*out)[i].command = states[i].command;
+      (*out)[i].tension = states[i].tension;
+    }
+    return out;
+  });
+}
+
+D::ChannelInfoSeq* ModelServant::list(const char* pattern) {
+  return Guard([&] { return ToIdl(core_.Channels(pattern)); });
+}
+
+D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
+  return Guard([&] {
+    const auto values = core_.Sample(FromIdl(ids));
+    auto* out = new D::ValueSeq;
+    out->length(static_cast<CORBA::ULong>(values.size()));
+    for (CORBA::ULong i = 0; i < values.size(); ++i) (*out)[i] = ToIdl(values[i]);
+    return out;
+  });
+}
+
+void ModelServant::set(const char* id, const D::Value& value) {
+  std::vector<double> values;
+  for (CORBA::ULong i = 0; i < value.data.length(); ++i) values.push_back(value.data[i]);
+  Guard([&] { core_.SetChannel(id, values); });
+}
+
+D::ChannelInfoSeq* ModelServant::channels(const char* pattern) { return list(pattern); }
+
+D::ValueSeq* ModelServant::sample(const S::StringSeq& ids) { return get(ids); }
+
+CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong every_n_steps,
+                                         D::DataConsumer_ptr consumer) {
+  if (CORBA::is_nil(consumer)) throw D::InvalidParameter("the consumer is nil");
+  // batches about twenty times a second of simulated time
+  const double dt = core_.status().time_step;
+  const double per_sample = (dt > 0 ? dt : 1e-3) * std::max<CORBA::ULong>(every_n_steps, 1);
+  const size_t batch_steps = std::max<size_t>(1, static_cast<size_t>(0.05 / per_sample));
+  const uint64_t id =
+      Guard([&] { return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps); });
+  std::lock_guard<std::mutex> lock(mutex_);
+  DropDead();
+  consumers_[id] = std::make_unique<ConsumerSender>(core_, id, consumer);
+  return id;
+}
+
+void ModelServant::unsubscribe(CORBA::ULongLong subscription) {
+  core_.Unsubscribe(subscription);
+  std::lock_guard<std::mutex> lock(mutex_);
+  consumers_.erase(subscription);
+}
+
+CORBA::ULongLong ModelServant::add_observer(S::SceneObserver_ptr observer) {
+  if (CORBA::is_nil(observer)) throw M::NotAvailable("the observer is nil");
+  std::lock_guard<std::mutex> lock(mutex_);
+  DropDead();
+  auto sender = std::make_unique<ObserverSender>(observer);
+  core_.AddListener(sender.get());
+  const uint64_t id = next_observer_++;
+  observers_[id] = std::move(sender);
+  return id;
+}
+
+void ModelServant::remove_observer(CORBA::ULongLong id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = observers_.find(id);
+  if (it == observers_.end()) return;
+  core_.RemoveListener(it->second.get());
+  observers_.erase(it);
+}
+
+}  // namespace caliper::model

@@ -1,0 +1,328 @@
+#include "caliper/daq/recorder.h"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace caliper::daq {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}  // namespace
+
+std::vector<double> Batch::Values(size_t column) const {
+  const Column& c = columns->at(column);
+  const size_t n = c.shape.size();
+  std::vector<double> out(step_count * n);
+  for (size_t k = 0; k < step_count; ++k)
+    std::copy_n(data.begin() + k * values_per_sample + c.offset, n, out.begin() + k * n);
+  return out;
+}
+
+std::vector<double> Batch::Values(const std::string& id) const {
+  for (size_t i = 0; i < columns->size(); ++i)
+    if ((*columns)[i].id == id) return Values(i);
+  throw UnknownId(id);
+}
+
+std::vector<std::string> Batch::StaleIds() const {
+  std::vector<std::string> out;
+  for (const auto& c : *columns)
+    if (c.stale) out.push_back(c.id);
+  return out;
+}
+
+/// The bounded hand-over between the simulation thread and a subscriber's sender.
+struct Recorder::Queue {
+  Queue(size_t capacity_, Consumer consumer_)
+      : capacity(capacity_), consumer(std::move(consumer_)) {}
+
+  /// Appends, dropping the oldest batch when full; never waits for a consumer.
+  void Push(Batch&& batch) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (batches.size() >= capacity) {
+        batches.pop_front();
+        ++dropped;
+      }
+      batches.push_back(std::move(batch));
+    }
+    ready.notify_one();
+  }
+  std::vector<Batch> Take(size_t max) {
+    std::vector<Batch> out;
+    std::lock_guard<std::mutex> lock(mutex);
+    while (!batches.empty() && out.size() < max) {
+      out.push_back(std::move(batches.front()));
+      batches.pop_front();
+    }
+    return out;
+  }
+  void Close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      closed = true;
+    }
+    ready.notify_all();
+  }
+
+  const size_t capacity;
+  const Consumer consumer;
+  std::mutex mutex;  // guards the fields below
+  std::condition_variable ready;
+  std::deque<Batch> batches;
+  uint64_t dropped = 0;
+  bool closed = false;
+};
+
+/// The simulation-thread state of one subscription.
+struct Recorder::Subscription {
+  SubscriptionId id = 0;
+  std::vector<std::string> ids;
+  uint64_t every_n_steps = 1;
+  size_t batch_steps = 1;
+  std::vector<Handle> handles;  // per column; meaningless for stale columns
+  std::shared_ptr<const std::vector<Column>> columns;
+  size_t values_per_sample = 0;
+  bool started = false;    // has taken a sample
+  uint64_t last_step = 0;  // of the last sample
+  uint64_t sequence = 0;   // of the last batch
+  uint64_t samples = 0;
+  std::string last_error;
+  Batch pending;  // the batch being filled (step_count 0 when none)
+  std::shared_ptr<Queue> queue;
+};
+
+Recorder::Recorder(const Registry& registry)
+    : registry_(registry), registry_version_(registry.version()) {}
+
+Recorder::~Recorder() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto& [id, s] : subscriptions_) s->queue->Close();
+}
+
+SubscriptionId Recorder::Subscribe(SubscriptionOptions options) {
+  if (options.ids.empty()) throw std::invalid_argument("subscription without ids");
+  if (options.every_n_steps == 0) throw std::invalid_argument("every_n_steps must be at least 1");
+  if (options.batch_steps == 0) throw std::invalid_argument("batch_steps must be at least 1");
+  if (options.queue_capacity == 0) throw std::invalid_argument("queue_capacity must be at least 1");
+  for (const auto& id : options.ids)
+    if (!registry_.Contains(id)) throw UnknownId(id);
+
+  auto s = std::make_unique<Subscription>();
+  s->ids = std::move(options.ids);
+  s->every_n_steps = options.every_n_steps;
+  s->batch_steps = options.batch_steps;
+  s->queue = std::make_shared<Queue>(options.queue_capacity, std::move(options.consumer));
+  std::lock_guard<std::mutex> lock(mutex_);
+  s->id = next_id_++;
+  Resolve(*s, true);
+  const SubscriptionId id = s->id;
+  subscriptions_.emplace(id, std::move(s));
+  return id;
+}
+
+std::vector<Batch> Recorder::Unsubscribe(SubscriptionId id) {
+  std::unique_ptr<Subscription> s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = subscriptions_.find(id);
+    if (it == subscriptions_.end()) throw UnknownId(std::to_string(id), "subscription");
+    s = std::move(it->second);
+    subscriptions_.erase(it);
+  }
+  Emit(*s);
+  auto rest = s->queue->Take(SIZE_MAX);
+  s->queue->Close();
+  return rest;
+}
+
+void Recorder::Resolve(Subscription& s, bool initial) {
+  auto columns = std::make_shared<std::vector<Column>>(s.ids.size());
+  s.handles.resize(s.ids.size());
+  size_t offset = 0;
+  for (size_t i = 0; i < s.ids.size(); ++i) {
+    Column& c = (*columns)[i];
+    c.id = s.ids[i];
+    if (registry_.TryResolve(c.id, &s.handles[i])) {
+      const ChannelInfo& info = registry_.Info(s.handles[i]);
+      c.unit = info.unit;
+      c.shape = info.shape;
+    } else {
+      // keep the last known layout so that the columns stay where they were
+      c.stale = true;
+      if (!initial) {
+        c.unit = (*s.columns)[i].unit;
+        c.shape = (*s.columns)[i].shape;
+      }
+    }
+    c.offset = offset;
+    offset += c.shape.size();
+  }
+  if (!initial) {
+    bool same = true;
+    for (size_t i = 0; i < columns->size() && same; ++i) {
+      const Column &a = (*columns)[i], &b = (*s.columns)[i];
+      same = a.unit == b.unit && a.shape == b.shape && a.stale == b.stale;
+    }
+    if (same) return;
+    // a batch has one layout: hand out what was sampled with the old one
+    Emit(s);
+  }
+  s.columns = std::move(columns);
+  s.values_per_sample = offset;
+}
+
+void Recorder::Sample(Subscription& s, uint64_t step, double sim_time) {
+  Batch& b = s.pending;
+  if (b.step_count == 0) {
+    b.subscription = s.id;
+    b.first_step = step;
+    b.every_n_steps = s.every_n_steps;
+    b.columns = s.columns;
+    b.values_per_sample = s.values_per_sample;
+    b.times.reserve(s.batch_steps);
+    b.data.reserve(s.batch_steps * s.values_per_sample);
+  }
+  b.times.push_back(sim_time);
+  const size_t base = b.data.size();
+  b.data.resize(base + s.values_per_sample);
+  double* out = b.data.data() + base;
+  const std::vector<Column>& columns = *s.columns;
+  for (size_t i = 0; i < columns.size(); ++i) {
+    const Column& c = columns[i];
+    if (c.stale) {
+      std::fill_n(out + c.offset, c.shape.size(), kNaN);
+      continue;
+    }
+    try {
+      registry_.Read(s.handles[i], out + c.offset);
+    } catch (const std::exception& e) {
+      std::fill_n(out + c.offset, c.shape.size(), kNaN);
+      s.last_error = c.id + ": " + e.what();
+    }
+  }
+  ++b.step_count;
+  ++s.samples;
+  s.started = true;
+  s.last_step = step;
+  if (b.step_count >= s.batch_steps) Emit(s);
+}
+
+void Recorder::Emit(Subscription& s) {
+  if (s.pending.step_count == 0) return;
+  s.pending.sequence = ++s.sequence;
+  s.queue->Push(std::move(s.pending));
+  s.pending = Batch();
+}
+
+void Recorder::OnStep(uint64_t step, double sim_time) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (registry_.version() != registry_version_) {
+    registry_version_ = registry_.version();
+    for (auto& [id, s] : subscriptions_) Resolve(*s, false);
+  }
+  for (auto& [id, sp] : subscriptions_) {
+    Subscription& s = *sp;
+    if (s.started) {
+      const uint64_t due = s.last_step + s.every_n_steps;
+      if (step < due && step > s.last_step) continue;  // not yet
+      // the clock went back (reset) or a due sample was missed: start a new batch
+      if (step != due) Emit(s);
+    }
+    Sample(s, step, sim_time);
+  }
+}
+
+void Recorder::Flush() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto& [id, s] : subscriptions_) Emit(*s);
+}
+
+void Recorder::Flush(SubscriptionId id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Emit(Find(id));
+}
+
+Recorder::Subscription& Recorder::Find(SubscriptionId id) {
+  const auto it = subscriptions_.find(id);
+  if (it == subscriptions_.end()) throw UnknownId(std::to_string(id), "subscription");
+  return *it->second;
+}
+
+std::shared_ptr<Recorder::Queue> Recorder::FindQueue(SubscriptionId id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = subscriptions_.find(id);
+  if (it == subscriptions_.end()) throw UnknownId(std::to_string(id), "subscription");
+  return it->second->queue;
+}
+
+std::vector<Batch> Recorder::TakeBatches(SubscriptionId id, size_t max) {
+  return FindQueue(id)->Take(max);
+}
+
+bool Recorder::WaitForBatches(SubscriptionId id, std::chrono::milliseconds timeout) {
+  const auto queue = FindQueue(id);
+  std::unique_lock<std::mutex> lock(queue->mutex);
+  queue->ready.wait_for(lock, timeout, [&] { return !queue->batches.empty() || queue->closed; });
+  return !queue->batches.empty() && !queue->closed;
+}
+
+size_t Recorder::Deliver(SubscriptionId id, size_t max) {
+  const auto queue = FindQueue(id);
+  if (!queue->consumer)
+    throw std::logic_error("subscription " + std::to_string(id) + " has no consumer");
+  size_t delivered = 0;
+  while (delivered < max) {
+    auto one = queue->Take(1);
+    if (one.empty()) break;
+    queue->consumer(one.front());
+    ++delivered;
+  }
+  return delivered;
+}
+
+size_t Recorder::DeliverAll() {
+  std::vector<std::shared_ptr<Queue>> queues;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, s] : subscriptions_)
+      if (s->queue->consumer) queues.push_back(s->queue);
+  }
+  size_t delivered = 0;
+  for (const auto& queue : queues) {
+    for (;;) {
+      auto one = queue->Take(1);
+      if (one.empty()) break;
+      queue->consumer(one.front());
+      ++delivered;
+    }
+  }
+  return delivered;
+}
+
+SubscriptionStats Recorder::Stats(SubscriptionId id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = subscriptions_.find(id);
+  if (it == subscriptions_.end()) throw UnknownId(std::to_string(id), "subscription");
+  const Subscription& s = *it->second;
+  SubscriptionStats out;
+  out.samples = s.samples;
+  out.batches = s.sequence;
+  for (const auto& c : *s.columns)
+    if (c.stale) out.stale.push_back(c.id);
+  out.last_error = s.last_error;
+  std::lock_guard<std::mutex> queue_lock(s.queue->mutex);
+  out.dropped = s.queue->dropped;
+  out.queued = s.queue->batches.size();
+  return out;
+}
+
+std::vector<SubscriptionId> Recorder::subscriptions() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<SubscriptionId> out;
+  for (const auto& [id, s] : subscriptions_) out.push_back(id);
+  return out;
+}
+
+}  // namespace caliper::daq
