@@ -334,7 +334,7 @@ std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
     s.name = a.name;
     const auto it = loaded_->commands.find(a.name);
     s.command = it == loaded_->commands.end() ? 0.0 : it->second;
-    s.tension = loaded_->physics->GetParameter(a.tendon + ".tension");
+    s.tension = loaded_->physics->GetParameter(a.tendon + ".tendon.tension");
     out.push_back(s);
   }
   return out;

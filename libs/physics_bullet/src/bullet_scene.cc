@@ -696,10 +696,11 @@ std::vector<sgal::ParameterInfo> BulletScene::Parameters() const {
     out.push_back({j.desc->name + ".spring_damping", hinge ? "N m s/rad" : "N s/m", true, true});
   }
   for (const auto& t : tendons_) {
-    out.push_back({t.desc->name + ".length", "m", false, false});
-    out.push_back({t.desc->name + ".speed", "m/s", false, false});
-    out.push_back({t.desc->name + ".tension", "N", false, false});
-    out.push_back({t.desc->name + ".contacts", "", false, false});
+    // tendons often share their actuator's name: their states live under `.tendon.`
+    out.push_back({t.desc->name + ".tendon.length", "m", false, false});
+    out.push_back({t.desc->name + ".tendon.speed", "m/s", false, false});
+    out.push_back({t.desc->name + ".tendon.tension", "N", false, false});
+    out.push_back({t.desc->name + ".tendon.contacts", "", false, false});
   }
   for (const auto& a : actuators_) {
     out.push_back({a.desc->name + ".command", a.model->command_unit(), true, false});
@@ -734,7 +735,7 @@ double BulletScene::GetParameter(const std::string& id) const {
     if (field == "spring_damping") return j.desc->springs[0].damping;
   }
   for (const auto& t : tendons_) {
-    if (t.desc->name != name) continue;
+    if (t.desc->name + ".tendon" != name) continue;
     if (field == "length") return t.geometry.length;
     if (field == "speed") return t.geometry.speed;
     if (field == "tension") return t.tension;
@@ -785,7 +786,7 @@ void BulletScene::SetParameter(const std::string& id, double value) {
       throw std::invalid_argument(id + " is read-only (a state of the simulation)");
   }
   for (auto& t : tendons_)
-    if (t.desc->name == name && (field == "length" || field == "speed" || field == "tension" ||
+    if (t.desc->name + ".tendon" == name && (field == "length" || field == "speed" || field == "tension" ||
                                  field == "contacts"))
       throw std::invalid_argument(id + " is read-only (a state of the simulation)");
   for (auto& a : actuators_) {

@@ -90,7 +90,7 @@ TEST_F(Fixture, RegistersEveryParameterAndTheBodyQuantities) {
     EXPECT_FALSE(info.description.empty());
   }
   EXPECT_EQ(registry.Info("pend.motor.current").unit, "A");
-  EXPECT_EQ(registry.Info("pend.cord.tension").unit, "N");
+  EXPECT_EQ(registry.Info("pend.cord.tendon.tension").unit, "N");
   EXPECT_EQ(registry.Info("pend.pivot.position").unit, "rad");
   EXPECT_TRUE(registry.Info("pend.bob.mass").is_static);
 
@@ -108,7 +108,7 @@ TEST_F(Fixture, RegistersEveryParameterAndTheBodyQuantities) {
   EXPECT_EQ(registry.Info("pend.bob.angular_velocity").unit, "rad/s");
   EXPECT_FALSE(registry.Info("pend.bob.position").writable);
   EXPECT_FALSE(registry.Info("pend.bob.position").is_static);
-  EXPECT_EQ(registry.List("pend.*.tension").size(), 2u);  // cord.tension, motor.tension
+  EXPECT_EQ(registry.List("pend.*.tension").size(), 2u);  // cord.tendon.tension, motor.tension
 }
 
 TEST_F(Fixture, ValuesAgreeWithTheScene) {
@@ -116,7 +116,7 @@ TEST_F(Fixture, ValuesAgreeWithTheScene) {
   const sgal::BodyState state = scene->BodyStates()[0];
   const auto r = registry.Sample({"pend.bob.position", "pend.bob.orientation", "pend.bob.rotation",
                                   "pend.bob.linear_velocity", "pend.bob.angular_velocity",
-                                  "pend.pivot.position", "pend.cord.length", "pend.motor.current"});
+                                  "pend.pivot.position", "pend.cord.tendon.length", "pend.motor.current"});
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(r[0].values[i], state.pose.position[i]);
     EXPECT_EQ(r[3].values[i], state.linear_velocity[i]);
@@ -129,7 +129,7 @@ TEST_F(Fixture, ValuesAgreeWithTheScene) {
     for (int col = 0; col < 3; ++col)
       EXPECT_NEAR(r[2].values[row * 3 + col], m(row, col), 1e-15) << "row-major";
   EXPECT_EQ(r[5].values[0], scene->GetParameter("pivot.position"));
-  EXPECT_EQ(r[6].values[0], scene->GetParameter("cord.length"));
+  EXPECT_EQ(r[6].values[0], scene->GetParameter("cord.tendon.length"));
   EXPECT_EQ(r[7].values[0], scene->GetParameter("motor.current"));
   EXPECT_GT(std::abs(r[3].values[0]), 1e-3) << "the pendulum swings";
 }

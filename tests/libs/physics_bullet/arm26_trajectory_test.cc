@@ -49,7 +49,7 @@ TEST(Arm26Trajectory, FollowsMuJoCoUnderConstantMuscleControls) {
       worst_free = std::max({worst_free, std::abs(shoulder - row[qs]) / std::max(row[qs], 0.1),
                              std::abs(elbow - row[qe]) / std::max(row[qe], 0.1)});
     worst_act = std::max(worst_act, std::abs(scene->GetParameter("SF.activation") - row[act_sf]));
-    if (caliper_at_limit < 0) worst_len = std::max(worst_len, std::abs(scene->GetParameter("BF.length") - row[len_bf]));
+    if (caliper_at_limit < 0) worst_len = std::max(worst_len, std::abs(scene->GetParameter("BF.tendon.length") - row[len_bf]));
   }
   const auto& last = ref.rows.back();
   const double final_error = std::max(std::abs(scene->GetParameter("shoulder.position") - last[qs]),
@@ -96,7 +96,7 @@ TEST(Arm26Trajectory, MatchesMuJoCoWhenBothStepFinely) {
                           std::max(row[qs], 0.1),
                       std::abs(scene->GetParameter("elbow.position") - row[qe]) /
                           std::max(row[qe], 0.1)});
-    worst_len = std::max(worst_len, std::abs(scene->GetParameter("BF.length") - row[len_bf]));
+    worst_len = std::max(worst_len, std::abs(scene->GetParameter("BF.tendon.length") - row[len_bf]));
   }
   std::printf("arm26 at 0.5 ms over 0.6 s: joint angles within %.2f %%, BF length within %.3f mm\n",
               100 * worst, 1e3 * worst_len);

@@ -159,8 +159,8 @@ TEST(BulletScene, TendonTensionHoldsAHangingBallAgainstGravity) {
   auto scene = MakeScene(s);
   for (int i = 0; i < 1000; ++i) scene->Step();
   EXPECT_NEAR(scene->BodyStates()[0].pose.position.z(), -0.5, 1e-6) << "equilibrium";
-  EXPECT_NEAR(scene->GetParameter("rope.length"), 0.45, 1e-9);
-  EXPECT_NEAR(scene->GetParameter("rope.tension"), 2.0 * kG, 1e-12);
+  EXPECT_NEAR(scene->GetParameter("rope.tendon.length"), 0.45, 1e-9);
+  EXPECT_NEAR(scene->GetParameter("rope.tendon.tension"), 2.0 * kG, 1e-12);
   EXPECT_NEAR(scene->GetParameter("holder.seen_length"), 0.45, 1e-9);
   // twice the tension: the ball accelerates upward at g
   scene->SetCommand("holder", 4.0 * kG);

@@ -1,0 +1,18 @@
+// caliper-pd-controller: an example PD position controller for one joint of a Model.
+#include "caliper/rtc/rtobject_servant.h"
+#include "pd_controller_component.h"
+
+int main(int argc, char** argv) {
+  using namespace caliper;
+  rtc::ComponentType type;
+  type.name = "pd_controller";
+  type.description = "PD position loop on one joint of a Model through its two tendon motors.";
+  type.category = "controller";
+  type.config_keys = pd_controller::PdControllerComponent::ConfigKeys();
+  return rtc::RunComponent(
+      argc, argv, type,
+      [](rtc::Runtime& rt) { return std::make_unique<pd_controller::PdControllerComponent>(rt); },
+      [](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
+        return new rtc::DataFlowServant(rt);
+      });
+}
