@@ -46,7 +46,10 @@ SceneChannels RegisterScene(Registry& registry, const std::string& model_name,
     info.is_static = p.is_static;
     info.description = std::string(p.is_static ? "model parameter " : "simulation state ") + p.id;
     sgal::PhysicsScene* s = &scene;
-    Getter get = [s, id = p.id](double* out) { out[0] = s->GetParameter(id); };
+    // by index: no string lookup per sample
+    Getter get = [s, index = s->ParameterIndex(p.id)](double* out) {
+      out[0] = s->GetParameter(index);
+    };
     Setter set;
     if (p.writable)
       set = [s, id = p.id](const double* v) {

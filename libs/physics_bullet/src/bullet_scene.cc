@@ -5,7 +5,9 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <functional>
 #include <sstream>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "caliper/actuators/actuator.h"
@@ -35,13 +37,6 @@ btTransform ToBt(const Isometry3d& t, double s) {
                      ToBt(Vector3d(t.translation()), s));
 }
 
-Isometry3d FromBt(const btTransform& t, double s) {
-  const btQuaternion q = t.getRotation();
-  Isometry3d out = Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-  out.translation() = FromBt(t.getOrigin(), s);
-  return out;
-}
 
 struct BodyData {
   const sgal::Body* desc = nullptr;
@@ -108,21 +103,29 @@ class BulletScene : public sgal::PhysicsScene {
   void SetCommand(const std::string& actuator, double value) override;
   std::vector<sgal::ParameterInfo> Parameters() const override;
   double GetParameter(const std::string& id) const override;
+  int ParameterIndex(const std::string& id) const override;
+  double GetParameter(int index) const override;
   void SetParameter(const std::string& id, double value) override;
 
  private:
   void BuildBody(size_t index);
   void BuildConstraint(size_t index);
   void BuildTendons();
-  Isometry3d BodyPose(int body) const;  // world pose of a body frame [m]
   void CacheBodyPoses();
-  Vector3d PointVelocity(int body, const Vector3d& world_point) const;
   void UpdateJoints();
   void RefreshWorldShapes();
   void EvaluateTendons();
   void ApplyTendonForces();
   void ApplyJointSprings();
   void CheckState();
+  void BuildParameters();
+
+  /// One parameter with its accessors, built once.
+  struct ParameterEntry {
+    sgal::ParameterInfo info;
+    std::function<double()> get;
+    std::function<void(double)> set;  // empty: read-only
+  };
 
   sgal::Scene scene_;
   Options options_;
@@ -142,11 +145,14 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
   std::vector<Isometry3d> poses_;        // body frames this step [m]
+  std::vector<sgal::Pose> body_poses_;   // the same as poses [m]
   std::vector<Vector3d> coms_;           // centres of mass this step [m]
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
   std::vector<Snapshot> snapshot_;
   double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
+  std::vector<ParameterEntry> parameters_;
+  std::unordered_map<std::string, int> parameter_index_;
 };
 
 std::unique_ptr<btCollisionShape> MakeShape(const sgal::Geometry& geometry, double s, bool dynamic,
@@ -213,6 +219,7 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
   joints_.resize(scene_.constraints.size());
   for (size_t i = 0; i < scene_.constraints.size(); ++i) BuildConstraint(i);
   BuildTendons();
+  BuildParameters();
 }
 
 BulletScene::~BulletScene() {
@@ -281,35 +288,32 @@ void BulletScene::BuildBody(size_t index) {
                        static_cast<int>(mask & 0x7fff));
 }
 
-Isometry3d BulletScene::BodyPose(int body) const {
-  if (body < 0) return Isometry3d::Identity();
-  const BodyData& b = bodies_[body];
-  return FromBt(b.rigid->getCenterOfMassTransform(), scale_) * b.com_in_body.inverse();
-}
 
 void BulletScene::CacheBodyPoses() {
   const size_t n = bodies_.size();
   poses_.resize(n);
+  body_poses_.resize(n);
   coms_.resize(n);
   velocities_.resize(n);
   spins_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
-    const Isometry3d com = FromBt(rb.getCenterOfMassTransform(), scale_);
-    poses_[i] = com * bodies_[i].com_in_body.inverse();
-    coms_[i] = com.translation();
+    const btTransform& t = rb.getCenterOfMassTransform();
+    const btQuaternion q = t.getRotation();
+    const Eigen::Quaterniond com_rotation(q.w(), q.x(), q.y(), q.z());
+    const Vector3d com = FromBt(t.getOrigin(), scale_);
+    const Isometry3d& com_in_body = bodies_[i].com_in_body;
+    // body frame = com frame * inverse(com in body)
+    sgal::Pose& pose = body_poses_[i];
+    pose.orientation = (com_rotation * Eigen::Quaterniond(com_in_body.linear()).conjugate()).normalized();
+    pose.position = com - pose.orientation * com_in_body.translation();
+    poses_[i] = pose.ToIsometry();
+    coms_[i] = com;
     velocities_[i] = FromBt(rb.getLinearVelocity(), scale_);
     spins_[i] = FromBt(rb.getAngularVelocity());
   }
 }
 
-
-Vector3d BulletScene::PointVelocity(int body, const Vector3d& p) const {
-  if (body < 0) return Vector3d::Zero();
-  const btRigidBody& rb = *bodies_[body].rigid;
-  const Vector3d com = FromBt(rb.getCenterOfMassPosition(), scale_);
-  return FromBt(rb.getLinearVelocity(), scale_) + FromBt(rb.getAngularVelocity()).cross(p - com);
-}
 
 void BulletScene::BuildConstraint(size_t index) {
   const sgal::Constraint& c = scene_.constraints[index];
@@ -613,7 +617,7 @@ void BulletScene::Step() {
     }
   };
 
-  CacheBodyPoses();
+  // poses were cached at the end of the last step (or at construction)
   RefreshWorldShapes();
   EvaluateTendons();
   UpdateJoints();
@@ -639,8 +643,11 @@ void BulletScene::Step() {
     CheckState();
   } catch (...) {
     restore();
+    CacheBodyPoses();
     throw;
   }
+  CacheBodyPoses();
+  UpdateJoints();
   time_ += dt_;
   ++steps_;
 }
@@ -648,10 +655,9 @@ void BulletScene::Step() {
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {
   std::vector<sgal::BodyState> states(bodies_.size());
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    states[i].pose = sgal::Pose::FromIsometry(BodyPose(static_cast<int>(i)));
-    const btRigidBody& rb = *bodies_[i].rigid;
-    states[i].angular_velocity = FromBt(rb.getAngularVelocity());
-    states[i].linear_velocity = PointVelocity(static_cast<int>(i), states[i].pose.position);
+    states[i].pose = body_poses_[i];
+    states[i].angular_velocity = spins_[i];
+    states[i].linear_velocity = velocities_[i] + spins_[i].cross(body_poses_[i].position - coms_[i]);
   }
   return states;
 }
@@ -681,128 +687,114 @@ void BulletScene::SetCommand(const std::string& actuator, double value) {
   throw std::out_of_range("no actuator '" + actuator + "'");
 }
 
+void BulletScene::BuildParameters() {
+  auto add = [&](sgal::ParameterInfo info, std::function<double()> get,
+                 std::function<void(double)> set = nullptr) {
+    info.writable = static_cast<bool>(set);
+    parameter_index_[info.id] = static_cast<int>(parameters_.size());
+    parameters_.push_back({std::move(info), std::move(get), std::move(set)});
+  };
+  add({"simulation.time_step", "s", true, true}, [this] { return dt_; }, [this](double v) {
+    if (!(v > 0 && v <= 0.1)) throw std::invalid_argument("simulation.time_step: must be in (0, 0.1] s");
+    dt_ = v;
+    scene_.settings.time_step = v;
+  });
+  add({"simulation.time", "s", false, false}, [this] { return time_; });
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    if (scene_.bodies[i].type != sgal::BodyType::kDynamic) continue;
+    const std::string id = scene_.bodies[i].name + ".mass";
+    btRigidBody* rb = bodies_[i].rigid.get();
+    add({id, "kg", true, true}, [rb] { return 1.0 / rb->getInvMass(); }, [this, i, rb, id](double value) {
+      if (!(value > 0)) throw std::invalid_argument(id + ": mass must be positive");
+      const double ratio = value / (1.0 / rb->getInvMass());
+      const btVector3 inv = rb->getInvInertiaDiagLocal();
+      const btVector3 inertia(inv.x() > 0 ? 1 / inv.x() : 0, inv.y() > 0 ? 1 / inv.y() : 0,
+                              inv.z() > 0 ? 1 / inv.z() : 0);
+      rb->setMassProps(static_cast<btScalar>(value), inertia * static_cast<btScalar>(ratio));
+      rb->updateInertiaTensor();
+      scene_.bodies[i].inertia.mass = value;
+      scene_.bodies[i].inertia.tensor *= ratio;
+    });
+  }
+  for (size_t k = 0; k < joints_.size(); ++k) {
+    JointData* j = &joints_[k];
+    const bool hinge = j->desc->kind == sgal::ConstraintKind::kHinge;
+    if (!hinge && j->desc->kind != sgal::ConstraintKind::kSlider) continue;
+    const std::string& n = j->desc->name;
+    sgal::JointSpring* spring = &scene_.constraints[k].springs[0];
+    add({n + ".position", hinge ? "rad" : "m", false, false}, [j] { return j->position; });
+    add({n + ".velocity", hinge ? "rad/s" : "m/s", false, false}, [j] { return j->velocity; });
+    add({n + ".spring_stiffness", hinge ? "N m/rad" : "N/m", true, true},
+        [spring] { return spring->stiffness; }, [spring, n](double v) {
+          if (v < 0) throw std::invalid_argument(n + ".spring_stiffness: must not be negative");
+          spring->stiffness = v;
+        });
+    add({n + ".spring_damping", hinge ? "N m s/rad" : "N s/m", true, true},
+        [spring] { return spring->damping; }, [spring, n](double v) {
+          if (v < 0) throw std::invalid_argument(n + ".spring_damping: must not be negative");
+          spring->damping = v;
+        });
+  }
+  for (auto& t : tendons_) {
+    // tendons often share their actuator's name: their states live under `.tendon.`
+    const std::string n = t.desc->name + ".tendon.";
+    TendonData* td = &t;
+    add({n + "length", "m", false, false}, [td] { return td->geometry.length; });
+    add({n + "speed", "m/s", false, false}, [td] { return td->geometry.speed; });
+    add({n + "tension", "N", false, false}, [td] { return td->tension; });
+    add({n + "contacts", "", false, false}, [td] { return static_cast<double>(td->contacts); });
+  }
+  for (size_t k = 0; k < actuators_.size(); ++k) {
+    actuators::TendonActuator* model = actuators_[k].model.get();
+    const std::string n = actuators_[k].desc->name + ".";
+    add({n + "command", model->command_unit(), true, false}, [model] { return model->command(); },
+        [model](double v) { model->SetCommand(v); });
+    for (const auto& q : model->Quantities()) {
+      const std::string field = q.name;
+      std::function<void(double)> set;
+      if (q.writable)
+        set = [this, model, field, k, is_static = q.is_static](double v) {
+          model->Set(field, v);
+          // a tuned model parameter goes into the description, so that a saved scene keeps it
+          if (is_static) scene_.actuators[k].parameters[field] = v;
+        };
+      add({n + field, q.unit, q.writable, q.is_static}, [model, field] { return model->Get(field); },
+          std::move(set));
+    }
+  }
+}
+
 std::vector<sgal::ParameterInfo> BulletScene::Parameters() const {
   std::vector<sgal::ParameterInfo> out;
-  out.push_back({"simulation.time_step", "s", true, true});
-  out.push_back({"simulation.time", "s", false, false});
-  for (const auto& b : scene_.bodies)
-    if (b.type == sgal::BodyType::kDynamic) out.push_back({b.name + ".mass", "kg", true, true});
-  for (const auto& j : joints_) {
-    const bool hinge = j.desc->kind == sgal::ConstraintKind::kHinge;
-    if (!hinge && j.desc->kind != sgal::ConstraintKind::kSlider) continue;
-    out.push_back({j.desc->name + ".position", hinge ? "rad" : "m", false, false});
-    out.push_back({j.desc->name + ".velocity", hinge ? "rad/s" : "m/s", false, false});
-    out.push_back({j.desc->name + ".spring_stiffness", hinge ? "N m/rad" : "N/m", true, true});
-    out.push_back({j.desc->name + ".spring_damping", hinge ? "N m s/rad" : "N s/m", true, true});
-  }
-  for (const auto& t : tendons_) {
-    // tendons often share their actuator's name: their states live under `.tendon.`
-    out.push_back({t.desc->name + ".tendon.length", "m", false, false});
-    out.push_back({t.desc->name + ".tendon.speed", "m/s", false, false});
-    out.push_back({t.desc->name + ".tendon.tension", "N", false, false});
-    out.push_back({t.desc->name + ".tendon.contacts", "", false, false});
-  }
-  for (const auto& a : actuators_) {
-    out.push_back({a.desc->name + ".command", a.model->command_unit(), true, false});
-    for (const auto& q : a.model->Quantities())
-      out.push_back({a.desc->name + "." + q.name, q.unit, q.writable, q.is_static});
-  }
+  out.reserve(parameters_.size());
+  for (const auto& p : parameters_) out.push_back(p.info);
   return out;
 }
 
-namespace {
-/// Splits `name.field` at the last dot.
-std::pair<std::string, std::string> SplitId(const std::string& id) {
-  const auto dot = id.rfind('.');
-  if (dot == std::string::npos) return {id, ""};
-  return {id.substr(0, dot), id.substr(dot + 1)};
+int BulletScene::ParameterIndex(const std::string& id) const {
+  const auto it = parameter_index_.find(id);
+  return it == parameter_index_.end() ? -1 : it->second;
 }
-}  // namespace
+
+double BulletScene::GetParameter(int index) const {
+  if (index < 0 || index >= static_cast<int>(parameters_.size()))
+    throw std::out_of_range("no parameter with index " + std::to_string(index));
+  return parameters_[index].get();
+}
 
 double BulletScene::GetParameter(const std::string& id) const {
-  const auto [name, field] = SplitId(id);
-  if (id == "simulation.time_step") return dt_;
-  if (id == "simulation.time") return time_;
-  for (size_t i = 0; i < bodies_.size(); ++i)
-    if (scene_.bodies[i].name == name && field == "mass" &&
-        scene_.bodies[i].type == sgal::BodyType::kDynamic)
-      return 1.0 / bodies_[i].rigid->getInvMass();
-  for (const auto& j : joints_) {
-    if (j.desc->name != name) continue;
-    if (field == "position") return j.position;
-    if (field == "velocity") return j.velocity;
-    if (field == "spring_stiffness") return j.desc->springs[0].stiffness;
-    if (field == "spring_damping") return j.desc->springs[0].damping;
-  }
-  for (const auto& t : tendons_) {
-    if (t.desc->name + ".tendon" != name) continue;
-    if (field == "length") return t.geometry.length;
-    if (field == "speed") return t.geometry.speed;
-    if (field == "tension") return t.tension;
-    if (field == "contacts") return t.contacts;
-  }
-  for (const auto& a : actuators_) {
-    if (a.desc->name != name) continue;
-    if (field == "command") return a.model->command();
-    return a.model->Get(field);
-  }
-  throw std::out_of_range("no parameter '" + id + "'");
+  const int index = ParameterIndex(id);
+  if (index < 0) throw std::out_of_range("no parameter '" + id + "'");
+  return parameters_[index].get();
 }
 
 void BulletScene::SetParameter(const std::string& id, double value) {
+  const int index = ParameterIndex(id);
+  if (index < 0) throw std::out_of_range("no parameter '" + id + "'");
   if (!std::isfinite(value)) throw std::invalid_argument(id + ": value is not finite");
-  const auto [name, field] = SplitId(id);
-  if (id == "simulation.time_step") {
-    if (!(value > 0 && value <= 0.1)) throw std::invalid_argument(id + ": must be in (0, 0.1] s");
-    dt_ = value;
-    scene_.settings.time_step = value;
-    return;
-  }
-  for (size_t i = 0; i < bodies_.size(); ++i) {
-    if (scene_.bodies[i].name != name || field != "mass") continue;
-    if (scene_.bodies[i].type != sgal::BodyType::kDynamic)
-      throw std::invalid_argument(id + ": the body is not dynamic");
-    if (!(value > 0)) throw std::invalid_argument(id + ": mass must be positive");
-    btRigidBody& rb = *bodies_[i].rigid;
-    const double ratio = value / (1.0 / rb.getInvMass());
-    const btVector3 inv = rb.getInvInertiaDiagLocal();
-    const btVector3 inertia(inv.x() > 0 ? 1 / inv.x() : 0, inv.y() > 0 ? 1 / inv.y() : 0,
-                            inv.z() > 0 ? 1 / inv.z() : 0);
-    rb.setMassProps(static_cast<btScalar>(value), inertia * static_cast<btScalar>(ratio));
-    rb.updateInertiaTensor();
-    scene_.bodies[i].inertia.mass = value;
-    scene_.bodies[i].inertia.tensor *= ratio;
-    return;
-  }
-  for (auto& j : joints_) {
-    if (j.desc->name != name) continue;
-    auto& spring = scene_.constraints[&j - &joints_[0]].springs[0];
-    if (field == "spring_stiffness" || field == "spring_damping") {
-      if (value < 0) throw std::invalid_argument(id + ": must not be negative");
-      (field == "spring_stiffness" ? spring.stiffness : spring.damping) = value;
-      return;
-    }
-    if (field == "position" || field == "velocity")
-      throw std::invalid_argument(id + " is read-only (a state of the simulation)");
-  }
-  for (auto& t : tendons_)
-    if (t.desc->name + ".tendon" == name && (field == "length" || field == "speed" || field == "tension" ||
-                                 field == "contacts"))
-      throw std::invalid_argument(id + " is read-only (a state of the simulation)");
-  for (auto& a : actuators_) {
-    if (a.desc->name != name) continue;
-    if (field == "command") {
-      a.model->SetCommand(value);
-      return;
-    }
-    a.model->Set(field, value);
-    // a tuned model parameter goes into the description, so that a saved scene keeps it
-    for (const auto& q : a.model->Quantities())
-      if (q.name == field && q.is_static)
-        scene_.actuators[&a - &actuators_[0]].parameters[field] = value;
-    return;
-  }
-  throw std::out_of_range("no parameter '" + id + "'");
+  const ParameterEntry& p = parameters_[index];
+  if (!p.set) throw std::invalid_argument(id + " is read-only (a state of the simulation)");
+  p.set(value);
 }
 
 }  // namespace

@@ -68,6 +68,10 @@ class PhysicsScene {
   virtual std::vector<ParameterInfo> Parameters() const = 0;
   /// Throws std::out_of_range for an unknown id.
   virtual double GetParameter(const std::string& id) const = 0;
+  /// Position of an id in Parameters() for repeated reads without string lookups (-1: unknown).
+  virtual int ParameterIndex(const std::string& id) const = 0;
+  /// The value of Parameters()[index]; throws std::out_of_range for a bad index.
+  virtual double GetParameter(int index) const = 0;
   /// Throws std::out_of_range (unknown), std::invalid_argument (read-only or bad value).
   virtual void SetParameter(const std::string& id, double value) = 0;
 };
