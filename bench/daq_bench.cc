@@ -170,6 +170,8 @@ void BenchScene(const std::string& name, sgal::PhysicsScene& scene, bool paramet
   const double record_us = TimeAfter(step, [&] { recorder.OnStep(scene.steps(), scene.time()); });
   std::printf("daq_record_1000_ids_us[%s] %.2f (%.1f %% of the step)\n", name.c_str(), record_us,
               100 * record_us / step_us);
+  std::printf("RATIO daq_1000_ids_share_of_step[%s] %.3f (target 0.10)%s\n", name.c_str(),
+              record_us / step_us, record_us / step_us <= 0.10 ? "" : "  <- off target");
 }
 
 void BenchSynthetic() {

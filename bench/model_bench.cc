@@ -1,0 +1,240 @@
+// Model benchmarks, one line per figure, measured in this run:
+//   RATIO control_cycle_vs_raw_omniorb  a control cycle (set_commands for 10 actuators + get of
+//        20 ids) on caliper-model against the same two round trips on a bare omniORB servant
+//        in another process
+//   RATIO observer_bytes_*               bytes per update sent to an observer as more bodies move
+//   RATIO slow_observer_slowdown         steps per second with a 100 ms observer / without
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "caliper/collada/exporter.h"
+#include "caliper/model.hh"
+#include "caliper/rtc/naming.h"
+#include "echo.hh"
+#include "support/process.h"
+
+namespace {
+
+using namespace caliper;
+namespace M = ::Caliper::Simulation;
+namespace S = ::Caliper::Scene;
+using Clock = std::chrono::steady_clock;
+
+class EchoServant : public virtual POA_CaliperBench::EchoServer {
+ public:
+  void take_commands(const M::CommandSeq&) override {}
+  S::DoubleSeq* values_for(const S::StringSeq& ids) override {
+    auto* out = new S::DoubleSeq;
+    out->length(ids.length());
+    for (CORBA::ULong i = 0; i < ids.length(); ++i) (*out)[i] = i;
+    return out;
+  }
+};
+
+int RunEchoServer(const std::string& ior_file) {
+  int argc = 3;
+  const char* args[] = {"echo", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
+  CORBA::Object_var obj = orb->resolve_initial_references("RootPOA");
+  PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
+  auto* servant = new EchoServant;
+  PortableServer::ObjectId_var id = poa->activate_object(servant);
+  CORBA::Object_var ref = poa->id_to_reference(id);
+  CORBA::String_var ior = orb->object_to_string(ref);
+  FILE* f = std::fopen(ior_file.c_str(), "w");
+  std::fputs(ior.in(), f);
+  std::fclose(f);
+  poa->the_POAManager()->activate();
+  orb->run();
+  return 0;
+}
+
+/// Median time per call [us] of `f` over `n` calls, 5 repetitions.
+template <class F>
+double Median(int n, F&& f) {
+  std::vector<double> runs;
+  for (int r = 0; r < 5; ++r) {
+    const auto begin = Clock::now();
+    for (int i = 0; i < n; ++i) f();
+    runs.push_back(std::chrono::duration<double, std::micro>(Clock::now() - begin).count() / n);
+  }
+  std::sort(runs.begin(), runs.end());
+  return runs[2];
+}
+
+void Ratio(const char* name, double value, double target, bool lower_is_better = true) {
+  const bool ok = lower_is_better ? value <= target : value >= target;
+  std::printf("RATIO %s %.3f (target %.2f)%s\n", name, value, target, ok ? "" : "  <- off target");
+  std::fflush(stdout);
+}
+
+/// N free bodies in zero gravity, the first `moving` of them drifting.
+sgal::Scene Drifters(int n, int moving) {
+  sgal::Scene s;
+  s.name = "drifters";
+  s.gravity = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    sgal::Body b;
+    b.name = "b" + std::to_string(i);
+    b.pose.position = Eigen::Vector3d(0.5 * i, 0, 0);
+    b.shapes.push_back({"s", sgal::Sphere{0.1}, {}, 0, 0});
+    if (i < moving) b.linear_velocity = Eigen::Vector3d(0, 0, 0.1);
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
+class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
+ public:
+  explicit CountingObserver(int sleep_ms) : sleep_ms_(sleep_ms) {}
+  void on_scene(const S::Description&) override {}
+  void on_transforms(CORBA::ULongLong, CORBA::Double, const S::BodyTransformSeq& changed,
+                     const S::TendonStateSeq&) override {
+    updates_++;
+    // CDR size of the body transforms: index (4) + seven doubles (56), aligned
+    bytes_ += 4 + 64 * changed.length();
+    if (sleep_ms_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms_));
+  }
+  void on_scene_cleared() override {}
+  std::atomic<uint64_t> updates_{0}, bytes_{0};
+
+ private:
+  int sleep_ms_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2]);
+  testing::TempDir dir;
+  // a private naming service and a Model with the shipped arm
+  testing::NamingService naming(dir.path());
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  const std::string root = source ? source : CALIPER_SOURCE_DIR_DEFAULT;
+  setenv("CALIPER_BIN_DIR", CALIPER_BIN_DIR_DEFAULT, 0);
+  testing::Process model({testing::Bin("caliper-model"), "--nameservice", naming.address(), "-o",
+                          "model.scene=" + root + "/models/ecce_arm.dae", "-o",
+                          "exec.auto_activate=true", "-o", "log.service=none", "-o",
+                          "log.spool_dir=" + dir.path() + "/spool", "-o", "log.level=warn"},
+                         dir.path() + "/model.out");
+  const std::string ior_file = dir.path() + "/echo.ior";
+  testing::Process echo({argv[0], "--echo-server", ior_file}, dir.path() + "/echo.out");
+
+  int orb_argc = 3;
+  const char* orb_args[] = {"bench", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+  CORBA::ORB_var orb = CORBA::ORB_init(orb_argc, const_cast<char**>(orb_args));
+  M::Model_var arm;
+  testing::WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root_ctx = rtc::ResolveRoot(orb, naming.address());
+          arm = M::Model::_narrow(rtc::FindComponent(root_ctx, "model0").object);
+          return !CORBA::is_nil(arm);
+        } catch (...) {
+          return false;
+        }
+      },
+      std::chrono::seconds(20));
+  testing::WaitFor([&] { return !testing::ReadFile(ior_file).empty(); }, std::chrono::seconds(10));
+  if (CORBA::is_nil(arm)) {
+    std::fprintf(stderr, "the Model did not come up: %s\n", model.Output().c_str());
+    return 1;
+  }
+  CORBA::Object_var echo_obj = orb->string_to_object(testing::ReadFile(ior_file).c_str());
+  CaliperBench::EchoServer_var server = CaliperBench::EchoServer::_narrow(echo_obj);
+
+  // 1. control cycle
+  M::ActuatorInfoSeq_var actuators = arm->actuators();
+  M::CommandSeq commands;
+  commands.length(10);
+  for (CORBA::ULong i = 0; i < 10; ++i) {
+    commands[i].actuator = actuators[i % actuators->length()].name;
+    commands[i].value = 0.1 * i;
+  }
+  Caliper::Daq::ChannelInfoSeq_var channels = arm->list("ecce_arm.*");
+  S::StringSeq ids;
+  ids.length(20);
+  for (CORBA::ULong i = 0; i < 20; ++i) ids[i] = channels[i * channels->length() / 20].id;
+  arm->set_real_time_factor(1.0);
+  arm->start();
+  const int calls = 2000;
+  const double cycle = Median(calls, [&] {
+    arm->set_commands(commands);
+    Caliper::Daq::ValueSeq_var v = arm->get(ids);
+  });
+  const double raw = Median(calls, [&] {
+    server->take_commands(commands);
+    S::DoubleSeq_var v = server->values_for(ids);
+  });
+  std::printf("# control cycle %.1f us on caliper-model (running in real time), %.1f us on a bare "
+              "omniORB servant with the same payloads\n", cycle, raw);
+  Ratio("control_cycle_vs_raw_omniorb", cycle / raw, 1.3);
+  arm->pause();
+
+  // 2. observer bytes per update as more of 40 bodies move
+  const int n = 40;
+  auto* counter = new CountingObserver(0);
+  CORBA::Object_var poa_obj = orb->resolve_initial_references("RootPOA");
+  PortableServer::POA_var poa = PortableServer::POA::_narrow(poa_obj);
+  poa->the_POAManager()->activate();
+  PortableServer::ObjectId_var counter_id = poa->activate_object(counter);
+  CORBA::Object_var counter_ref = poa->id_to_reference(counter_id);
+  std::vector<double> per_update;
+  for (int moving : {1, 10, 20, 40}) {
+    const std::string file = dir.path() + "/drifters" + std::to_string(moving) + ".dae";
+    collada::Export(Drifters(n, moving), file);
+    arm->load_scene(file.c_str());
+    const CORBA::ULongLong id = arm->add_observer(S::SceneObserver::_narrow(counter_ref));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const uint64_t u0 = counter->updates_, b0 = counter->bytes_;
+    arm->step(200);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    arm->remove_observer(id);
+    const double updates = static_cast<double>(counter->updates_ - u0);
+    per_update.push_back(updates > 0 ? (counter->bytes_ - b0) / updates : 0);
+    std::printf("# %2d of %d bodies moving: %.0f bytes of transforms per update (%.0f updates)\n",
+                moving, n, per_update.back(), updates);
+  }
+  Ratio("observer_bytes_1_vs_40_moving", per_update.front() / per_update.back(), 0.1);
+  Ratio("observer_bytes_20_vs_40_moving", per_update[2] / per_update.back(), 0.6);
+
+  // 3. a slow observer (100 ms per batch) against none, the Model running as fast as it can
+  arm->load_scene((root + "/models/ecce_arm.dae").c_str());
+  arm->set_real_time_factor(0);
+  auto rate = [&] {
+    arm->reset();
+    arm->start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const auto s0 = arm->status();
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    const auto s1 = arm->status();
+    arm->pause();
+    return (s1->steps - s0->steps) / 2.0;
+  };
+  const double free_rate = rate();
+  auto* slow = new CountingObserver(100);
+  PortableServer::ObjectId_var slow_id = poa->activate_object(slow);
+  CORBA::Object_var slow_ref = poa->id_to_reference(slow_id);
+  const CORBA::ULongLong observer = arm->add_observer(S::SceneObserver::_narrow(slow_ref));
+  const double slowed_rate = rate();
+  arm->remove_observer(observer);
+  std::printf("# steps per second: %.0f without an observer, %.0f with one taking 100 ms per "
+              "update (%llu updates received)\n", free_rate, slowed_rate,
+              static_cast<unsigned long long>(slow->updates_.load()));
+  Ratio("slow_observer_slowdown", free_rate / slowed_rate, 1.05);
+  model.Signal(SIGTERM);
+  echo.Signal(SIGTERM);
+  model.Wait(std::chrono::seconds(5));
+  orb->destroy();
+  return 0;
+}
