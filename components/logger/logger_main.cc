@@ -11,10 +11,5 @@ int main(int argc, char** argv) {
   type.category = "infrastructure";
   type.config_keys = logger::LoggerComponent::ConfigKeys();
   type.remote_logging = false;
-  return rtc::RunComponent(
-      argc, argv, type,
-      [](rtc::Runtime& rt) { return std::make_unique<logger::LoggerComponent>(rt); },
-      [](rtc::Runtime& rt, rtc::Component& c) -> PortableServer::Servant {
-        return new logger::LoggerServant(rt, static_cast<logger::LoggerComponent&>(c));
-      });
+  return rtc::RunComponentOf<logger::LoggerComponent, logger::LoggerServant>(argc, argv, type);
 }

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
       argc, argv, type,
       [](rtc::Runtime& rt) { return std::make_unique<model::ModelComponent>(rt); },
       [](rtc::Runtime& rt, rtc::Component& c) -> PortableServer::Servant {
+        // the servant serves the component's core, which outlives it
         return new model::ModelServant(rt, static_cast<model::ModelComponent&>(c).core());
       });
 }

@@ -9,10 +9,5 @@ int main(int argc, char** argv) {
   type.description = "PD position loop on one joint of a Model through its two tendon motors.";
   type.category = "controller";
   type.config_keys = pd_controller::PdControllerComponent::ConfigKeys();
-  return rtc::RunComponent(
-      argc, argv, type,
-      [](rtc::Runtime& rt) { return std::make_unique<pd_controller::PdControllerComponent>(rt); },
-      [](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
-        return new rtc::DataFlowServant(rt);
-      });
+  return rtc::RunComponentOf<pd_controller::PdControllerComponent, rtc::DataFlowServant>(argc, argv, type);
 }

@@ -9,10 +9,5 @@ int main(int argc, char** argv) {
   type.description = "Sample component: logs numbered records while ACTIVE.";
   type.category = "example";
   type.config_keys = sample::SampleComponent::ConfigKeys();
-  return rtc::RunComponent(
-      argc, argv, type,
-      [](rtc::Runtime& rt) { return std::make_unique<sample::SampleComponent>(rt); },
-      [](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
-        return new rtc::DataFlowServant(rt);
-      });
+  return rtc::RunComponentOf<sample::SampleComponent, rtc::DataFlowServant>(argc, argv, type);
 }

@@ -137,21 +137,6 @@ struct Crossing {
   const WorldShape* shape = nullptr;
 };
 
-/// Radius of a sphere about the shape's origin that holds it (infinite for planes and meshes).
-double BoundingRadius(const sgal::Geometry& geometry) {
-  return std::visit(
-      [](const auto& g) -> double {
-        using T = std::decay_t<decltype(g)>;
-        if constexpr (std::is_same_v<T, sgal::Box>) return g.size.norm() / 2;
-        else if constexpr (std::is_same_v<T, sgal::Sphere>) return g.radius;
-        else if constexpr (std::is_same_v<T, sgal::Capsule>) return g.radius + g.length / 2;
-        else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>)
-          return std::hypot(g.radius, g.length / 2);
-        else return kInf;
-      },
-      geometry);
-}
-
 /// Whether the segment a-b passes within `reach` of point c.
 bool Near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double reach) {
   if (!std::isfinite(reach)) return true;
@@ -169,7 +154,7 @@ Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   double best_len = 0;
   for (const auto& s : shapes) {
     if (s.body == exclude_a || s.body == exclude_b) continue;
-    if (!Near(a, b, s.pose.translation(), BoundingRadius(*s.geometry) + margin)) continue;
+    if (!Near(a, b, s.pose.translation(), sgal::BoundingRadius(*s.geometry) + margin)) continue;
     const auto i = SegmentInside(s, a, b, margin);
     if (!i || i->second - i->first <= 1e-9) continue;
     if (i->second - i->first > best_len) {

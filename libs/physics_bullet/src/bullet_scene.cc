@@ -413,23 +413,8 @@ void BulletScene::BuildTendons() {
   double largest = 0;
   for (const auto& b : scene_.bodies)
     for (const auto& shape : b.shapes) {
-      const double r = std::visit(
-          [](const auto& g) -> double {
-            using T = std::decay_t<decltype(g)>;
-            if constexpr (std::is_same_v<T, sgal::Box>) return g.size.norm() / 2;
-            else if constexpr (std::is_same_v<T, sgal::Sphere>) return g.radius;
-            else if constexpr (std::is_same_v<T, sgal::Capsule>) return g.radius + g.length / 2;
-            else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>)
-              return std::hypot(g.radius, g.length / 2);
-            else if constexpr (std::is_same_v<T, sgal::Plane>) return 0.0;
-            else {
-              double m = 0;
-              if (g.mesh)
-                for (const auto& v : g.mesh->vertices) m = std::max(m, static_cast<double>(v.norm()));
-              return m;
-            }
-          },
-          shape.geometry);
+      const double r = sgal::BoundingRadius(shape.geometry);
+      if (!std::isfinite(r)) continue;  // planes: their contacts come from their normal
       largest = std::max(largest, r + shape.pose.position.norm());
     }
   detour_reach_ = 2 * largest;

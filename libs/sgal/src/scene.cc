@@ -2,7 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 namespace caliper::sgal {
@@ -39,6 +41,31 @@ const char* GeometryName(const Geometry& g) {
   static const char* const kNames[] = {"box",   "sphere", "capsule",     "cylinder",
                                        "cone",  "plane",  "convex_hull", "triangle_mesh"};
   return kNames[g.index()];
+}
+
+double BoundingRadius(const Geometry& geometry) {
+  return std::visit(
+      [](const auto& g) -> double {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, Box>) {
+          return g.size.norm() / 2;
+        } else if constexpr (std::is_same_v<T, Sphere>) {
+          return g.radius;
+        } else if constexpr (std::is_same_v<T, Capsule>) {
+          return g.radius + g.length / 2;
+        } else if constexpr (std::is_same_v<T, Cylinder> || std::is_same_v<T, Cone>) {
+          return std::hypot(g.radius, g.length / 2);
+        } else if constexpr (std::is_same_v<T, Plane>) {
+          return std::numeric_limits<double>::infinity();
+        } else {
+          double farthest = 0;
+          if (g.mesh)
+            for (const auto& v : g.mesh->vertices)
+              farthest = std::max(farthest, static_cast<double>(v.norm()));
+          return farthest;
+        }
+      },
+      geometry);
 }
 
 const Body* Scene::FindBody(const std::string& n) const {

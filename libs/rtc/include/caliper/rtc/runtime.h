@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "caliper/core/config.h"
@@ -89,5 +90,19 @@ class Runtime {
 /// configuration or arguments, 1 when the component could not start.
 int RunComponent(int argc, char** argv, const ComponentType& type,
                  const ComponentFactory& make_component, const ServantFactory& make_servant);
+
+/// RunComponent for the usual pair: ComponentT constructed from the Runtime, ServantT from the
+/// Runtime and the component (or from the Runtime alone, for lifecycle-only servants).
+template <class ComponentT, class ServantT>
+int RunComponentOf(int argc, char** argv, const ComponentType& type) {
+  return RunComponent(
+      argc, argv, type, [](Runtime& rt) { return std::make_unique<ComponentT>(rt); },
+      [](Runtime& rt, Component& c) -> PortableServer::Servant {
+        if constexpr (std::is_constructible_v<ServantT, Runtime&, ComponentT&>)
+          return new ServantT(rt, static_cast<ComponentT&>(c));
+        else
+          return new ServantT(rt);
+      });
+}
 
 }  // namespace caliper::rtc

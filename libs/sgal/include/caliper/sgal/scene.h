@@ -74,6 +74,10 @@ using Geometry = std::variant<Box, Sphere, Capsule, Cylinder, Cone, Plane, Conve
 /// `box`, `sphere`, ... for messages.
 const char* GeometryName(const Geometry& g);
 
+/// Radius of a sphere about the geometry's origin that holds it [m]: infinite for a plane, the
+/// farthest vertex for meshes.
+double BoundingRadius(const Geometry& g);
+
 struct Material {
   std::string name;
   double friction = 0.5;     // Coulomb coefficient [-]
