@@ -1,0 +1,44 @@
+#pragma once
+// The Scene Renderer's lifecycle: while active it keeps itself registered as a SceneObserver of
+// the Model, checking periodically, so that a restarted Model finds it again. What the Model sends
+// lands in the SceneMailbox, which the GUI thread drains.
+//
+// Configuration (config/renderer.conf):
+//   renderer.model            instance name of the Model (model0)
+//   renderer.check_interval   how often the registration is checked [s]
+//   renderer.max_fps          largest frame rate of the view [Hz]
+//   renderer.width, renderer.height   size of screenshots [px]
+
+#include <chrono>
+#include <string>
+
+#include "caliper/model.hh"
+#include "caliper/rtc/runtime.h"
+#include "scene_mailbox.h"
+
+namespace caliper::renderer {
+
+class RendererComponent : public rtc::Component {
+ public:
+  RendererComponent(rtc::Runtime& runtime, SceneMailbox& mailbox);
+  rtc::ReturnCode OnInitialize() override;
+  rtc::ReturnCode OnActivated() override;
+  rtc::ReturnCode OnExecute() override;
+  rtc::ReturnCode OnDeactivated() override;
+  static std::vector<core::ConfigKey> ConfigKeys();
+
+ private:
+  /// Registers with the Model found under renderer.model unless already registered with it.
+  void CheckRegistration();
+  void Unregister();
+
+  rtc::Runtime& runtime_;
+  SceneMailbox& mailbox_;
+  Caliper::Scene::SceneObserver_var observer_;
+  Caliper::Simulation::Model_var model_;
+  CORBA::ULongLong observer_id_ = 0;
+  std::chrono::steady_clock::time_point next_check_{};
+  bool reported_missing_ = false;
+};
+
+}  // namespace caliper::renderer

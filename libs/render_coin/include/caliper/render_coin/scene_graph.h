@@ -1,0 +1,72 @@
+#pragma once
+// The Inventor scene of a Caliper model: one separator per body with a transform updated from the
+// Model's poses, its visuals in their COLLADA colours, translucent wrap obstacles, tendons as lines
+// through their path points coloured by tension (blue low .. red high) with a legend, a ground
+// grid and world axes. Coin3D types appear only as forward declarations.
+//
+// Not thread-safe: build, update and render from the GUI thread.
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "caliper/render_coin/scene_description.h"
+
+class SoCamera;
+class SoSeparator;
+
+namespace caliper::render_coin {
+
+/// Initializes Coin's database once (idempotent); enough for building graphs without a display.
+void InitializeCoin();
+
+class SceneGraph {
+ public:
+  /// Calls InitializeCoin(). The graph starts empty (grid and axes only).
+  SceneGraph();
+  ~SceneGraph();
+  SceneGraph(const SceneGraph&) = delete;
+  SceneGraph& operator=(const SceneGraph&) = delete;
+
+  /// Replaces the model content (bodies, obstacles, tendons) with `scene`.
+  void Build(const SceneDescription& scene);
+  /// Removes the model content.
+  void Clear();
+  /// Moves bodies: poses[i] is the world pose of body indices[i]; unknown indices are ignored.
+  void SetBodyPoses(const std::vector<uint32_t>& indices, const std::vector<Pose>& poses);
+  /// Redraws the listed tendons through their points, coloured by tension on the current scale.
+  void SetTendons(const std::vector<TendonState>& tendons);
+
+  size_t body_count() const;
+  size_t tendon_count() const;
+  /// World pose of a body as last set.
+  Pose body_pose(size_t index) const;
+  /// Tension that maps to full red [N]: the largest seen so far, at least 1 N.
+  double tension_scale() const { return tension_scale_; }
+  /// The legend's text, e.g. "tendon tension  0 N (blue) .. 12.5 N (red)".
+  std::string legend_text() const;
+  /// Colour of a tendon as last drawn (rgb in [0, 1]).
+  std::array<float, 3> tendon_color(size_t index) const;
+  /// Blue (0) .. purple .. red (1); fractions are clamped.
+  static std::array<float, 3> TensionColor(double fraction);
+
+  /// Axis-aligned world bounds of the bodies; false when there are none.
+  bool BodyBounds(std::array<double, 3>* min, std::array<double, 3>* max) const;
+
+  /// Frames all bodies, keeping the viewing direction; `aspect` = width / height.
+  void ViewAll(double aspect);
+  void SetCamera(const CameraPose& camera);
+  CameraPose camera_pose() const;
+
+  /// What viewers show: the camera, the content and the legend (owned by this graph).
+  SoSeparator* root() const;
+  SoCamera* camera() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double tension_scale_ = 1.0;
+};
+
+}  // namespace caliper::render_coin

@@ -1,0 +1,501 @@
+#include "caliper/render_coin/scene_graph.h"
+
+#include <Inventor/SbLinear.h>
+#include <Inventor/SbViewportRegion.h>
+#include <Inventor/SoDB.h>
+#include <Inventor/actions/SoGetBoundingBoxAction.h>
+#include <Inventor/nodes/SoAnnotation.h>
+#include <Inventor/nodes/SoBaseColor.h>
+#include <Inventor/nodes/SoCone.h>
+#include <Inventor/nodes/SoCoordinate3.h>
+#include <Inventor/nodes/SoCube.h>
+#include <Inventor/nodes/SoCylinder.h>
+#include <Inventor/nodes/SoDrawStyle.h>
+#include <Inventor/nodes/SoFont.h>
+#include <Inventor/nodes/SoIndexedFaceSet.h>
+#include <Inventor/nodes/SoLightModel.h>
+#include <Inventor/nodes/SoLineSet.h>
+#include <Inventor/nodes/SoMaterial.h>
+#include <Inventor/nodes/SoNormal.h>
+#include <Inventor/nodes/SoNormalBinding.h>
+#include <Inventor/nodes/SoOrthographicCamera.h>
+#include <Inventor/nodes/SoPerspectiveCamera.h>
+#include <Inventor/nodes/SoPointSet.h>
+#include <Inventor/nodes/SoRotationXYZ.h>
+#include <Inventor/nodes/SoSeparator.h>
+#include <Inventor/nodes/SoShapeHints.h>
+#include <Inventor/nodes/SoSphere.h>
+#include <Inventor/nodes/SoText2.h>
+#include <Inventor/nodes/SoTransform.h>
+#include <Inventor/nodes/SoTranslation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace caliper::render_coin {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGridHalfSize = 1.0;  // [m]
+constexpr double kGridSpacing = 0.1;   // [m]
+constexpr double kAxisLength = 0.2;    // [m]
+constexpr float kTendonWidth = 3.0f;   // [px]
+constexpr float kObstacleTransparency = 0.65f;
+
+void SetTransform(SoTransform* t, const Pose& pose) {
+  t->translation.setValue(static_cast<float>(pose.p[0]), static_cast<float>(pose.p[1]),
+                          static_cast<float>(pose.p[2]));
+  // SbRotation takes x y z w
+  t->rotation.setValue(static_cast<float>(pose.q[1]), static_cast<float>(pose.q[2]),
+                       static_cast<float>(pose.q[3]), static_cast<float>(pose.q[0]));
+}
+
+double Dim(const Shape& s, size_t i, double fallback) {
+  return i < s.dims.size() ? s.dims[i] : fallback;
+}
+
+// Coin's cylinders and cones run along y, ours along z
+SoRotationXYZ* YToZ() {
+  auto* r = new SoRotationXYZ;
+  r->axis = SoRotationXYZ::X;
+  r->angle = static_cast<float>(kPi / 2);
+  return r;
+}
+
+SoNode* MeshNode(const Mesh& mesh) {
+  auto* sep = new SoSeparator;
+  auto* hints = new SoShapeHints;
+  hints->creaseAngle = 0.6f;
+  sep->addChild(hints);
+  auto* coords = new SoCoordinate3;
+  const int n = static_cast<int>(mesh.vertices.size() / 3);
+  coords->point.setNum(n);
+  SbVec3f* pts = coords->point.startEditing();
+  for (int i = 0; i < n; ++i)
+    pts[i].setValue(mesh.vertices[3 * i], mesh.vertices[3 * i + 1], mesh.vertices[3 * i + 2]);
+  coords->point.finishEditing();
+  sep->addChild(coords);
+  if (mesh.triangles.empty()) {
+    sep->addChild(new SoPointSet);
+    return sep;
+  }
+  if (mesh.normals.size() == mesh.vertices.size()) {
+    auto* normals = new SoNormal;
+    normals->vector.setNum(n);
+    SbVec3f* v = normals->vector.startEditing();
+    for (int i = 0; i < n; ++i)
+      v[i].setValue(mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]);
+    normals->vector.finishEditing();
+    sep->addChild(normals);
+    auto* binding = new SoNormalBinding;
+    binding->value = SoNormalBinding::PER_VERTEX_INDEXED;
+    sep->addChild(binding);
+  }
+  auto* faces = new SoIndexedFaceSet;
+  const size_t triangles = mesh.triangles.size() / 3;
+  faces->coordIndex.setNum(static_cast<int>(triangles * 4));
+  int32_t* idx = faces->coordIndex.startEditing();
+  for (size_t t = 0; t < triangles; ++t) {
+    for (int k = 0; k < 3; ++k) idx[4 * t + k] = static_cast<int32_t>(mesh.triangles[3 * t + k]);
+    idx[4 * t + 3] = SO_END_FACE_INDEX;
+  }
+  faces->coordIndex.finishEditing();
+  sep->addChild(faces);
+  return sep;
+}
+
+// the shape of a visual in its own frame; nullptr for what is not drawn (planes: the grid)
+SoNode* ShapeNode(const Shape& shape, const std::vector<Mesh>& meshes) {
+  switch (shape.kind) {
+    case ShapeKind::kBox: {
+      auto* cube = new SoCube;
+      cube->width = static_cast<float>(Dim(shape, 0, 0.1));
+      cube->height = static_cast<float>(Dim(shape, 1, 0.1));
+      cube->depth = static_cast<float>(Dim(shape, 2, 0.1));
+      return cube;
+    }
+    case ShapeKind::kSphere: {
+      auto* sphere = new SoSphere;
+      sphere->radius = static_cast<float>(Dim(shape, 0, 0.05));
+      return sphere;
+    }
+    case ShapeKind::kCylinder: {
+      auto* sep = new SoSeparator;
+      sep->addChild(YToZ());
+      auto* cylinder = new SoCylinder;
+      cylinder->radius = static_cast<float>(Dim(shape, 0, 0.05));
+      cylinder->height = static_cast<float>(Dim(shape, 1, 0.1));
+      sep->addChild(cylinder);
+      return sep;
+    }
+    case ShapeKind::kCone: {
+      auto* sep = new SoSeparator;
+      sep->addChild(YToZ());
+      auto* cone = new SoCone;
+      cone->bottomRadius = static_cast<float>(Dim(shape, 0, 0.05));
+      cone->height = static_cast<float>(Dim(shape, 1, 0.1));
+      sep->addChild(cone);
+      return sep;
+    }
+    case ShapeKind::kCapsule: {
+      const float r = static_cast<float>(Dim(shape, 0, 0.05));
+      const float length = static_cast<float>(Dim(shape, 1, 0.1));
+      auto* sep = new SoSeparator;
+      sep->addChild(YToZ());
+      auto* cylinder = new SoCylinder;
+      cylinder->radius = r;
+      cylinder->height = length;
+      cylinder->parts = SoCylinder::SIDES;
+      sep->addChild(cylinder);
+      auto* sphere = new SoSphere;
+      sphere->radius = r;
+      auto* up = new SoTranslation;
+      up->translation.setValue(0, length / 2, 0);
+      sep->addChild(up);
+      sep->addChild(sphere);
+      auto* down = new SoTranslation;
+      down->translation.setValue(0, -length, 0);
+      sep->addChild(down);
+      sep->addChild(sphere);
+      return sep;
+    }
+    case ShapeKind::kConvexHull:
+    case ShapeKind::kTriangleMesh:
+      if (shape.mesh < 0 || static_cast<size_t>(shape.mesh) >= meshes.size()) return nullptr;
+      return MeshNode(meshes[static_cast<size_t>(shape.mesh)]);
+    case ShapeKind::kPlane:
+      return nullptr;
+  }
+  return nullptr;
+}
+
+SoSeparator* ObstacleNode(const Obstacle& o) {
+  auto* sep = new SoSeparator;
+  auto* t = new SoTransform;
+  SetTransform(t, o.pose);
+  sep->addChild(t);
+  auto* material = new SoMaterial;
+  material->diffuseColor.setValue(0.9f, 0.9f, 0.3f);
+  material->transparency = kObstacleTransparency;
+  sep->addChild(material);
+  Shape shape;
+  if (o.kind == "cylinder") {
+    shape.kind = ShapeKind::kCylinder;
+    shape.dims = {o.radius, o.length};
+  } else {
+    shape.kind = ShapeKind::kSphere;
+    shape.dims = {o.radius};
+  }
+  sep->addChild(ShapeNode(shape, {}));
+  return sep;
+}
+
+// lines in the z = 0 plane every kGridSpacing, unlit grey
+SoSeparator* GridNode() {
+  auto* sep = new SoSeparator;
+  auto* model = new SoLightModel;
+  model->model = SoLightModel::BASE_COLOR;
+  sep->addChild(model);
+  auto* color = new SoBaseColor;
+  color->rgb.setValue(0.45f, 0.45f, 0.48f);
+  sep->addChild(color);
+  auto* coords = new SoCoordinate3;
+  auto* lines = new SoLineSet;
+  const int n = static_cast<int>(std::lround(2 * kGridHalfSize / kGridSpacing)) + 1;
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    const float c = static_cast<float>(-kGridHalfSize + i * kGridSpacing);
+    const float h = static_cast<float>(kGridHalfSize);
+    coords->point.set1Value(k++, c, -h, 0);
+    coords->point.set1Value(k++, c, h, 0);
+    coords->point.set1Value(k++, -h, c, 0);
+    coords->point.set1Value(k++, h, c, 0);
+  }
+  for (int i = 0; i < 2 * n; ++i) lines->numVertices.set1Value(i, 2);
+  sep->addChild(coords);
+  sep->addChild(lines);
+  return sep;
+}
+
+// x red, y green, z blue from the origin
+SoSeparator* AxesNode() {
+  auto* sep = new SoSeparator;
+  auto* model = new SoLightModel;
+  model->model = SoLightModel::BASE_COLOR;
+  sep->addChild(model);
+  auto* style = new SoDrawStyle;
+  style->lineWidth = 3;
+  sep->addChild(style);
+  const float l = static_cast<float>(kAxisLength);
+  const float dirs[3][3] = {{l, 0, 0}, {0, l, 0}, {0, 0, l}};
+  for (int a = 0; a < 3; ++a) {
+    auto* axis = new SoSeparator;
+    auto* color = new SoBaseColor;
+    color->rgb.setValue(a == 0 ? 1.f : 0.f, a == 1 ? 0.8f : 0.f, a == 2 ? 1.f : 0.f);
+    axis->addChild(color);
+    auto* coords = new SoCoordinate3;
+    coords->point.set1Value(0, 0, 0, 0);
+    coords->point.set1Value(1, dirs[a][0], dirs[a][1], dirs[a][2]);
+    axis->addChild(coords);
+    axis->addChild(new SoLineSet);
+    sep->addChild(axis);
+  }
+  return sep;
+}
+
+}  // namespace
+
+void InitializeCoin() {
+  if (!SoDB::isInitialized()) SoDB::init();
+}
+
+struct SceneGraph::Impl {
+  SoSeparator* root = nullptr;       // camera, world, legend
+  SoPerspectiveCamera* camera = nullptr;
+  SoSeparator* bodies = nullptr;     // one separator per body
+  SoSeparator* tendons = nullptr;    // style, then one separator per tendon
+  SoText2* legend = nullptr;
+  SoBaseColor* legend_low = nullptr;
+  std::vector<SoTransform*> body_transforms;
+  std::vector<Pose> body_poses;
+  std::vector<SoSeparator*> tendon_nodes;
+  std::vector<std::array<float, 3>> tendon_colors;
+  std::vector<double> tendon_tensions;
+};
+
+SceneGraph::SceneGraph() : impl_(std::make_unique<Impl>()) {
+  InitializeCoin();
+  Impl& m = *impl_;
+  m.root = new SoSeparator;
+  m.root->ref();
+  m.camera = new SoPerspectiveCamera;
+  m.root->addChild(m.camera);
+  CameraPose initial;
+  initial.position[0] = 1.2;
+  initial.position[1] = -1.6;
+  initial.position[2] = 0.9;
+  SetCamera(initial);
+
+  auto* world = new SoSeparator;
+  world->addChild(GridNode());
+  world->addChild(AxesNode());
+  m.bodies = new SoSeparator;
+  world->addChild(m.bodies);
+  m.tendons = new SoSeparator;
+  world->addChild(m.tendons);
+  m.root->addChild(world);
+
+  // the legend in normalized screen coordinates, drawn over everything
+  auto* legend = new SoAnnotation;
+  auto* ortho = new SoOrthographicCamera;
+  ortho->viewportMapping = SoCamera::LEAVE_ALONE;
+  ortho->height = 2;
+  ortho->position.setValue(0, 0, 1);
+  legend->addChild(ortho);
+  auto* model = new SoLightModel;
+  model->model = SoLightModel::BASE_COLOR;
+  legend->addChild(model);
+  auto* font = new SoFont;
+  font->size = 14;
+  legend->addChild(font);
+  m.legend_low = new SoBaseColor;
+  m.legend_low->rgb.setValue(0.9f, 0.9f, 0.9f);
+  legend->addChild(m.legend_low);
+  auto* where = new SoTranslation;
+  where->translation.setValue(-0.95f, -0.92f, 0);
+  legend->addChild(where);
+  m.legend = new SoText2;
+  legend->addChild(m.legend);
+  m.root->addChild(legend);
+  m.legend->string = legend_text().c_str();
+}
+
+SceneGraph::~SceneGraph() { impl_->root->unref(); }
+
+void SceneGraph::Clear() {
+  Impl& m = *impl_;
+  m.bodies->removeAllChildren();
+  m.tendons->removeAllChildren();
+  m.body_transforms.clear();
+  m.body_poses.clear();
+  m.tendon_nodes.clear();
+  m.tendon_colors.clear();
+  m.tendon_tensions.clear();
+  tension_scale_ = 1.0;
+  m.legend->string = legend_text().c_str();
+}
+
+void SceneGraph::Build(const SceneDescription& scene) {
+  Clear();
+  Impl& m = *impl_;
+  std::map<std::string, SoSeparator*> by_name;
+  for (const Body& body : scene.bodies) {
+    auto* sep = new SoSeparator;
+    auto* t = new SoTransform;
+    SetTransform(t, body.pose);
+    sep->addChild(t);
+    for (const Visual& v : body.visuals) {
+      SoNode* shape = ShapeNode(v.geometry, scene.meshes);
+      if (shape == nullptr) continue;
+      auto* vsep = new SoSeparator;
+      auto* vt = new SoTransform;
+      SetTransform(vt, v.pose);
+      vsep->addChild(vt);
+      auto* material = new SoMaterial;
+      material->diffuseColor.setValue(v.rgba[0], v.rgba[1], v.rgba[2]);
+      material->ambientColor.setValue(0.3f * v.rgba[0], 0.3f * v.rgba[1], 0.3f * v.rgba[2]);
+      material->specularColor.setValue(0.15f, 0.15f, 0.15f);
+      material->transparency = 1.0f - v.rgba[3];
+      vsep->addChild(material);
+      vsep->addChild(shape);
+      sep->addChild(vsep);
+    }
+    m.bodies->addChild(sep);
+    m.body_transforms.push_back(t);
+    m.body_poses.push_back(body.pose);
+    by_name[body.name] = sep;
+  }
+  for (const Obstacle& o : scene.obstacles) {
+    const auto it = by_name.find(o.body);
+    (it == by_name.end() ? m.bodies : it->second)->addChild(ObstacleNode(o));
+  }
+  auto* model = new SoLightModel;
+  model->model = SoLightModel::BASE_COLOR;
+  m.tendons->addChild(model);
+  auto* style = new SoDrawStyle;
+  style->lineWidth = kTendonWidth;
+  m.tendons->addChild(style);
+  for (size_t i = 0; i < scene.tendons.size(); ++i) {
+    auto* sep = new SoSeparator;
+    auto* color = new SoBaseColor;
+    const auto rgb = TensionColor(0);
+    color->rgb.setValue(rgb[0], rgb[1], rgb[2]);
+    sep->addChild(color);
+    sep->addChild(new SoCoordinate3);
+    auto* lines = new SoLineSet;
+    lines->numVertices.setValue(0);
+    sep->addChild(lines);
+    m.tendons->addChild(sep);
+    m.tendon_nodes.push_back(sep);
+    m.tendon_colors.push_back(rgb);
+    m.tendon_tensions.push_back(0);
+  }
+}
+
+void SceneGraph::SetBodyPoses(const std::vector<uint32_t>& indices, const std::vector<Pose>& poses) {
+  Impl& m = *impl_;
+  const size_t n = std::min(indices.size(), poses.size());
+  for (size_t i = 0; i < n; ++i) {
+    if (indices[i] >= m.body_transforms.size()) continue;
+    SetTransform(m.body_transforms[indices[i]], poses[i]);
+    m.body_poses[indices[i]] = poses[i];
+  }
+}
+
+void SceneGraph::SetTendons(const std::vector<TendonState>& tendons) {
+  Impl& m = *impl_;
+  double largest = tension_scale_;
+  for (const TendonState& t : tendons) largest = std::max(largest, t.tension);
+  const bool rescaled = largest > tension_scale_;
+  tension_scale_ = largest;
+  for (const TendonState& t : tendons) {
+    if (t.tendon_index >= m.tendon_nodes.size()) continue;
+    SoSeparator* sep = m.tendon_nodes[t.tendon_index];
+    auto* coords = static_cast<SoCoordinate3*>(sep->getChild(1));
+    auto* lines = static_cast<SoLineSet*>(sep->getChild(2));
+    const int n = static_cast<int>(t.points.size() / 3);
+    coords->point.setNum(n);
+    SbVec3f* pts = coords->point.startEditing();
+    for (int i = 0; i < n; ++i)
+      pts[i].setValue(static_cast<float>(t.points[3 * i]), static_cast<float>(t.points[3 * i + 1]),
+                      static_cast<float>(t.points[3 * i + 2]));
+    coords->point.finishEditing();
+    lines->numVertices.setValue(n);
+    m.tendon_tensions[t.tendon_index] = t.tension;
+  }
+  // colours of all tendons follow the scale, which may just have grown
+  for (size_t i = 0; i < m.tendon_nodes.size(); ++i) {
+    const auto rgb = TensionColor(m.tendon_tensions[i] / tension_scale_);
+    if (rgb == m.tendon_colors[i] && !rescaled) continue;
+    static_cast<SoBaseColor*>(m.tendon_nodes[i]->getChild(0))->rgb.setValue(rgb[0], rgb[1], rgb[2]);
+    m.tendon_colors[i] = rgb;
+  }
+  if (rescaled) m.legend->string = legend_text().c_str();
+}
+
+size_t SceneGraph::body_count() const { return impl_->body_transforms.size(); }
+size_t SceneGraph::tendon_count() const { return impl_->tendon_nodes.size(); }
+Pose SceneGraph::body_pose(size_t index) const { return impl_->body_poses.at(index); }
+std::array<float, 3> SceneGraph::tendon_color(size_t index) const {
+  return impl_->tendon_colors.at(index);
+}
+
+std::string SceneGraph::legend_text() const {
+  char text[96];
+  std::snprintf(text, sizeof text, "tendon tension  0 N (blue) .. %.3g N (red)", tension_scale_);
+  return text;
+}
+
+std::array<float, 3> SceneGraph::TensionColor(double fraction) {
+  const float f = static_cast<float>(std::clamp(fraction, 0.0, 1.0));
+  return {0.1f + 0.9f * f, 0.1f, 1.0f - 0.9f * f};
+}
+
+bool SceneGraph::BodyBounds(std::array<double, 3>* min, std::array<double, 3>* max) const {
+  if (impl_->body_transforms.empty()) return false;
+  SoGetBoundingBoxAction action(SbViewportRegion(640, 480));
+  action.apply(impl_->bodies);
+  const SbBox3f box = action.getBoundingBox();
+  if (box.isEmpty()) return false;
+  for (int i = 0; i < 3; ++i) {
+    (*min)[i] = box.getMin()[i];
+    (*max)[i] = box.getMax()[i];
+  }
+  return true;
+}
+
+void SceneGraph::ViewAll(double aspect) {
+  const int height = 1000;
+  const int width = std::max(1, static_cast<int>(std::lround(height * aspect)));
+  SoNode* what = impl_->body_transforms.empty() ? static_cast<SoNode*>(impl_->root->getChild(1))
+                                                : static_cast<SoNode*>(impl_->bodies);
+  impl_->camera->viewAll(what, SbViewportRegion(static_cast<short>(width), height), 1.1f);
+}
+
+void SceneGraph::SetCamera(const CameraPose& c) {
+  SoPerspectiveCamera* camera = impl_->camera;
+  const SbVec3f position(static_cast<float>(c.position[0]), static_cast<float>(c.position[1]),
+                         static_cast<float>(c.position[2]));
+  const SbVec3f target(static_cast<float>(c.look_at[0]), static_cast<float>(c.look_at[1]),
+                       static_cast<float>(c.look_at[2]));
+  camera->position = position;
+  camera->heightAngle = static_cast<float>(c.height_angle);
+  camera->focalDistance = (target - position).length();
+  camera->pointAt(target, SbVec3f(static_cast<float>(c.up[0]), static_cast<float>(c.up[1]),
+                                  static_cast<float>(c.up[2])));
+}
+
+CameraPose SceneGraph::camera_pose() const {
+  const SoPerspectiveCamera* camera = impl_->camera;
+  CameraPose c;
+  const SbVec3f p = camera->position.getValue();
+  SbVec3f direction, up;
+  camera->orientation.getValue().multVec(SbVec3f(0, 0, -1), direction);
+  camera->orientation.getValue().multVec(SbVec3f(0, 1, 0), up);
+  const SbVec3f target = p + direction * camera->focalDistance.getValue();
+  for (int i = 0; i < 3; ++i) {
+    c.position[i] = p[i];
+    c.look_at[i] = target[i];
+    c.up[i] = up[i];
+  }
+  c.height_angle = camera->heightAngle.getValue();
+  return c;
+}
+
+SoSeparator* SceneGraph::root() const { return impl_->root; }
+SoCamera* SceneGraph::camera() const { return impl_->camera; }
+
+}  // namespace caliper::render_coin

@@ -1,0 +1,161 @@
+// The Scene Renderer as its own process: it finds the Model with the shipped arm, observes it and
+// writes a screenshot in which the arm and its tendons are drawn; it follows a restarted Model.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <QImage>
+#include <cstdlib>
+#include <fstream>
+
+#include "caliper/model.hh"
+#include "caliper/rtc/naming.h"
+#include "support/process.h"
+
+namespace caliper::testing {
+namespace {
+
+using std::chrono::seconds;
+namespace M = ::Caliper::Simulation;
+
+struct PixelCounts {
+  int arm = 0;        // the bones' ivory and the joints' gold
+  int tendon = 0;     // saturated blue .. purple .. red, unlit
+  int background = 0;
+};
+
+// counts in the upper two thirds of the frame, where the hanging arm is framed (the world axes,
+// also red and blue, are at the bottom)
+PixelCounts Count(const QImage& image) {
+  PixelCounts n;
+  const QColor background = image.pixelColor(2, 2);
+  for (int y = 0; y < image.height() * 2 / 3; ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c = image.pixelColor(x, y);
+      const int r = c.red(), g = c.green(), b = c.blue();
+      if (c == background) ++n.background;
+      if (r > 120 && g > 100 && r > b + 30 && g > b) ++n.arm;
+      if (g < 70 && r + b > 180 && std::max(r, b) > 120) ++n.tendon;
+    }
+  }
+  return n;
+}
+
+std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {
+  const char* dir = std::getenv("CALIPER_ARTIFACT_DIR");
+  return (dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir) + "/" + name;
+}
+
+class Renderer : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0')
+      GTEST_SKIP() << "no DISPLAY: the renderer needs X with GLX (launch/caliper test starts Xvfb; "
+                      "or run `Xvfb :57 -screen 0 1280x800x24 & export DISPLAY=:57`)";
+    naming_ = std::make_unique<NamingService>(dir_.path());
+    common_ = {"--nameservice", naming_->address(), "-o", "log.service=none", "-o",
+               "log.spool_dir=" + dir_.path() + "/spool"};
+  }
+
+  std::unique_ptr<Process> StartModel(const std::string& log) {
+    const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
+    std::vector<std::string> args = {Bin("caliper-model"), "-o",
+                                     "model.scene=" + models + "/ecce_arm.dae", "-o",
+                                     "exec.auto_activate=true"};
+    args.insert(args.end(), common_.begin(), common_.end());
+    return std::make_unique<Process>(args, dir_.path() + "/" + log);
+  }
+
+  std::unique_ptr<Process> StartRenderer(const std::string& png, double after) {
+    std::vector<std::string> args = {Bin("caliper-renderer"), "--screenshot", png, "--after",
+                                     std::to_string(after), "-o", "renderer.check_interval=0.2"};
+    args.insert(args.end(), common_.begin(), common_.end());
+    return std::make_unique<Process>(args, dir_.path() + "/renderer.out");
+  }
+
+  M::Model_var WaitForModel(CORBA::ORB_ptr orb) {
+    M::Model_var model;
+    WaitFor(
+        [&] {
+          try {
+            CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, naming_->address());
+            model = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
+            return !CORBA::is_nil(model) && !model->_non_existent();
+          } catch (...) {
+            return false;
+          }
+        },
+        seconds(20));
+    return model;
+  }
+
+  TempDir dir_;
+  std::unique_ptr<NamingService> naming_;
+  std::vector<std::string> common_;
+};
+
+TEST_F(Renderer, DrawsTheArmAndItsTendonsIntoAScreenshot) {
+  auto model = StartModel("model.out");
+  int argc = 3;
+  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
+  M::Model_var arm = WaitForModel(orb);
+  ASSERT_FALSE(CORBA::is_nil(arm)) << model->Output();
+  arm->step(200);  // the arm settles a little and its tendons carry some tension
+
+  const std::string png = ArtifactPath("renderer.png", dir_.path());
+  std::remove(png.c_str());
+  auto renderer = StartRenderer(png, 3.0);
+  ASSERT_EQ(renderer->Wait(seconds(40)), 0) << renderer->Output();
+  EXPECT_NE(renderer->Output().find("observing the Model"), std::string::npos) << renderer->Output();
+
+  QImage image;
+  ASSERT_TRUE(image.load(QString::fromStdString(png))) << "no readable PNG at " << png;
+  EXPECT_EQ(image.width(), 1024);
+  EXPECT_EQ(image.height(), 768);
+  const PixelCounts n = Count(image);
+  const int area = image.width() * image.height() * 2 / 3;
+  EXPECT_LT(n.background, area * 95 / 100) << "an empty frame";
+  EXPECT_GT(n.arm, 2000) << "the arm's coloured visuals are drawn";
+  EXPECT_GT(n.tendon, 300) << "the tendons are drawn in their tension colours";
+
+  model->Signal(SIGTERM);
+  EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
+  orb->destroy();
+}
+
+TEST_F(Renderer, ObservesARestartedModelAgain) {
+  auto model = StartModel("model1.out");
+  int argc = 3;
+  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
+  ASSERT_FALSE(CORBA::is_nil(WaitForModel(orb))) << model->Output();
+
+  const std::string png = dir_.path() + "/restarted.png";
+  auto renderer = StartRenderer(png, 8.0);
+  ASSERT_TRUE(WaitFor([&] { return renderer->Output().find("observing the Model") !=
+                                   std::string::npos; },
+                      seconds(10)))
+      << renderer->Output();
+  model->Signal(SIGTERM);
+  ASSERT_EQ(model->Wait(seconds(10)), 0) << model->Output();
+  model = StartModel("model2.out");
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const std::string out = renderer->Output();
+        const auto first = out.find("observing the Model");
+        return out.find("observing the Model", first + 1) != std::string::npos;
+      },
+      seconds(15)))
+      << "re-registers with the new Model\n"
+      << renderer->Output();
+  ASSERT_EQ(renderer->Wait(seconds(20)), 0) << renderer->Output();
+  QImage image;
+  ASSERT_TRUE(image.load(QString::fromStdString(png)));
+  EXPECT_GT(Count(image).arm, 2000) << "the new Model's scene is drawn";
+  model->Signal(SIGTERM);
+  EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
+  orb->destroy();
+}
+
+}  // namespace
+}  // namespace caliper::testing
