@@ -20,105 +20,15 @@
 #include "caliper/rtc.hh"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
+#include "client.h"
 #include "inspect.h"
+#include "model_verbs.h"
 
 namespace caliper::ctl {
 namespace {
 
 namespace RTC = ::Caliper::RTC;
 namespace LogIdl = ::Caliper::Logging;
-
-/// A usage error: the message, then the verb's help; exit code 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-/// A failure the user should read: exit code 1.
-struct Failure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-struct Options {
-  std::string nameservice;
-  double timeout_s = 5.0;
-};
-
-/// The connection to a session: the ORB is started by the first verb that needs it, so that
-/// verbs working on files alone (inspect) run without a naming service.
-class Client {
- public:
-  explicit Client(const Options& options) : options_(options) {}
-  ~Client() {
-    if (CORBA::is_nil(orb_)) return;
-    try {
-      orb_->destroy();
-    } catch (...) {
-    }
-  }
-
-  CosNaming::NamingContext_ptr Root() {
-    Connect();
-    try {
-      return rtc::ResolveRoot(orb_, address_);
-    } catch (const rtc::Unreachable& e) {
-      throw Failure(std::string(e.what()) +
-                    "\n  (is a session running? start one with `launch/caliper demo`, or pass "
-                    "--nameservice corbaname::HOST:PORT)");
-    }
-  }
-
-  rtc::ComponentEntry Find(const std::string& name) {
-    CosNaming::NamingContext_var root = Root();
-    try {
-      return rtc::FindComponent(root, name);
-    } catch (const rtc::NotFound& e) {
-      throw Failure(e.what());
-    }
-  }
-
-  RTC::LightweightRTObject_ptr Component(const std::string& name, std::string* path = nullptr) {
-    rtc::ComponentEntry e = Find(name);
-    if (path) *path = e.path;
-    try {
-      RTC::LightweightRTObject_var obj = RTC::LightweightRTObject::_narrow(e.object);
-      if (CORBA::is_nil(obj)) throw Failure(e.path + " is not a Caliper component");
-      return obj._retn();
-    } catch (const CORBA::Exception& ex) {
-      throw Failure(Unreachable(e.path, ex));
-    }
-  }
-
-  static std::string Unreachable(const std::string& path, const CORBA::Exception& e) {
-    return "cannot reach " + path + ": " + rtc::Describe(e) +
-           " (the process may have died; its name is stale)";
-  }
-
-  CORBA::ORB_ptr orb() {
-    Connect();
-    return orb_.in();
-  }
-  const std::string& address() {
-    Connect();
-    return address_;
-  }
-
- private:
-  void Connect() {
-    if (!CORBA::is_nil(orb_)) return;
-    const std::string ms = std::to_string(static_cast<int>(options_.timeout_s * 1000));
-    std::vector<std::string> args = {"caliper-ctl", "-ORBendPoint", "giop:tcp:127.0.0.1:",
-                                     "-ORBclientCallTimeOutPeriod", ms,
-                                     "-ORBclientConnectTimeOutPeriod", ms};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    int argc = static_cast<int>(argv.size());
-    orb_ = CORBA::ORB_init(argc, argv.data());
-    address_ = rtc::NamingAddress(options_.nameservice);
-  }
-
-  Options options_;
-  CORBA::ORB_var orb_;
-  std::string address_;
-};
 
 const char* StateName(RTC::LifeCycleState s) {
   switch (s) {
@@ -146,34 +56,6 @@ RTC::LifeCycleState StateOf(RTC::LightweightRTObject_ptr comp) {
   RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
   if (ecs->length() == 0) throw Failure("the component owns no execution context");
   return ecs[0]->get_component_state(comp);
-}
-
-struct Verb {
-  std::string usage;
-  std::string summary;
-  std::function<int(Client&, std::vector<std::string>&)> run;
-};
-
-/// Takes `--flag VALUE` out of args; returns true when it was there.
-bool TakeOption(std::vector<std::string>& args, const std::string& flag, std::string* value) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] != flag) continue;
-    if (i + 1 >= args.size()) throw UsageError(flag + " needs a value");
-    *value = args[i + 1];
-    args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
-    return true;
-  }
-  return false;
-}
-
-bool TakeFlag(std::vector<std::string>& args, const std::string& flag) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == flag) {
-      args.erase(args.begin() + static_cast<long>(i));
-      return true;
-    }
-  }
-  return false;
 }
 
 std::string OneName(std::vector<std::string>& args) {
@@ -337,9 +219,7 @@ int Log(Client& client, std::vector<std::string>& args) {
     CORBA::ULongLong listener_id = 0;
     if (follow) {
       // listen first, then print the backlog: nothing falls between the two
-      CORBA::Object_var poa_obj = client.orb()->resolve_initial_references("RootPOA");
-      PortableServer::POA_var poa = PortableServer::POA::_narrow(poa_obj);
-      poa->the_POAManager()->activate();
+      PortableServer::POA_var poa = client.RootPoa();
       listener = new FollowListener(q, &printed);
       PortableServer::ObjectId_var id = poa->activate_object(listener);
       CORBA::Object_var ref = poa->id_to_reference(id);
@@ -418,10 +298,12 @@ std::map<std::string, Verb> Verbs() {
                   "print the session log (the newest N records, 50 by default); --follow keeps "
                   "printing new ones until Ctrl-C",
                   Log};
+  verbs["log"].takes_interrupt = true;
   verbs["inspect"] = {"inspect FILE [--export OUT.dae]",
                       "report what a COLLADA file (.dae, .zae) holds, or why it does not import "
                       "(no session needed); --export writes the imported scene back out",
-                      Inspect};
+                      Inspect, "files"};
+  AddModelVerbs(&verbs);
   return verbs;
 }
 
@@ -430,21 +312,22 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
             << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
             << "$CALIPER_NAMESERVICE, else corbaname::127.0.0.1:2809. NAME is an instance name\n"
             << "(model0), host/model0, or host.host_cxt/model0.rtc. `inspect` reads a file\n"
-            << "and needs no session.\n\nVerbs:\n";
-  for (const auto& [name, verb] : verbs)
-    std::cout << "  " << std::left << std::setw(12) << name << verb.summary << "\n";
+            << "and needs no session.\n";
+  const std::pair<const char*, const char*> groups[] = {
+      {"components", "Components"},
+      {"model", "Model (model0, or --model NAME on each verb)"},
+      {"files", "Files"}};
+  for (const auto& [group, title] : groups) {
+    std::cout << "\n" << title << ":\n";
+    for (const auto& [name, verb] : verbs)
+      if (verb.group == group)
+        std::cout << "  " << std::left << std::setw(12) << name << verb.summary << "\n";
+  }
   std::cout << "\n`caliper-ctl VERB --help` describes one verb. Exit status: 0 done, 1 failed, "
                "2 bad usage.\n";
 }
 
 int Main(int argc, char** argv) {
-  // SIGINT/SIGTERM are taken with sigwait by `log --follow`; block them in every thread
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
-
   const auto verbs = Verbs();
   Options options;
   std::vector<std::string> args(argv + 1, argv + argc);
@@ -484,8 +367,17 @@ int Main(int argc, char** argv) {
   }
   const Verb& verb = it->second;
   if (TakeFlag(rest, "--help") || TakeFlag(rest, "-h")) {
-    std::cout << "Usage: caliper-ctl " << verb.usage << "\n  " << verb.summary << "\n";
+    std::cout << "Usage: caliper-ctl " << verb.usage << "\n  " << verb.summary << "\n"
+              << verb.details;
     return 0;
+  }
+  if (verb.takes_interrupt) {
+    // taken with sigwait by the verb: blocked before the ORB starts its threads
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
   }
   try {
     Client client(options);

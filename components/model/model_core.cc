@@ -151,8 +151,11 @@ void ModelCore::Reset() {
   const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
   RewindLocked();
   state_ = keep;
+  // pacing and the achieved factor start again from the rewound time
   run_wall_start_ = Clock::now();
-  run_sim_start_ = 0;
+  run_sim_start_ = loaded_->physics->time();
+  rate_wall_ = run_wall_start_;
+  rate_sim_ = run_sim_start_;
 }
 
 void ModelCore::StepNow(uint64_t n) {
@@ -201,11 +204,9 @@ Status ModelCore::status() const {
   return s;
 }
 
-void ModelCore::StepLocked() {
-  sgal::PhysicsScene& physics = *loaded_->physics;
-  // commands and parameter writes take effect at this step boundary, in the order they came
+void ModelCore::ApplyPendingLocked() {
   for (const auto& [name, value] : pending_commands_) {
-    physics.SetCommand(name, value);
+    loaded_->physics->SetCommand(name, value);
     loaded_->commands[name] = value;
   }
   pending_commands_.clear();
@@ -217,6 +218,12 @@ void ModelCore::StepLocked() {
     }
   }
   pending_sets_.clear();
+}
+
+void ModelCore::StepLocked() {
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  // commands and parameter writes take effect at this step boundary, in the order they came
+  ApplyPendingLocked();
   try {
     physics.Step();
   } catch (const sgal::SimulationFault& fault) {
@@ -321,7 +328,12 @@ void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& c
       throw InvalidValue("command for '" + name + "' is not finite");
   }
   pending_commands_.insert(pending_commands_.end(), commands.begin(), commands.end());
-  // while not running, the next step may be far away: keep the command visible now
+  // while not running, the next step may be far away: apply now, between steps (after anything
+  // still queued), so that the engine and its channels show the command at once
+  if (state_ != RunState::kRunning) {
+    ApplyPendingLocked();
+    loaded_->sampler->Refresh();
+  }
   for (const auto& [name, value] : commands) loaded_->commands[name] = value;
 }
 
@@ -332,8 +344,8 @@ std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
   for (const auto& a : loaded_->description->actuators) {
     ActuatorState s;
     s.name = a.name;
-    const auto it = loaded_->commands.find(a.name);
-    s.command = it == loaded_->commands.end() ? 0.0 : it->second;
+    // the engine's: also a command written as the `<actuator>.command` parameter
+    s.command = loaded_->physics->GetParameter(a.name + ".command");
     s.tension = loaded_->physics->GetParameter(a.tendon + ".tendon.tension");
     out.push_back(s);
   }
@@ -370,7 +382,9 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
     pending_sets_.emplace_back(id, values);
     return;
   }
-  // nothing steps soon: apply now, between steps, and let the engine's refusal reach the caller
+  // nothing steps soon: apply now, between steps (after anything still queued, to keep the
+  // order), and let the engine's refusal reach the caller
+  ApplyPendingLocked();
   try {
     registry_.Set(id, values);
   } catch (const daq::InvalidValue& e) {

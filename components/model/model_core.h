@@ -141,6 +141,8 @@ class ModelCore {
  private:
   struct Loaded;
   void BuildLocked(std::unique_ptr<Loaded> loaded);
+  /// Applies the queued commands and parameter writes, in the order they came.
+  void ApplyPendingLocked();
   void StepLocked();
   void PublishLocked();
   void RewindLocked();

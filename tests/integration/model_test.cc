@@ -1,5 +1,7 @@
 // The Model component with real processes: a private omniNames and caliper-model, driven by
 // caliper-ctl's model verbs and, for SceneObservers, over CORBA by servants in this test.
+#include "caliper/model.hh"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 #include <thread>
 #include <vector>
 
-#include "caliper/model.hh"
 #include "caliper/rtc/naming.h"
 #include "support/process.h"
 
@@ -83,8 +84,9 @@ class OrbEnvironment : public ::testing::Environment {
  public:
   static CORBA::ORB_ptr orb() {
     static CORBA::ORB_var orb = [] {
-      std::vector<std::string> args = {"model_test", "-ORBendPoint", "giop:tcp:127.0.0.1:",
-                                       "-ORBclientCallTimeOutPeriod", "10000"};
+      std::vector<std::string> args = {"model_test", "-ORBendPoint",
+                                       "giop:tcp:127.0.0.1:", "-ORBclientCallTimeOutPeriod",
+                                       "10000"};
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(a.data());
       int argc = static_cast<int>(argv.size());
@@ -139,7 +141,8 @@ class RecordingObserver : public virtual POA_Caliper::Scene::SceneObserver {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       Update u{update, sim_time, {}, tendons.length()};
-      for (CORBA::ULong i = 0; i < changed.length(); ++i) u.changed.push_back(changed[i].body_index);
+      for (CORBA::ULong i = 0; i < changed.length(); ++i)
+        u.changed.push_back(changed[i].body_index);
       updates_.push_back(u);
     }
     if (delay_.count() > 0) std::this_thread::sleep_for(delay_);
@@ -275,8 +278,8 @@ TEST_F(ModelTest, CtlLoadsStepsRunsPausesAndStops) {
     EXPECT_TRUE(Contains(step.out, std::to_string(n) + " steps")) << step.out;
     status = Status();
     EXPECT_EQ(Field(status, "state"), "PAUSED");
-    EXPECT_NEAR(std::strtod(Field(status, "simulated time [s]").c_str(), nullptr) - before,
-                n * kDt, 1e-9);
+    EXPECT_NEAR(std::strtod(Field(status, "simulated time [s]").c_str(), nullptr) - before, n * kDt,
+                1e-9);
   }
   EXPECT_EQ(Field(status, "steps"), "350");
 
@@ -317,14 +320,11 @@ TEST_F(ModelTest, AchievedRealTimeFactorStaysPositiveAcrossAResetWhileRunning) {
   std::this_thread::sleep_for(milliseconds(1100));
   const std::string status = Status();
   EXPECT_EQ(Field(status, "state"), "RUNNING");
-  const double achieved = std::strtod(Field(status, "real-time factor").c_str(), nullptr);
-  EXPECT_TRUE(Contains(Field(status, "real-time factor"), "achieved")) << status;
-  const std::regex factor("requested, ([-0-9.e]+) achieved");
-  std::smatch m;
   const std::string line = Field(status, "real-time factor");
-  ASSERT_TRUE(std::regex_search(line, m, factor)) << status;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(line, m, std::regex("^1 requested, ([-0-9.e]+) achieved")))
+      << status;
   EXPECT_NEAR(std::strtod(m[1].str().c_str(), nullptr), 1.0, 0.2) << status;
-  EXPECT_EQ(achieved, 1.0) << "requested";
 }
 
 // ------------------------------------------------------------------------ parameters
@@ -352,11 +352,13 @@ TEST_F(ModelTest, ParamsListsIdsWithUnitsShapesAndAccess) {
   const auto tension = Ctl({"params", "tension"});
   ASSERT_EQ(tension.exit_code, 0) << tension.err;
   const auto lines = Lines(tension.out);
-  ASSERT_EQ(lines.size(), 3u) << tension.out;  // the header, the tendon's and the motor's
+  ASSERT_GE(lines.size(), 3u) << tension.out;
   for (size_t i = 1; i < lines.size(); ++i) {
     EXPECT_TRUE(Contains(lines[i], "tension")) << lines[i];
     EXPECT_TRUE(std::regex_search(lines[i], std::regex(" N +1x1 "))) << lines[i];
   }
+  EXPECT_TRUE(Contains(tension.out, "\npendulum_tendon.line.tendon.tension ")) << tension.out;
+  EXPECT_TRUE(Contains(tension.out, "\npendulum_tendon.motor.tension ")) << tension.out;
   const auto glob = Ctl({"params", "pendulum_tendon.motor.*_inertia"});
   EXPECT_EQ(Lines(glob.out).size(), 3u) << glob.out;
   const auto none = Ctl({"params", "nothing_like_this"});
@@ -422,8 +424,8 @@ TEST_F(ModelTest, UnknownIdsAndActuatorsAreNamed) {
   const auto motor = Ctl({"motor", "no_such_motor", "3"});
   EXPECT_EQ(motor.exit_code, 1);
   EXPECT_TRUE(Contains(motor.err, "no actuator 'no_such_motor'")) << motor.err;
-  const auto record = Ctl({"record", "pendulum_tendon.nope", "--duration", "0.1", "--csv",
-                           dir_.path() + "/never.csv"});
+  const auto record = Ctl(
+      {"record", "pendulum_tendon.nope", "--duration", "0.1", "--csv", dir_.path() + "/never.csv"});
   EXPECT_EQ(record.exit_code, 1);
   EXPECT_TRUE(Contains(record.err, "'pendulum_tendon.nope'")) << record.err;
   const auto model = Ctl({"status", "--model", "model7"});
@@ -444,7 +446,9 @@ TEST_F(ModelTest, MalformedFileFailsWithTheImportersMessageAndThePreviousSceneKe
       {"tests/data/collada/malformed_negative_mass.dae", "a dynamic body needs a positive mass"},
       {"tests/data/collada/malformed_xml.dae", ":40: malformed XML"},
       {"tests/data/collada/malformed_unknown_kind.dae", "unknown actuator kind"},
-      {"tests/data/collada/malformed_dangling_tendon_body.dae", "malformed_dangling_tendon_body"},
+      {"tests/data/collada/malformed_dangling_tendon_body.dae",
+       ":102: attachment: dangling reference: tendon 'line' point on unknown body"},
+      {"tests/data/collada/no_such_file.dae", "cannot open"},
   };
   for (const Case& c : cases) {
     const auto r = Ctl({"load", Source(c.file)});
@@ -479,6 +483,12 @@ TEST_F(ModelTest, MotorChangesTheCommandAndTheTendonTension) {
   EXPECT_GT(pulled, slack + 0.5) << "the motor winds the line in";
   EXPECT_EQ(Get("pendulum_tendon.motor.tension"), pulled);
   EXPECT_GT(Get("pendulum_tendon.pivot.position"), 0.01) << "and lifts the pendulum";
+
+  // a command written as a parameter is the actuator's command too
+  ASSERT_EQ(Ctl({"set", "pendulum_tendon.motor.command", "3"}).exit_code, 0);
+  const auto three = Ctl({"motor"});
+  EXPECT_TRUE(std::regex_search(three.out, std::regex("\nmotor +dc_motor_tendon +line +3 V ")))
+      << three.out;
 
   const auto bad = Ctl({"motor", "motor", "nan"});
   EXPECT_EQ(bad.exit_code, 1);
@@ -553,7 +563,8 @@ TEST_F(ModelTest, SaveWritesAFileThatInspectAccepts) {
   const auto inspect = Ctl({"inspect", out});
   ASSERT_EQ(inspect.exit_code, 0) << inspect.err;
   EXPECT_TRUE(Contains(inspect.out, "bodies (2: 1 dynamic, 1 static)")) << inspect.out;
-  EXPECT_TRUE(Contains(inspect.out, "pendulum              dynamic, 0.75 kg")) << inspect.out;
+  EXPECT_TRUE(std::regex_search(inspect.out, std::regex("\n  pendulum +dynamic, 0\\.75 kg")))
+      << inspect.out;
   EXPECT_TRUE(Contains(inspect.out, "actuators (1: 1 dc_motor_tendon)")) << inspect.out;
   // the saved file loads back into the Model
   const auto load = Ctl({"load", out});
@@ -619,8 +630,8 @@ TEST_F(ModelTest, ASlowObserverDoesNotSlowTheSimulation) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   EXPECT_EQ(status->state, M::RUNNING);
-  EXPECT_NEAR(status->achieved_real_time_factor, 1.0, 0.05);
-  EXPECT_NEAR(status->sim_time / wall, 1.0, 0.05);
+  EXPECT_NEAR(status->achieved_real_time_factor, 1.0, 0.1);
+  EXPECT_NEAR(status->sim_time / wall, 1.0, 0.1);
 
   // the observer got coalesced updates, numbered without a break
   const auto updates = slow.observer().updates();
@@ -628,7 +639,9 @@ TEST_F(ModelTest, ASlowObserverDoesNotSlowTheSimulation) {
   EXPECT_GE(updates.size(), 5u);
   for (size_t i = 1; i < updates.size(); ++i) {
     EXPECT_EQ(updates[i].update, updates[i - 1].update + 1);
-    if (i > 1) EXPECT_GT(updates[i].time - updates[i - 1].time, 0.05) << "coalesced";
+    if (i > 1) {
+      EXPECT_GT(updates[i].time - updates[i - 1].time, 0.05) << "coalesced";
+    }
   }
 }
 
@@ -641,13 +654,13 @@ TEST_F(ModelTest, AnObserverThatIsGoneIsDroppedAndTheModelKeepsRunning) {
   model->start();
   ASSERT_TRUE(WaitFor([&] { return gone.observer().updates().size() >= 3; }, seconds(5)));
   gone.Deactivate();  // its calls raise OBJECT_NOT_EXIST, as for a process that ended
-  ASSERT_TRUE(WaitFor([&] { return Contains(model_->Output(), "dropping an observer"); },
-                      seconds(5)))
+  ASSERT_TRUE(
+      WaitFor([&] { return Contains(model_->Output(), "dropping an observer"); }, seconds(5)))
       << model_->Output();
   EXPECT_TRUE(Contains(model_->Output(), "OBJECT_NOT_EXIST")) << model_->Output();
 
   // the simulation runs on, and other observers are served
-  const double t = model->status()->sim_time;
+  const double t = M::SimulationStatus_var(model->status())->sim_time;
   EXPECT_TRUE(WaitFor([&] { return M::SimulationStatus_var(model->status())->sim_time > t + 0.2; },
                       seconds(5)));
   EXPECT_EQ(M::SimulationStatus_var(model->status())->state, M::RUNNING);
@@ -673,11 +686,19 @@ TEST(ModelVerbs, EveryVerbHasHelpAndBadUsageExits2WithoutASession) {
     EXPECT_TRUE(std::regex_search(help.out, std::regex("\n  " + verb + " +[a-z]"))) << help.out;
   EXPECT_TRUE(Contains(help.out, "--model NAME")) << help.out;
 
-  const std::vector<std::vector<std::string>> usage = {
-      {"step"},         {"step", "ten"},     {"step", "-3"},         {"load"},
-      {"load", "a", "b"}, {"get"},           {"set", "x"},           {"status", "extra"},
-      {"params", "a", "b"}, {"save"},        {"start", "--frob"},    {"step", "1", "--model"},
-      {"reset", "sample0", "--model", "model0"}};
+  const std::vector<std::vector<std::string>> usage = {{"step"},
+                                                       {"step", "ten"},
+                                                       {"step", "-3"},
+                                                       {"load"},
+                                                       {"load", "a", "b"},
+                                                       {"get"},
+                                                       {"set", "x"},
+                                                       {"status", "extra"},
+                                                       {"params", "a", "b"},
+                                                       {"save"},
+                                                       {"start", "--frob"},
+                                                       {"step", "1", "--model"},
+                                                       {"reset", "sample0", "--model", "model0"}};
   for (const auto& args : usage) {
     const auto r = caliper::testing::Ctl(none, args);
     EXPECT_EQ(r.exit_code, 2) << args[0] << " " << (args.size() > 1 ? args[1] : "") << ": "

@@ -1,0 +1,116 @@
+#include "client.h"
+
+#include <cctype>
+
+namespace caliper::ctl {
+
+Client::~Client() {
+  if (CORBA::is_nil(orb_)) return;
+  try {
+    orb_->destroy();
+  } catch (...) {
+  }
+}
+
+CosNaming::NamingContext_ptr Client::Root() {
+  Connect();
+  try {
+    return rtc::ResolveRoot(orb_, address_);
+  } catch (const rtc::Unreachable& e) {
+    throw Failure(std::string(e.what()) +
+                  "\n  (is a session running? start one with `launch/caliper demo`, or pass "
+                  "--nameservice corbaname::HOST:PORT)");
+  }
+}
+
+rtc::ComponentEntry Client::Find(const std::string& name) {
+  CosNaming::NamingContext_var root = Root();
+  try {
+    return rtc::FindComponent(root, name);
+  } catch (const rtc::NotFound& e) {
+    throw Failure(e.what());
+  }
+}
+
+::Caliper::RTC::LightweightRTObject_ptr Client::Component(const std::string& name,
+                                                          std::string* path) {
+  rtc::ComponentEntry e = Find(name);
+  if (path) *path = e.path;
+  try {
+    ::Caliper::RTC::LightweightRTObject_var obj =
+        ::Caliper::RTC::LightweightRTObject::_narrow(e.object);
+    if (CORBA::is_nil(obj)) throw Failure(e.path + " is not a Caliper component");
+    return obj._retn();
+  } catch (const CORBA::Exception& ex) {
+    throw Failure(Unreachable(e.path, ex));
+  }
+}
+
+std::string Client::Unreachable(const std::string& path, const CORBA::Exception& e) {
+  return "cannot reach " + path + ": " + rtc::Describe(e) +
+         " (the process may have died; its name is stale)";
+}
+
+CORBA::ORB_ptr Client::orb() {
+  Connect();
+  return orb_.in();
+}
+
+PortableServer::POA_ptr Client::RootPoa() {
+  CORBA::Object_var obj = orb()->resolve_initial_references("RootPOA");
+  PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
+  poa->the_POAManager()->activate();
+  return poa._retn();
+}
+
+const std::string& Client::address() {
+  Connect();
+  return address_;
+}
+
+void Client::Connect() {
+  if (!CORBA::is_nil(orb_)) return;
+  const std::string ms = std::to_string(static_cast<int>(options_.timeout_s * 1000));
+  std::vector<std::string> args = {"caliper-ctl",
+                                   "-ORBendPoint",
+                                   "giop:tcp:127.0.0.1:",
+                                   "-ORBclientCallTimeOutPeriod",
+                                   ms,
+                                   "-ORBclientConnectTimeOutPeriod",
+                                   ms};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  int argc = static_cast<int>(argv.size());
+  orb_ = CORBA::ORB_init(argc, argv.data());
+  address_ = rtc::NamingAddress(options_.nameservice);
+}
+
+bool TakeOption(std::vector<std::string>& args, const std::string& flag, std::string* value) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] != flag) continue;
+    if (i + 1 >= args.size()) throw UsageError(flag + " needs a value");
+    *value = args[i + 1];
+    args.erase(args.begin() + static_cast<long>(i), args.begin() + static_cast<long>(i) + 2);
+    return true;
+  }
+  return false;
+}
+
+bool TakeFlag(std::vector<std::string>& args, const std::string& flag) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == flag) {
+      args.erase(args.begin() + static_cast<long>(i));
+      return true;
+    }
+  }
+  return false;
+}
+
+void RejectOptions(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a.size() > 2 && a[0] == '-' && a[1] == '-' &&
+        std::isalpha(static_cast<unsigned char>(a[2])))
+      throw UsageError("unknown option '" + a + "'");
+}
+
+}  // namespace caliper::ctl

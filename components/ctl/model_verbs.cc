@@ -1,0 +1,660 @@
+#include "model_verbs.h"
+
+#include <limits.h>
+#include <signal.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+
+#include "caliper/model.hh"
+#include "csv_recording.h"
+
+namespace caliper::ctl {
+namespace {
+
+namespace M = ::Caliper::Simulation;
+namespace D = ::Caliper::Daq;
+namespace S = ::Caliper::Scene;
+
+constexpr const char* kDefaultModel = "model0";
+// load, step and save take as long as their work: no short call timeout for them [ms]
+constexpr CORBA::ULong kLongCallMs = 3600 * 1000;
+constexpr int kLabelWidth = 22;
+
+// values print with 7 significant digits (Bullet computes in single precision); times with more
+std::string Num(double v, int precision = 7) {
+  std::ostringstream s;
+  s << std::setprecision(precision) << v;
+  return s.str();
+}
+
+const char* StateName(M::SimulationState s) {
+  switch (s) {
+    case M::EMPTY: return "EMPTY";
+    case M::STOPPED: return "STOPPED";
+    case M::RUNNING: return "RUNNING";
+    case M::PAUSED: return "PAUSED";
+    case M::FAULTED: return "FAULTED";
+  }
+  return "?";
+}
+
+/// A number given on the command line (nan and inf pass: the Model judges values).
+double ParseNumber(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size())
+    throw UsageError(what + ": '" + text + "' is not a number");
+  return v;
+}
+
+/// A count from 1 to 2^32 - 1.
+CORBA::ULong ParseCount(const std::string& text, const std::string& what) {
+  const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c));
+  });
+  const unsigned long long v = digits && text.size() <= 10 ? std::stoull(text) : 0;
+  if (v < 1 || v > std::numeric_limits<CORBA::ULong>::max())
+    throw UsageError(what + ": '" + text + "' is not a whole number from 1 to 4294967295");
+  return static_cast<CORBA::ULong>(v);
+}
+
+/// The Model's process has another working directory: send it absolute paths.
+std::string Absolute(const std::string& path) {
+  if (path.empty() || path[0] == '/') return path;
+  char cwd[PATH_MAX];
+  if (getcwd(cwd, sizeof cwd) == nullptr) return path;
+  return std::string(cwd) + "/" + path;
+}
+
+S::StringSeq ToSeq(const std::vector<std::string>& ids) {
+  S::StringSeq out;
+  out.length(static_cast<CORBA::ULong>(ids.size()));
+  for (CORBA::ULong i = 0; i < ids.size(); ++i) out[i] = ids[i].c_str();
+  return out;
+}
+
+/// The Model a verb works on.
+struct ModelRef {
+  std::string name;
+  std::string path;
+  M::Model_var model;
+};
+
+std::string TakeModel(std::vector<std::string>& args) {
+  std::string name = kDefaultModel;
+  TakeOption(args, "--model", &name);
+  return name;
+}
+
+void NoArguments(const std::vector<std::string>& args) {
+  RejectOptions(args);
+  if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
+}
+
+ModelRef Connect(Client& client, const std::string& name) {
+  rtc::ComponentEntry e = client.Find(name);
+  ModelRef ref;
+  ref.name = name;
+  ref.path = e.path;
+  try {
+    ref.model = M::Model::_narrow(e.object);
+  } catch (const CORBA::Exception& ex) {
+    throw Failure(Client::Unreachable(e.path, ex));
+  }
+  if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
+  return ref;
+}
+
+/// Runs calls on the Model and turns what they raise into messages: a user exception's reason
+/// (exit 1), or that the Model cannot be reached.
+template <class F>
+auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const D::UnknownId& e) {
+    const std::string reason = e.reason.in(), id = e.id.in();
+    throw Failure(reason.find("'" + id + "'") != std::string::npos
+                      ? reason
+                      : "unknown id '" + id + "': " + reason);
+  } catch (const D::InvalidParameter& e) {
+    throw Failure(e.reason.in());
+  } catch (const M::NotAvailable& e) {
+    throw Failure(m.name + ": " + e.reason.in());
+  } catch (const M::LoadFailed& e) {
+    throw Failure(e.reason.in());
+  } catch (const CORBA::UserException& e) {
+    throw Failure(m.path + ": " + rtc::Describe(e));
+  } catch (const CORBA::SystemException& e) {
+    throw Failure(Client::Unreachable(m.path, e));
+  }
+}
+
+M::SimulationStatus* StatusOf(const ModelRef& m) {
+  return Call(m, [&] { return m.model->status(); });
+}
+
+/// Channel metadata by id (one list call).
+std::map<std::string, D::ChannelInfo> Channels(const ModelRef& m, const std::string& pattern) {
+  D::ChannelInfoSeq_var list = Call(m, [&] { return m.model->list(pattern.c_str()); });
+  std::map<std::string, D::ChannelInfo> out;
+  for (CORBA::ULong i = 0; i < list->length(); ++i) out[list[i].id.in()] = list[i];
+  return out;
+}
+
+std::string UnitOf(const std::map<std::string, D::ChannelInfo>& channels, const std::string& id) {
+  const auto it = channels.find(id);
+  return it == channels.end() ? "" : it->second.unit.in();
+}
+
+/// `id = v unit`, `id = [a, b, c] unit`, or a matrix row by row under `id (RxC, unit) =`.
+void PrintValue(const std::string& id, const std::string& unit, const D::Value& v) {
+  const CORBA::ULong n = v.data.length();
+  const std::string u = unit.empty() ? "" : " " + unit;
+  if (n == 1) {
+    std::cout << id << " = " << Num(v.data[0]) << u << "\n";
+  } else if (v.rows == 1 || v.cols == 1 || v.rows * v.cols != n) {
+    std::cout << id << " = [";
+    for (CORBA::ULong i = 0; i < n; ++i) std::cout << (i ? ", " : "") << Num(v.data[i]);
+    std::cout << "]" << u << "\n";
+  } else {
+    size_t width = 0;
+    for (CORBA::ULong i = 0; i < n; ++i) width = std::max(width, Num(v.data[i]).size());
+    std::cout << id << " (" << v.rows << "x" << v.cols << (unit.empty() ? "" : ", " + unit)
+              << ") =\n";
+    for (CORBA::ULong r = 0; r < v.rows; ++r) {
+      std::cout << " ";
+      for (CORBA::ULong c = 0; c < v.cols; ++c)
+        std::cout << " " << std::right << std::setw(static_cast<int>(width))
+                  << Num(v.data[r * v.cols + c]);
+      std::cout << "\n";
+    }
+  }
+}
+
+void Line(const std::string& label, const std::string& value) {
+  std::cout << std::left << std::setw(kLabelWidth) << label << value << "\n";
+}
+
+// ------------------------------------------------------------------------ simulation control
+
+int Load(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() != 1) throw UsageError("expected one FILE");
+  const std::string path = Absolute(args[0]);
+  ModelRef m = Connect(client, name);
+  omniORB::setClientCallTimeout(m.model, kLongCallMs);
+  Call(m, [&] {
+    try {
+      m.model->load_scene(path.c_str());
+    } catch (const M::LoadFailed& e) {
+      std::string message = e.reason.in();
+      M::SimulationStatus_var s = StatusOf(m);
+      if (s->state != M::EMPTY)
+        message += "\n  (" + name + " keeps " + s->scene.in() + ", " + StateName(s->state) + ")";
+      throw Failure(message);
+    }
+  });
+  M::SimulationStatus_var s = StatusOf(m);
+  std::cout << name << ": loaded " << path << " (" << StateName(s->state) << ", time step "
+            << Num(s->time_step) << " s)\n";
+  return 0;
+}
+
+/// start, pause, stop and reset: the call, then the state and time it left.
+int Control(Client& client, std::vector<std::string>& args, const std::string& verb) {
+  const std::string name = TakeModel(args);
+  NoArguments(args);
+  ModelRef m = Connect(client, name);
+  Call(m, [&] {
+    if (verb == "start")
+      m.model->start();
+    else if (verb == "pause")
+      m.model->pause();
+    else if (verb == "stop")
+      m.model->stop();
+    else
+      m.model->reset();
+  });
+  M::SimulationStatus_var s = StatusOf(m);
+  std::cout << name << ": " << StateName(s->state) << " at t = " << Num(s->sim_time, 10) << " s\n";
+  return 0;
+}
+
+int Step(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() != 1) throw UsageError("expected N, the number of steps");
+  const CORBA::ULong n = ParseCount(args[0], "N");
+  ModelRef m = Connect(client, name);
+  M::SimulationStatus_var before = StatusOf(m);
+  omniORB::setClientCallTimeout(m.model, kLongCallMs);
+  Call(m, [&] { m.model->step(n); });
+  M::SimulationStatus_var after = StatusOf(m);
+  const unsigned long long done = after->steps - before->steps;
+  if (after->state == M::FAULTED)
+    throw Failure(name + ": the simulation faulted after " + std::to_string(done) + " of " +
+                  std::to_string(n) + " steps: " + after->last_error.in());
+  std::cout << name << ": " << done << " steps, t = " << Num(after->sim_time, 10) << " s (+"
+            << Num(after->sim_time - before->sim_time, 10) << " s), " << StateName(after->state)
+            << "\n";
+  return 0;
+}
+
+int Status(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  NoArguments(args);
+  ModelRef m = Connect(client, name);
+  M::SimulationStatus_var s = StatusOf(m);
+  const bool running = s->state == M::RUNNING;
+  Line("model", name + " (" + m.path + ")");
+  Line("state", StateName(s->state));
+  Line("scene", std::strlen(s->scene) > 0 ? s->scene.in() : "(none)");
+  Line("simulated time [s]", Num(s->sim_time, 12));
+  Line("steps", std::to_string(s->steps));
+  Line("time step [s]", Num(s->time_step));
+  Line("real-time factor",
+       (s->real_time_factor == 0 ? std::string("0 (as fast as possible)")
+                                 : Num(s->real_time_factor)) +
+           " requested, " +
+           (running ? Num(s->achieved_real_time_factor, 4) + " achieved (over the last second)"
+                    : "- achieved (not running)"));
+  Line("last error", std::strlen(s->last_error) > 0 ? s->last_error.in() : "-");
+  return 0;
+}
+
+int Save(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() != 1) throw UsageError("expected one FILE");
+  const std::string path = Absolute(args[0]);
+  ModelRef m = Connect(client, name);
+  omniORB::setClientCallTimeout(m.model, kLongCallMs);
+  Call(m, [&] { m.model->save_scene(path.c_str()); });
+  std::cout << name << ": saved the scene with its current parameters to " << path << "\n";
+  return 0;
+}
+
+// ------------------------------------------------------------------------ parameters and motors
+
+int Params(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() > 1) throw UsageError("expected at most one PATTERN");
+  std::string pattern = args.empty() ? "*" : args[0];
+  if (pattern.find_first_of("*?") == std::string::npos) pattern = "*" + pattern + "*";
+  ModelRef m = Connect(client, name);
+  D::ChannelInfoSeq_var list = Call(m, [&] { return m.model->list(pattern.c_str()); });
+  if (list->length() == 0) {
+    M::SimulationStatus_var s = StatusOf(m);
+    std::cout << (s->state == M::EMPTY ? "(no scene is loaded)"
+                                       : "(no id matches '" + pattern + "')")
+              << "\n";
+    return 0;
+  }
+  // the scalars' current values, in one call
+  std::vector<std::string> scalars;
+  for (CORBA::ULong i = 0; i < list->length(); ++i)
+    if (list[i].rows * list[i].cols == 1) scalars.emplace_back(list[i].id.in());
+  std::map<std::string, double> values;
+  if (!scalars.empty()) {
+    const S::StringSeq ids = ToSeq(scalars);
+    D::ValueSeq_var read = Call(m, [&] { return m.model->get(ids); });
+    for (CORBA::ULong i = 0; i < read->length() && i < scalars.size(); ++i)
+      if (read[i].data.length() == 1) values[scalars[i]] = read[i].data[0];
+  }
+  size_t id_width = 2, unit_width = 4;
+  for (CORBA::ULong i = 0; i < list->length(); ++i) {
+    id_width = std::max(id_width, std::strlen(list[i].id));
+    unit_width = std::max(unit_width, std::strlen(list[i].unit));
+  }
+  const int iw = static_cast<int>(id_width + 2), uw = static_cast<int>(unit_width + 2);
+  std::cout << std::left << std::setw(iw) << "ID" << std::setw(uw) << "UNIT" << std::setw(7)
+            << "SHAPE" << std::setw(8) << "ACCESS" << std::setw(9) << "KIND"
+            << "VALUE\n";
+  for (CORBA::ULong i = 0; i < list->length(); ++i) {
+    const D::ChannelInfo& c = list[i];
+    const std::string unit = std::strlen(c.unit) > 0 ? c.unit.in() : "-";
+    const auto value = values.find(c.id.in());
+    std::cout << std::setw(iw) << c.id.in() << std::setw(uw) << unit << std::setw(7)
+              << (std::to_string(c.rows) + "x" + std::to_string(c.cols)) << std::setw(8)
+              << (c.writable ? "rw" : "ro") << std::setw(9) << (c.is_static ? "static" : "dynamic")
+              << (value != values.end() ? Num(value->second) : "") << "\n";
+  }
+  return 0;
+}
+
+int Get(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.empty()) throw UsageError("expected at least one ID");
+  ModelRef m = Connect(client, name);
+  const S::StringSeq ids = ToSeq(args);
+  D::ValueSeq_var values = Call(m, [&] { return m.model->get(ids); });
+  const auto channels = Channels(m, "*");
+  for (CORBA::ULong i = 0; i < values->length() && i < args.size(); ++i)
+    PrintValue(args[i], UnitOf(channels, args[i]), values[i]);
+  return 0;
+}
+
+int Set(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() < 2) throw UsageError("expected an ID and its value (one per element)");
+  const std::string id = args[0];
+  D::Value value;
+  value.data.length(static_cast<CORBA::ULong>(args.size() - 1));
+  for (size_t i = 1; i < args.size(); ++i)
+    value.data[static_cast<CORBA::ULong>(i - 1)] = ParseNumber(args[i], "VALUE");
+  ModelRef m = Connect(client, name);
+  // the shape the Model wants; an unknown id or a wrong count is the Model's to name
+  const auto channels = Channels(m, id);
+  const auto it = channels.find(id);
+  value.rows = value.data.length();
+  value.cols = 1;
+  if (it != channels.end() && it->second.rows * it->second.cols == value.data.length()) {
+    value.rows = it->second.rows;
+    value.cols = it->second.cols;
+  }
+  Call(m, [&] { m.model->set(id.c_str(), value); });
+  M::SimulationStatus_var s = StatusOf(m);
+  PrintValue(id, UnitOf(channels, id), value);
+  if (s->state == M::RUNNING) std::cout << "(applied at the next step boundary)\n";
+  return 0;
+}
+
+int Motor(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  RejectOptions(args);
+  if (args.size() == 1 || args.size() > 2) throw UsageError("expected NAME VALUE (or nothing)");
+  const double value = args.empty() ? 0.0 : ParseNumber(args[1], "VALUE");
+  ModelRef m = Connect(client, name);
+  M::ActuatorInfoSeq_var info = Call(m, [&] { return m.model->actuators(); });
+  if (args.empty()) {
+    M::ActuatorStateSeq_var states = Call(m, [&] { return m.model->actuator_states(); });
+    size_t width = 4;
+    for (CORBA::ULong i = 0; i < info->length(); ++i)
+      width = std::max(width, std::strlen(info[i].name));
+    const int w = static_cast<int>(width + 2);
+    std::cout << std::left << std::setw(w) << "NAME" << std::setw(18) << "KIND" << std::setw(w)
+              << "TENDON" << std::setw(18) << "COMMAND"
+              << "TENSION [N]\n";
+    for (CORBA::ULong i = 0; i < info->length() && i < states->length(); ++i)
+      std::cout << std::setw(w) << info[i].name.in() << std::setw(18) << info[i].kind.in()
+                << std::setw(w) << info[i].tendon.in() << std::setw(18)
+                << (Num(states[i].command) + " " + info[i].command_unit.in())
+                << Num(states[i].tension) << "\n";
+    return 0;
+  }
+  const std::string actuator = args[0];
+  Call(m, [&] { m.model->set_command(actuator.c_str(), value); });
+  std::string unit;
+  for (CORBA::ULong i = 0; i < info->length(); ++i)
+    if (actuator == info[i].name.in()) unit = info[i].command_unit.in();
+  std::cout << actuator << " command = " << Num(value) << (unit.empty() ? "" : " " + unit) << "\n";
+  return 0;
+}
+
+// ------------------------------------------------------------------------ record
+
+/// Receives the subscription's batches (on ORB threads) and hands them to the recording.
+class CsvConsumer : public virtual POA_Caliper::Daq::DataConsumer {
+ public:
+  explicit CsvConsumer(CsvRecording* recording) : recording_(recording) {}
+
+  void on_samples(const D::SampleBatch& batch) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (closed_) return;
+    ++batches;
+    for (CORBA::ULong i = 0; i < batch.stale_ids.length(); ++i)
+      stale.insert(batch.stale_ids[i].in());
+    const size_t width = batch.values_per_sample;
+    size_t count = batch.times.length();
+    if (width > 0 && batch.data.length() < count * width) count = batch.data.length() / width;
+    recording_->Add(batch.batch, batch.times.get_buffer(), count, batch.data.get_buffer(), width);
+  }
+
+  /// No batch reaches the recording after this.
+  void Close() {
+    std::lock_guard<std::mutex> lock(mutex);
+    closed_ = true;
+  }
+
+  std::mutex mutex;  // guards the recording and the fields below
+  uint64_t batches = 0;
+  std::set<std::string> stale;
+
+ private:
+  CsvRecording* recording_;
+  bool closed_ = false;
+};
+
+/// `recording:  45% (t = 0.450 of 1 s), 45 samples`; a complete recording shows 100 %.
+std::string Progress(const CsvRecording& r, double start, double duration) {
+  const double t = std::isnan(r.last_time()) ? start : r.last_time();
+  std::ostringstream s;
+  s << std::fixed;
+  if (std::isfinite(duration)) {
+    const bool complete = r.done() && r.error().empty();
+    const double share = complete ? 1.0 : std::clamp((t - start) / duration, 0.0, 1.0);
+    s << "recording: " << std::setprecision(0) << std::setw(3) << 100 * share
+      << "% (t = " << std::setprecision(3) << t - start << " of " << Num(duration) << " s), "
+      << r.samples() << " samples";
+  } else {
+    s << "recording: t = " << std::setprecision(3) << t - start << " s, " << r.samples()
+      << " samples (Ctrl-C ends)";
+  }
+  return s.str();
+}
+
+int Record(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  std::string value, csv_path;
+  CORBA::ULong every = 1;
+  double duration = std::numeric_limits<double>::infinity();
+  if (TakeOption(args, "--every", &value)) every = ParseCount(value, "--every");
+  if (TakeOption(args, "--duration", &value)) {
+    duration = ParseNumber(value, "--duration");
+    if (!(duration > 0) || !std::isfinite(duration))
+      throw UsageError("--duration wants seconds of simulated time > 0, got '" + value + "'");
+  }
+  if (!TakeOption(args, "--csv", &csv_path)) throw UsageError("--csv FILE is required");
+  RejectOptions(args);
+  if (args.empty()) throw UsageError("expected at least one ID");
+
+  ModelRef m = Connect(client, name);
+  const S::StringSeq ids = ToSeq(args);
+  // shapes (and an unknown id, named by the Model) from one sample; units from the list
+  D::ValueSeq_var now = Call(m, [&] { return m.model->get(ids); });
+  const auto channels = Channels(m, "*");
+  std::vector<RecordedChannel> columns;
+  for (CORBA::ULong i = 0; i < now->length() && i < args.size(); ++i)
+    columns.push_back({args[i], UnitOf(channels, args[i]), now[i].rows, now[i].cols});
+  M::SimulationStatus_var status = StatusOf(m);
+  const double start = status->sim_time;
+
+  std::ofstream file(csv_path);
+  if (!file) throw Failure("cannot write " + csv_path + ": " + std::strerror(errno));
+  CsvRecording recording(file, columns, start + duration);
+
+  // the consumer lives in this process's RootPOA; the Model calls it from its sender thread
+  PortableServer::POA_var poa = client.RootPoa();
+  auto* consumer = new CsvConsumer(&recording);
+  PortableServer::ServantBase_var owner = consumer;
+  PortableServer::ObjectId_var oid = poa->activate_object(consumer);
+  CORBA::Object_var ref = poa->id_to_reference(oid);
+  D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(ref);
+  const CORBA::ULongLong subscription =
+      Call(m, [&] { return m.model->subscribe(ids, every, consumer_ref); });
+
+  std::cerr << "recording " << args.size() << " id" << (args.size() == 1 ? "" : "s") << " ("
+            << recording.values_per_sample() << " columns) every " << every << " step"
+            << (every == 1 ? "" : "s") << " (" << Num(every * status->time_step) << " s) "
+            << (std::isfinite(duration) ? "for " + Num(duration) + " s of simulated time"
+                                        : "until Ctrl-C")
+            << " to " << csv_path << "\n";
+  if (status->state != M::RUNNING)
+    std::cerr << name << " is " << StateName(status->state)
+              << ": samples come once it runs (caliper-ctl start) or steps\n";
+
+  // Ctrl-C and SIGTERM are blocked in every thread (Main) and taken here
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  using Clock = std::chrono::steady_clock;
+  auto last_progress = Clock::now() - std::chrono::seconds(1);
+  auto last_check = Clock::now();
+  std::string shown, lost, interrupted;
+  while (true) {
+    {
+      std::lock_guard<std::mutex> lock(consumer->mutex);
+      if (recording.done()) break;
+    }
+    const timespec wait = {0, 100 * 1000 * 1000};
+    const int sig = sigtimedwait(&signals, nullptr, &wait);
+    if (sig == SIGINT || sig == SIGTERM) {
+      interrupted = sig == SIGINT ? "interrupted (Ctrl-C)" : "terminated (SIGTERM)";
+      break;
+    }
+    const auto t = Clock::now();
+    if (t - last_progress >= std::chrono::milliseconds(250)) {
+      std::lock_guard<std::mutex> lock(consumer->mutex);
+      const std::string text = Progress(recording, start, duration);
+      if (text != shown) std::cerr << "\r" << text << std::flush;
+      shown = text;
+      last_progress = t;
+    }
+    if (t - last_check >= std::chrono::seconds(1)) {
+      // a Model that went away sends nothing more: say so instead of waiting forever
+      try {
+        M::SimulationStatus_var alive = m.model->status();
+      } catch (const CORBA::SystemException& e) {
+        lost = Client::Unreachable(m.path, e);
+        break;
+      }
+      last_check = t;
+    }
+  }
+  consumer->Close();
+  try {
+    m.model->unsubscribe(subscription);
+  } catch (const CORBA::Exception&) {
+    // gone already: it sends nothing more either way
+  }
+  poa->deactivate_object(oid);
+  file.flush();
+  const bool written = static_cast<bool>(file);
+  file.close();
+
+  std::lock_guard<std::mutex> lock(consumer->mutex);
+  std::cerr << "\r" << Progress(recording, start, duration) << "\n";
+  if (!interrupted.empty()) std::cerr << interrupted << "\n";
+  std::cout << "wrote " << recording.samples() << " samples";
+  if (recording.samples() > 0)
+    std::cout << " (t = " << Num(recording.first_time(), 10) << " .. "
+              << Num(recording.last_time(), 10) << " s)";
+  std::cout << " to " << csv_path << "\n";
+  if (recording.missing_batches() == 0)
+    std::cout << "no gaps: " << consumer->batches << " batch"
+              << (consumer->batches == 1 ? "" : "es") << ", numbered without a break\n";
+  else
+    std::cout << "gaps: " << recording.missing_batches() << " batches never arrived (numbers "
+              << recording.gaps() << "); the samples they held are missing from the file\n";
+  if (!consumer->stale.empty()) {
+    std::cerr << "warning: ids no longer in the Model (a scene was loaded; their values are nan):";
+    for (const auto& id : consumer->stale) std::cerr << " " << id;
+    std::cerr << "\n";
+  }
+  if (!written) throw Failure("write error on " + csv_path);
+  if (!lost.empty()) throw Failure(lost);
+  if (!recording.error().empty()) throw Failure(recording.error());
+  return 0;
+}
+
+}  // namespace
+
+void AddModelVerbs(std::map<std::string, Verb>* verbs) {
+  const std::string on = "  The Model is model0, or --model NAME.\n";
+  auto add = [&](const std::string& name, const std::string& usage, const std::string& summary,
+                 std::function<int(Client&, std::vector<std::string>&)> run,
+                 const std::string& details, bool takes_interrupt = false) {
+    Verb verb{usage, summary, std::move(run), "model", details + on};
+    verb.takes_interrupt = takes_interrupt;
+    (*verbs)[name] = verb;
+  };
+  add("load", "load FILE [--model NAME]", "load a COLLADA scene into a Model", Load,
+      "  On failure the Model keeps (and runs) the scene it had, and the importer's message\n"
+      "  (file, line, element, problem) is printed. FILE is sent as an absolute path.\n");
+  for (const std::string v : {"start", "pause", "stop"}) {
+    const std::string summary = v == "start"   ? "run the simulation (at the real-time factor)"
+                                : v == "pause" ? "pause the simulation"
+                                               : "pause and rewind to the loaded state";
+    add(
+        v, v + " [--model NAME]", summary,
+        [v](Client& c, std::vector<std::string>& a) { return Control(c, a, v); }, "");
+  }
+  const Verb lifecycle = (*verbs)["reset"];
+  add(
+      "reset", "reset NAME | reset [--model NAME]",
+      "reset a component in ERROR; without NAME, rewind a Model keeping its run state",
+      [lifecycle](Client& c, std::vector<std::string>& a) {
+        std::vector<std::string> probe = a;
+        std::string model;
+        const bool has_model = TakeOption(probe, "--model", &model);
+        RejectOptions(probe);
+        if (!probe.empty() && has_model)
+          throw UsageError("give NAME (a component's lifecycle) or --model NAME, not both");
+        if (!probe.empty()) return lifecycle.run(c, a);
+        return Control(c, a, "reset");
+      },
+      "  reset NAME: in NAME's execution context, from ERROR back to INACTIVE (any component).\n"
+      "  reset [--model NAME]: rewinds the Model's simulation to the loaded state; a running\n"
+      "  simulation keeps running.\n");
+  (*verbs)["reset"].group = "components";
+  add("step", "step N [--model NAME]", "run N steps now (while not running), then pause", Step,
+      "  Returns when the N steps are done and prints the simulated time they advanced.\n"
+      "  Exits 1 when the simulation faults on the way.\n");
+  add("status", "status [--model NAME]",
+      "a Model's state, scene, simulated time, steps, time step, real-time factor, last error",
+      Status, "");
+  add("params", "params [PATTERN] [--model NAME]",
+      "list a Model's parameters and states: id, unit, shape, rw/ro, static/dynamic, value", Params,
+      "  PATTERN is a glob (* and ?); without one it matches the ids that contain it.\n"
+      "  VALUE is the current value of scalars.\n");
+  add("get", "get ID... [--model NAME]", "print values with their units", Get,
+      "  Vectors print on one line, matrices row by row.\n");
+  add("set", "set ID VALUE... [--model NAME]",
+      "write a parameter (as many values as its shape, row-major)", Set,
+      "  Applied at the next step boundary while running, at once otherwise. Read-only ids,\n"
+      "  NaN or infinite values and values the engine refuses fail with the reason.\n");
+  add("motor", "motor [NAME VALUE] [--model NAME]",
+      "set an actuator's command; without arguments list actuators, commands and tensions", Motor,
+      "  VALUE is in the actuator's command unit (V for dc_motor_tendon).\n");
+  add("record", "record ID... --csv FILE [--every N] [--duration T] [--model NAME]",
+      "stream ids to a CSV file with units, for T s of simulated time or until Ctrl-C", Record,
+      "  Subscribes to the Model's data acquisition: one sample every N steps (1), one column\n"
+      "  per scalar element (`time [s],arm.hand.position[0] [m],...`). Progress goes to stderr;\n"
+      "  at the end it reports the samples written and any gaps in batch numbers.\n",
+      true);
+  add("save", "save FILE [--model NAME]", "export the scene with its current parameters as COLLADA",
+      Save, "  FILE is written by the Model's process (sent as an absolute path).\n");
+}
+
+}  // namespace caliper::ctl
