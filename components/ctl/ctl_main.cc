@@ -67,7 +67,7 @@ int List(Client& client, std::vector<std::string>& args) {
   if (!args.empty()) throw UsageError("ls takes no arguments");
   CosNaming::NamingContext_var root = client.Root();
   const auto entries = rtc::ListComponents(root);
-  std::cout << std::left << std::setw(14) << "NAME" << std::setw(12) << "STATE" << std::setw(10)
+  std::cout << std::left << std::setw(17) << "NAME" << std::setw(12) << "STATE" << std::setw(15)
             << "TYPE" << std::setw(8) << "PID" << "PATH\n";
   for (const auto& e : entries) {
     std::string state = "UNREACHABLE", type = "-", pid = "-";
@@ -84,7 +84,7 @@ int List(Client& client, std::vector<std::string>& args) {
     } catch (const CORBA::Exception&) {
     } catch (const Failure&) {
     }
-    std::cout << std::setw(14) << e.instance << std::setw(12) << state << std::setw(10) << type
+    std::cout << std::setw(17) << e.instance << std::setw(12) << state << std::setw(15) << type
               << std::setw(8) << pid << e.path << "\n";
   }
   if (entries.empty()) std::cout << "(no components bound in " << client.address() << ")\n";

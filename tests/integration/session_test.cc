@@ -78,8 +78,8 @@ TEST_F(SessionTest, CtlListsComponentsAndDrivesTheLifecycle) {
 
   const auto ls = Ctl(naming_->address(), {"ls"});
   EXPECT_EQ(ls.exit_code, 0);
-  EXPECT_NE(ls.out.find("logger0       ACTIVE"), std::string::npos) << ls.out;
-  EXPECT_NE(ls.out.find("sample0       INACTIVE"), std::string::npos) << ls.out;
+  EXPECT_NE(ls.out.find("logger0          ACTIVE"), std::string::npos) << ls.out;
+  EXPECT_NE(ls.out.find("sample0          INACTIVE"), std::string::npos) << ls.out;
   EXPECT_NE(ls.out.find(".host_cxt/sample0.rtc"), std::string::npos) << ls.out;
 
   EXPECT_EQ(Ctl(naming_->address(), {"activate", "sample0"}).exit_code, 0);
