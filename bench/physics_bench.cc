@@ -76,7 +76,7 @@ double TimeMuJoCo(const TreeOptions& tree) {
       [&] {
         if (d) mj_deleteData(d);
         d = mj_makeData(m);
-        for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 5.0;
+        for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 1.0;  // [N]
       },
       [&] { mj_step(m, d); });
   mj_deleteData(d);
@@ -94,6 +94,7 @@ void Ratio(const char* name, double value, double target) {
 }  // namespace caliper::bench
 
 int main(int argc, char** argv) {
+  using namespace caliper;
   using namespace caliper::bench;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);
@@ -114,6 +115,22 @@ int main(int argc, char** argv) {
   std::printf("# step time [us]: Caliper %.1f, raw Bullet with 80 springs %.1f (floor + self contact)\n",
               caliper_contact, raw_contact);
   Ratio("caliper_vs_raw_bullet", caliper_contact / raw_contact, 1.15);
+
+  // like for like with the baseline's plain springs: passive tendons, no tendon-body contact
+  TreeOptions springs = contact;
+  springs.actuator_kind = "ligament";
+  std::unique_ptr<sgal::PhysicsScene> plain;
+  sgal::Scene plain_description = MakeTree(springs);
+  for (auto& a : plain_description.actuators) a.parameters["stiffness"] = 2000;
+  physics_bullet::Options no_contact;
+  no_contact.tendon_body_contact = false;
+  const double caliper_springs = Time(
+      [&] { plain = physics_bullet::MakeScene(plain_description, no_contact); },
+      [&] { plain->Step(); });
+  std::printf("# step time [us]: Caliper with 80 passive tendons and no tendon contact %.1f "
+              "(information: the cost of the DC motors and of tendon contact is the rest)\n",
+              caliper_springs);
+  Ratio("caliper_passive_tendons_vs_raw_bullet", caliper_springs / raw_contact, 1.15);
 
   const double mujoco_contact = TimeMuJoCo(contact);
   std::printf("# step time [us]: MuJoCo 2.2.2 %.1f (floor + self contact)\n", mujoco_contact);
