@@ -1,0 +1,265 @@
+#include "main_window.h"
+
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QPushButton>
+#include <QSpinBox>
+#include <QStatusBar>
+#include <QTimer>
+#include <QTreeWidget>
+#include <QVBoxLayout>
+#include <algorithm>
+
+namespace caliper::main_window {
+
+namespace {
+
+constexpr int kIdRole = Qt::UserRole;
+constexpr int kErrorShowMs = 8000;
+
+QPushButton* Button(const QString& text, const char* name, QWidget* parent) {
+  auto* b = new QPushButton(text, parent);
+  b->setObjectName(name);
+  return b;
+}
+
+QString Number(double v) { return QString::number(v, 'g', 7); }
+
+}  // namespace
+
+MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidget* parent)
+    : QMainWindow(parent), link_(std::move(link)) {
+  setWindowTitle("Caliper");
+  auto* central = new QWidget(this);
+  auto* layout = new QVBoxLayout(central);
+
+  // simulation controls
+  auto* controls = new QHBoxLayout;
+  open_ = Button("Open model...", "open", central);
+  start_ = Button("Start", "start", central);
+  pause_ = Button("Pause", "pause", central);
+  step_ = Button("Step", "step", central);
+  step_count_ = new QSpinBox(central);
+  step_count_->setObjectName("step_count");
+  step_count_->setRange(1, 1000000);
+  step_count_->setValue(1);
+  step_count_->setToolTip("steps per Step");
+  stop_ = Button("Stop", "stop", central);
+  reset_ = Button("Reset", "reset", central);
+  time_step_ = new QDoubleSpinBox(central);
+  time_step_->setObjectName("time_step");
+  time_step_->setDecimals(6);
+  time_step_->setRange(1e-6, 1.0);
+  time_step_->setSingleStep(0.0005);
+  time_step_->setValue(0.001);
+  time_step_->setSuffix(" s");
+  real_time_factor_ = new QDoubleSpinBox(central);
+  real_time_factor_->setObjectName("real_time_factor");
+  real_time_factor_->setDecimals(2);
+  real_time_factor_->setRange(0.0, 1000.0);
+  real_time_factor_->setSingleStep(0.1);
+  real_time_factor_->setValue(1.0);
+  real_time_factor_->setSpecialValueText("max");
+  real_time_factor_->setToolTip("real-time factor: 1 real time, 0 as fast as possible");
+  for (QWidget* w : {static_cast<QWidget*>(open_), static_cast<QWidget*>(start_),
+                     static_cast<QWidget*>(pause_), static_cast<QWidget*>(step_),
+                     static_cast<QWidget*>(step_count_), static_cast<QWidget*>(stop_),
+                     static_cast<QWidget*>(reset_)})
+    controls->addWidget(w);
+  controls->addSpacing(12);
+  controls->addWidget(new QLabel("Time step", central));
+  controls->addWidget(time_step_);
+  controls->addWidget(new QLabel("Real-time factor", central));
+  controls->addWidget(real_time_factor_);
+  controls->addStretch();
+  layout->addLayout(controls);
+
+  no_model_ = new QLabel(central);
+  no_model_->setObjectName("no_model");
+  no_model_->setStyleSheet("QLabel { color: #b00020; font-weight: bold; }");
+  no_model_->setWordWrap(true);
+  layout->addWidget(no_model_);
+
+  // parameter browser
+  tree_ = new QTreeWidget(central);
+  tree_->setObjectName("parameters");
+  tree_->setColumnCount(3);
+  tree_->setHeaderLabels({"Parameter", "Value", "Unit"});
+  tree_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  tree_->header()->setSectionResizeMode(0, QHeaderView::Stretch);
+  tree_->setColumnWidth(1, 160);
+  tree_->header()->setStretchLastSection(false);
+  tree_->setColumnWidth(2, 90);
+  layout->addWidget(tree_);
+  setCentralWidget(central);
+
+  // status bar
+  state_ = new QLabel(this);
+  state_->setObjectName("state");
+  sim_time_ = new QLabel(this);
+  sim_time_->setObjectName("sim_time");
+  steps_ = new QLabel(this);
+  steps_->setObjectName("steps");
+  achieved_ = new QLabel(this);
+  achieved_->setObjectName("achieved_rtf");
+  for (QLabel* l : {state_, sim_time_, steps_, achieved_}) statusBar()->addPermanentWidget(l);
+
+  connect(open_, &QPushButton::clicked, this, [this] { OpenModelFile(); });
+  connect(start_, &QPushButton::clicked, this, [this] { link_->Start(); });
+  connect(pause_, &QPushButton::clicked, this, [this] { link_->Pause(); });
+  connect(step_, &QPushButton::clicked, this,
+          [this] { link_->Step(static_cast<unsigned>(step_count_->value())); });
+  connect(stop_, &QPushButton::clicked, this, [this] { link_->Stop(); });
+  connect(reset_, &QPushButton::clicked, this, [this] { link_->Reset(); });
+  connect(time_step_, &QDoubleSpinBox::editingFinished, this,
+          [this] { link_->SetTimeStep(time_step_->value()); });
+  connect(real_time_factor_, &QDoubleSpinBox::editingFinished, this,
+          [this] { link_->SetRealTimeFactor(real_time_factor_->value()); });
+  connect(tree_, &QTreeWidget::itemDoubleClicked, this, [this](QTreeWidgetItem* item, int column) {
+    if (column == 1 && (item->flags() & Qt::ItemIsEditable)) tree_->editItem(item, 1);
+  });
+  connect(tree_, &QTreeWidget::itemChanged, this,
+          [this](QTreeWidgetItem* item, int column) { OnItemChanged(item, column); });
+
+  timer_ = new QTimer(this);
+  connect(timer_, &QTimer::timeout, this, [this] { Refresh(); });
+  timer_->start(static_cast<int>(1000.0 / std::max(refresh_hz, 0.1)));
+  resize(980, 640);
+  Refresh();
+}
+
+MainWindow::~MainWindow() = default;
+
+void MainWindow::OpenModelFile() {
+  const QString path = QFileDialog::getOpenFileName(this, "Open model", QString(),
+                                                    "COLLADA (*.dae);;All files (*)");
+  if (path.isEmpty()) return;
+  link_->LoadScene(path.toStdString());
+  statusBar()->showMessage("loading " + path + " ...", kErrorShowMs);
+}
+
+void MainWindow::ShowError(const QString& message) {
+  statusBar()->showMessage(message, kErrorShowMs);
+}
+
+QTreeWidgetItem* MainWindow::ItemOf(const std::string& id) const {
+  const auto it = items_.find(id);
+  return it == items_.end() ? nullptr : it->second;
+}
+
+void MainWindow::Refresh() {
+  const Snapshot s = link_->snapshot();
+  if (s.error_serial != error_serial_) {
+    error_serial_ = s.error_serial;
+    ShowError(QString::fromStdString(s.last_error));
+  }
+
+  no_model_->setVisible(!s.connected);
+  for (QWidget* w : {static_cast<QWidget*>(start_), static_cast<QWidget*>(pause_),
+                     static_cast<QWidget*>(step_), static_cast<QWidget*>(stop_),
+                     static_cast<QWidget*>(reset_), static_cast<QWidget*>(open_)})
+    w->setEnabled(s.connected);
+  if (!s.connected) {
+    const QString why = QString::fromStdString(s.connection_message);
+    no_model_->setText(why);
+    state_->setText("no Model");
+    sim_time_->clear();
+    steps_->clear();
+    achieved_->clear();
+    if (statusBar()->currentMessage().isEmpty()) statusBar()->showMessage(why, 1000);
+    return;
+  }
+
+  const ModelStatus& st = s.status;
+  state_->setText(QString::fromStdString(st.state));
+  sim_time_->setText(QString("t = %1 s").arg(st.sim_time, 0, 'f', 3));
+  steps_->setText(QString("%1 steps").arg(static_cast<qulonglong>(st.steps)));
+  achieved_->setText(QString("RTF %1").arg(st.achieved_real_time_factor, 0, 'f', 2));
+  if (!st.last_error.empty()) state_->setToolTip(QString::fromStdString(st.last_error));
+  if (!time_step_->hasFocus() && st.time_step > 0) time_step_->setValue(st.time_step);
+  if (!real_time_factor_->hasFocus()) real_time_factor_->setValue(st.real_time_factor);
+
+  if (s.channels_version != channels_version_) {
+    channels_version_ = s.channels_version;
+    BuildTree(s);
+  }
+
+  // live values of the scalars in expanded groups; those are the ones watched next
+  updating_ = true;
+  std::vector<std::string> visible;
+  for (const auto& [id, item] : items_) {
+    bool shown = true;
+    for (QTreeWidgetItem* p = item->parent(); p != nullptr; p = p->parent())
+      shown = shown && p->isExpanded();
+    if (!shown || item->data(1, kIdRole + 1).toBool() == false) continue;  // not a scalar
+    visible.push_back(id);
+    const auto v = s.values.find(id);
+    if (v != s.values.end() && !tree_->isPersistentEditorOpen(item, 1))
+      item->setText(1, Number(v->second));
+  }
+  updating_ = false;
+  link_->Watch(std::move(visible));
+}
+
+void MainWindow::BuildTree(const Snapshot& s) {
+  updating_ = true;
+  tree_->clear();
+  items_.clear();
+  std::map<std::string, QTreeWidgetItem*> groups;  // dotted prefix -> its row
+  for (const Channel& c : s.channels) {
+    QTreeWidgetItem* parent = nullptr;
+    std::string prefix;
+    size_t start = 0;
+    for (size_t dot = c.id.find('.'); dot != std::string::npos; dot = c.id.find('.', start)) {
+      const std::string part = c.id.substr(start, dot - start);
+      prefix = c.id.substr(0, dot);
+      QTreeWidgetItem*& g = groups[prefix];
+      if (g == nullptr) {
+        g = parent == nullptr ? new QTreeWidgetItem(tree_) : new QTreeWidgetItem(parent);
+        g->setText(0, QString::fromStdString(part));
+        g->setFlags(Qt::ItemIsEnabled);
+      }
+      parent = g;
+      start = dot + 1;
+    }
+    auto* item = parent == nullptr ? new QTreeWidgetItem(tree_) : new QTreeWidgetItem(parent);
+    item->setText(0, QString::fromStdString(c.id.substr(start)));
+    item->setData(0, kIdRole, QString::fromStdString(c.id));
+    item->setData(1, kIdRole + 1, c.scalar());
+    item->setText(2, QString::fromStdString(c.unit));
+    item->setToolTip(0, QString::fromStdString(c.id + (c.description.empty() ? "" : ": ") +
+                                               c.description));
+    if (!c.scalar()) item->setText(1, QString("%1x%2").arg(c.rows).arg(c.cols));
+    Qt::ItemFlags flags = Qt::ItemIsEnabled | Qt::ItemIsSelectable;
+    if (c.writable && c.scalar()) {
+      flags |= Qt::ItemIsEditable;
+      item->setToolTip(1, "double-click to edit");
+    } else {
+      item->setForeground(1, QBrush(Qt::darkGray));
+    }
+    item->setFlags(flags);
+    items_[c.id] = item;
+  }
+  tree_->expandAll();
+  updating_ = false;
+}
+
+void MainWindow::OnItemChanged(QTreeWidgetItem* item, int column) {
+  if (updating_ || column != 1) return;
+  const std::string id = item->data(0, kIdRole).toString().toStdString();
+  if (id.empty()) return;
+  bool ok = false;
+  const double value = item->text(1).trimmed().toDouble(&ok);
+  if (!ok) {
+    ShowError(QString("%1: '%2' is not a number").arg(QString::fromStdString(id), item->text(1)));
+    return;  // the next refresh shows the Model's value again
+  }
+  link_->Set(id, value);
+  statusBar()->showMessage(QString("set %1 = %2").arg(QString::fromStdString(id), Number(value)),
+                           3000);
+}
+
+}  // namespace caliper::main_window

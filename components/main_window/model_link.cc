@@ -1,0 +1,259 @@
+#include "model_link.h"
+
+#include <chrono>
+#include <utility>
+
+#include "caliper/model.hh"
+#include "caliper/rtc/naming.h"
+
+namespace caliper::main_window {
+
+namespace M = ::Caliper::Simulation;
+namespace D = ::Caliper::Daq;
+namespace S = ::Caliper::Scene;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const char* StateName(M::SimulationState s) {
+  switch (s) {
+    case M::EMPTY: return "EMPTY";
+    case M::STOPPED: return "STOPPED";
+    case M::RUNNING: return "RUNNING";
+    case M::PAUSED: return "PAUSED";
+    case M::FAULTED: return "FAULTED";
+  }
+  return "?";
+}
+
+CORBA::ORB_ptr ProcessOrb() {
+  int argc = 0;
+  char* argv[] = {nullptr};
+  return CORBA::ORB_init(argc, argv);
+}
+
+}  // namespace
+
+/// The worker's CORBA state; touched by the worker thread only.
+struct ModelLink::Impl {
+  CORBA::ORB_var orb;
+  M::Model_var model;
+  std::string scene;              // the scene the channel list belongs to
+  bool channels_listed = false;
+  Clock::time_point last_lookup{};
+};
+
+ModelLink::ModelLink(Options options) : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
+  impl_->orb = ProcessOrb();
+  snapshot_.connection_message = "no Model: looking for " + options_.instance + " ...";
+  worker_ = std::thread([this] { Run(); });
+}
+
+ModelLink::~ModelLink() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+}
+
+Snapshot ModelLink::snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return snapshot_;
+}
+
+void ModelLink::Queue(std::string what, std::function<void(Impl&)> call) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.emplace_back(std::move(what), std::move(call));
+  }
+  wake_.notify_all();
+}
+
+void ModelLink::LoadScene(const std::string& path) {
+  const int long_ms = options_.long_call_timeout_ms;
+  Queue("load " + path, [path, long_ms](Impl& i) {
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
+    i.model->load_scene(path.c_str());
+    i.channels_listed = false;
+  });
+}
+void ModelLink::Start() { Queue("start", [](Impl& i) { i.model->start(); }); }
+void ModelLink::Pause() { Queue("pause", [](Impl& i) { i.model->pause(); }); }
+void ModelLink::Stop() { Queue("stop", [](Impl& i) { i.model->stop(); }); }
+void ModelLink::Reset() { Queue("reset", [](Impl& i) { i.model->reset(); }); }
+void ModelLink::Step(unsigned n) {
+  const int long_ms = options_.long_call_timeout_ms;
+  Queue("step " + std::to_string(n), [n, long_ms](Impl& i) {
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
+    i.model->step(n);
+  });
+}
+void ModelLink::SetTimeStep(double seconds) {
+  Queue("set the time step", [seconds](Impl& i) { i.model->set_time_step(seconds); });
+}
+void ModelLink::SetRealTimeFactor(double factor) {
+  Queue("set the real-time factor", [factor](Impl& i) { i.model->set_real_time_factor(factor); });
+}
+void ModelLink::Set(const std::string& id, double value) {
+  Queue("set " + id, [id, value](Impl& i) {
+    D::Value v;
+    v.rows = 1;
+    v.cols = 1;
+    v.data.length(1);
+    v.data[0] = value;
+    i.model->set(id.c_str(), v);
+  });
+}
+
+void ModelLink::Watch(std::vector<std::string> ids) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  watched_ = std::move(ids);
+}
+
+void ModelLink::Run() {
+  // per-thread call timeouts need an omni_thread
+  omni_thread* self = omni_thread::create_dummy();
+  Impl& i = *impl_;
+  const auto short_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
+  omniORB::setClientConnectTimeout(short_ms);
+  const auto period = std::chrono::milliseconds(options_.poll_period_ms);
+  auto next_poll = Clock::now();
+
+  // drops the Model after a system exception: it is looked up again
+  auto lost = [&](const std::string& why) {
+    i.model = M::Model::_nil();
+    i.channels_listed = false;
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.connected = false;
+    snapshot_.connection_message = "no Model reachable: " + why;
+  };
+
+  for (;;) {
+    std::deque<std::pair<std::string, std::function<void(Impl&)>>> commands;
+    std::vector<std::string> watched;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait_until(lock, next_poll, [&] { return stopping_ || !queue_.empty(); });
+      if (stopping_) break;
+      commands.swap(queue_);
+      watched = watched_;
+    }
+
+    for (auto& [what, call] : commands) {
+      std::string error;
+      if (CORBA::is_nil(i.model)) {
+        error = what + ": no Model reachable";
+      } else {
+        try {
+          omniORB::setClientThreadCallTimeout(short_ms);
+          call(i);
+        } catch (const D::UnknownId& e) {
+          error = what + ": " + e.reason.in();
+        } catch (const D::InvalidParameter& e) {
+          error = what + ": " + e.reason.in();
+        } catch (const M::NotAvailable& e) {
+          error = what + ": " + e.reason.in();
+        } catch (const M::LoadFailed& e) {
+          error = what + ": " + e.reason.in();
+        } catch (const CORBA::SystemException& e) {
+          error = what + ": " + rtc::Describe(e);
+          lost(rtc::Describe(e));
+        } catch (const CORBA::Exception& e) {
+          error = what + ": " + rtc::Describe(e);
+        }
+      }
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++snapshot_.commands_done;
+      if (!error.empty()) {
+        snapshot_.last_error = error;
+        ++snapshot_.error_serial;
+      }
+    }
+
+    if (Clock::now() < next_poll) continue;
+    next_poll = Clock::now() + period;
+    omniORB::setClientThreadCallTimeout(short_ms);
+
+    // look the Model up (not more often than the reconnect period)
+    if (CORBA::is_nil(i.model)) {
+      if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
+        continue;
+      i.last_lookup = Clock::now();
+      try {
+        CosNaming::NamingContext_var root =
+            rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
+        M::Model_var model =
+            M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+        if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
+        i.model = model;
+      } catch (const CORBA::Exception& e) {
+        lost(rtc::Describe(e));
+        continue;
+      } catch (const std::exception& e) {
+        lost(e.what());
+        continue;
+      }
+    }
+
+    try {
+      M::SimulationStatus_var s = i.model->status();
+      ModelStatus status;
+      status.state = StateName(s->state);
+      status.scene = s->scene.in();
+      status.sim_time = s->sim_time;
+      status.steps = s->steps;
+      status.time_step = s->time_step;
+      status.real_time_factor = s->real_time_factor;
+      status.achieved_real_time_factor = s->achieved_real_time_factor;
+      status.last_error = s->last_error.in();
+
+      std::vector<Channel> channels;
+      const bool relist = !i.channels_listed || status.scene != i.scene;
+      if (relist) {
+        D::ChannelInfoSeq_var infos = i.model->list("*");
+        for (CORBA::ULong k = 0; k < infos->length(); ++k) {
+          const D::ChannelInfo& c = infos[k];
+          channels.push_back(Channel{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.writable),
+                                     bool(c.is_static), c.description.in()});
+        }
+        i.channels_listed = true;
+        i.scene = status.scene;
+      }
+
+      std::map<std::string, double> values;
+      if (!watched.empty() && !relist) {
+        S::StringSeq ids;
+        ids.length(static_cast<CORBA::ULong>(watched.size()));
+        for (CORBA::ULong k = 0; k < ids.length(); ++k) ids[k] = watched[k].c_str();
+        try {
+          D::ValueSeq_var got = i.model->get(ids);
+          for (CORBA::ULong k = 0; k < got->length() && k < ids.length(); ++k)
+            if (got[k].data.length() == 1) values[watched[k]] = got[k].data[0];
+        } catch (const D::UnknownId&) {
+          i.channels_listed = false;  // the scene changed under us: list again
+        }
+      }
+
+      std::lock_guard<std::mutex> lock(mutex_);
+      snapshot_.connected = true;
+      snapshot_.connection_message.clear();
+      snapshot_.status = status;
+      if (relist) {
+        snapshot_.channels = std::move(channels);
+        ++snapshot_.channels_version;
+        snapshot_.values.clear();
+      }
+      for (auto& [id, v] : values) snapshot_.values[id] = v;
+    } catch (const CORBA::SystemException& e) {
+      lost(rtc::Describe(e));
+    } catch (const CORBA::Exception& e) {
+      lost(rtc::Describe(e));
+    }
+  }
+  i.model = M::Model::_nil();
+  if (self != nullptr) omni_thread::release_dummy();
+}
+
+}  // namespace caliper::main_window

@@ -1,0 +1,107 @@
+#pragma once
+// The Main Window's connection to the Model: a worker thread that finds `model0` in the naming
+// service, polls its status and the watched parameter values, and runs the queued commands. The
+// GUI only reads snapshots and queues commands, so a dead or slow Model never blocks it. No Qt
+// here; CORBA stays in the .cc file.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace caliper::main_window {
+
+/// The Model's SimulationStatus, without CORBA.
+struct ModelStatus {
+  std::string state;                       ///< EMPTY, STOPPED, RUNNING, PAUSED, FAULTED
+  std::string scene;                       ///< file of the loaded scene
+  double sim_time = 0;                     ///< simulated time [s]
+  std::uint64_t steps = 0;                 ///< steps since the scene was loaded or reset
+  double time_step = 0;                    ///< [s]
+  double real_time_factor = 0;             ///< requested: 1 real time, 0 as fast as possible
+  double achieved_real_time_factor = 0;    ///< measured over the last second
+  std::string last_error;                  ///< why the simulation last stopped, if it did
+};
+
+/// One of the Model's parameter or state channels.
+struct Channel {
+  std::string id;           ///< e.g. pendulum_tendon.pendulum.mass
+  std::string unit;         ///< SI unit, "" for none
+  unsigned rows = 1;        ///< shape of the value
+  unsigned cols = 1;
+  bool writable = false;
+  bool is_static = false;   ///< a parameter (true) or a state changing every step (false)
+  std::string description;
+  bool scalar() const { return rows == 1 && cols == 1; }
+};
+
+/// What the GUI reads: a copy of everything the worker last learnt.
+struct Snapshot {
+  bool connected = false;
+  std::string connection_message;          ///< why no Model is reachable (when not connected)
+  ModelStatus status;
+  std::uint64_t channels_version = 0;      ///< changes whenever `channels` is listed anew
+  std::vector<Channel> channels;
+  std::map<std::string, double> values;    ///< latest values of the watched scalar ids
+  std::string last_error;                  ///< the latest failed command's message
+  std::uint64_t error_serial = 0;          ///< counts failed commands
+  std::uint64_t commands_done = 0;         ///< counts finished commands (failed or not)
+};
+
+/// The worker and its command queue. Every method returns at once.
+class ModelLink {
+ public:
+  struct Options {
+    std::string nameservice;          ///< corbaname::HOST:PORT; "" for the default
+    std::string instance = "model0";  ///< the Model's instance name
+    int call_timeout_ms = 1500;       ///< every short call (status, list, get, set, start, ...)
+    int long_call_timeout_ms = 120000;  ///< load_scene and step, which take as long as their work
+    int poll_period_ms = 200;         ///< status and values
+    int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
+  };
+
+  /// Uses the process's ORB (initialises one when there is none) and starts the worker.
+  explicit ModelLink(Options options);
+  ~ModelLink();
+  ModelLink(const ModelLink&) = delete;
+  ModelLink& operator=(const ModelLink&) = delete;
+
+  Snapshot snapshot() const;
+
+  void LoadScene(const std::string& path);
+  void Start();
+  void Pause();
+  void Stop();
+  void Reset();
+  void Step(unsigned n);
+  void SetTimeStep(double seconds);
+  void SetRealTimeFactor(double factor);
+  /// Writes a scalar parameter.
+  void Set(const std::string& id, double value);
+  /// The scalar ids whose values are polled (e.g. the visible rows).
+  void Watch(std::vector<std::string> ids);
+
+  struct Impl;
+
+ private:
+  void Queue(std::string what, std::function<void(Impl&)> call);
+  void Run();
+
+  std::unique_ptr<Impl> impl_;
+  Options options_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::deque<std::pair<std::string, std::function<void(Impl&)>>> queue_;
+  std::vector<std::string> watched_;
+  Snapshot snapshot_;
+  std::thread worker_;
+};
+
+}  // namespace caliper::main_window

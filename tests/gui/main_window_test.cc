@@ -1,0 +1,217 @@
+// The Main Window in the test process against a real caliper-model: Start advances the simulated
+// time shown, editing a parameter in the tree changes the Model's value over CORBA, and with no
+// Model in reach the window says so and stays responsive. Widgets run on QT_QPA_PLATFORM=offscreen.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <QApplication>
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QLineEdit>
+#include <QHeaderView>
+#include <QPushButton>
+#include <QStatusBar>
+#include <QTest>
+#include <QTreeWidget>
+#include <chrono>
+#include <cstdlib>
+
+#include "caliper/model.hh"
+#include "caliper/rtc/naming.h"
+#include "main_window.h"
+#include "model_link.h"
+#include "support/process.h"
+
+namespace caliper::testing {
+namespace {
+
+using std::chrono::seconds;
+namespace M = ::Caliper::Simulation;
+namespace D = ::Caliper::Daq;
+namespace S = ::Caliper::Scene;
+using main_window::MainWindow;
+using main_window::ModelLink;
+
+constexpr const char* kMassId = "pendulum_tendon.pendulum.mass";
+
+QApplication& App() {
+  static int argc = 1;
+  static char name[] = "main_window_test";
+  static char* argv[] = {name, nullptr};
+  if (std::getenv("QT_QPA_PLATFORM") == nullptr) qputenv("QT_QPA_PLATFORM", "offscreen");
+  static QApplication app(argc, argv);
+  return app;
+}
+
+CORBA::ORB_ptr Orb() {
+  static CORBA::ORB_ptr orb = [] {
+    int argc = 3;
+    const char* args[] = {"main_window_test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+    return CORBA::ORB_init(argc, const_cast<char**>(args));
+  }();
+  return orb;
+}
+
+/// Processes events until `condition` holds or `timeout` passes.
+bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+  QElapsedTimer t;
+  t.start();
+  while (t.elapsed() < timeout.count()) {
+    QApplication::processEvents(QEventLoop::AllEvents, 50);
+    if (condition()) return true;
+    QTest::qWait(50);
+  }
+  return condition();
+}
+
+std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {
+  const char* dir = std::getenv("CALIPER_ARTIFACT_DIR");
+  return (dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir) + "/" + name;
+}
+
+double SimTimeShown(MainWindow& w) {
+  const QString text = w.findChild<QLabel*>("sim_time")->text();  // "t = 1.234 s"
+  const QStringList parts = text.split(' ');
+  return parts.size() >= 3 ? parts[2].toDouble() : -1.0;
+}
+
+class MainWindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    App();
+    Orb();
+    naming_ = std::make_unique<NamingService>(dir_.path());
+  }
+
+  std::unique_ptr<Process> StartModel() {
+    const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
+    return std::make_unique<Process>(
+        std::vector<std::string>{Bin("caliper-model"), "-o",
+                                 "model.scene=" + models + "/pendulum_tendon.dae", "-o",
+                                 "exec.auto_activate=true", "--nameservice", naming_->address(),
+                                 "-o", "log.service=none", "-o",
+                                 "log.spool_dir=" + dir_.path() + "/spool"},
+        dir_.path() + "/model.out");
+  }
+
+  M::Model_var WaitForModel() {
+    M::Model_var model;
+    WaitFor(
+        [&] {
+          try {
+            CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming_->address());
+            model = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
+            return !CORBA::is_nil(model) && !model->_non_existent();
+          } catch (...) {
+            return false;
+          }
+        },
+        seconds(20));
+    return model;
+  }
+
+  std::unique_ptr<MainWindow> Window(const std::string& nameservice) {
+    ModelLink::Options options;
+    options.nameservice = nameservice;
+    options.reconnect_period_ms = 300;
+    auto w = std::make_unique<MainWindow>(std::make_unique<ModelLink>(options), 10.0);
+    w->show();
+    return w;
+  }
+
+  TempDir dir_;
+  std::unique_ptr<NamingService> naming_;
+};
+
+TEST_F(MainWindowTest, StartAdvancesTheSimulatedTimeAndEditingAParameterReachesTheModel) {
+  auto process = StartModel();
+  M::Model_var model = WaitForModel();
+  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
+
+  auto w = Window(naming_->address());
+  ASSERT_TRUE(WaitInGui([&] { return w->ItemOf(kMassId) != nullptr; }, seconds(10)))
+      << "the parameter tree is filled from the Model";
+  EXPECT_FALSE(w->findChild<QLabel*>("no_model")->isVisible());
+  const double t0 = SimTimeShown(*w);
+  EXPECT_GE(t0, 0.0);
+
+  // Start: the simulated time shown advances
+  QTest::mouseClick(w->findChild<QPushButton*>("start"), Qt::LeftButton);
+  ASSERT_TRUE(WaitInGui([&] { return SimTimeShown(*w) > t0 + 0.2; }, seconds(10)))
+      << "shown: " << w->findChild<QLabel*>("sim_time")->text().toStdString();
+  EXPECT_EQ(w->findChild<QLabel*>("state")->text().toStdString(), "RUNNING");
+
+  // edit the pendulum's mass in place: double-click its value, type, Enter
+  // (the Model keeps single-precision values: compare to 1e-6)
+  auto* tree = w->findChild<QTreeWidget*>("parameters");
+  QTreeWidgetItem* mass = w->ItemOf(kMassId);
+  tree->scrollToItem(mass);
+  QApplication::processEvents();
+  const QRect cell = tree->visualItemRect(mass).intersected(
+      QRect(tree->header()->sectionPosition(1), 0, tree->header()->sectionSize(1), 100000));
+  QTest::mouseClick(tree->viewport(), Qt::LeftButton, Qt::NoModifier, cell.center());
+  QTest::mouseDClick(tree->viewport(), Qt::LeftButton, Qt::NoModifier, cell.center());
+  auto* editor = tree->viewport()->findChild<QLineEdit*>();
+  ASSERT_NE(editor, nullptr) << "double-clicking a writable value opens an editor";
+  editor->selectAll();
+  QTest::keyClicks(editor, "0.9");
+  QTest::keyClick(editor, Qt::Key_Return);
+
+  auto mass_in_model = [&] {
+    S::StringSeq ids;
+    ids.length(1);
+    ids[0] = kMassId;
+    D::ValueSeq_var v = model->get(ids);
+    return v[0].data[0];
+  };
+  ASSERT_TRUE(WaitInGui([&] { return std::abs(mass_in_model() - 0.9) < 1e-6; }, seconds(5)))
+      << "the Model's mass is " << mass_in_model();
+  EXPECT_TRUE(WaitInGui([&] { return mass->text(1) == "0.9"; }, seconds(3)))
+      << "the tree shows " << mass->text(1).toStdString();
+
+
+  WaitInGui([] { return false; }, std::chrono::milliseconds(600));
+  const std::string png = ArtifactPath("main_window.png", dir_.path());
+  EXPECT_TRUE(w->grab().save(QString::fromStdString(png))) << png;
+
+  QTest::mouseClick(w->findChild<QPushButton*>("pause"), Qt::LeftButton);
+  EXPECT_TRUE(WaitInGui([&] { return model->status()->state == M::PAUSED; }, seconds(5)));
+  w.reset();
+  process->Signal(SIGTERM);
+  EXPECT_EQ(process->Wait(seconds(10)), 0) << process->Output();
+}
+
+TEST_F(MainWindowTest, SaysSoAndStaysResponsiveWithNoModelInReach) {
+  // a naming service without a Model, then an address where nothing listens
+  for (const std::string& address :
+       {naming_->address(), "corbaname::127.0.0.1:" + std::to_string(FreePort())}) {
+    SCOPED_TRACE(address);
+    auto w = Window(address);
+    auto* label = w->findChild<QLabel*>("no_model");
+    ASSERT_TRUE(WaitInGui([&] { return label->isVisible() && label->text().contains("no Model"); },
+                          seconds(5)))
+        << label->text().toStdString();
+    EXPECT_FALSE(w->findChild<QPushButton*>("start")->isEnabled());
+
+    // the event loop keeps turning: no event waits long for several seconds of lookups
+    QElapsedTimer t;
+    t.start();
+    qint64 longest = 0;
+    while (t.elapsed() < 3000) {
+      QElapsedTimer one;
+      one.start();
+      QApplication::processEvents(QEventLoop::AllEvents, 20);
+      longest = std::max(longest, one.elapsed());
+      QTest::qWait(20);
+    }
+    EXPECT_LT(longest, 300) << "the GUI thread was blocked for " << longest << " ms";
+    EXPECT_EQ(w->findChild<QLabel*>("state")->text().toStdString(), "no Model");
+    QElapsedTimer closing;
+    closing.start();
+    w.reset();
+    EXPECT_LT(closing.elapsed(), 3000) << "closing does not hang on the dead peer";
+  }
+}
+
+}  // namespace
+}  // namespace caliper::testing
