@@ -9,8 +9,6 @@ namespace caliper::renderer {
 namespace S = ::Caliper::Scene;
 namespace R = render_coin;
 
-namespace {
-
 R::Pose FromIdl(const S::Frame& f) {
   R::Pose p;
   p.p[0] = f.px;
@@ -22,6 +20,8 @@ R::Pose FromIdl(const S::Frame& f) {
   p.q[3] = f.qz;
   return p;
 }
+
+namespace {
 
 R::ShapeKind FromIdl(S::ShapeKind kind) {
   switch (kind) {
@@ -77,6 +77,17 @@ R::SceneDescription FromIdl(const S::Description& scene) {
     mesh.triangles = ToVector<S::IndexSeq, uint32_t>(scene.meshes[m].triangles);
     mesh.normals = ToVector<S::FloatSeq, float>(scene.meshes[m].normals);
     out.meshes.push_back(std::move(mesh));
+  }
+  for (CORBA::ULong c = 0; c < scene.constraints.length(); ++c) {
+    const S::Constraint& in = scene.constraints[c];
+    R::Constraint constraint;
+    constraint.name = in.name.in();
+    constraint.kind = in.kind.in();
+    constraint.body_a = in.body_a.in();
+    constraint.body_b = in.body_b.in();
+    constraint.frame_a = FromIdl(in.frame_a);
+    constraint.frame_b = FromIdl(in.frame_b);
+    out.constraints.push_back(std::move(constraint));
   }
   for (CORBA::ULong o = 0; o < scene.obstacles.length(); ++o) {
     const S::Obstacle& in = scene.obstacles[o];

@@ -20,6 +20,8 @@ class ObserverServant : public virtual POA_Caliper::Scene::SceneObserver {
   SceneMailbox& mailbox_;
 };
 
+/// The plain mirror of an IDL frame.
+render_coin::Pose FromIdl(const Caliper::Scene::Frame& frame);
 /// The plain mirror of an IDL scene description.
 render_coin::SceneDescription FromIdl(const Caliper::Scene::Description& scene);
 

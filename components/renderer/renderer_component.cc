@@ -17,6 +17,8 @@ std::vector<core::ConfigKey> RendererComponent::ConfigKeys() {
       {"renderer.max_fps", Type::kDouble, "30", "largest frame rate of the view [Hz]", 1, 240},
       {"renderer.width", Type::kInt, "1024", "screenshot width [px]", 16, 8192},
       {"renderer.height", Type::kInt, "768", "screenshot height [px]", 16, 8192},
+      {"renderer.show_constraint_axes", Type::kBool, "false",
+       "draw the hinge and slider axes of the constraints"},
   };
 }
 
@@ -29,6 +31,7 @@ rtc::ReturnCode RendererComponent::OnInitialize() {
   settings.max_fps = c.GetDouble("renderer.max_fps");
   settings.width = static_cast<int>(c.GetInt("renderer.width"));
   settings.height = static_cast<int>(c.GetInt("renderer.height"));
+  settings.show_constraint_axes = c.GetBool("renderer.show_constraint_axes");
   mailbox_.SetSettings(settings);
   CORBA::Object_var obj = runtime_.Activate(new ObserverServant(mailbox_));
   observer_ = S::SceneObserver::_narrow(obj);

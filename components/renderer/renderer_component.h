@@ -8,6 +8,7 @@
 //   renderer.check_interval   how often the registration is checked [s]
 //   renderer.max_fps          largest frame rate of the view [Hz]
 //   renderer.width, renderer.height   size of screenshots [px]
+//   renderer.show_constraint_axes     draw the hinge and slider axes (false; also over CORBA)
 
 #include <chrono>
 #include <string>

@@ -9,7 +9,11 @@
 #include <QApplication>
 #include <QTimer>
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
+#include <future>
+#include <memory>
+#include <stdexcept>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -21,6 +25,7 @@
 #include "caliper/render_coin/viewer.h"
 #include "caliper/rtc/rtobject_servant.h"
 #include "renderer_component.h"
+#include "renderer_servant.h"
 
 namespace {
 
@@ -75,6 +80,62 @@ bool Apply(renderer::SceneMailbox& mailbox, render_coin::SceneGraph& graph, bool
   return true;
 }
 
+// frames a newly built scene once: through the viewer (its window's aspect) or the graph alone
+void FrameIfNew(render_coin::SceneGraph& graph, render_coin::Viewer* viewer, bool* framed,
+                double aspect) {
+  if (*framed || graph.body_count() == 0) return;
+  if (viewer != nullptr)
+    viewer->ViewAll();
+  else
+    graph.ViewAll(aspect);
+  *framed = true;
+}
+
+// the control interface's work, on the GUI thread
+class GuiControl : public renderer::ViewControl {
+ public:
+  GuiControl(renderer::SceneMailbox& mailbox, render_coin::SceneGraph& graph, bool* framed)
+      : mailbox_(mailbox), graph_(graph), framed_(framed) {}
+  void set_viewer(render_coin::Viewer* viewer) { viewer_ = viewer; }
+
+  void ViewAll() override {
+    Apply(mailbox_, graph_, framed_);
+    if (viewer_ != nullptr)
+      viewer_->ViewAll();
+    else
+      graph_.ViewAll(4.0 / 3.0);
+    *framed_ = graph_.body_count() > 0;
+  }
+  void SetCamera(const render_coin::CameraPose& camera) override {
+    Apply(mailbox_, graph_, framed_);
+    FrameIfNew(graph_, viewer_, framed_, 4.0 / 3.0);  // a later frame must not move it again
+    graph_.SetCamera(camera);
+  }
+  void Screenshot(const std::string& path, int width, int height) override {
+    Apply(mailbox_, graph_, framed_);
+    if (graph_.body_count() == 0) throw std::runtime_error("no scene received from the Model yet");
+    FrameIfNew(graph_, viewer_, framed_, static_cast<double>(width) / height);
+    if (!offscreen_) offscreen_ = std::make_unique<render_coin::OffscreenRenderer>();
+    offscreen_->SavePng(graph_, path, width, height, /*view_all=*/false);
+    const render_coin::CameraPose c = graph_.camera_pose();
+    logging::Get("renderer").info(
+        "screenshot %s (%dx%d), camera at %.2f %.2f %.2f looking at %.2f %.2f %.2f", path.c_str(),
+        width, height, c.position[0], c.position[1], c.position[2], c.look_at[0], c.look_at[1],
+        c.look_at[2]);
+  }
+  void ShowConstraintAxes(bool on) override {
+    graph_.SetConstraintAxesVisible(on);
+    logging::Get("renderer").info("constraint axes %s", on ? "shown" : "hidden");
+  }
+
+ private:
+  renderer::SceneMailbox& mailbox_;
+  render_coin::SceneGraph& graph_;
+  bool* framed_;
+  render_coin::Viewer* viewer_ = nullptr;
+  std::unique_ptr<render_coin::OffscreenRenderer> offscreen_;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,6 +159,36 @@ int main(int argc, char** argv) {
   if (options.screenshot.empty()) top_level = render_coin::InitializeViewer(argc, argv, "caliper-renderer");
   render_coin::SceneGraph graph;
   renderer::SceneMailbox mailbox;
+  bool framed = false;
+  GuiControl control(mailbox, graph, &framed);
+  // runs a function on the GUI thread and waits; a call the GUI drops (it ended) or never gets to
+  // is reported, never waited for forever
+  renderer::GuiCall gui_call = [&app](std::function<void()> what) -> std::string {
+    std::promise<std::string> done;
+    std::future<std::string> result = done.get_future();
+    const bool queued = QMetaObject::invokeMethod(
+        &app,
+        [what = std::move(what), done = std::make_shared<std::promise<std::string>>(
+                                     std::move(done))] {
+          try {
+            what();
+            done->set_value("");
+          } catch (const std::exception& e) {
+            done->set_value(e.what());
+          } catch (...) {
+            done->set_value("unknown error");
+          }
+        },
+        Qt::QueuedConnection);
+    if (!queued) return "the renderer's GUI has ended";
+    if (result.wait_for(std::chrono::seconds(30)) != std::future_status::ready)
+      return "the renderer's GUI does not answer";
+    try {
+      return result.get();
+    } catch (const std::future_error&) {
+      return "the renderer's GUI has ended";
+    }
+  };
 
   // the component runtime; when it ends (signal, exit(), bad arguments), the GUI ends too
   std::atomic<int> rtc_exit{0};
@@ -113,33 +204,34 @@ int main(int argc, char** argv) {
     rtc_exit = rtc::RunComponent(
         rest_argc, options.rest.data(), type,
         [&](rtc::Runtime& rt) { return std::make_unique<renderer::RendererComponent>(rt, mailbox); },
-        [](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
-          return new rtc::DataFlowServant(rt);
+        [&](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
+          return new renderer::RendererServant(rt, control, gui_call);
         });
     QMetaObject::invokeMethod(&app, "quit", Qt::QueuedConnection);
   });
   auto request_exit = [] { kill(getpid(), SIGTERM); };
 
-  bool framed = false;
   std::unique_ptr<render_coin::Viewer> viewer;
   if (top_level != nullptr) viewer = std::make_unique<render_coin::Viewer>(top_level, graph);
+  control.set_viewer(viewer.get());
 
   // at most max_fps: apply what arrived; the viewer redraws when the graph changed
   QTimer frame_timer;
   QObject::connect(&frame_timer, &QTimer::timeout, [&] {
     const int interval = static_cast<int>(1000.0 / mailbox.settings().max_fps);
     if (frame_timer.interval() != interval) frame_timer.setInterval(interval);
+    if (mailbox.TakeSettingsChanged())
+      graph.SetConstraintAxesVisible(mailbox.settings().show_constraint_axes);
     if (!Apply(mailbox, graph, &framed)) return;
-    if (!framed && graph.body_count() > 0) {
-      if (viewer) viewer->ViewAll();
-      framed = true;
-    }
+    if (viewer) FrameIfNew(graph, viewer.get(), &framed, 1.0);
   });
   frame_timer.start(33);
 
   int screenshot_exit = 0;
   if (!options.screenshot.empty()) {
     QTimer::singleShot(static_cast<int>(options.after * 1000), [&] {
+      if (mailbox.TakeSettingsChanged())
+        graph.SetConstraintAxesVisible(mailbox.settings().show_constraint_axes);
       Apply(mailbox, graph, &framed);
       auto& log = logging::Get("renderer");
       try {

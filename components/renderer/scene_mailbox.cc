@@ -5,6 +5,14 @@ namespace caliper::renderer {
 void SceneMailbox::SetSettings(const ViewSettings& settings) {
   std::lock_guard<std::mutex> lock(mutex_);
   settings_ = settings;
+  settings_changed_ = true;
+}
+
+bool SceneMailbox::TakeSettingsChanged() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool changed = settings_changed_;
+  settings_changed_ = false;
+  return changed;
 }
 
 ViewSettings SceneMailbox::settings() const {

@@ -31,6 +31,7 @@ struct ViewSettings {
   double max_fps = 30;  // [Hz]
   int width = 1024;     // screenshot size [px]
   int height = 768;
+  bool show_constraint_axes = false;  // as configured; show_constraint_axes() overrides it
 };
 
 /// Thread-safe; any number of producers, one consumer.
@@ -38,6 +39,8 @@ class SceneMailbox {
  public:
   void SetSettings(const ViewSettings& settings);
   ViewSettings settings() const;
+  /// True once after each SetSettings(): the GUI applies what it takes over from them.
+  bool TakeSettingsChanged();
   /// A new scene replaces whatever was pending.
   void PutScene(render_coin::SceneDescription scene);
   void PutCleared();
@@ -53,6 +56,7 @@ class SceneMailbox {
  private:
   mutable std::mutex mutex_;
   ViewSettings settings_;
+  bool settings_changed_ = false;
   bool cleared_ = false;
   std::unique_ptr<render_coin::SceneDescription> scene_;
   std::map<uint32_t, render_coin::Pose> poses_;

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "caliper/model.hh"
+#include "caliper/renderer.hh"
 #include "caliper/rtc/naming.h"
 #include "support/process.h"
 
@@ -70,6 +71,13 @@ class Renderer : public ::testing::Test {
                                      std::to_string(after), "-o", "renderer.check_interval=0.2"};
     args.insert(args.end(), common_.begin(), common_.end());
     return std::make_unique<Process>(args, dir_.path() + "/renderer.out");
+  }
+
+  // the interactive viewer window (no --screenshot), controlled over CORBA
+  std::unique_ptr<Process> StartViewer() {
+    std::vector<std::string> args = {Bin("caliper-renderer"), "-o", "renderer.check_interval=0.2"};
+    args.insert(args.end(), common_.begin(), common_.end());
+    return std::make_unique<Process>(args, dir_.path() + "/viewer.out");
   }
 
   M::Model_var WaitForModel(CORBA::ORB_ptr orb) {
@@ -152,6 +160,89 @@ TEST_F(Renderer, ObservesARestartedModelAgain) {
   QImage image;
   ASSERT_TRUE(image.load(QString::fromStdString(png)));
   EXPECT_GT(Count(image).arm, 2000) << "the new Model's scene is drawn";
+  model->Signal(SIGTERM);
+  EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
+  orb->destroy();
+}
+
+TEST_F(Renderer, TakesScreenshotsAndShowsConstraintAxesOverCorba) {
+  namespace V = ::Caliper::Viewer;
+  auto model = StartModel("model.out");
+  int argc = 3;
+  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
+  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
+  ASSERT_FALSE(CORBA::is_nil(WaitForModel(orb))) << model->Output();
+  auto viewer = StartViewer();
+
+  V::Renderer_var renderer;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, naming_->address());
+          renderer = V::Renderer::_narrow(rtc::FindComponent(root, "renderer0").object);
+          return !CORBA::is_nil(renderer) && !renderer->_non_existent();
+        } catch (...) {
+          return false;
+        }
+      },
+      seconds(20)))
+      << viewer->Output();
+
+  // the first screenshot succeeds once the Model's scene has arrived
+  const std::string plain = ArtifactPath("renderer_corba.png", dir_.path());
+  const std::string axes = ArtifactPath("renderer_corba_axes.png", dir_.path());
+  std::remove(plain.c_str());
+  std::remove(axes.c_str());
+  std::string last_reason;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        try {
+          renderer->screenshot(plain.c_str(), 640, 480);
+          return true;
+        } catch (const V::NotAvailable& e) {
+          last_reason = e.reason.in();
+          return false;
+        }
+      },
+      seconds(20)))
+      << last_reason << "\n"
+      << viewer->Output();
+  QImage first;
+  ASSERT_TRUE(first.load(QString::fromStdString(plain))) << "no readable PNG at " << plain;
+  EXPECT_EQ(first.width(), 640);
+  EXPECT_EQ(first.height(), 480);
+  const PixelCounts n = Count(first);
+  EXPECT_LT(n.background, 640 * 480 * 2 / 3 * 95 / 100) << "an empty frame";
+  EXPECT_GT(n.arm, 500) << "the arm is drawn\n" << viewer->Output();
+
+  renderer->show_constraint_axes(true);
+  renderer->screenshot(axes.c_str(), 640, 480);
+  QImage second;
+  ASSERT_TRUE(second.load(QString::fromStdString(axes))) << "no readable PNG at " << axes;
+  ASSERT_EQ(second.size(), first.size());
+  int differing = 0;
+  for (int y = 0; y < first.height(); ++y)
+    for (int x = 0; x < first.width(); ++x)
+      if (first.pixel(x, y) != second.pixel(x, y)) ++differing;
+  EXPECT_GT(differing, 100) << "the constraint axes are drawn";
+
+  // the camera can be put anywhere; bad angles are refused
+  Caliper::Scene::Frame pose{1.5, -1.5, 1.0, 1, 0, 0, 0};
+  EXPECT_THROW(renderer->set_camera(pose, 0.0), V::NotAvailable);
+  EXPECT_NO_THROW(renderer->set_camera(pose, 0.8));
+  EXPECT_NO_THROW(renderer->view_all());
+
+  try {
+    renderer->screenshot("/nonexistent-dir/cannot/shot.png", 640, 480);
+    ADD_FAILURE() << "a screenshot to an unwritable path succeeded";
+  } catch (const V::NotAvailable& e) {
+    EXPECT_NE(std::string(e.reason.in()).find("/nonexistent-dir/cannot/shot.png"), std::string::npos)
+        << e.reason.in();
+  }
+  EXPECT_TRUE(viewer->Running()) << viewer->Output();
+
+  viewer->Signal(SIGTERM);
+  EXPECT_EQ(viewer->Wait(seconds(10)), 0) << viewer->Output();
   model->Signal(SIGTERM);
   EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
   orb->destroy();

@@ -46,6 +46,7 @@ QImage OffscreenRenderer::RenderToImage(SceneGraph& scene, int width, int height
   if (!impl_->context.makeCurrent(&impl_->surface))
     throw std::runtime_error("cannot make the offscreen OpenGL context current");
   if (view_all) scene.ViewAll(static_cast<double>(width) / height);
+  scene.FitClippingPlanes();
 
   QOpenGLFramebufferObjectFormat fbo_format;
   fbo_format.setAttachment(QOpenGLFramebufferObject::CombinedDepthStencil);

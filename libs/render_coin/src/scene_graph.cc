@@ -25,6 +25,7 @@
 #include <Inventor/nodes/SoSeparator.h>
 #include <Inventor/nodes/SoShapeHints.h>
 #include <Inventor/nodes/SoSphere.h>
+#include <Inventor/nodes/SoSwitch.h>
 #include <Inventor/nodes/SoText2.h>
 #include <Inventor/nodes/SoTransform.h>
 #include <Inventor/nodes/SoTranslation.h>
@@ -44,6 +45,8 @@ constexpr double kGridSpacing = 0.1;   // [m]
 constexpr double kAxisLength = 0.2;    // [m]
 constexpr float kTendonWidth = 3.0f;   // [px]
 constexpr float kObstacleTransparency = 0.65f;
+constexpr double kJointAxisLength = 0.12;  // [m], centred on the joint
+constexpr float kJointAxisWidth = 4.0f;     // [px]
 
 void SetTransform(SoTransform* t, const Pose& pose) {
   t->translation.setValue(static_cast<float>(pose.p[0]), static_cast<float>(pose.p[1]),
@@ -246,6 +249,41 @@ SoSeparator* AxesNode() {
   return sep;
 }
 
+// a constraint's axis: a line along z of `frame` (in the body frame), unlit, with a dot at the joint
+SoSeparator* JointAxisNode(const Constraint& c) {
+  auto* sep = new SoSeparator;
+  auto* t = new SoTransform;
+  SetTransform(t, c.frame_a);
+  sep->addChild(t);
+  auto* model = new SoLightModel;
+  model->model = SoLightModel::BASE_COLOR;
+  sep->addChild(model);
+  auto* style = new SoDrawStyle;
+  style->lineWidth = kJointAxisWidth;
+  style->pointSize = 2 * kJointAxisWidth;
+  sep->addChild(style);
+  auto* color = new SoBaseColor;
+  if (c.kind == "slider")
+    color->rgb.setValue(1.0f, 0.55f, 0.0f);
+  else
+    color->rgb.setValue(0.0f, 1.0f, 1.0f);
+  sep->addChild(color);
+  auto* coords = new SoCoordinate3;
+  const float h = static_cast<float>(kJointAxisLength / 2);
+  coords->point.set1Value(0, 0, 0, -h);
+  coords->point.set1Value(1, 0, 0, h);
+  coords->point.set1Value(2, 0, 0, 0);
+  sep->addChild(coords);
+  auto* line = new SoLineSet;
+  line->numVertices.setValue(2);
+  sep->addChild(line);
+  auto* dot = new SoPointSet;
+  dot->startIndex = 2;
+  dot->numPoints = 1;
+  sep->addChild(dot);
+  return sep;
+}
+
 }  // namespace
 
 void InitializeCoin() {
@@ -259,6 +297,8 @@ struct SceneGraph::Impl {
   SoSeparator* tendons = nullptr;    // style, then one separator per tendon
   SoText2* legend = nullptr;
   SoBaseColor* legend_low = nullptr;
+  std::vector<SoSwitch*> joint_axes;  // one per hinge or slider, under its body_a
+  bool joint_axes_visible = false;
   std::vector<SoTransform*> body_transforms;
   std::vector<Pose> body_poses;
   std::vector<SoSeparator*> tendon_nodes;
@@ -319,6 +359,7 @@ void SceneGraph::Clear() {
   Impl& m = *impl_;
   m.bodies->removeAllChildren();
   m.tendons->removeAllChildren();
+  m.joint_axes.clear();
   m.body_transforms.clear();
   m.body_poses.clear();
   m.tendon_nodes.clear();
@@ -357,6 +398,16 @@ void SceneGraph::Build(const SceneDescription& scene) {
     m.body_transforms.push_back(t);
     m.body_poses.push_back(body.pose);
     by_name[body.name] = sep;
+  }
+  for (const Constraint& c : scene.constraints) {
+    if (c.kind != "hinge" && c.kind != "slider") continue;
+    const auto it = by_name.find(c.body_a);
+    if (it == by_name.end()) continue;
+    auto* sw = new SoSwitch;
+    sw->addChild(JointAxisNode(c));
+    sw->whichChild = m.joint_axes_visible ? 0 : SO_SWITCH_NONE;
+    it->second->addChild(sw);
+    m.joint_axes.push_back(sw);
   }
   for (const Obstacle& o : scene.obstacles) {
     const auto it = by_name.find(o.body);
@@ -426,6 +477,14 @@ void SceneGraph::SetTendons(const std::vector<TendonState>& tendons) {
   if (rescaled) m.legend->string = legend_text().c_str();
 }
 
+void SceneGraph::SetConstraintAxesVisible(bool on) {
+  Impl& m = *impl_;
+  m.joint_axes_visible = on;
+  for (SoSwitch* sw : m.joint_axes) sw->whichChild = on ? 0 : SO_SWITCH_NONE;
+}
+bool SceneGraph::constraint_axes_visible() const { return impl_->joint_axes_visible; }
+size_t SceneGraph::constraint_axis_count() const { return impl_->joint_axes.size(); }
+
 size_t SceneGraph::body_count() const { return impl_->body_transforms.size(); }
 size_t SceneGraph::tendon_count() const { return impl_->tendon_nodes.size(); }
 Pose SceneGraph::body_pose(size_t index) const { return impl_->body_poses.at(index); }
@@ -459,10 +518,36 @@ bool SceneGraph::BodyBounds(std::array<double, 3>* min, std::array<double, 3>* m
 
 void SceneGraph::ViewAll(double aspect) {
   const int height = 1000;
+  // a window being laid out may report any size: keep the region within what SbViewportRegion holds
+  if (!(aspect > 0.1)) aspect = aspect > 0 ? 0.1 : 1.0;
+  aspect = std::min(aspect, 10.0);
   const int width = std::max(1, static_cast<int>(std::lround(height * aspect)));
   SoNode* what = impl_->body_transforms.empty() ? static_cast<SoNode*>(impl_->root->getChild(1))
                                                 : static_cast<SoNode*>(impl_->bodies);
   impl_->camera->viewAll(what, SbViewportRegion(static_cast<short>(width), height), 1.1f);
+}
+
+void SceneGraph::FitClippingPlanes() {
+  SoGetBoundingBoxAction action(SbViewportRegion(640, 480));
+  action.apply(impl_->root->getChild(1));  // the world: grid, axes, bodies, tendons
+  const SbBox3f box = action.getBoundingBox();
+  if (box.isEmpty()) return;
+  SoPerspectiveCamera* camera = impl_->camera;
+  SbVec3f direction;
+  camera->orientation.getValue().multVec(SbVec3f(0, 0, -1), direction);
+  const SbVec3f position = camera->position.getValue();
+  const SbVec3f lo = box.getMin(), hi = box.getMax();
+  float nearest = 1e30f, farthest = -1e30f;
+  for (int i = 0; i < 8; ++i) {
+    const SbVec3f corner(i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]);
+    const float d = (corner - position).dot(direction);
+    nearest = std::min(nearest, d);
+    farthest = std::max(farthest, d);
+  }
+  farthest = std::max(farthest * 1.05f, 0.01f);
+  nearest = std::max(nearest * 0.95f, farthest * 1e-4f);
+  camera->nearDistance = nearest;
+  camera->farDistance = farthest;
 }
 
 void SceneGraph::SetCamera(const CameraPose& c) {

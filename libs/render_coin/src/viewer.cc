@@ -28,7 +28,7 @@ Viewer::~Viewer() { delete impl_->viewer; }
 
 void Viewer::ViewAll() {
   const SbVec2s size = impl_->viewer->getViewportRegion().getWindowSize();
-  impl_->scene->ViewAll(size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0);
+  impl_->scene->ViewAll(size[0] > 0 && size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0);
 }
 
 void Viewer::Render() { impl_->viewer->render(); }

@@ -50,6 +50,33 @@ TEST(SceneGraph, BuildsOneEntryPerBodyAndTendon) {
   EXPECT_NEAR(max[2], 1.6, 1e-5);
 }
 
+TEST(SceneGraph, DrawsHingeAndSliderAxesOnlyWhenEnabled) {
+  SceneDescription scene = TwoBoxesAndATendon();
+  for (const char* kind : {"hinge", "slider", "ball"}) {
+    Constraint c;
+    c.name = kind;
+    c.kind = kind;
+    c.body_a = "b1";
+    c.body_b = "b0";
+    c.frame_a.p[0] = 0.5;  // reaches beyond the box: it widens the bounds once shown
+    scene.constraints.push_back(c);
+  }
+  SceneGraph graph;
+  EXPECT_FALSE(graph.constraint_axes_visible());
+  graph.Build(scene);
+  EXPECT_EQ(graph.constraint_axis_count(), 2u) << "hinge and slider, not the ball joint";
+  std::array<double, 3> min{}, max{};
+  ASSERT_TRUE(graph.BodyBounds(&min, &max));
+  EXPECT_NEAR(max[0], 0.1, 1e-5) << "hidden";
+  graph.SetConstraintAxesVisible(true);
+  ASSERT_TRUE(graph.BodyBounds(&min, &max));
+  EXPECT_NEAR(max[0], 0.5, 1e-5) << "shown on b1, at its joint frame";
+  graph.Build(scene);
+  EXPECT_TRUE(graph.constraint_axes_visible()) << "the setting outlives a rebuild";
+  ASSERT_TRUE(graph.BodyBounds(&min, &max));
+  EXPECT_NEAR(max[0], 0.5, 1e-5);
+}
+
 TEST(SceneGraph, MovesOnlyTheBodiesGiven) {
   SceneGraph graph;
   graph.Build(TwoBoxesAndATendon());

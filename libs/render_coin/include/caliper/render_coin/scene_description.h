@@ -55,6 +55,16 @@ struct Obstacle {
   double length = 0;   // [m]
 };
 
+/// A joint between two bodies; hinge and slider axes are drawn (SceneGraph::SetConstraintAxesVisible).
+struct Constraint {
+  std::string name;
+  std::string kind;    // hinge, slider, ball, fixed, generic_6dof
+  std::string body_a;  // the body the axis is drawn on and moves with
+  std::string body_b;  // "" for the world
+  Pose frame_a;        // in body_a's frame; the axis is z
+  Pose frame_b;        // in body_b's frame
+};
+
 struct Tendon {
   std::string name;
   double radius = 0;  // [m]
@@ -64,6 +74,7 @@ struct SceneDescription {
   std::string name;
   std::vector<Body> bodies;
   std::vector<Mesh> meshes;
+  std::vector<Constraint> constraints;
   std::vector<Obstacle> obstacles;
   std::vector<Tendon> tendons;
 };

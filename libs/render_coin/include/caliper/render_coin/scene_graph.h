@@ -38,6 +38,14 @@ class SceneGraph {
   /// Redraws the listed tendons through their points, coloured by tension on the current scale.
   void SetTendons(const std::vector<TendonState>& tendons);
 
+  /// Shows or hides the axes of the hinge (cyan) and slider (orange) constraints: a short line
+  /// along the z axis of frame_a on body_a, moving with the body. Hidden by default; the setting
+  /// outlives Build() and Clear().
+  void SetConstraintAxesVisible(bool on);
+  bool constraint_axes_visible() const;
+  /// Hinge and slider axes in the current scene (drawn or not).
+  size_t constraint_axis_count() const;
+
   size_t body_count() const;
   size_t tendon_count() const;
   /// World pose of a body as last set.
@@ -57,6 +65,9 @@ class SceneGraph {
   /// Frames all bodies, keeping the viewing direction; `aspect` = width / height.
   void ViewAll(double aspect);
   void SetCamera(const CameraPose& camera);
+  /// Sets the camera's near and far distances to enclose everything drawn (an interactive viewer
+  /// adjusts them only when it draws; offscreen renders call this).
+  void FitClippingPlanes();
   CameraPose camera_pose() const;
 
   /// What viewers show: the camera, the content and the legend (owned by this graph).
