@@ -1,6 +1,15 @@
 #include "main_window.h"
 
+#include <QCloseEvent>
+#include <QCoreApplication>
+#include <QDir>
+#include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMenuBar>
+#include <QProcess>
+#include <QSettings>
 #include <QFileDialog>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -30,7 +39,8 @@ QString Number(double v) { return QString::number(v, 'g', 7); }
 
 }  // namespace
 
-MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidget* parent)
+MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidget* parent,
+                       bool restore_tools)
     : QMainWindow(parent), link_(std::move(link)) {
   setWindowTitle("Caliper");
   auto* central = new QWidget(this);
@@ -81,7 +91,12 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   no_model_->setObjectName("no_model");
   no_model_->setStyleSheet("QLabel { color: #b00020; font-weight: bold; }");
   no_model_->setWordWrap(true);
-  layout->addWidget(no_model_);
+  start_model_ = Button("Start a Model", "start_model", central);
+  start_model_->setToolTip("start caliper-model with the last model file");
+  auto* no_model_row = new QHBoxLayout;
+  no_model_row->addWidget(no_model_, 1);
+  no_model_row->addWidget(start_model_);
+  layout->addLayout(no_model_row);
 
   // parameter browser
   tree_ = new QTreeWidget(central);
@@ -96,6 +111,42 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   layout->addWidget(tree_);
   setCentralWidget(central);
 
+  // components panel: everything in the naming service with its lifecycle state
+  auto* dock = new QDockWidget("Components", this);
+  dock->setObjectName("components_dock");
+  auto* panel = new QWidget(dock);
+  auto* panel_layout = new QVBoxLayout(panel);
+  components_ = new QTreeWidget(panel);
+  components_->setObjectName("components");
+  components_->setColumnCount(3);
+  components_->setHeaderLabels({"Component", "State", "Path"});
+  components_->setRootIsDecorated(false);
+  components_->setSelectionMode(QAbstractItemView::SingleSelection);
+  panel_layout->addWidget(components_);
+  auto* actions = new QHBoxLayout;
+  for (const char* verb : {"activate", "deactivate", "reset", "exit"}) {
+    QString label = QString(verb);
+    label[0] = label[0].toUpper();
+    auto* b = Button(label, (std::string("component_") + verb).c_str(), panel);
+    const std::string v = verb;
+    connect(b, &QPushButton::clicked, this, [this, v] { SelectedComponentAction(v); });
+    actions->addWidget(b);
+  }
+  panel_layout->addLayout(actions);
+  dock->setWidget(panel);
+  addDockWidget(Qt::BottomDockWidgetArea, dock);
+
+  // menus: tools as their own processes, and the panels
+  QMenu* tools = menuBar()->addMenu("&Tools");
+  QAction* renderer = tools->addAction("Scene &Renderer");
+  renderer->setObjectName("tool_renderer");
+  connect(renderer, &QAction::triggered, this, [this] { StartTool("renderer"); });
+  QAction* model = tools->addAction("Start a &Model...");
+  model->setObjectName("tool_model");
+  connect(model, &QAction::triggered, this, [this] { StartModel(); });
+  tools->addSeparator();
+  tools->addAction(dock->toggleViewAction());
+
   // status bar
   state_ = new QLabel(this);
   state_->setObjectName("state");
@@ -108,6 +159,7 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   for (QLabel* l : {state_, sim_time_, steps_, achieved_}) statusBar()->addPermanentWidget(l);
 
   connect(open_, &QPushButton::clicked, this, [this] { OpenModelFile(); });
+  connect(start_model_, &QPushButton::clicked, this, [this] { StartModel(); });
   connect(start_, &QPushButton::clicked, this, [this] { link_->Start(); });
   connect(pause_, &QPushButton::clicked, this, [this] { link_->Pause(); });
   connect(step_, &QPushButton::clicked, this,
@@ -127,11 +179,189 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   timer_ = new QTimer(this);
   connect(timer_, &QTimer::timeout, this, [this] { Refresh(); });
   timer_->start(static_cast<int>(1000.0 / std::max(refresh_hz, 0.1)));
-  resize(980, 640);
+  resize(1180, 760);
+  RestoreSettings(restore_tools);
   Refresh();
 }
 
-MainWindow::~MainWindow() = default;
+MainWindow::~MainWindow() {
+  timer_->stop();
+  // the tools and the Model started here end with the window
+  std::vector<QProcess*> processes;
+  for (auto& [name, p] : tools_) processes.push_back(p);
+  if (model_process_ != nullptr) processes.push_back(model_process_);
+  for (QProcess* p : processes) {
+    p->disconnect();
+    if (p->state() != QProcess::NotRunning) p->terminate();
+  }
+  for (QProcess* p : processes) {
+    if (p->state() != QProcess::NotRunning && !p->waitForFinished(5000)) {
+      p->kill();
+      p->waitForFinished(2000);
+    }
+  }
+  link_.reset();  // joins the worker
+}
+
+QString MainWindow::SettingsPath() {
+  const QByteArray env = qgetenv("CALIPER_MAIN_SETTINGS");
+  if (!env.isEmpty()) return QString::fromLocal8Bit(env);
+  return QSettings(QSettings::IniFormat, QSettings::UserScope, "caliper", "caliper-main")
+      .fileName();
+}
+
+void MainWindow::SaveSettings() {
+  QSettings st(SettingsPath(), QSettings::IniFormat);
+  st.setValue("window/geometry", geometry());
+  st.setValue("window/maximized", isMaximized());
+  st.setValue("window/state", saveState());
+  st.setValue("model/last", last_model_);
+  st.setValue("simulation/time_step", time_step_->value());
+  st.setValue("simulation/real_time_factor", real_time_factor_->value());
+  st.setValue("tools/open", OpenTools());
+  st.sync();
+}
+
+void MainWindow::RestoreSettings(bool restore_tools) {
+  QSettings st(SettingsPath(), QSettings::IniFormat);
+  const QRect rect = st.value("window/geometry").toRect();
+  if (rect.isValid()) setGeometry(rect);
+  if (st.value("window/maximized", false).toBool()) setWindowState(Qt::WindowMaximized);
+  restoreState(st.value("window/state").toByteArray());
+  last_model_ = st.value("model/last").toString();
+  saved_time_step_ = st.value("simulation/time_step", 0.0).toDouble();
+  saved_real_time_factor_ = st.value("simulation/real_time_factor", -1.0).toDouble();
+  if (saved_time_step_ > 0) time_step_->setValue(saved_time_step_);
+  if (saved_real_time_factor_ >= 0) real_time_factor_->setValue(saved_real_time_factor_);
+  if (restore_tools)
+    for (const QString& tool : st.value("tools/open").toStringList()) StartTool(tool);
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  SaveSettings();
+  QMainWindow::closeEvent(event);
+}
+
+QString MainWindow::BinPath(const QString& name) const {
+  // caliper-main's own directory; $CALIPER_BIN_DIR first when set (the tests run elsewhere)
+  const QByteArray env = qgetenv("CALIPER_BIN_DIR");
+  if (!env.isEmpty()) return QDir(QString::fromLocal8Bit(env)).filePath(name);
+  return QDir(QCoreApplication::applicationDirPath()).filePath(name);
+}
+
+QStringList MainWindow::NameserviceArgs() const {
+  const std::string& ns = link_->options().nameservice;
+  if (ns.empty()) return {};
+  return {"--nameservice", QString::fromStdString(ns)};
+}
+
+QStringList MainWindow::OpenTools() const {
+  QStringList open;
+  for (const auto& [name, p] : tools_)
+    if (p->state() != QProcess::NotRunning) open << name;
+  return open;
+}
+
+bool MainWindow::StartTool(const QString& name) {
+  const auto it = tools_.find(name);
+  if (it != tools_.end() && it->second->state() != QProcess::NotRunning) return true;
+  if (name != "renderer") {
+    ShowError("unknown tool " + name);
+    return false;
+  }
+  const QString program = BinPath("caliper-renderer");
+  if (!QFileInfo(program).isExecutable()) {
+    ShowError("no " + program);
+    return false;
+  }
+  if (it != tools_.end()) {
+    it->second->deleteLater();
+    tools_.erase(it);
+  }
+  auto* p = new QProcess(this);
+  p->setProcessChannelMode(QProcess::ForwardedChannels);
+  p->start(program, NameserviceArgs());
+  if (!p->waitForStarted(3000)) {
+    ShowError("could not start " + program + ": " + p->errorString());
+    p->deleteLater();
+    return false;
+  }
+  tools_[name] = p;
+  statusBar()->showMessage("started " + name, 3000);
+  return true;
+}
+
+void MainWindow::StartModel(QString path) {
+  if (model_process_ != nullptr && model_process_->state() != QProcess::NotRunning) {
+    ShowError("a Model started here is still running");
+    return;
+  }
+  if (path.isEmpty()) path = last_model_;
+  if (path.isEmpty())
+    path = QFileDialog::getOpenFileName(this, "Model file for the new Model", QString(),
+                                        "COLLADA (*.dae);;All files (*)");
+  if (path.isEmpty()) return;
+  const QString program = BinPath("caliper-model");
+  if (!QFileInfo(program).isExecutable()) {
+    ShowError("no " + program);
+    return;
+  }
+  path = QFileInfo(path).absoluteFilePath();
+  if (model_process_ != nullptr) model_process_->deleteLater();
+  model_process_ = new QProcess(this);
+  model_process_->setProcessChannelMode(QProcess::ForwardedChannels);
+  QStringList args = {"-o", "model.scene=" + path, "-o", "exec.auto_activate=true"};
+  args << NameserviceArgs();
+  model_process_->start(program, args);
+  if (!model_process_->waitForStarted(3000)) {
+    ShowError("could not start caliper-model: " + model_process_->errorString());
+    return;
+  }
+  last_model_ = path;
+  statusBar()->showMessage("starting a Model with " + path + " ...", kErrorShowMs);
+}
+
+void MainWindow::RefreshComponents(const Snapshot& s) {
+  if (s.components_version == components_version_) return;
+  components_version_ = s.components_version;
+  QString selected;
+  if (QTreeWidgetItem* item = components_->currentItem())
+    selected = item->data(0, kIdRole).toString();
+  // update the rows in place when the same components are listed: the selection stays
+  bool same = components_->topLevelItemCount() == static_cast<int>(s.components.size());
+  for (int k = 0; same && k < components_->topLevelItemCount(); ++k)
+    same = components_->topLevelItem(k)->data(0, kIdRole).toString().toStdString() ==
+           s.components[k].path;
+  if (!same) components_->clear();
+  for (size_t k = 0; k < s.components.size(); ++k) {
+    const ComponentInfo& c = s.components[k];
+    QTreeWidgetItem* item =
+        same ? components_->topLevelItem(static_cast<int>(k)) : new QTreeWidgetItem(components_);
+    item->setText(0, QString::fromStdString(c.instance));
+    item->setText(1, QString::fromStdString(c.state));
+    item->setText(2, QString::fromStdString(c.path));
+    item->setData(0, kIdRole, QString::fromStdString(c.path));
+    item->setForeground(1, QBrush(c.state == "ACTIVE"     ? QColor(0, 128, 0)
+                                  : c.state == "INACTIVE" ? QColor(90, 90, 90)
+                                                          : QColor(176, 0, 32)));
+    if (!same && item->data(0, kIdRole).toString() == selected) components_->setCurrentItem(item);
+  }
+  if (!s.naming_reachable && components_->topLevelItemCount() == 0)
+    components_->setToolTip("the naming service does not answer");
+  else
+    components_->setToolTip(QString());
+}
+
+void MainWindow::SelectedComponentAction(const std::string& verb) {
+  QTreeWidgetItem* item = components_->currentItem();
+  if (item == nullptr) {
+    ShowError("select a component first");
+    return;
+  }
+  link_->ComponentAction(item->data(0, kIdRole).toString().toStdString(), verb);
+  statusBar()->showMessage(QString("%1 %2 ...").arg(QString::fromStdString(verb), item->text(0)),
+                           3000);
+}
 
 void MainWindow::OpenModelFile() {
   const QString path = QFileDialog::getOpenFileName(this, "Open model", QString(),
@@ -152,12 +382,16 @@ QTreeWidgetItem* MainWindow::ItemOf(const std::string& id) const {
 
 void MainWindow::Refresh() {
   const Snapshot s = link_->snapshot();
+  RefreshComponents(s);
   if (s.error_serial != error_serial_) {
     error_serial_ = s.error_serial;
     ShowError(QString::fromStdString(s.last_error));
   }
 
   no_model_->setVisible(!s.connected);
+  start_model_->setVisible(!s.connected);
+  start_model_->setEnabled(model_process_ == nullptr ||
+                           model_process_->state() == QProcess::NotRunning);
   for (QWidget* w : {static_cast<QWidget*>(start_), static_cast<QWidget*>(pause_),
                      static_cast<QWidget*>(step_), static_cast<QWidget*>(stop_),
                      static_cast<QWidget*>(reset_), static_cast<QWidget*>(open_)})
@@ -174,6 +408,14 @@ void MainWindow::Refresh() {
   }
 
   const ModelStatus& st = s.status;
+  if (!st.scene.empty()) last_model_ = QString::fromStdString(st.scene);
+  if (!settings_applied_) {  // the saved simulation settings reach the first Model found
+    settings_applied_ = true;
+    if (saved_time_step_ > 0 && saved_time_step_ != st.time_step)
+      link_->SetTimeStep(saved_time_step_);
+    if (saved_real_time_factor_ >= 0 && saved_real_time_factor_ != st.real_time_factor)
+      link_->SetRealTimeFactor(saved_real_time_factor_);
+  }
   state_->setText(QString::fromStdString(st.state));
   sim_time_->setText(QString("t = %1 s").arg(st.sim_time, 0, 'f', 3));
   steps_->setText(QString("%1 steps").arg(static_cast<qulonglong>(st.steps)));

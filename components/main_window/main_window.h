@@ -10,7 +10,10 @@
 
 #include "model_link.h"
 
+class QCloseEvent;
 class QDoubleSpinBox;
+class QProcess;
+class QSettings;
 class QLabel;
 class QPushButton;
 class QSpinBox;
@@ -23,8 +26,10 @@ namespace caliper::main_window {
 class MainWindow : public QMainWindow {
  public:
   /// Takes the link; `refresh_hz` is how often the snapshot is shown.
+  /// Restores the session from the settings file (SettingsPath()); `restore_tools` starts the
+  /// tools that were open when it was saved.
   explicit MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz = 5.0,
-                      QWidget* parent = nullptr);
+                      QWidget* parent = nullptr, bool restore_tools = true);
   ~MainWindow() override;
 
   ModelLink& link() { return *link_; }
@@ -33,11 +38,31 @@ class MainWindow : public QMainWindow {
   /// The tree row of a channel id, or nullptr.
   QTreeWidgetItem* ItemOf(const std::string& id) const;
 
+  /// The per-user session file, or $CALIPER_MAIN_SETTINGS.
+  static QString SettingsPath();
+  /// Saves geometry, last model, simulation settings and open tools (closing does it too).
+  void SaveSettings();
+  const QString& last_model() const { return last_model_; }
+  /// Starts a tool (`renderer`) from caliper-main's bin directory as its own process.
+  bool StartTool(const QString& name);
+  /// Starts caliper-model with `path` (the last model when empty; asks when there is none).
+  void StartModel(QString path = QString());
+  /// The names of the tools started here and still running.
+  QStringList OpenTools() const;
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
+
  private:
   void BuildTree(const Snapshot& s);
   void OnItemChanged(QTreeWidgetItem* item, int column);
   void OpenModelFile();
   void ShowError(const QString& message);
+  void RestoreSettings(bool restore_tools);
+  void RefreshComponents(const Snapshot& s);
+  void SelectedComponentAction(const std::string& verb);
+  QString BinPath(const QString& name) const;
+  QStringList NameserviceArgs() const;
 
   std::unique_ptr<ModelLink> link_;
   QTimer* timer_ = nullptr;
@@ -56,6 +81,15 @@ class MainWindow : public QMainWindow {
   QLabel* steps_ = nullptr;
   QLabel* achieved_ = nullptr;
   QTreeWidget* tree_ = nullptr;
+  QPushButton* start_model_ = nullptr;
+  QTreeWidget* components_ = nullptr;
+  std::uint64_t components_version_ = 0;
+  std::map<QString, QProcess*> tools_;             // tool name -> its process
+  QProcess* model_process_ = nullptr;              // a Model started by "Start a Model"
+  QString last_model_;
+  bool settings_applied_ = false;                  // saved simulation settings sent to the Model
+  double saved_time_step_ = 0;
+  double saved_real_time_factor_ = -1;
   std::map<std::string, QTreeWidgetItem*> items_;   // channel id -> its row
   std::uint64_t channels_version_ = 0;
   std::uint64_t error_serial_ = 0;

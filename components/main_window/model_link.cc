@@ -1,9 +1,11 @@
 #include "model_link.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <utility>
 
 #include "caliper/model.hh"
+#include "caliper/rtc.hh"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::main_window {
@@ -11,6 +13,7 @@ namespace caliper::main_window {
 namespace M = ::Caliper::Simulation;
 namespace D = ::Caliper::Daq;
 namespace S = ::Caliper::Scene;
+namespace RTC = ::Caliper::RTC;
 using Clock = std::chrono::steady_clock;
 
 namespace {
@@ -22,6 +25,28 @@ const char* StateName(M::SimulationState s) {
     case M::RUNNING: return "RUNNING";
     case M::PAUSED: return "PAUSED";
     case M::FAULTED: return "FAULTED";
+  }
+  return "?";
+}
+
+const char* LifeCycleName(RTC::LifeCycleState s) {
+  switch (s) {
+    case RTC::CREATED_STATE: return "CREATED";
+    case RTC::INACTIVE_STATE: return "INACTIVE";
+    case RTC::ACTIVE_STATE: return "ACTIVE";
+    case RTC::ERROR_STATE: return "ERROR";
+  }
+  return "?";
+}
+
+const char* CodeName(RTC::ReturnCode c) {
+  switch (c) {
+    case RTC::RTC_OK: return "RTC_OK";
+    case RTC::RTC_ERROR: return "RTC_ERROR";
+    case RTC::BAD_PARAMETER: return "BAD_PARAMETER";
+    case RTC::UNSUPPORTED: return "UNSUPPORTED";
+    case RTC::OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
+    case RTC::PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
   }
   return "?";
 }
@@ -41,6 +66,13 @@ struct ModelLink::Impl {
   std::string scene;              // the scene the channel list belongs to
   bool channels_listed = false;
   Clock::time_point last_lookup{};
+  Clock::time_point last_listing{};
+  CosNaming::NamingContext_var root;  // nil until resolved; dropped on failure
+
+  CosNaming::NamingContext_ptr Root(const std::string& nameservice) {
+    if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
+    return root.in();
+  }
 };
 
 ModelLink::ModelLink(Options options) : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
@@ -63,10 +95,10 @@ Snapshot ModelLink::snapshot() const {
   return snapshot_;
 }
 
-void ModelLink::Queue(std::string what, std::function<void(Impl&)> call) {
+void ModelLink::Queue(std::string what, std::function<void(Impl&)> call, bool needs_model) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    queue_.emplace_back(std::move(what), std::move(call));
+    queue_.push_back(Command{std::move(what), std::move(call), needs_model});
   }
   wake_.notify_all();
 }
@@ -107,6 +139,64 @@ void ModelLink::Set(const std::string& id, double value) {
   });
 }
 
+void ModelLink::ComponentAction(const std::string& instance, const std::string& verb) {
+  const std::string ns = options_.nameservice;
+  Queue(verb + " " + instance, [instance, verb, ns](Impl& i) {
+    RTC::LightweightRTObject_var comp =
+        RTC::LightweightRTObject::_narrow(rtc::FindComponent(i.Root(ns), instance).object);
+    if (CORBA::is_nil(comp)) throw std::runtime_error(instance + " is not a component");
+    RTC::ReturnCode rc;
+    if (verb == "exit") {
+      rc = comp->exit();
+    } else {
+      RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+      if (ecs->length() == 0) throw std::runtime_error(instance + " owns no execution context");
+      RTC::ExecutionContext_ptr ec = ecs[0];
+      rc = verb == "activate"     ? ec->activate_component(comp)
+           : verb == "deactivate" ? ec->deactivate_component(comp)
+           : verb == "reset"      ? ec->reset_component(comp)
+                                  : throw std::runtime_error("unknown action " + verb);
+    }
+    if (rc != RTC::RTC_OK) {
+      std::string msg = CodeName(rc);
+      CORBA::String_var why = comp->get_last_error();
+      if (std::string(why.in()).size() > 0) msg += "; reason: " + std::string(why.in());
+      throw std::runtime_error(msg);
+    }
+  }, false);
+}
+
+// Lists the naming service's components with their states; on the worker thread only.
+void ModelLink::ListComponents() {
+  Impl& i = *impl_;
+  std::vector<ComponentInfo> list;
+  bool reachable = false;
+  try {
+    const auto entries = rtc::ListComponents(i.Root(options_.nameservice));
+    reachable = true;
+    for (const auto& e : entries) {
+      ComponentInfo info{e.instance, e.path, "UNREACHABLE"};
+      try {
+        RTC::LightweightRTObject_var comp = RTC::LightweightRTObject::_narrow(e.object);
+        if (!CORBA::is_nil(comp)) {
+          RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+          info.state = ecs->length() == 0 ? "?" : LifeCycleName(ecs[0]->get_component_state(comp));
+        }
+      } catch (const CORBA::Exception&) {
+      }
+      list.push_back(std::move(info));
+    }
+  } catch (const CORBA::Exception&) {
+    i.root = CosNaming::NamingContext::_nil();
+  } catch (const std::exception&) {
+    i.root = CosNaming::NamingContext::_nil();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_.naming_reachable = reachable;
+  snapshot_.components = std::move(list);
+  ++snapshot_.components_version;
+}
+
 void ModelLink::Watch(std::vector<std::string> ids) {
   std::lock_guard<std::mutex> lock(mutex_);
   watched_ = std::move(ids);
@@ -131,7 +221,7 @@ void ModelLink::Run() {
   };
 
   for (;;) {
-    std::deque<std::pair<std::string, std::function<void(Impl&)>>> commands;
+    std::deque<Command> commands;
     std::vector<std::string> watched;
     {
       std::unique_lock<std::mutex> lock(mutex_);
@@ -141,9 +231,20 @@ void ModelLink::Run() {
       watched = watched_;
     }
 
-    for (auto& [what, call] : commands) {
+    bool relist_components = false;
+    for (auto& [what, call, needs_model] : commands) {
       std::string error;
-      if (CORBA::is_nil(i.model)) {
+      if (!needs_model) {
+        relist_components = true;
+        try {
+          omniORB::setClientThreadCallTimeout(short_ms);
+          call(i);
+        } catch (const CORBA::Exception& e) {
+          error = what + ": " + rtc::Describe(e);
+        } catch (const std::exception& e) {
+          error = what + ": " + e.what();
+        }
+      } else if (CORBA::is_nil(i.model)) {
         error = what + ": no Model reachable";
       } else {
         try {
@@ -172,9 +273,15 @@ void ModelLink::Run() {
       }
     }
 
+    omniORB::setClientThreadCallTimeout(short_ms);
+    if (relist_components || Clock::now() - i.last_listing >=
+                                 std::chrono::milliseconds(options_.components_period_ms)) {
+      i.last_listing = Clock::now();
+      ListComponents();
+    }
+
     if (Clock::now() < next_poll) continue;
     next_poll = Clock::now() + period;
-    omniORB::setClientThreadCallTimeout(short_ms);
 
     // look the Model up (not more often than the reconnect period)
     if (CORBA::is_nil(i.model)) {
@@ -253,6 +360,7 @@ void ModelLink::Run() {
     }
   }
   i.model = M::Model::_nil();
+  i.root = CosNaming::NamingContext::_nil();
   if (self != nullptr) omni_thread::release_dummy();
 }
 

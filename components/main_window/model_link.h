@@ -41,6 +41,13 @@ struct Channel {
   bool scalar() const { return rows == 1 && cols == 1; }
 };
 
+/// A component bound in the naming service, with its lifecycle state.
+struct ComponentInfo {
+  std::string instance;  ///< e.g. model0
+  std::string path;      ///< host.host_cxt/model0.rtc
+  std::string state;     ///< CREATED, INACTIVE, ACTIVE, ERROR or UNREACHABLE
+};
+
 /// What the GUI reads: a copy of everything the worker last learnt.
 struct Snapshot {
   bool connected = false;
@@ -52,6 +59,9 @@ struct Snapshot {
   std::string last_error;                  ///< the latest failed command's message
   std::uint64_t error_serial = 0;          ///< counts failed commands
   std::uint64_t commands_done = 0;         ///< counts finished commands (failed or not)
+  bool naming_reachable = false;           ///< the naming service answered the last listing
+  std::uint64_t components_version = 0;    ///< counts the listings of `components`
+  std::vector<ComponentInfo> components;   ///< everything bound in the naming service
 };
 
 /// The worker and its command queue. Every method returns at once.
@@ -64,6 +74,7 @@ class ModelLink {
     int long_call_timeout_ms = 120000;  ///< load_scene and step, which take as long as their work
     int poll_period_ms = 200;         ///< status and values
     int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
+    int components_period_ms = 1000;  ///< listing the naming service's components
   };
 
   /// Uses the process's ORB (initialises one when there is none) and starts the worker.
@@ -86,11 +97,22 @@ class ModelLink {
   void Set(const std::string& id, double value);
   /// The scalar ids whose values are polled (e.g. the visible rows).
   void Watch(std::vector<std::string> ids);
+  /// A lifecycle transition of a component in the naming service: `verb` is activate,
+  /// deactivate, reset or exit. Needs no Model.
+  void ComponentAction(const std::string& instance, const std::string& verb);
+
+  const Options& options() const { return options_; }
 
   struct Impl;
 
  private:
-  void Queue(std::string what, std::function<void(Impl&)> call);
+  struct Command {
+    std::string what;
+    std::function<void(Impl&)> call;
+    bool needs_model = true;
+  };
+  void Queue(std::string what, std::function<void(Impl&)> call, bool needs_model = true);
+  void ListComponents();
   void Run();
 
   std::unique_ptr<Impl> impl_;
@@ -98,7 +120,7 @@ class ModelLink {
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;
-  std::deque<std::pair<std::string, std::function<void(Impl&)>>> queue_;
+  std::deque<Command> queue_;
   std::vector<std::string> watched_;
   Snapshot snapshot_;
   std::thread worker_;

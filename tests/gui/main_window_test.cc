@@ -6,6 +6,8 @@
 
 #include <QApplication>
 #include <QElapsedTimer>
+#include <QFileInfo>
+#include <QSettings>
 #include <QLabel>
 #include <QLineEdit>
 #include <QHeaderView>
@@ -17,6 +19,7 @@
 #include <cstdlib>
 
 #include "caliper/model.hh"
+#include "caliper/rtc.hh"
 #include "caliper/rtc/naming.h"
 #include "main_window.h"
 #include "model_link.h"
@@ -81,6 +84,8 @@ class MainWindowTest : public ::testing::Test {
     App();
     Orb();
     naming_ = std::make_unique<NamingService>(dir_.path());
+    settings_ = dir_.path() + "/caliper-main.ini";
+    qputenv("CALIPER_MAIN_SETTINGS", QByteArray::fromStdString(settings_));
   }
 
   std::unique_ptr<Process> StartModel() {
@@ -121,7 +126,117 @@ class MainWindowTest : public ::testing::Test {
 
   TempDir dir_;
   std::unique_ptr<NamingService> naming_;
+  std::string settings_;
 };
+
+/// The lifecycle state of `instance` read over CORBA.
+std::string StateOverCorba(const std::string& address, const std::string& instance) {
+  namespace RTC = ::Caliper::RTC;
+  try {
+    CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), address);
+    RTC::LightweightRTObject_var comp =
+        RTC::LightweightRTObject::_narrow(rtc::FindComponent(root, instance).object);
+    RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+    switch (ecs[0]->get_component_state(comp)) {
+      case RTC::CREATED_STATE: return "CREATED";
+      case RTC::INACTIVE_STATE: return "INACTIVE";
+      case RTC::ACTIVE_STATE: return "ACTIVE";
+      case RTC::ERROR_STATE: return "ERROR";
+    }
+  } catch (...) {
+  }
+  return "?";
+}
+
+/// The row of `instance` in the components panel, or nullptr.
+QTreeWidgetItem* ComponentRow(MainWindow& w, const QString& instance) {
+  auto* tree = w.findChild<QTreeWidget*>("components");
+  for (int k = 0; k < tree->topLevelItemCount(); ++k)
+    if (tree->topLevelItem(k)->text(0) == instance) return tree->topLevelItem(k);
+  return nullptr;
+}
+
+TEST_F(MainWindowTest, ComponentsPanelShowsAndChangesLifecycleStatesAndTheSessionIsRestored) {
+  auto process = StartModel();
+  M::Model_var model = WaitForModel();
+  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
+  auto w = Window(naming_->address());
+
+  // the panel lists model0, ACTIVE
+  ASSERT_TRUE(WaitInGui(
+      [&] {
+        QTreeWidgetItem* row = ComponentRow(*w, "model0");
+        return row != nullptr && row->text(1) == "ACTIVE";
+      },
+      seconds(10)));
+
+  // Deactivate: INACTIVE over CORBA and in the panel; Activate brings it back
+  auto* tree = w->findChild<QTreeWidget*>("components");
+  tree->setCurrentItem(ComponentRow(*w, "model0"));
+  QTest::mouseClick(w->findChild<QPushButton*>("component_deactivate"), Qt::LeftButton);
+  EXPECT_TRUE(WaitInGui([&] { return StateOverCorba(naming_->address(), "model0") == "INACTIVE"; },
+                        seconds(5)));
+  EXPECT_TRUE(WaitInGui([&] { return ComponentRow(*w, "model0")->text(1) == "INACTIVE"; },
+                        seconds(5)));
+  EXPECT_EQ(tree->currentItem(), ComponentRow(*w, "model0")) << "the selection stays";
+  QTest::mouseClick(w->findChild<QPushButton*>("component_activate"), Qt::LeftButton);
+  EXPECT_TRUE(WaitInGui([&] { return StateOverCorba(naming_->address(), "model0") == "ACTIVE"; },
+                        seconds(5)));
+  EXPECT_TRUE(WaitInGui([&] { return ComponentRow(*w, "model0")->text(1) == "ACTIVE"; },
+                        seconds(5)));
+
+  // the session file: geometry and the last model survive closing the window
+  const QString scene =
+      QString::fromStdString(std::string(std::getenv("CALIPER_SOURCE_DIR")) +
+                             "/models/pendulum_tendon.dae");
+  ASSERT_TRUE(WaitInGui([&] { return !w->last_model().isEmpty(); }, seconds(5)));
+  EXPECT_EQ(QFileInfo(w->last_model()).canonicalFilePath(), QFileInfo(scene).canonicalFilePath());
+  const QRect rect(40, 50, 1250, 720);
+  w->setGeometry(rect);
+  WaitInGui([] { return false; }, std::chrono::milliseconds(200));
+  const QRect before = w->geometry();
+  EXPECT_TRUE(w->close());
+  w.reset();
+  ASSERT_TRUE(QFileInfo::exists(QString::fromStdString(settings_)));
+
+  auto restored = Window(naming_->address());
+  WaitInGui([] { return false; }, std::chrono::milliseconds(200));
+  EXPECT_EQ(restored->geometry(), before);
+  EXPECT_EQ(restored->geometry().size(), rect.size());
+  EXPECT_EQ(QFileInfo(restored->last_model()).canonicalFilePath(),
+            QFileInfo(scene).canonicalFilePath());
+  restored.reset();
+  process->Signal(SIGTERM);
+  EXPECT_EQ(process->Wait(seconds(10)), 0) << process->Output();
+}
+
+TEST_F(MainWindowTest, StartAModelStartsTheLastModelWhenNoneIsInReach) {
+  const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
+  {
+    QSettings st(QString::fromStdString(settings_), QSettings::IniFormat);
+    st.setValue("model/last", QString::fromStdString(models + "/pendulum_tendon.dae"));
+  }
+  auto w = Window(naming_->address());
+  auto* button = w->findChild<QPushButton*>("start_model");
+  ASSERT_TRUE(WaitInGui([&] { return button->isVisible(); }, seconds(5)));
+  QTest::mouseClick(button, Qt::LeftButton);
+  ASSERT_TRUE(WaitInGui([&] { return w->ItemOf(kMassId) != nullptr; }, seconds(20)))
+      << "the Model started by the window is found";
+  EXPECT_FALSE(w->findChild<QLabel*>("no_model")->isVisible());
+  EXPECT_FALSE(button->isVisible());
+  w.reset();  // ends the Model it started
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming_->address());
+          return rtc::ListComponents(root).empty();
+        } catch (...) {
+          return false;
+        }
+      },
+      seconds(10)))
+      << "no stale model0 in the naming service";
+}
 
 TEST_F(MainWindowTest, StartAdvancesTheSimulatedTimeAndEditingAParameterReachesTheModel) {
   auto process = StartModel();
