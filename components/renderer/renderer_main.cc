@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <QApplication>
+
+#include <cstdio>
 #include <QTimer>
 #include <atomic>
 #include <chrono>
@@ -34,6 +36,7 @@ using namespace caliper;
 struct Options {
   std::string screenshot;  // PNG path; empty for the interactive viewer
   double after = 3.0;      // [s] of wall time before the screenshot
+  std::string geometry;    // WxH+X+Y of the viewer window (the session arranges its tools)
   std::vector<char*> rest;  // what RunComponent parses
 };
 
@@ -42,7 +45,7 @@ bool ParseOptions(int argc, char** argv, Options* out) {
   out->rest.push_back(argv[0]);
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--screenshot" || arg == "--after") {
+    if (arg == "--screenshot" || arg == "--after" || arg == "--geometry") {
       if (i + 1 >= argc) {
         std::cerr << "caliper-renderer: error: option " << arg << " needs a value\n";
         return false;
@@ -50,6 +53,13 @@ bool ParseOptions(int argc, char** argv, Options* out) {
       const std::string value = argv[++i];
       if (arg == "--screenshot") {
         out->screenshot = value;
+      } else if (arg == "--geometry") {
+        int w, h, x, y;
+        if (std::sscanf(value.c_str(), "%dx%d+%d+%d", &w, &h, &x, &y) != 4 || w <= 0 || h <= 0) {
+          std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y\n";
+          return false;
+        }
+        out->geometry = value;
       } else {
         char* end = nullptr;
         out->after = std::strtod(value.c_str(), &end);
@@ -249,6 +259,11 @@ int main(int argc, char** argv) {
       request_exit();
     });
   } else {
+    if (!options.geometry.empty()) {
+      int w, h, x, y;
+      std::sscanf(options.geometry.c_str(), "%dx%d+%d+%d", &w, &h, &x, &y);
+      top_level->setGeometry(x, y, w, h);
+    }
     render_coin::Viewer::Show(top_level);
     viewer->Render();
   }
