@@ -19,6 +19,7 @@
 #include "caliper/logging/record.h"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/log_service_sink.h"
+#include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
 #include "client.h"
 #include "inspect.h"
@@ -29,28 +30,6 @@ namespace {
 
 namespace RTC = ::Caliper::RTC;
 namespace LogIdl = ::Caliper::Logging;
-
-const char* StateName(RTC::LifeCycleState s) {
-  switch (s) {
-    case RTC::CREATED_STATE: return "CREATED";
-    case RTC::INACTIVE_STATE: return "INACTIVE";
-    case RTC::ACTIVE_STATE: return "ACTIVE";
-    case RTC::ERROR_STATE: return "ERROR";
-  }
-  return "?";
-}
-
-const char* CodeName(RTC::ReturnCode c) {
-  switch (c) {
-    case RTC::RTC_OK: return "RTC_OK";
-    case RTC::RTC_ERROR: return "RTC_ERROR";
-    case RTC::BAD_PARAMETER: return "BAD_PARAMETER";
-    case RTC::UNSUPPORTED: return "UNSUPPORTED";
-    case RTC::OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
-    case RTC::PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
-  }
-  return "?";
-}
 
 RTC::LifeCycleState StateOf(RTC::LightweightRTObject_ptr comp) {
   RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
@@ -74,7 +53,7 @@ int List(Client& client, std::vector<std::string>& args) {
     try {
       RTC::LightweightRTObject_var comp = RTC::LightweightRTObject::_narrow(e.object);
       if (!CORBA::is_nil(comp)) {
-        state = StateName(StateOf(comp));
+        state = rtc::Name(StateOf(comp));
         RTC::ComponentProfile_var profile = comp->get_component_profile();
         type = profile->type_name.in();
         for (CORBA::ULong i = 0; i < profile->properties.length(); ++i)
@@ -96,7 +75,7 @@ int State(Client& client, std::vector<std::string>& args) {
   RTC::LightweightRTObject_var comp = client.Component(OneName(args), &path);
   try {
     const auto state = StateOf(comp);
-    std::cout << StateName(state) << "\n";
+    std::cout << rtc::Name(state) << "\n";
     if (state == RTC::ERROR_STATE) {
       CORBA::String_var why = comp->get_last_error();
       std::cout << "reason: " << why.in() << "\n";
@@ -124,8 +103,8 @@ int Transition(Client& client, std::vector<std::string>& args, const std::string
                                   : ec->reset_component(comp);
     }
     if (rc != RTC::RTC_OK) {
-      std::string msg = verb + " " + name + ": " + CodeName(rc);
-      if (verb != "exit") msg += std::string(" (state is ") + StateName(StateOf(comp)) + ")";
+      std::string msg = verb + " " + name + ": " + rtc::Name(rc);
+      if (verb != "exit") msg += std::string(" (state is ") + rtc::Name(StateOf(comp)) + ")";
       CORBA::String_var why = comp->get_last_error();
       if (rc == RTC::RTC_ERROR && std::strlen(why.in()) > 0) msg += "; reason: " + std::string(why);
       throw Failure(msg);
@@ -133,7 +112,7 @@ int Transition(Client& client, std::vector<std::string>& args, const std::string
     if (verb == "exit")
       std::cout << name << ": exiting\n";
     else
-      std::cout << name << ": " << StateName(StateOf(comp)) << "\n";
+      std::cout << name << ": " << rtc::Name(StateOf(comp)) << "\n";
     return 0;
   } catch (const CORBA::Exception& e) {
     throw Failure(Client::Unreachable(path, e));

@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "caliper/model.hh"
+#include "caliper/rtc/idl_names.h"
 #include "csv_recording.h"
 
 namespace caliper::ctl {
@@ -41,17 +42,6 @@ std::string Num(double v, int precision = 7) {
   std::ostringstream s;
   s << std::setprecision(precision) << v;
   return s.str();
-}
-
-const char* StateName(M::SimulationState s) {
-  switch (s) {
-    case M::EMPTY: return "EMPTY";
-    case M::STOPPED: return "STOPPED";
-    case M::RUNNING: return "RUNNING";
-    case M::PAUSED: return "PAUSED";
-    case M::FAULTED: return "FAULTED";
-  }
-  return "?";
 }
 
 /// A number given on the command line (nan and inf pass: the Model judges values).
@@ -207,12 +197,12 @@ int Load(Client& client, std::vector<std::string>& args) {
       std::string message = e.reason.in();
       M::SimulationStatus_var s = StatusOf(m);
       if (s->state != M::EMPTY)
-        message += "\n  (" + name + " keeps " + s->scene.in() + ", " + StateName(s->state) + ")";
+        message += "\n  (" + name + " keeps " + s->scene.in() + ", " + rtc::Name(s->state) + ")";
       throw Failure(message);
     }
   });
   M::SimulationStatus_var s = StatusOf(m);
-  std::cout << name << ": loaded " << path << " (" << StateName(s->state) << ", time step "
+  std::cout << name << ": loaded " << path << " (" << rtc::Name(s->state) << ", time step "
             << Num(s->time_step) << " s)\n";
   return 0;
 }
@@ -233,7 +223,7 @@ int Control(Client& client, std::vector<std::string>& args, const std::string& v
       m.model->reset();
   });
   M::SimulationStatus_var s = StatusOf(m);
-  std::cout << name << ": " << StateName(s->state) << " at t = " << Num(s->sim_time, 10) << " s\n";
+  std::cout << name << ": " << rtc::Name(s->state) << " at t = " << Num(s->sim_time, 10) << " s\n";
   return 0;
 }
 
@@ -252,7 +242,7 @@ int Step(Client& client, std::vector<std::string>& args) {
     throw Failure(name + ": the simulation faulted after " + std::to_string(done) + " of " +
                   std::to_string(n) + " steps: " + after->last_error.in());
   std::cout << name << ": " << done << " steps, t = " << Num(after->sim_time, 10) << " s (+"
-            << Num(after->sim_time - before->sim_time, 10) << " s), " << StateName(after->state)
+            << Num(after->sim_time - before->sim_time, 10) << " s), " << rtc::Name(after->state)
             << "\n";
   return 0;
 }
@@ -264,7 +254,7 @@ int Status(Client& client, std::vector<std::string>& args) {
   M::SimulationStatus_var s = StatusOf(m);
   const bool running = s->state == M::RUNNING;
   Line("model", name + " (" + m.path + ")");
-  Line("state", StateName(s->state));
+  Line("state", rtc::Name(s->state));
   Line("scene", std::strlen(s->scene) > 0 ? s->scene.in() : "(none)");
   Line("simulated time [s]", Num(s->sim_time, 12));
   Line("steps", std::to_string(s->steps));
@@ -510,7 +500,7 @@ int Record(Client& client, std::vector<std::string>& args) {
                                         : "until Ctrl-C")
             << " to " << csv_path << "\n";
   if (status->state != M::RUNNING)
-    std::cerr << name << " is " << StateName(status->state)
+    std::cerr << name << " is " << rtc::Name(status->state)
               << ": samples come once it runs (caliper-ctl start) or steps\n";
 
   // Ctrl-C and SIGTERM are blocked in every thread (Main) and taken here

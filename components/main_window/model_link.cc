@@ -6,6 +6,7 @@
 
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
+#include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::main_window {
@@ -17,39 +18,6 @@ namespace RTC = ::Caliper::RTC;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-const char* StateName(M::SimulationState s) {
-  switch (s) {
-    case M::EMPTY: return "EMPTY";
-    case M::STOPPED: return "STOPPED";
-    case M::RUNNING: return "RUNNING";
-    case M::PAUSED: return "PAUSED";
-    case M::FAULTED: return "FAULTED";
-  }
-  return "?";
-}
-
-const char* LifeCycleName(RTC::LifeCycleState s) {
-  switch (s) {
-    case RTC::CREATED_STATE: return "CREATED";
-    case RTC::INACTIVE_STATE: return "INACTIVE";
-    case RTC::ACTIVE_STATE: return "ACTIVE";
-    case RTC::ERROR_STATE: return "ERROR";
-  }
-  return "?";
-}
-
-const char* CodeName(RTC::ReturnCode c) {
-  switch (c) {
-    case RTC::RTC_OK: return "RTC_OK";
-    case RTC::RTC_ERROR: return "RTC_ERROR";
-    case RTC::BAD_PARAMETER: return "BAD_PARAMETER";
-    case RTC::UNSUPPORTED: return "UNSUPPORTED";
-    case RTC::OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
-    case RTC::PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
-  }
-  return "?";
-}
 
 CORBA::ORB_ptr ProcessOrb() {
   int argc = 0;
@@ -158,7 +126,7 @@ void ModelLink::ComponentAction(const std::string& instance, const std::string& 
                                   : throw std::runtime_error("unknown action " + verb);
     }
     if (rc != RTC::RTC_OK) {
-      std::string msg = CodeName(rc);
+      std::string msg = rtc::Name(rc);
       CORBA::String_var why = comp->get_last_error();
       if (std::string(why.in()).size() > 0) msg += "; reason: " + std::string(why.in());
       throw std::runtime_error(msg);
@@ -180,7 +148,7 @@ void ModelLink::ListComponents() {
         RTC::LightweightRTObject_var comp = RTC::LightweightRTObject::_narrow(e.object);
         if (!CORBA::is_nil(comp)) {
           RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
-          info.state = ecs->length() == 0 ? "?" : LifeCycleName(ecs[0]->get_component_state(comp));
+          info.state = ecs->length() == 0 ? "?" : rtc::Name(ecs[0]->get_component_state(comp));
         }
       } catch (const CORBA::Exception&) {
       }
@@ -307,7 +275,7 @@ void ModelLink::Run() {
     try {
       M::SimulationStatus_var s = i.model->status();
       ModelStatus status;
-      status.state = StateName(s->state);
+      status.state = rtc::Name(s->state);
       status.scene = s->scene.in();
       status.sim_time = s->sim_time;
       status.steps = s->steps;
