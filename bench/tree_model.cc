@@ -166,7 +166,6 @@ sgal::Scene MakeTree(const TreeOptions& options) {
 std::string MakeTreeMjcf(const TreeOptions& options) {
   const auto links = Links();
   std::ostringstream x;
-  const int contype = options.self_contact ? 1 : 0;
   x << "<mujoco model=\"tree40\">\n<option timestep=\"0.001\"/>\n<worldbody>\n";
   if (options.floor) x << "<geom name=\"floor\" type=\"plane\" size=\"10 10 .1\" contype=\"2\" conaffinity=\"1\"/>\n";
   // nested bodies: write each link, children inside
@@ -187,7 +186,6 @@ std::string MakeTreeMjcf(const TreeOptions& options) {
       << -half.y() << " " << -half.z() << " " << half.x() << " " << half.y() << " " << half.z()
       << "\" mass=\"0.2\" contype=\"" << (options.self_contact ? 1 : 0) << "\" conaffinity=\""
       << (options.self_contact || options.floor ? 1 : 0) << "\"/>\n";
-    (void)contype;
     for (const auto& t : Tendons(links, options.spanning_tendons)) {
       for (int end = 0; end < 2; ++end) {
         const int body = end ? t.body_b : t.body_a;

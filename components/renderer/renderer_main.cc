@@ -36,7 +36,8 @@ using namespace caliper;
 struct Options {
   std::string screenshot;  // PNG path; empty for the interactive viewer
   double after = 3.0;      // [s] of wall time before the screenshot
-  std::string geometry;    // WxH+X+Y of the viewer window (the session arranges its tools)
+  bool place = false;      // --geometry WxH+X+Y given: where the viewer window goes
+  int x = 0, y = 0, width = 0, height = 0;
   std::vector<char*> rest;  // what RunComponent parses
 };
 
@@ -54,12 +55,13 @@ bool ParseOptions(int argc, char** argv, Options* out) {
       if (arg == "--screenshot") {
         out->screenshot = value;
       } else if (arg == "--geometry") {
-        int w, h, x, y;
-        if (std::sscanf(value.c_str(), "%dx%d+%d+%d", &w, &h, &x, &y) != 4 || w <= 0 || h <= 0) {
+        if (std::sscanf(value.c_str(), "%dx%d+%d+%d", &out->width, &out->height, &out->x,
+                        &out->y) != 4 ||
+            out->width <= 0 || out->height <= 0) {
           std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y\n";
           return false;
         }
-        out->geometry = value;
+        out->place = true;
       } else {
         char* end = nullptr;
         out->after = std::strtod(value.c_str(), &end);
@@ -259,11 +261,7 @@ int main(int argc, char** argv) {
       request_exit();
     });
   } else {
-    if (!options.geometry.empty()) {
-      int w, h, x, y;
-      std::sscanf(options.geometry.c_str(), "%dx%d+%d+%d", &w, &h, &x, &y);
-      top_level->setGeometry(x, y, w, h);
-    }
+    if (options.place) top_level->setGeometry(options.x, options.y, options.width, options.height);
     render_coin::Viewer::Show(top_level);
     viewer->Render();
   }

@@ -194,7 +194,6 @@ void Runtime::BindUnique() {
 }
 
 void Runtime::Rebind() {
-  static bool warned = false;
   std::string failure;
   // a restarted naming service first fails the call on the old connection: try twice
   for (int attempt = 0; attempt < 2; ++attempt) {
@@ -202,8 +201,8 @@ void Runtime::Rebind() {
       CosNaming::NamingContext_var root = ResolveRoot(orb_, naming_address_);
       CosNaming::NamingContext_var host = HostContext(root, host_);
       host->rebind(Leaf(instance()), self_);
-      if (warned) logging::Get("rtc").notice("registered again in %s", naming_address_.c_str());
-      warned = false;
+      if (rebind_warned_) logging::Get("rtc").notice("registered again in %s", naming_address_.c_str());
+      rebind_warned_ = false;
       return;
     } catch (const std::exception& e) {
       failure = e.what();
@@ -211,8 +210,9 @@ void Runtime::Rebind() {
       failure = Describe(e);
     }
   }
-  if (!warned) logging::Get("rtc").warn("re-registration failed (will retry): %s", failure.c_str());
-  warned = true;
+  if (!rebind_warned_)
+    logging::Get("rtc").warn("re-registration failed (will retry): %s", failure.c_str());
+  rebind_warned_ = true;
 }
 
 void Runtime::Unbind() {

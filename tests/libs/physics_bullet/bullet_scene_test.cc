@@ -127,14 +127,21 @@ TEST(BulletScene, JointSpringConservesEnergyWithoutDamping) {
   };
   const double e0 = 0.5 * izz * 4.0;
   double lo = e0, hi = e0;
+  std::vector<double> crossings;  // times the angle passes zero [s]
+  double previous = 0;
   for (int i = 0; i < 5000; ++i) {
     scene->Step();
     lo = std::min(lo, energy());
     hi = std::max(hi, energy());
+    const double q = scene->GetParameter("spring_hinge.position");
+    if (i > 0 && (previous < 0) != (q < 0)) crossings.push_back(scene->time());
+    previous = q;
   }
   EXPECT_LT((hi - lo) / e0, 0.02) << "energy drifted between " << lo << " and " << hi << " J";
-  // and it oscillated with the spring's period 2 pi sqrt(I/k)
-  EXPECT_GT(std::abs(scene->GetParameter("spring_hinge.position")), 0.0);
+  // and it oscillated with the spring's period 2 pi sqrt(I/k) (two zero crossings a period)
+  ASSERT_GE(crossings.size(), 4u);
+  const double period = 2 * (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  EXPECT_NEAR(period, 2 * M_PI * std::sqrt(izz / k), 0.01 * 2 * M_PI * std::sqrt(izz / k));
 }
 
 TEST(BulletScene, TendonTensionHoldsAHangingBallAgainstGravity) {

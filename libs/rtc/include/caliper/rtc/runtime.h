@@ -82,6 +82,7 @@ class Runtime {
   bool exit_requested_ = false;
   std::string instance_;
   bool bound_ = false;
+  bool rebind_warned_ = false;  // said once that re-registration fails, until it works again
 };
 
 /// Parses the command line and configuration, sets up CORBA and logging, creates, initializes,
