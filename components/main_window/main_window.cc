@@ -11,6 +11,9 @@
 #include <QProcess>
 #include <QSettings>
 #include <QFileDialog>
+#include <QGuiApplication>
+#include <QScreen>
+#include <QWindow>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
@@ -21,6 +24,9 @@
 #include <QTreeWidget>
 #include <QVBoxLayout>
 #include <algorithm>
+#include <memory>
+
+#include "caliper/gui_session/tool_window.h"
 
 namespace caliper::main_window {
 
@@ -36,6 +42,24 @@ QPushButton* Button(const QString& text, const char* name, QWidget* parent) {
 }
 
 QString Number(double v) { return QString::number(v, 'g', 7); }
+
+// the tools the Main Window opens: name, program, menu label
+struct ToolSpec {
+  const char* name;
+  const char* program;
+  const char* label;
+};
+constexpr ToolSpec kTools[] = {
+    {"renderer", "caliper-renderer", "Scene &Renderer"},
+    {"plotter", "caliper-plotter", "Graph &Plotter"},
+    {"log_viewer", "caliper-logviewer", "&Log Viewer"},
+};
+
+const ToolSpec* FindTool(const QString& name) {
+  for (const ToolSpec& t : kTools)
+    if (name == t.name) return &t;
+  return nullptr;
+}
 
 }  // namespace
 
@@ -79,13 +103,16 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
                      static_cast<QWidget*>(step_count_), static_cast<QWidget*>(stop_),
                      static_cast<QWidget*>(reset_)})
     controls->addWidget(w);
-  controls->addSpacing(12);
-  controls->addWidget(new QLabel("Time step", central));
-  controls->addWidget(time_step_);
-  controls->addWidget(new QLabel("Real-time factor", central));
-  controls->addWidget(real_time_factor_);
   controls->addStretch();
   layout->addLayout(controls);
+  auto* settings = new QHBoxLayout;
+  settings->addWidget(new QLabel("Time step", central));
+  settings->addWidget(time_step_);
+  settings->addSpacing(12);
+  settings->addWidget(new QLabel("Real-time factor", central));
+  settings->addWidget(real_time_factor_);
+  settings->addStretch();
+  layout->addLayout(settings);
 
   no_model_ = new QLabel(central);
   no_model_->setObjectName("no_model");
@@ -138,9 +165,16 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
 
   // menus: tools as their own processes, and the panels
   QMenu* tools = menuBar()->addMenu("&Tools");
-  QAction* renderer = tools->addAction("Scene &Renderer");
-  renderer->setObjectName("tool_renderer");
-  connect(renderer, &QAction::triggered, this, [this] { StartTool("renderer"); });
+  for (const ToolSpec& t : kTools) {
+    QAction* action = tools->addAction(t.label);
+    action->setObjectName(QString("tool_") + t.name);
+    const QString name = t.name;
+    connect(action, &QAction::triggered, this, [this, name] { StartTool(name); });
+  }
+  QAction* arrange = tools->addAction("&Arrange Windows");
+  arrange->setObjectName("arrange_windows");
+  connect(arrange, &QAction::triggered, this, [this] { ArrangeWindows(); });
+  tools->addSeparator();
   QAction* model = tools->addAction("Start a &Model...");
   model->setObjectName("tool_model");
   connect(model, &QAction::triggered, this, [this] { StartModel(); });
@@ -225,7 +259,7 @@ void MainWindow::SaveSettings() {
 void MainWindow::RestoreSettings(bool restore_tools) {
   QSettings st(SettingsPath(), QSettings::IniFormat);
   const QRect rect = st.value("window/geometry").toRect();
-  if (rect.isValid()) setGeometry(rect);
+  setGeometry(rect.isValid() ? rect : ArrangedGeometry("main"));  // the first time: its place
   if (st.value("window/maximized", false).toBool()) setWindowState(Qt::WindowMaximized);
   restoreState(st.value("window/state").toByteArray());
   last_model_ = st.value("model/last").toString();
@@ -262,14 +296,31 @@ QStringList MainWindow::OpenTools() const {
   return open;
 }
 
+QStringList MainWindow::ToolNames() {
+  QStringList names;
+  for (const ToolSpec& t : kTools) names << t.name;
+  return names;
+}
+
+void MainWindow::SetToolArguments(const QString& name, const QStringList& arguments) {
+  tool_arguments_[name] = arguments;
+}
+
+long long MainWindow::ToolPid(const QString& name) const {
+  const auto it = tools_.find(name);
+  if (it == tools_.end() || it->second->state() == QProcess::NotRunning) return 0;
+  return it->second->processId();
+}
+
 bool MainWindow::StartTool(const QString& name) {
   const auto it = tools_.find(name);
   if (it != tools_.end() && it->second->state() != QProcess::NotRunning) return true;
-  if (name != "renderer") {
-    ShowError("unknown tool " + name);
+  const ToolSpec* spec = FindTool(name);
+  if (spec == nullptr) {
+    ShowError("unknown tool '" + name + "' (known: " + ToolNames().join(", ") + ")");
     return false;
   }
-  const QString program = BinPath("caliper-renderer");
+  const QString program = BinPath(spec->program);
   if (!QFileInfo(program).isExecutable()) {
     ShowError("no " + program);
     return false;
@@ -278,9 +329,16 @@ bool MainWindow::StartTool(const QString& name) {
     it->second->deleteLater();
     tools_.erase(it);
   }
+  QStringList args = NameserviceArgs();
+  if (name == "plotter") args << "--model" << QString::fromStdString(link_->options().instance);
+  args << "--session" << SettingsPath();
+  // a tool that has been open before restores its own geometry from the session file
+  if (!gui_session::ReadToolWindow(SettingsPath(), name).geometry.isValid())
+    args << "--geometry" << gui_session::FormatGeometry(ArrangedGeometry(name));
+  args << tool_arguments_[name];
   auto* p = new QProcess(this);
   p->setProcessChannelMode(QProcess::ForwardedChannels);
-  p->start(program, NameserviceArgs());
+  p->start(program, args);
   if (!p->waitForStarted(3000)) {
     ShowError("could not start " + program + ": " + p->errorString());
     p->deleteLater();
@@ -289,6 +347,56 @@ bool MainWindow::StartTool(const QString& name) {
   tools_[name] = p;
   statusBar()->showMessage("started " + name, 3000);
   return true;
+}
+
+QRect MainWindow::ArrangedGeometry(const QString& name) const {
+  const QScreen* screen = this->screen() != nullptr ? this->screen() : QGuiApplication::primaryScreen();
+  const QRect area = screen != nullptr ? screen->availableGeometry() : QRect(0, 0, 1280, 800);
+  // left column: this window over the log viewer; right: the renderer over the plotter
+  const int left_width =
+      std::min(area.width() * 6 / 10, std::max(area.width() * 42 / 100, minimumSizeHint().width()));
+  const int top_height = area.height() * 62 / 100;
+  QRect cell;
+  if (name == "main")
+    cell = QRect(area.left(), area.top(), left_width, top_height);
+  else if (name == "log_viewer")
+    cell = QRect(area.left(), area.top() + top_height, left_width, area.height() - top_height);
+  else if (name == "renderer")
+    cell = QRect(area.left() + left_width, area.top(), area.width() - left_width, top_height);
+  else
+    cell = QRect(area.left() + left_width, area.top() + top_height, area.width() - left_width,
+                 area.height() - top_height);
+  // the window manager's frame (as measured on this window) goes around the client area
+  const QRect frame = frameGeometry();
+  const QRect client = geometry();
+  return cell.adjusted(client.left() - frame.left(), client.top() - frame.top(),
+                       client.right() - frame.right(), client.bottom() - frame.bottom());
+}
+
+void MainWindow::ArrangeWindows() {
+  if (isMaximized()) showNormal();
+  setGeometry(ArrangedGeometry("main"));
+  QStringList moved;
+  QStringList waiting;
+  for (const auto& [name, process] : tools_) {
+    if (process->state() != QProcess::Running) continue;
+    const gui_session::ToolWindowRecord record =
+        gui_session::ReadToolWindow(SettingsPath(), name);
+    if (record.pid != process->processId() || record.window_id == 0) {
+      waiting << name;  // started but not shown yet: it comes up in its place anyway
+      continue;
+    }
+    std::unique_ptr<QWindow> window(QWindow::fromWinId(static_cast<WId>(record.window_id)));
+    if (!window) {
+      waiting << name;
+      continue;
+    }
+    window->setGeometry(ArrangedGeometry(name));
+    moved << name;
+  }
+  QString message = "arranged " + (QStringList("main window") + moved).join(", ");
+  if (!waiting.isEmpty()) message += "; not shown yet: " + waiting.join(", ");
+  statusBar()->showMessage(message, kErrorShowMs);
 }
 
 void MainWindow::StartModel(QString path) {

@@ -13,6 +13,7 @@
 class QCloseEvent;
 class QDoubleSpinBox;
 class QProcess;
+class QRect;
 class QSettings;
 class QLabel;
 class QPushButton;
@@ -43,12 +44,24 @@ class MainWindow : public QMainWindow {
   /// Saves geometry, last model, simulation settings and open tools (closing does it too).
   void SaveSettings();
   const QString& last_model() const { return last_model_; }
-  /// Starts a tool (`renderer`) from caliper-main's bin directory as its own process.
+  /// The tools the Main Window opens: renderer, plotter, log_viewer.
+  static QStringList ToolNames();
+  /// Starts a tool from caliper-main's bin directory as its own process, on the session file;
+  /// a tool with no stored geometry is given its place in the arrangement.
   bool StartTool(const QString& name);
+  /// Extra command line arguments for a tool (e.g. the plotter's `--ids`), used when it starts.
+  void SetToolArguments(const QString& name, const QStringList& arguments);
+  /// Tiles the screen: this window and the log viewer on the left, the renderer and the
+  /// plotter on the right. Running tools are moved through their native windows.
+  void ArrangeWindows();
+  /// Where `name` (a tool, or "main") goes in the arrangement, as the window's client area.
+  QRect ArrangedGeometry(const QString& name) const;
   /// Starts caliper-model with `path` (the last model when empty; asks when there is none).
   void StartModel(QString path = QString());
   /// The names of the tools started here and still running.
   QStringList OpenTools() const;
+  /// The process id of a running tool started here, 0 when there is none.
+  long long ToolPid(const QString& name) const;
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -85,6 +98,7 @@ class MainWindow : public QMainWindow {
   QTreeWidget* components_ = nullptr;
   std::uint64_t components_version_ = 0;
   std::map<QString, QProcess*> tools_;             // tool name -> its process
+  std::map<QString, QStringList> tool_arguments_;  // tool name -> extra arguments
   QProcess* model_process_ = nullptr;              // a Model started by "Start a Model"
   QString last_model_;
   bool settings_applied_ = false;                  // saved simulation settings sent to the Model

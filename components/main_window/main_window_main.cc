@@ -1,10 +1,12 @@
 // caliper-main: the Main Window, a plain Qt client of the Model (no component lifecycle).
 //
-//   caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE] [--no-tools] [MODEL_FILE]
+//   caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE] [--no-tools]
+//                [--tools renderer,plotter,log_viewer] [--plot ID,ID,...] [--arrange] [MODEL_FILE]
 //
-// The session (window geometry, last model, simulation settings, open tools) is kept in a
-// per-user settings file, or in $CALIPER_MAIN_SETTINGS. --no-tools does not start the tools that
-// were open last time (launch/caliper starts them itself).
+// The session (window geometry, last model, simulation settings, open tools and their windows) is
+// kept in a per-user settings file, or in $CALIPER_MAIN_SETTINGS. --no-tools does not start the
+// tools that were open last time; --tools starts the ones named; --plot gives the plotter the ids
+// it shows when it has no layout of its own; --arrange tiles the windows once the tools are up.
 #include <signal.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -12,7 +14,9 @@
 #include <QApplication>
 #include <QSocketNotifier>
 #include <QFileInfo>
+#include <QTimer>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,20 +33,50 @@ void OnSignal(int) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  QApplication app(argc, argv);
   caliper::main_window::ModelLink::Options options;
   std::string model_file;
   bool restore_tools = true;
-  const QStringList args = QApplication::arguments();
+  bool arrange = false;
+  QStringList tools;
+  QStringList plot_ids;
+  // --help needs no display: looked for before Qt starts (which then takes out its own options,
+  // -geometry, -platform, ...)
+  bool help = false;
+  for (int i = 1; i < argc; ++i) help |= std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h";
+  std::unique_ptr<QApplication> app;
+  if (!help) app = std::make_unique<QApplication>(argc, argv);
+  QStringList args;
+  if (app) {
+    args = QApplication::arguments();
+  } else {
+    args << "caliper-main" << "--help";
+  }
   for (int i = 1; i < args.size(); ++i) {
     const std::string a = args[i].toStdString();
     if ((a == "--nameservice" || a == "--model") && i + 1 < args.size()) {
       (a == "--nameservice" ? options.nameservice : options.instance) = args[++i].toStdString();
     } else if (a == "--no-tools") {
       restore_tools = false;
+    } else if (a == "--arrange") {
+      arrange = true;
+    } else if ((a == "--tools" || a == "--plot") && i + 1 < args.size()) {
+      (a == "--tools" ? tools : plot_ids) = args[++i].split(',', Qt::SkipEmptyParts);
     } else if (a == "--help" || a == "-h") {
-      std::cout << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE] "
-                   "[--no-tools] [MODEL_FILE]\n";
+      std::cout
+          << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE]\n"
+             "                    [--no-tools] [--tools LIST] [--plot IDS] [--arrange] [MODEL_FILE]\n"
+             "  The Main Window: simulation control, parameters, components, and the other tools.\n"
+             "  --nameservice ADDR  the naming service (default: omniORB's configuration)\n"
+             "  --model INSTANCE    the Model's instance name (default model0)\n"
+             "  --no-tools          do not reopen the tools that were open last time\n"
+             "  --tools LIST        open these tools (comma separated: "
+          << caliper::main_window::MainWindow::ToolNames().join(",").toStdString()
+          << ")\n"
+             "  --plot IDS          ids the plotter shows when it has no saved layout\n"
+             "  --arrange           tile the main window and the tools on the screen\n"
+             "  MODEL_FILE          load this model into the Model\n"
+             "  The session is kept in $CALIPER_MAIN_SETTINGS, or else in "
+          << caliper::main_window::MainWindow::SettingsPath().toStdString() << "\n";
       return 0;
     } else if (!a.empty() && a[0] != '-') {
       model_file = a;
@@ -66,7 +100,12 @@ int main(int argc, char** argv) {
       link->LoadScene(path.toStdString());
     }
     caliper::main_window::MainWindow window(std::move(link), 5.0, nullptr, restore_tools);
+    if (!plot_ids.isEmpty()) window.SetToolArguments("plotter", {"--ids", plot_ids.join(',')});
+    if (arrange) window.setGeometry(window.ArrangedGeometry("main"));
+    for (const QString& tool : tools) window.StartTool(tool);
     window.show();
+    // the tools place themselves; arranging again once they are shown also moves restored ones
+    if (arrange) QTimer::singleShot(3000, &window, [&window] { window.ArrangeWindows(); });
     // SIGTERM/SIGINT (launch/caliper ending the session) close the window, which saves the session
     QSocketNotifier* notifier = nullptr;
     if (::socketpair(AF_UNIX, SOCK_STREAM, 0, signal_pipe) == 0) {

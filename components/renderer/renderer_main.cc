@@ -3,12 +3,14 @@
 //
 //   caliper-renderer [component options]                    an examiner viewer window
 //   caliper-renderer --screenshot FILE [--after SECONDS]    a PNG after SECONDS of wall time, exit
+//   --geometry WxH+X+Y   where the viewer window goes
+//   --session FILE       the GUI session file shared with the Main Window: the window's geometry
+//                        is restored from it (unless --geometry) and written back to it
 #include <signal.h>
 #include <unistd.h>
 
 #include <QApplication>
 
-#include <cstdio>
 #include <QTimer>
 #include <atomic>
 #include <chrono>
@@ -21,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "caliper/gui_session/tool_window.h"
 #include "caliper/logging/log.h"
 #include "caliper/render_coin/offscreen_renderer.h"
 #include "caliper/render_coin/scene_graph.h"
@@ -36,8 +39,8 @@ using namespace caliper;
 struct Options {
   std::string screenshot;  // PNG path; empty for the interactive viewer
   double after = 3.0;      // [s] of wall time before the screenshot
-  bool place = false;      // --geometry WxH+X+Y given: where the viewer window goes
-  int x = 0, y = 0, width = 0, height = 0;
+  QRect geometry;          // --geometry WxH+X+Y: where the viewer window goes (invalid: none)
+  QString session;         // --session FILE: the GUI session file
   std::vector<char*> rest;  // what RunComponent parses
 };
 
@@ -46,7 +49,7 @@ bool ParseOptions(int argc, char** argv, Options* out) {
   out->rest.push_back(argv[0]);
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--screenshot" || arg == "--after" || arg == "--geometry") {
+    if (arg == "--screenshot" || arg == "--after" || arg == "--geometry" || arg == "--session") {
       if (i + 1 >= argc) {
         std::cerr << "caliper-renderer: error: option " << arg << " needs a value\n";
         return false;
@@ -55,13 +58,13 @@ bool ParseOptions(int argc, char** argv, Options* out) {
       if (arg == "--screenshot") {
         out->screenshot = value;
       } else if (arg == "--geometry") {
-        if (std::sscanf(value.c_str(), "%dx%d+%d+%d", &out->width, &out->height, &out->x,
-                        &out->y) != 4 ||
-            out->width <= 0 || out->height <= 0) {
-          std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y\n";
+        if (!gui_session::ParseGeometry(QString::fromStdString(value), &out->geometry)) {
+          std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y, not '"
+                    << value << "'\n";
           return false;
         }
-        out->place = true;
+      } else if (arg == "--session") {
+        out->session = QString::fromStdString(value);
       } else {
         char* end = nullptr;
         out->after = std::strtod(value.c_str(), &end);
@@ -261,8 +264,11 @@ int main(int argc, char** argv) {
       request_exit();
     });
   } else {
-    if (options.place) top_level->setGeometry(options.x, options.y, options.width, options.height);
+    auto* window = new gui_session::ToolWindow(top_level, "renderer", options.session);
+    const QRect wanted = window->Restore(options.geometry);
     render_coin::Viewer::Show(top_level);
+    // SoQt sizes a top-level viewer to its own preference when showing it: place it again
+    if (wanted.isValid() && top_level->geometry() != wanted) top_level->setGeometry(wanted);
     viewer->Render();
   }
 
