@@ -10,6 +10,7 @@
 #include "caliper/model.hh"
 #include "caliper/renderer.hh"
 #include "caliper/rtc/naming.h"
+#include "support/gui_test.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -39,11 +40,6 @@ PixelCounts Count(const QImage& image) {
     }
   }
   return n;
-}
-
-std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {
-  const char* dir = std::getenv("CALIPER_ARTIFACT_DIR");
-  return (dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir) + "/" + name;
 }
 
 class Renderer : public ::testing::Test {

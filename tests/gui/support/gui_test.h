@@ -1,0 +1,26 @@
+#pragma once
+// Helpers for the GUI tests that run widgets in the test process: one QApplication, one ORB,
+// waiting while processing events, and where screenshots go.
+
+#include <QApplication>
+#include <chrono>
+#include <functional>
+#include <string>
+
+#include "caliper/rtc.hh"
+
+namespace caliper::testing {
+
+/// The process's QApplication (made on first use, on $QT_QPA_PLATFORM, offscreen when unset).
+QApplication& App();
+
+/// The process's ORB, listening on 127.0.0.1.
+CORBA::ORB_ptr Orb();
+
+/// Processes events until `condition` holds or `timeout` passes; returns its last value.
+bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds timeout);
+
+/// `name` in $CALIPER_ARTIFACT_DIR (the screenshots kept by the test run), else in `fallback_dir`.
+std::string ArtifactPath(const std::string& name, const std::string& fallback_dir);
+
+}  // namespace caliper::testing
