@@ -126,6 +126,8 @@ auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
     throw Failure(e.reason.in());
   } catch (const M::NotAvailable& e) {
     throw Failure(m.name + ": " + e.reason.in());
+  } catch (const D::NotAvailable& e) {
+    throw Failure(m.name + ": " + e.reason.in());
   } catch (const M::LoadFailed& e) {
     throw Failure(e.reason.in());
   } catch (const CORBA::UserException& e) {

@@ -49,8 +49,10 @@ class MainWindow : public QMainWindow {
   /// Starts a tool from caliper-main's bin directory as its own process, on the session file;
   /// a tool with no stored geometry is given its place in the arrangement.
   bool StartTool(const QString& name);
-  /// Extra command line arguments for a tool (e.g. the plotter's `--ids`), used when it starts.
+  /// Extra command line arguments for a tool, used whenever it starts.
   void SetToolArguments(const QString& name, const QStringList& arguments);
+  /// The ids the plotter shows when the session holds no plot layout of its own.
+  void SetDefaultPlotIds(const QStringList& ids) { default_plot_ids_ = ids; }
   /// Tiles the screen: this window and the log viewer on the left, the renderer and the
   /// plotter on the right. Running tools are moved through their native windows.
   void ArrangeWindows();
@@ -99,6 +101,7 @@ class MainWindow : public QMainWindow {
   std::uint64_t components_version_ = 0;
   std::map<QString, QProcess*> tools_;             // tool name -> its process
   std::map<QString, QStringList> tool_arguments_;  // tool name -> extra arguments
+  QStringList default_plot_ids_;
   QProcess* model_process_ = nullptr;              // a Model started by "Start a Model"
   QString last_model_;
   bool settings_applied_ = false;                  // saved simulation settings sent to the Model

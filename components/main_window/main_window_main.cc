@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       link->LoadScene(path.toStdString());
     }
     caliper::main_window::MainWindow window(std::move(link), 5.0, nullptr, restore_tools);
-    if (!plot_ids.isEmpty()) window.SetToolArguments("plotter", {"--ids", plot_ids.join(',')});
+    window.SetDefaultPlotIds(plot_ids);
     if (arrange) window.setGeometry(window.ArrangedGeometry("main"));
     for (const QString& tool : tools) window.StartTool(tool);
     window.show();

@@ -224,6 +224,8 @@ void ModelLink::Run() {
           error = what + ": " + e.reason.in();
         } catch (const M::NotAvailable& e) {
           error = what + ": " + e.reason.in();
+        } catch (const D::NotAvailable& e) {
+          error = what + ": " + e.reason.in();
         } catch (const M::LoadFailed& e) {
           error = what + ": " + e.reason.in();
         } catch (const CORBA::SystemException& e) {

@@ -125,8 +125,9 @@ std::vector<std::string> FromIdl(const S::StringSeq& ids) {
   return out;
 }
 
-/// Runs a core call and turns its C++ exceptions into the IDL's user exceptions.
-template <class F>
+/// Runs a core call and turns its C++ exceptions into the IDL's user exceptions; `Unavailable`
+/// is the operation's declared "cannot serve now" exception (Simulation's or Daq's NotAvailable).
+template <class Unavailable = M::NotAvailable, class F>
 auto Guard(F&& f) -> decltype(f()) {
   try {
     return f();
@@ -135,12 +136,12 @@ auto Guard(F&& f) -> decltype(f()) {
   } catch (const InvalidValue& e) {
     throw D::InvalidParameter(e.what());
   } catch (const NotAvailable& e) {
-    throw M::NotAvailable(e.what());
+    throw Unavailable(e.what());
   } catch (const CORBA::UserException&) {
     throw;
   } catch (const std::exception& e) {
     logging::Get("model").error("internal error: %s", e.what());
-    throw M::NotAvailable((std::string("internal error: ") + e.what()).c_str());
+    throw Unavailable((std::string("internal error: ") + e.what()).c_str());
   }
 }
 
@@ -394,10 +395,12 @@ void ModelServant::pause() { Guard([&] { core_.Pause(); }); }
 void ModelServant::stop() { Guard([&] { core_.Stop(); }); }
 void ModelServant::reset() { Guard([&] { core_.Reset(); }); }
 void ModelServant::step(CORBA::ULong n) { Guard([&] { core_.StepNow(n); }); }
-void ModelServant::set_time_step(CORBA::Double s) { Guard([&] { core_.SetTimeStep(s); }); }
+void ModelServant::set_time_step(CORBA::Double s) {
+  Guard<D::NotAvailable>([&] { core_.SetTimeStep(s); });
+}
 
 void ModelServant::set_real_time_factor(CORBA::Double f) {
-  Guard([&] { core_.SetRealTimeFactor(f); });
+  Guard<D::NotAvailable>([&] { core_.SetRealTimeFactor(f); });
 }
 
 M::SimulationStatus* ModelServant::status() {
@@ -451,14 +454,14 @@ M::ActuatorInfoSeq* ModelServant::actuators() {
 }
 
 void ModelServant::set_command(const char* actuator, CORBA::Double value) {
-  Guard([&] { core_.SetCommands({{actuator, value}}); });
+  Guard<D::NotAvailable>([&] { core_.SetCommands({{actuator, value}}); });
 }
 
 void ModelServant::set_commands(const M::CommandSeq& commands) {
   std::vector<std::pair<std::string, double>> list;
   for (CORBA::ULong i = 0; i < commands.length(); ++i)
     list.emplace_back(commands[i].actuator.in(), commands[i].value);
-  Guard([&] { core_.SetCommands(list); });
+  Guard<D::NotAvailable>([&] { core_.SetCommands(list); });
 }
 
 M::ActuatorStateSeq* ModelServant::actuator_states() {
@@ -476,11 +479,11 @@ M::ActuatorStateSeq* ModelServant::actuator_states() {
 }
 
 D::ChannelInfoSeq* ModelServant::list(const char* pattern) {
-  return Guard([&] { return ToIdl(core_.Channels(pattern)); });
+  return Guard<D::NotAvailable>([&] { return ToIdl(core_.Channels(pattern)); });
 }
 
 D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
-  return Guard([&] {
+  return Guard<D::NotAvailable>([&] {
     const auto values = core_.Sample(FromIdl(ids));
     auto* out = new D::ValueSeq;
     out->length(static_cast<CORBA::ULong>(values.size()));
@@ -492,7 +495,7 @@ D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
 void ModelServant::set(const char* id, const D::Value& value) {
   std::vector<double> values;
   for (CORBA::ULong i = 0; i < value.data.length(); ++i) values.push_back(value.data[i]);
-  Guard([&] { core_.SetChannel(id, values); });
+  Guard<D::NotAvailable>([&] { core_.SetChannel(id, values); });
 }
 
 D::ChannelInfoSeq* ModelServant::channels(const char* pattern) { return list(pattern); }
@@ -507,7 +510,7 @@ CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong e
   const double per_sample = (dt > 0 ? dt : 1e-3) * std::max<CORBA::ULong>(every_n_steps, 1);
   const size_t batch_steps = std::max<size_t>(1, static_cast<size_t>(0.05 / per_sample));
   const uint64_t id =
-      Guard([&] { return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps); });
+      Guard<D::NotAvailable>([&] { return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps); });
   std::lock_guard<std::mutex> lock(mutex_);
   DropDead();
   consumers_[id] = std::make_unique<ConsumerSender>(core_, id, consumer);

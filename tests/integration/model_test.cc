@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <regex>
@@ -23,6 +24,7 @@ namespace {
 
 namespace M = ::Caliper::Simulation;
 namespace S = ::Caliper::Scene;
+namespace D = ::Caliper::Daq;
 
 using std::chrono::milliseconds;
 using std::chrono::seconds;
@@ -431,6 +433,49 @@ TEST_F(ModelTest, UnknownIdsAndActuatorsAreNamed) {
   const auto model = Ctl({"status", "--model", "model7"});
   EXPECT_EQ(model.exit_code, 1);
   EXPECT_TRUE(Contains(model.err, "model7")) << model.err;
+}
+
+TEST_F(ModelTest, WithoutASceneEveryCallRaisesItsDeclaredNotAvailableWithTheReason) {
+  // a client sees the reason, not CORBA::UNKNOWN: each operation declares what it raises
+  S::StringSeq ids;
+  ids.length(1);
+  ids[0] = CORBA::string_dup(kMass);
+  const auto expect_daq_unavailable = [](const char* what, const std::function<void()>& call) {
+    try {
+      call();
+      ADD_FAILURE() << what << " succeeded without a scene";
+    } catch (const D::NotAvailable& e) {
+      EXPECT_TRUE(Contains(e.reason.in(), "no scene is loaded")) << what << ": " << e.reason.in();
+    } catch (const CORBA::Exception& e) {
+      ADD_FAILURE() << what << " raised " << e._name() << ", not Daq::NotAvailable";
+    }
+  };
+  expect_daq_unavailable("sample", [&] { D::ValueSeq_var v = Model()->sample(ids); });
+  expect_daq_unavailable("get", [&] { D::ValueSeq_var v = Model()->get(ids); });
+  expect_daq_unavailable("set", [&] {
+    D::Value value;
+    value.rows = value.cols = 1;
+    value.data.length(1);
+    value.data[0] = 1.0;
+    Model()->set(kMass, value);
+  });
+  expect_daq_unavailable("set_command", [&] { Model()->set_command("motor", 1.0); });
+  struct Discard : public virtual POA_Caliper::Daq::DataConsumer {
+    void on_samples(const D::SampleBatch&) override {}
+  };
+  auto* consumer = new Discard;
+  PortableServer::ObjectId_var oid = OrbEnvironment::poa()->activate_object(consumer);
+  consumer->_remove_ref();
+  CORBA::Object_var consumer_obj = OrbEnvironment::poa()->id_to_reference(oid);
+  D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(consumer_obj);
+  expect_daq_unavailable("subscribe", [&] { Model()->subscribe(ids, 1, consumer_ref); });
+  OrbEnvironment::poa()->deactivate_object(oid);
+  try {
+    Model()->start();
+    ADD_FAILURE() << "start succeeded without a scene";
+  } catch (const M::NotAvailable& e) {
+    EXPECT_TRUE(Contains(e.reason.in(), "no scene is loaded")) << e.reason.in();
+  }
 }
 
 // ------------------------------------------------------------------------ loading

@@ -11,8 +11,10 @@ QApplication& App() {
   static char name[] = "caliper_gui_test";
   static char* argv[] = {name, nullptr};
   if (std::getenv("QT_QPA_PLATFORM") == nullptr) qputenv("QT_QPA_PLATFORM", "offscreen");
-  static QApplication app(argc, argv);
-  return app;
+  // never destroyed: Qwt's widgets outlive a function-local static QApplication's destructor
+  // at exit (it would run after Qt's thread storage is gone)
+  static QApplication* app = new QApplication(argc, argv);
+  return *app;
 }
 
 CORBA::ORB_ptr Orb() {
