@@ -1,0 +1,481 @@
+#include "daq_link.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <utility>
+
+#include "caliper/model.hh"
+#include "caliper/rtc/idl_names.h"
+#include "caliper/rtc/naming.h"
+#include "data_consumer_servant.h"
+
+namespace caliper::plotter {
+
+namespace M = ::Caliper::Simulation;
+namespace D = ::Caliper::Daq;
+namespace S = ::Caliper::Scene;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr size_t kPendingBatches = 256;  // held while a subscribe call is under way
+
+CORBA::ORB_ptr ProcessOrb() {
+  int argc = 0;
+  char* argv[] = {nullptr};
+  return CORBA::ORB_init(argc, argv);
+}
+
+bool Contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+bool SameChannels(const std::vector<ChannelEntry>& a, const std::vector<ChannelEntry>& b) {
+  return std::equal(
+      a.begin(), a.end(), b.begin(), b.end(), [](const ChannelEntry& x, const ChannelEntry& y) {
+        return x.id == y.id && x.unit == y.unit && x.rows == y.rows && x.cols == y.cols &&
+               x.is_static == y.is_static && x.description == y.description;
+      });
+}
+
+bool Subset(const std::vector<std::string>& a, const std::vector<std::string>& b) {
+  return std::all_of(a.begin(), a.end(), [&](const std::string& s) { return Contains(b, s); });
+}
+
+}  // namespace
+
+/// What the servant's ORB threads and the worker share.
+struct DaqLink::Shared {
+  std::mutex mutex;      // guards everything below
+  uint64_t current = 0;  // the subscription whose batches are kept
+  std::shared_ptr<const std::vector<SubscribedId>> layout;
+  bool subscribing = false;  // a subscribe call is under way: its first batches may come early
+  std::map<uint64_t, std::deque<ReceivedBatch>> pending;
+  size_t pending_count = 0;
+  std::set<uint64_t> foreign;  // subscriptions not (or no longer) ours that still send
+  std::deque<ReceivedBatch> inbox;
+  size_t inbox_capacity = 4096;
+  uint64_t next_batch = 1;
+  uint64_t received = 0;
+  uint64_t missing = 0;
+  uint64_t dropped = 0;
+  double last_sample_time = kNaN;  // [s] of the current subscription
+  Clock::time_point last_batch_wall{};
+
+  // with the mutex held
+  void Accept(ReceivedBatch&& b) {
+    b.layout = layout;
+    if (b.number > next_batch) missing += b.number - next_batch;
+    if (b.number >= next_batch) next_batch = b.number + 1;
+    ++received;
+    if (!b.times.empty()) last_sample_time = b.times.back();
+    last_batch_wall = Clock::now();
+    inbox.push_back(std::move(b));
+    while (inbox.size() > inbox_capacity) {
+      inbox.pop_front();
+      ++dropped;
+    }
+  }
+
+  void Receive(ReceivedBatch&& b) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (current != 0 && b.subscription == current) {
+      Accept(std::move(b));
+    } else if (subscribing && pending_count < kPendingBatches) {
+      pending[b.subscription].push_back(std::move(b));
+      ++pending_count;
+    } else if (b.subscription != current) {
+      foreign.insert(b.subscription);
+    }
+  }
+};
+
+/// The worker's CORBA state; touched by the worker thread only (and the constructor).
+struct DaqLink::Impl {
+  CORBA::ORB_var orb;
+  PortableServer::POA_var poa;
+  PortableServer::ObjectId_var oid;
+  D::DataConsumer_var consumer;
+  M::Model_var model;
+  Clock::time_point last_lookup{};
+  Clock::time_point last_listing{};
+  bool channels_listed = false;
+  std::string scene;  // the scene the channel list belongs to
+  uint64_t steps = 0;
+  std::vector<ChannelEntry> channels;
+  std::vector<std::string> subscribed;  // ids of the current subscription
+  uint32_t subscribed_every = 0;
+  double watch_time = 0;           // [s] simulated time of the last sign of life of the stream
+  Clock::time_point watch_wall{};  // and when it was seen
+};
+
+DaqLink::DaqLink(Options options)
+    : options_(std::move(options)),
+      impl_(std::make_unique<Impl>()),
+      shared_(std::make_shared<Shared>()) {
+  shared_->inbox_capacity = std::max<size_t>(1, options_.inbox_batches);
+  status_.instance = options_.instance;
+  status_.message = "no Model: looking for " + options_.instance + " ...";
+  Impl& i = *impl_;
+  i.orb = ProcessOrb();
+  CORBA::Object_var obj = i.orb->resolve_initial_references("RootPOA");
+  i.poa = PortableServer::POA::_narrow(obj);
+  i.poa->the_POAManager()->activate();
+  std::shared_ptr<Shared> shared = shared_;
+  auto* servant =
+      new DataConsumerServant([shared](ReceivedBatch&& b) { shared->Receive(std::move(b)); });
+  PortableServer::ServantBase_var owner = servant;  // the POA keeps its own reference
+  i.oid = i.poa->activate_object(servant);
+  CORBA::Object_var ref = i.poa->id_to_reference(i.oid);
+  i.consumer = D::DataConsumer::_narrow(ref);
+  worker_ = std::thread([this] { Run(); });
+}
+
+DaqLink::~DaqLink() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+  try {
+    impl_->poa->deactivate_object(impl_->oid);
+  } catch (const CORBA::Exception&) {
+    // the ORB is shutting down: nothing to deactivate any more
+  }
+}
+
+LinkStatus DaqLink::status() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  LinkStatus s = status_;
+  std::lock_guard<std::mutex> shared_lock(shared_->mutex);
+  s.batches_received = shared_->received;
+  s.batches_missing = shared_->missing;
+  s.batches_dropped = shared_->dropped;
+  return s;
+}
+
+void DaqLink::Want(std::vector<std::string> ids, uint32_t every_n_steps) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const uint32_t every = std::max<uint32_t>(1, every_n_steps);
+    if (ids == wanted_ && every == every_n_steps_) return;
+    wanted_ = std::move(ids);
+    every_n_steps_ = every;
+    ++wanted_version_;
+  }
+  wake_.notify_all();
+}
+
+std::vector<ReceivedBatch> DaqLink::TakeBatches() {
+  std::lock_guard<std::mutex> lock(shared_->mutex);
+  std::vector<ReceivedBatch> out(std::make_move_iterator(shared_->inbox.begin()),
+                                 std::make_move_iterator(shared_->inbox.end()));
+  shared_->inbox.clear();
+  return out;
+}
+
+void DaqLink::Relist() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    relist_ = true;
+  }
+  wake_.notify_all();
+}
+
+void DaqLink::Run() {
+  // per-thread call timeouts need an omni_thread
+  omni_thread* self = omni_thread::create_dummy();
+  Impl& i = *impl_;
+  Shared& sh = *shared_;
+  const auto timeout_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
+  omniORB::setClientConnectTimeout(timeout_ms);
+  omniORB::setClientThreadCallTimeout(timeout_ms);
+  const auto period = std::chrono::milliseconds(options_.poll_period_ms);
+  auto next_poll = Clock::now();
+  uint64_t seen_version = 0;
+
+  auto set_message = [&](const std::string& message) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_.message = message;
+  };
+
+  // forgets the Model after a system exception: it is looked up again
+  auto lost = [&](const std::string& why) {
+    i.model = M::Model::_nil();
+    i.channels_listed = false;
+    i.subscribed.clear();
+    {
+      std::lock_guard<std::mutex> lock(sh.mutex);
+      sh.current = 0;
+      sh.layout.reset();
+      sh.subscribing = false;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_.connected = false;
+    status_.state.clear();
+    status_.subscription = 0;
+    status_.subscribed.clear();
+    status_.missing.clear();
+    status_.message = "no Model reachable: " + why;
+  };
+
+  // ends the current subscription and makes one for `ids` (none when empty); a system exception
+  // propagates (the Model is gone)
+  auto resubscribe = [&](const std::vector<std::string>& ids, uint32_t every, double sim_time) {
+    uint64_t old = 0;
+    {
+      std::lock_guard<std::mutex> lock(sh.mutex);
+      old = sh.current;
+      sh.current = 0;
+      sh.layout.reset();
+    }
+    i.subscribed.clear();
+    if (old != 0) {
+      try {
+        i.model->unsubscribe(old);
+      } catch (const CORBA::UserException&) {
+        // gone already
+      }
+    }
+    if (ids.empty()) return;
+
+    auto layout = std::make_shared<std::vector<SubscribedId>>();
+    size_t offset = 0;
+    S::StringSeq seq;
+    seq.length(static_cast<CORBA::ULong>(ids.size()));
+    for (size_t k = 0; k < ids.size(); ++k) {
+      const auto c = std::find_if(i.channels.begin(), i.channels.end(),
+                                  [&](const ChannelEntry& e) { return e.id == ids[k]; });
+      SubscribedId s{ids[k], c->unit, c->rows, c->cols, offset};
+      offset += static_cast<size_t>(c->rows) * c->cols;
+      layout->push_back(s);
+      seq[static_cast<CORBA::ULong>(k)] = ids[k].c_str();
+    }
+    {
+      std::lock_guard<std::mutex> lock(sh.mutex);
+      sh.subscribing = true;
+      sh.pending.clear();
+      sh.pending_count = 0;
+    }
+    // whatever happens, the batches held meanwhile are settled
+    auto settle = [&](uint64_t id) {
+      std::lock_guard<std::mutex> lock(sh.mutex);
+      sh.subscribing = false;
+      if (id != 0) {
+        sh.current = id;
+        sh.layout = layout;
+        sh.next_batch = 1;
+        sh.last_sample_time = kNaN;
+        sh.last_batch_wall = Clock::now();
+      }
+      for (auto& [sub, batches] : sh.pending) {
+        if (sub == id) {
+          for (auto& b : batches) sh.Accept(std::move(b));
+        } else {
+          sh.foreign.insert(sub);
+        }
+      }
+      sh.pending.clear();
+      sh.pending_count = 0;
+    };
+    CORBA::ULongLong id = 0;
+    try {
+      id = i.model->subscribe(seq, every, i.consumer);
+    } catch (const D::UnknownId& e) {
+      settle(0);
+      i.channels_listed = false;  // the scene changed under us: list again
+      set_message("subscribing: " + std::string(e.reason.in()));
+      return;
+    } catch (const D::InvalidParameter& e) {
+      settle(0);
+      set_message("subscribing: " + std::string(e.reason.in()));
+      return;
+    } catch (const D::NotAvailable& e) {
+      settle(0);
+      set_message("the Model takes no subscription now: " + std::string(e.reason.in()));
+      return;
+    } catch (...) {
+      settle(0);
+      throw;
+    }
+    settle(id);
+    i.subscribed = ids;
+    i.subscribed_every = every;
+    i.watch_time = sim_time;
+    i.watch_wall = Clock::now();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++status_.subscriptions_made;
+    status_.message.clear();
+  };
+
+  for (;;) {
+    std::vector<std::string> wanted;
+    uint32_t every = 1;
+    bool relist_asked = false;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait_until(lock, next_poll, [&] {
+        return stopping_ || relist_ || (wanted_version_ != seen_version && !CORBA::is_nil(i.model));
+      });
+      if (stopping_) break;
+      wanted = wanted_;
+      every = every_n_steps_;
+      seen_version = wanted_version_;
+      relist_asked = relist_;
+      relist_ = false;
+    }
+    next_poll = Clock::now() + period;
+    omniORB::setClientThreadCallTimeout(timeout_ms);
+
+    // look the Model up (not more often than the reconnect period)
+    if (CORBA::is_nil(i.model)) {
+      if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
+        continue;
+      i.last_lookup = Clock::now();
+      try {
+        CosNaming::NamingContext_var root =
+            rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
+        M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+        if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
+        i.model = model;
+        i.channels_listed = false;
+        i.steps = 0;
+      } catch (const CORBA::Exception& e) {
+        lost(rtc::Describe(e));
+        continue;
+      } catch (const std::exception& e) {
+        lost(e.what());
+        continue;
+      }
+    }
+
+    try {
+      M::SimulationStatus_var s = i.model->status();
+      const std::string scene = s->scene.in();
+      const bool rewound = s->steps < i.steps;
+      i.steps = s->steps;
+      {
+        // subscriptions that are not ours any more but still send: end them
+        std::set<uint64_t> foreign;
+        {
+          std::lock_guard<std::mutex> lock(sh.mutex);
+          foreign.swap(sh.foreign);
+          foreign.erase(sh.current);
+        }
+        for (const uint64_t f : foreign) i.model->unsubscribe(f);
+      }
+
+      bool listed = false;
+      const bool due =
+          Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.relist_period_ms);
+      if (!i.channels_listed || scene != i.scene || rewound || relist_asked || due) {
+        D::ChannelInfoSeq_var infos = i.model->channels("*");
+        std::vector<ChannelEntry> channels;
+        channels.reserve(infos->length());
+        for (CORBA::ULong k = 0; k < infos->length(); ++k) {
+          const D::ChannelInfo& c = infos[k];
+          channels.push_back(ChannelEntry{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.is_static),
+                                          c.description.in()});
+        }
+        // a periodic listing that finds nothing new changes nothing for the GUI
+        listed = !i.channels_listed || !SameChannels(channels, i.channels);
+        i.channels = std::move(channels);
+        i.channels_listed = true;
+        i.scene = scene;
+        i.last_listing = Clock::now();
+      }
+
+      // the wanted ids the Model has (in the order wanted) and those it has not
+      std::vector<std::string> target, missing;
+      for (const auto& id : wanted) {
+        const bool known = std::any_of(i.channels.begin(), i.channels.end(),
+                                       [&](const ChannelEntry& c) { return c.id == id; });
+        (known ? target : missing).push_back(id);
+      }
+      uint64_t current = 0;
+      double last_sample = kNaN;
+      Clock::time_point last_batch_wall;
+      {
+        std::lock_guard<std::mutex> lock(sh.mutex);
+        current = sh.current;
+        last_sample = sh.last_sample_time;
+        last_batch_wall = sh.last_batch_wall;
+      }
+      // ids that vanished stay subscribed (their values come as NaN, marked stale, and come back
+      // when a scene has them again); a new wanted id, a removed one or a new rate subscribe anew
+      bool renew = (current == 0 && !target.empty()) || !Subset(target, i.subscribed) ||
+                   !Subset(i.subscribed, wanted) || (current != 0 && every != i.subscribed_every);
+      std::string why;
+      // a stream gone quiet while the Model runs (e.g. the Model dropped us): subscribe again
+      if (current != 0) {
+        if (!std::isnan(last_sample) && last_sample <= s->sim_time &&
+            last_batch_wall > i.watch_wall) {
+          i.watch_time = last_sample;
+          i.watch_wall = last_batch_wall;
+        }
+        if (s->sim_time < i.watch_time) {  // rewound
+          i.watch_time = s->sim_time;
+          i.watch_wall = Clock::now();
+        }
+        const double quiet_wall =
+            std::chrono::duration<double>(Clock::now() - i.watch_wall).count();
+        if (s->state == M::RUNNING && s->sim_time - i.watch_time > options_.silence_s &&
+            quiet_wall > options_.silence_s) {
+          renew = true;
+          why = "no samples for " + std::to_string(s->sim_time - i.watch_time) +
+                " s of simulated time: subscribed again";
+        }
+      }
+      if (renew) resubscribe(target, every, s->sim_time);
+
+      std::lock_guard<std::mutex> lock(mutex_);
+      status_.connected = true;
+      if (!why.empty()) status_.message = why;
+      if (status_.message.rfind("no Model", 0) == 0) status_.message.clear();
+      status_.state = rtc::Name(s->state);
+      status_.scene = scene;
+      status_.sim_time = s->sim_time;
+      status_.time_step = s->time_step;
+      if (listed) {
+        status_.channels = i.channels;
+        ++status_.channels_version;
+      }
+      status_.subscribed = i.subscribed;
+      status_.missing = missing;
+      {
+        std::lock_guard<std::mutex> shared_lock(sh.mutex);
+        status_.subscription = sh.current;
+      }
+    } catch (const CORBA::SystemException& e) {
+      lost(rtc::Describe(e));
+    } catch (const CORBA::Exception& e) {
+      lost(rtc::Describe(e));
+    }
+  }
+
+  // closing: end the subscription so that the Model stops sending
+  uint64_t current = 0;
+  {
+    std::lock_guard<std::mutex> lock(sh.mutex);
+    current = sh.current;
+    sh.current = 0;
+  }
+  if (current != 0 && !CORBA::is_nil(i.model)) {
+    try {
+      i.model->unsubscribe(current);
+    } catch (const CORBA::Exception&) {
+      // the Model is gone: it sends nothing more either way
+    }
+  }
+  i.model = M::Model::_nil();
+  if (self != nullptr) omni_thread::release_dummy();
+}
+
+}  // namespace caliper::plotter

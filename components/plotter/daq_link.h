@@ -1,0 +1,127 @@
+#pragma once
+// The Graph Plotter's connection to the Model's data acquisition: a worker thread that finds the
+// Model (`model0`) in the naming service, lists its channels, keeps one DAQ subscription for the
+// ids being plotted and re-makes it when the ids change, when the Model is restarted or reloaded,
+// or when batches stop coming while the Model runs. The Model pushes sample batches to a
+// DataConsumer servant in this process; they wait in an inbox until the GUI takes them. The GUI
+// only reads status snapshots, takes batches and says which ids it wants, so a dead or slow Model
+// never blocks it. No Qt here; CORBA stays in the .cc files.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace caliper::plotter {
+
+/// One of the Model's DAQ channels.
+struct ChannelEntry {
+  std::string id;     ///< e.g. pendulum_tendon.pivot.position
+  std::string unit;   ///< SI unit, "" for none
+  unsigned rows = 1;  ///< shape of the value
+  unsigned cols = 1;
+  bool is_static = false;  ///< a parameter (true) or a state changing every step (false)
+  std::string description;
+};
+
+/// Where one subscribed id's values sit within a sample of the subscription's batches.
+struct SubscribedId {
+  std::string id;
+  std::string unit;
+  unsigned rows = 1;
+  unsigned cols = 1;
+  size_t offset = 0;  ///< index of its first value within a sample
+};
+
+/// A batch of samples of the current subscription, without CORBA.
+struct ReceivedBatch {
+  uint64_t subscription = 0;
+  uint64_t number = 0;                                      ///< 1, 2, 3, ... per subscription
+  std::shared_ptr<const std::vector<SubscribedId>> layout;  ///< the subscription's ids
+  std::vector<double> times;                                ///< simulated time of each sample [s]
+  size_t values_per_sample = 0;
+  std::vector<double> data;            ///< times.size() * values_per_sample values
+  std::vector<std::string> stale_ids;  ///< subscribed ids the Model no longer has (NaN)
+};
+
+/// What the GUI reads: a copy of what the worker last learnt.
+struct LinkStatus {
+  bool connected = false;         ///< the Model answered the last poll
+  std::string message;            ///< why not connected, or the last problem
+  std::string instance;           ///< the Model's instance name
+  std::string state;              ///< EMPTY, STOPPED, RUNNING, PAUSED, FAULTED
+  std::string scene;              ///< file of the loaded scene
+  double sim_time = 0;            ///< [s]
+  double time_step = 0;           ///< [s]
+  uint64_t channels_version = 0;  ///< changes whenever `channels` is listed anew
+  std::vector<ChannelEntry> channels;
+  std::vector<std::string> subscribed;  ///< ids of the current subscription
+  std::vector<std::string> missing;     ///< wanted ids the connected Model does not have
+  uint64_t subscription = 0;            ///< the current subscription (0: none)
+  uint64_t subscriptions_made = 0;      ///< counts successful subscribe calls
+  uint64_t batches_received = 0;        ///< of the current subscriptions, since start
+  uint64_t batches_missing = 0;         ///< batch numbers skipped (the Model dropped them)
+  uint64_t batches_dropped = 0;         ///< dropped here: the GUI took none for too long
+};
+
+/// The worker, its subscription and its inbox. Every method returns at once.
+class DaqLink {
+ public:
+  struct Options {
+    std::string nameservice;          ///< corbaname::HOST:PORT; "" for the default
+    std::string instance = "model0";  ///< the Model's instance name
+    int call_timeout_ms = 1500;       ///< every call to the Model and the naming service
+    int poll_period_ms = 250;         ///< status (and channels when the scene changed)
+    int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
+    int relist_period_ms = 5000;      ///< listing the channels again (also on a new scene)
+    /// Re-subscribe when the Model runs and this much simulated time passed without a batch [s].
+    double silence_s = 2.0;
+    size_t inbox_batches = 4096;  ///< batches kept for the GUI before the oldest are dropped
+  };
+
+  /// Uses the process's ORB (initialises one when there is none), activates the consumer servant
+  /// in its RootPOA and starts the worker.
+  explicit DaqLink(Options options);
+  /// Ends the subscription (at most the call timeout) and stops the worker.
+  ~DaqLink();
+  DaqLink(const DaqLink&) = delete;
+  DaqLink& operator=(const DaqLink&) = delete;
+
+  /// A copy of the latest status (cheap enough for a few calls a second).
+  LinkStatus status() const;
+  /// The ids to stream (whole DAQ ids, not elements) and one sample every `every_n_steps` steps;
+  /// the worker subscribes anew when they differ from the current subscription.
+  void Want(std::vector<std::string> ids, uint32_t every_n_steps);
+  /// Moves out the batches received since the last call, oldest first.
+  std::vector<ReceivedBatch> TakeBatches();
+  /// Lists the channels again at the next poll.
+  void Relist();
+
+  /// The options it was made with.
+  const Options& options() const { return options_; }
+
+  struct Impl;    ///< the worker's CORBA state
+  struct Shared;  ///< shared with the consumer servant
+
+ private:
+  void Run();
+
+  Options options_;
+  std::unique_ptr<Impl> impl_;
+  std::shared_ptr<Shared> shared_;
+  mutable std::mutex mutex_;  // guards the fields below
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool relist_ = false;
+  std::vector<std::string> wanted_;
+  uint32_t every_n_steps_ = 1;
+  uint64_t wanted_version_ = 0;
+  LinkStatus status_;
+  std::thread worker_;
+};
+
+}  // namespace caliper::plotter

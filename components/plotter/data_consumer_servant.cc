@@ -1,0 +1,29 @@
+#include "data_consumer_servant.h"
+
+#include <exception>
+
+namespace caliper::plotter {
+
+DataConsumerServant::DataConsumerServant(std::function<void(ReceivedBatch&&)> sink)
+    : sink_(std::move(sink)) {}
+
+void DataConsumerServant::on_samples(const Caliper::Daq::SampleBatch& batch) {
+  try {
+    ReceivedBatch b;
+    b.subscription = batch.subscription;
+    b.number = batch.batch;
+    b.values_per_sample = batch.values_per_sample;
+    b.times.assign(batch.times.get_buffer(), batch.times.get_buffer() + batch.times.length());
+    b.data.assign(batch.data.get_buffer(), batch.data.get_buffer() + batch.data.length());
+    for (CORBA::ULong i = 0; i < batch.stale_ids.length(); ++i)
+      b.stale_ids.emplace_back(batch.stale_ids[i].in());
+    // a short data array would be read past its end: keep the whole samples only
+    if (b.values_per_sample > 0 && b.data.size() < b.times.size() * b.values_per_sample)
+      b.times.resize(b.data.size() / b.values_per_sample);
+    sink_(std::move(b));
+  } catch (const std::exception&) {
+    // out of memory or a failing sink: this batch is lost, the next one may not be
+  }
+}
+
+}  // namespace caliper::plotter

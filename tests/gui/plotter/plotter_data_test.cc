@@ -1,0 +1,384 @@
+// The Graph Plotter's data class on its own (no Qt, no CORBA): the ring buffer and its cap, time
+// window queries, rewinds, min/max thinning for drawing, CSV export of every sample with units,
+// layouts written and read back (and rejected with the line named), stale series.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "csv_export.h"
+#include "decimate.h"
+#include "plot_layout.h"
+#include "sample_store.h"
+
+namespace caliper::plotter {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Appends samples t = first*dt ... with one value per series: value(series, i).
+template <typename F>
+void Fill(SampleStore* store, size_t first, size_t count, double dt, F value) {
+  const size_t n = store->series_count();
+  std::vector<double> times, data;
+  std::vector<SampleStore::Column> columns;
+  for (size_t s = 0; s < n; ++s) columns.push_back({s, s});
+  for (size_t i = first; i < first + count; ++i) {
+    times.push_back(static_cast<double>(i) * dt);
+    for (size_t s = 0; s < n; ++s) data.push_back(value(s, i));
+  }
+  store->Append(times.data(), count, data.data(), n, columns);
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::vector<std::string> Fields(const std::string& line) {
+  std::vector<std::string> f;
+  std::istringstream in(line);
+  for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+  return f;
+}
+
+TEST(SampleStoreTest, KeepsTheNewestSamplesUpToItsCapacity) {
+  SampleStore store(1000);
+  store.AddSeries("a.x", "m");
+  Fill(&store, 1, 2500, 0.001, [](size_t, size_t i) { return static_cast<double>(i); });
+  ASSERT_EQ(store.size(), 1000u);
+  EXPECT_EQ(store.samples_appended(), 2500u);
+  EXPECT_EQ(store.samples_overwritten(), 1500u);
+  // the oldest held is sample 1501, the newest 2500, in order across the ring's seam
+  EXPECT_DOUBLE_EQ(store.value(0, 0), 1501.0);
+  EXPECT_DOUBLE_EQ(store.value(0, 999), 2500.0);
+  for (size_t i = 1; i < store.size(); ++i) {
+    ASSERT_GT(store.time(i), store.time(i - 1)) << i;
+    ASSERT_DOUBLE_EQ(store.value(0, i), store.value(0, i - 1) + 1) << i;
+  }
+  EXPECT_DOUBLE_EQ(store.first_time(), 1.501);
+  EXPECT_DOUBLE_EQ(store.last_time(), 2.5);
+}
+
+TEST(SampleStoreTest, ShrinkingTheCapacityKeepsTheNewestAndGrowingKeepsAll) {
+  SampleStore store(1000);
+  store.AddSeries("a", "");
+  Fill(&store, 1, 1700, 0.001, [](size_t, size_t i) { return static_cast<double>(i); });
+  store.SetCapacity(300);
+  ASSERT_EQ(store.size(), 300u);
+  EXPECT_DOUBLE_EQ(store.value(0, 0), 1401.0);
+  EXPECT_DOUBLE_EQ(store.value(0, 299), 1700.0);
+  store.SetCapacity(5000);
+  Fill(&store, 1701, 100, 0.001, [](size_t, size_t i) { return static_cast<double>(i); });
+  ASSERT_EQ(store.size(), 400u);
+  EXPECT_DOUBLE_EQ(store.value(0, 399), 1800.0);
+  EXPECT_THROW(store.SetCapacity(0), std::invalid_argument);
+  EXPECT_THROW(SampleStore(0), std::invalid_argument);
+}
+
+TEST(SampleStoreTest, IndexRangeFindsTheSamplesOfATimeWindow) {
+  SampleStore store(500);
+  store.AddSeries("a", "");
+  Fill(&store, 1, 800, 0.01, [](size_t, size_t i) { return static_cast<double>(i); });
+  // held: t = 3.01 .. 8.00 (ring wrapped)
+  auto [first, last] = store.IndexRange(5.0, 6.0);
+  EXPECT_DOUBLE_EQ(store.time(first), 5.0);
+  EXPECT_DOUBLE_EQ(store.time(last - 1), 6.0);
+  EXPECT_EQ(last - first, 101u);
+  std::tie(first, last) = store.IndexRange(0.0, 3.5);
+  EXPECT_EQ(first, 0u);
+  EXPECT_DOUBLE_EQ(store.time(last - 1), 3.5);
+  std::tie(first, last) = store.IndexRange(9.0, 10.0);
+  EXPECT_EQ(first, last);
+  std::tie(first, last) = store.IndexRange(6.0, 5.0);
+  EXPECT_EQ(first, last);
+}
+
+TEST(SampleStoreTest, ATimeGoingBackStartsTheBufferAnewAndDuplicatesAreSkipped) {
+  SampleStore store(100);
+  store.AddSeries("a", "");
+  Fill(&store, 1, 50, 0.001, [](size_t, size_t) { return 1.0; });
+  const double again[] = {0.050, 0.051};
+  const double values[] = {7, 8};
+  auto r = store.Append(again, 2, values, 1, {{0, 0}});
+  EXPECT_EQ(r.duplicates, 1u);
+  EXPECT_EQ(r.appended, 1u);
+  EXPECT_FALSE(r.rewound);
+  EXPECT_EQ(store.size(), 51u);
+  // a reset: t = 0.001 again
+  const double rewound[] = {0.001, 0.002};
+  r = store.Append(rewound, 2, values, 1, {{0, 0}});
+  EXPECT_TRUE(r.rewound);
+  EXPECT_EQ(store.rewinds(), 1u);
+  ASSERT_EQ(store.size(), 2u);
+  EXPECT_DOUBLE_EQ(store.value(0, 0), 7.0);
+  EXPECT_DOUBLE_EQ(store.first_time(), 0.001);
+}
+
+TEST(SampleStoreTest, ClearDropsSamplesKeepsSeriesAndTheRingWorksAfterwards) {
+  for (const size_t before : {30u, 250u}) {  // growing and full (wrapped) buffers
+    SCOPED_TRACE(before);
+    SampleStore store(100);
+    store.AddSeries("a", "");
+    Fill(&store, 1, before, 0.001, [](size_t, size_t i) { return static_cast<double>(i); });
+    const uint64_t version = store.version();
+    store.Clear();
+    EXPECT_NE(store.version(), version);
+    EXPECT_TRUE(store.empty());
+    EXPECT_TRUE(std::isnan(store.last_time()));
+    EXPECT_EQ(store.series_count(), 1u);
+    Fill(&store, 1000, 150, 0.001, [](size_t, size_t i) { return static_cast<double>(i); });
+    ASSERT_EQ(store.size(), 100u);
+    for (size_t i = 0; i < store.size(); ++i) ASSERT_DOUBLE_EQ(store.value(0, i), 1050.0 + i);
+  }
+}
+
+TEST(SampleStoreTest, ASeriesAddedLaterHasNaNForTheSamplesBefore) {
+  SampleStore store(100);
+  store.AddSeries("a", "m");
+  Fill(&store, 1, 10, 0.1, [](size_t, size_t) { return 1.0; });
+  EXPECT_EQ(store.AddSeries("a", ""), 0u) << "an existing key keeps its index";
+  EXPECT_EQ(store.series(0).unit, "m") << "and its unit when none is given";
+  const size_t b = store.AddSeries("b", "N");
+  EXPECT_EQ(b, 1u);
+  EXPECT_TRUE(std::isnan(store.value(b, 9)));
+  const double t[] = {1.1};
+  const double v[] = {3.0, 4.0};
+  store.Append(t, 1, v, 2, {{0, 0}, {1, 1}});
+  EXPECT_DOUBLE_EQ(store.value(b, 10), 4.0);
+  EXPECT_THROW(store.Append(t, 1, v, 2, {{0, 2}}), std::invalid_argument);
+  EXPECT_THROW(store.Append(t, 1, v, 2, {{5, 0}}), std::invalid_argument);
+  EXPECT_TRUE(store.RemoveSeries("a"));
+  EXPECT_FALSE(store.RemoveSeries("a"));
+  EXPECT_EQ(store.Find("b"), 0);
+  EXPECT_DOUBLE_EQ(store.value(0, 10), 4.0);
+}
+
+TEST(SampleStoreTest, StaleMarksASeriesAndChangesTheVersion) {
+  SampleStore store(10);
+  const size_t a = store.AddSeries("pendulum.angle", "rad");
+  EXPECT_FALSE(store.series(a).stale);
+  const uint64_t v0 = store.version();
+  store.SetStale(a, true);
+  EXPECT_TRUE(store.series(a).stale);
+  EXPECT_GT(store.version(), v0);
+  const uint64_t v1 = store.version();
+  store.SetStale(a, true);
+  EXPECT_EQ(store.version(), v1) << "no change, no new version";
+  store.SetStale(a, false);
+  EXPECT_FALSE(store.series(a).stale);
+}
+
+TEST(SampleStoreTest, KeysSplitIntoIdAndElementIndices) {
+  EXPECT_EQ(SplitKey("a.b").id, "a.b");
+  EXPECT_TRUE(SplitKey("a.b").indices.empty());
+  const KeyParts v = SplitKey("arm.hand.position[2]");
+  EXPECT_EQ(v.id, "arm.hand.position");
+  EXPECT_EQ(v.indices, std::vector<unsigned>{2});
+  const KeyParts m = SplitKey("arm.hand.rotation[1][0]");
+  EXPECT_EQ(m.id, "arm.hand.rotation");
+  EXPECT_EQ(m.indices, (std::vector<unsigned>{1, 0}));
+  EXPECT_EQ(SplitKey("odd[x]").id, "odd[x]");
+  EXPECT_EQ(ElementOffset(SplitKey("s"), 1, 1), 0);
+  EXPECT_EQ(ElementOffset(SplitKey("v"), 3, 1), -1) << "a vector needs an index";
+  EXPECT_EQ(ElementOffset(SplitKey("v[2]"), 3, 1), 2);
+  EXPECT_EQ(ElementOffset(SplitKey("v[3]"), 3, 1), -1);
+  EXPECT_EQ(ElementOffset(SplitKey("m[1][2]"), 3, 3), 5);
+  EXPECT_EQ(ElementOffset(SplitKey("m[4]"), 3, 3), -1) << "a matrix needs two indices";
+}
+
+// ------------------------------------------------------------------------ thinning
+
+TEST(DecimateTest, KeepsEverySampleWhenThereAreFewPerColumn) {
+  SampleStore store(1000);
+  store.AddSeries("a", "");
+  Fill(&store, 0, 100, 0.01, [](size_t, size_t i) { return std::sin(0.1 * i); });
+  DrawPoints p;
+  Decimate(store, 0, 0.0, 0.99, 500, &p);
+  ASSERT_EQ(p.t.size(), 100u);
+  EXPECT_EQ(p.samples, 100u);
+  for (size_t i = 0; i < 100; ++i) EXPECT_DOUBLE_EQ(p.v[i], std::sin(0.1 * i));
+}
+
+TEST(DecimateTest, AMillionPointsBecomeAboutTwoPerPixelKeepingEachColumnsMinAndMax) {
+  constexpr size_t kN = 1'000'000;
+  constexpr int kColumns = 1000;
+  SampleStore store(kN);
+  store.AddSeries("noisy", "N");
+  // a slow sine with a one-sample spike up at 400,000 and down at 700,001
+  Fill(&store, 0, kN, 1e-4, [](size_t, size_t i) {
+    if (i == 400'000) return 50.0;
+    if (i == 700'001) return -60.0;
+    return std::sin(1e-5 * static_cast<double>(i));
+  });
+  DrawPoints p;
+  const double t0 = store.first_time(), t1 = store.last_time();
+  Decimate(store, 0, t0, t1, kColumns, &p);
+  EXPECT_EQ(p.samples, kN);
+  EXPECT_LE(p.t.size(), 2u * kColumns);
+  EXPECT_GE(p.t.size(), 2u * kColumns - 10) << "about two points per pixel column";
+  EXPECT_DOUBLE_EQ(p.v_max, 50.0);
+  EXPECT_DOUBLE_EQ(p.v_min, -60.0);
+  // the spikes survive at their own times
+  bool up = false, down = false;
+  for (size_t k = 0; k < p.t.size(); ++k) {
+    if (p.v[k] == 50.0) up = std::abs(p.t[k] - 40.0) < 1e-9;
+    if (p.v[k] == -60.0) down = std::abs(p.t[k] - 70.0001) < 1e-9;
+  }
+  EXPECT_TRUE(up);
+  EXPECT_TRUE(down);
+  // every column's min and max (over all samples) are exactly the min and max of its points
+  const double scale = kColumns / (t1 - t0);
+  auto column = [&](double t) { return std::min<long>(kColumns - 1, long((t - t0) * scale)); };
+  std::vector<double> lo(kColumns, 1e300), hi(kColumns, -1e300);
+  store.ForEach(0, 0, store.size(), [&](double t, double v) {
+    lo[column(t)] = std::min(lo[column(t)], v);
+    hi[column(t)] = std::max(hi[column(t)], v);
+  });
+  std::vector<double> plo(kColumns, 1e300), phi(kColumns, -1e300);
+  for (size_t k = 0; k < p.t.size(); ++k) {
+    plo[column(p.t[k])] = std::min(plo[column(p.t[k])], p.v[k]);
+    phi[column(p.t[k])] = std::max(phi[column(p.t[k])], p.v[k]);
+  }
+  for (int c = 0; c < kColumns; ++c) {
+    ASSERT_EQ(plo[c], lo[c]) << "column " << c;
+    ASSERT_EQ(phi[c], hi[c]) << "column " << c;
+  }
+  for (size_t k = 1; k < p.t.size(); ++k) ASSERT_LT(p.t[k - 1], p.t[k]) << k;
+}
+
+TEST(DecimateTest, AddsTheNeighboursOutsideTheWindowAndSkipsNaN) {
+  SampleStore store(100);
+  store.AddSeries("a", "");
+  Fill(&store, 0, 100, 0.1, [](size_t, size_t i) { return i == 50 ? kNaN : double(i); });
+  DrawPoints p;
+  Decimate(store, 0, 4.0, 6.0, 1000, &p);
+  ASSERT_FALSE(p.t.empty());
+  EXPECT_DOUBLE_EQ(p.t.front(), 3.9);
+  EXPECT_DOUBLE_EQ(p.t.back(), 6.1);
+  EXPECT_EQ(p.t.size(), 2u + 21u - 1u) << "the NaN at t = 5 is not drawn";
+  for (double v : p.v) EXPECT_FALSE(std::isnan(v));
+  EXPECT_DOUBLE_EQ(p.v_min, 40.0);
+  EXPECT_DOUBLE_EQ(p.v_max, 60.0);
+}
+
+// ------------------------------------------------------------------------ CSV
+
+TEST(CsvExportTest, WritesTimeAndOneColumnPerCurveWithUnitsAndEverySample) {
+  SampleStore store(5000);
+  store.AddSeries("pendulum.angle", "rad");
+  store.AddSeries("motor.current", "A");
+  store.AddSeries("motor.gear_ratio", "");
+  Fill(&store, 1, 4321, 0.001, [](size_t s, size_t i) { return (s + 1) * 0.5 * i; });
+  std::ostringstream out;
+  EXPECT_EQ(WriteCsv(store, {0, 1, 2}, out), 4321u);
+  const auto lines = Lines(out.str());
+  ASSERT_EQ(lines.size(), 4322u);
+  EXPECT_EQ(lines[0], "time [s],pendulum.angle [rad],motor.current [A],motor.gear_ratio [-]");
+  for (size_t r = 1; r < lines.size(); ++r) {
+    const auto f = Fields(lines[r]);
+    ASSERT_EQ(f.size(), 4u) << lines[r];
+    ASSERT_DOUBLE_EQ(std::stod(f[0]), r * 0.001) << "exact round trip of the time";
+    ASSERT_DOUBLE_EQ(std::stod(f[2]), 1.0 * r);
+  }
+  // a subset, in the order asked; NaN where a series has no value
+  SampleStore late(10);
+  late.AddSeries("a", "m");
+  Fill(&late, 1, 2, 1.0, [](size_t, size_t) { return 1.0; });
+  late.AddSeries("b", "m");
+  std::ostringstream two;
+  WriteCsv(late, {1, 0}, two);
+  EXPECT_EQ(two.str(), "time [s],b [m],a [m]\n1,nan,1\n2,nan,1\n");
+  EXPECT_THROW(WriteCsv(late, {2}, two), std::out_of_range);
+}
+
+// ------------------------------------------------------------------------ layouts
+
+Layout Example() {
+  Layout l;
+  l.window_s = 2.5;
+  l.buffer_samples = 250'000;
+  l.every_n_steps = 4;
+  PlotSpec a;
+  a.curves = {{"pendulum_tendon.pivot.position", CurveStyle::kLine, ""},
+              {"pendulum_tendon.motor.current", CurveStyle::kScatter, "#d62728"}};
+  PlotSpec b;
+  b.autoscale = false;
+  b.y_min = -0.125;
+  b.y_max = 3.3;
+  b.curves = {{"pendulum_tendon.pendulum.position[2]", CurveStyle::kLine, "#1f77b4"}};
+  l.plots = {a, b};
+  return l;
+}
+
+TEST(LayoutTest, SavesAndLoadsTheSameLayout) {
+  const Layout l = Example();
+  const std::string path = ::testing::TempDir() + "/plotter_layout_test.layout";
+  SaveLayout(l, path);
+  const Layout back = LoadLayout(path);
+  EXPECT_EQ(back, l) << FormatLayout(back);
+  EXPECT_EQ(ParseLayout(FormatLayout(l)), l);
+  EXPECT_EQ(back.Keys(), (std::vector<std::string>{"pendulum_tendon.pivot.position",
+                                                   "pendulum_tendon.motor.current",
+                                                   "pendulum_tendon.pendulum.position[2]"}));
+  std::remove(path.c_str());
+  // defaults: 10 s window, a million samples, every step
+  const Layout empty = ParseLayout("");
+  EXPECT_EQ(empty.window_s, 10.0);
+  EXPECT_EQ(empty.buffer_samples, 1'000'000u);
+  EXPECT_EQ(empty.every_n_steps, 1u);
+}
+
+TEST(LayoutTest, RejectsMalformedLayoutsNamingTheLine) {
+  struct Case {
+    std::string text, message;
+  };
+  const std::vector<Case> cases = {
+      {"window_s = 10\nwindow = 3\n", "f:2: unknown key 'window'"},
+      {"window_s = -1\n", "f:1: window_s = -1 s is out of range"},
+      {"window_s = abc\n", "f:1: window_s wants a number, not 'abc'"},
+      {"buffer_samples = 10\n", "f:1: buffer_samples = 10 is out of range [100, 200000000]"},
+      {"every_n_steps = 0\n", "f:1: every_n_steps = 0 is out of range"},
+      {"version = 2\n", "f:1: unsupported layout version 2"},
+      {"curve = a\n", "f:1: curve before the first [plot]"},
+      {"[plot]\ncurve = a dotted\n", "f:2: curve style 'dotted' is neither line nor scatter"},
+      {"[plot]\ncurve = a line red\n", "f:2: curve colour 'red' is not #rrggbb"},
+      {"[plot]\nautoscale = maybe\n", "f:2: autoscale wants true or false"},
+      {"[plot]\nautoscale = false\n", "f:3: the last plot has autoscale = false but no y_range"},
+      {"[plot]\ny_range = 2 1\n", "f:2: y_range wants MIN < MAX"},
+      {"[plots]\n", "f:1: unknown section [plots]"},
+      {"[plot]\njust words\n", "f:2: expected key = value"},
+  };
+  for (const auto& c : cases) {
+    try {
+      ParseLayout(c.text, "f");
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const LayoutError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(c.message, 0), 0u)
+          << "got: " << e.what() << "\nwanted: " << c.message;
+    }
+  }
+  EXPECT_THROW(LoadLayout("/nonexistent/x.layout"), LayoutError);
+  EXPECT_THROW(SaveLayout(Example(), "/nonexistent/x.layout"), LayoutError);
+}
+
+TEST(LayoutTest, IdsFromTheCommandLineMakeAPlot) {
+  EXPECT_EQ(SplitIds(" a.b, c ,,d[1]"), (std::vector<std::string>{"a.b", "c", "d[1]"}));
+  Layout l;
+  AddPlot(&l, SplitIds("a,b"));
+  AddPlot(&l, {});
+  ASSERT_EQ(l.plots.size(), 1u);
+  EXPECT_EQ(l.plots[0].curves.size(), 2u);
+  EXPECT_EQ(l.plots[0].curves[1].key, "b");
+}
+
+}  // namespace
+}  // namespace caliper::plotter
