@@ -51,7 +51,7 @@ PlotView::PlotView(QWidget* parent) : QwtPlot(parent) {
   legend->setMaxColumns(2);
   insertLegend(legend, QwtPlot::BottomLegend);
   setAxisTitle(QwtPlot::xBottom, "time [s]");
-  setMinimumHeight(140);
+  setMinimumHeight(110);
 
   zoomer_ = new QwtPlotZoomer(QwtPlot::xBottom, QwtPlot::yLeft, canvas());
   zoomer_->setRubberBandPen(QPen(Qt::darkGray, 1, Qt::DashLine));

@@ -90,6 +90,7 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   channels_tree_->setTextElideMode(Qt::ElideLeft);  // the ends of ids tell them apart
   channels_tree_->setToolTip("Double click or Add: plot the selected ids in the target plot");
   connect(channels_tree_, &QTreeWidget::itemDoubleClicked, this, [this] { AddSelected(); });
+  channels_tree_->setMinimumHeight(48);  // the window fits a small arranged cell
   sv->addWidget(channels_tree_, 3);
   auto* add_row = new QHBoxLayout;
   target_ = new QComboBox;
@@ -110,6 +111,7 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   curves_tree_->setTextElideMode(Qt::ElideLeft);
   connect(curves_tree_, &QTreeWidget::itemSelectionChanged, this,
           [this] { CurveSelectionChanged(); });
+  curves_tree_->setMinimumHeight(36);
   sv->addWidget(curves_tree_, 2);
   auto* curve_row = new QHBoxLayout;
   style_ = new QComboBox;

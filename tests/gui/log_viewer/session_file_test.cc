@@ -1,0 +1,144 @@
+// Reading and writing session logs: the known file, its malformed line, and export round trips.
+#include "session_file.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "known_session.h"
+
+namespace caliper::log_viewer {
+namespace {
+
+using testing::KnownSessionPath;
+
+std::string TempPath(const std::string& name) {
+  const char* base = std::getenv("TMPDIR");
+  return std::string(base ? base : "/tmp") + "/log_viewer_" + std::to_string(getpid()) + "_" + name;
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(SessionFileTest, ReadsEveryRecordOfTheKnownFile) {
+  const SessionFileContents c = ReadSessionFile(KnownSessionPath());
+  EXPECT_EQ(c.records.size(), static_cast<size_t>(testing::kKnownRecords));
+  EXPECT_EQ(c.lines, 34u);
+  EXPECT_EQ(c.records.front().component, "logger0");
+  EXPECT_EQ(c.records.front().time_us, testing::kKnownStartUs + 1007);
+  EXPECT_EQ(c.records[10].priority, logging::kError);
+  EXPECT_EQ(c.records[10].message, "Tendon triceps exceeded max force 900 N");
+  // escaped tab, newline and backslash come back as they were
+  EXPECT_EQ(c.records[26].message, "tendon length\tbiceps 0.31 m\nsecond line \\ with a backslash");
+}
+
+TEST(SessionFileTest, KnownFileIsInTheFormatLineFormat) {
+  // every line that is not a comment is FormatLine of what ParseLine makes of it
+  std::istringstream in(Slurp(KnownSessionPath()));
+  std::string line;
+  int n = 0, records = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    logging::Record r;
+    if (line.empty() || line[0] == '#' || n == testing::kKnownMalformedLine) continue;
+    ASSERT_TRUE(logging::ParseLine(line, &r)) << "line " << n;
+    EXPECT_EQ(logging::FormatLine(r), line) << "line " << n;
+    ++records;
+  }
+  EXPECT_EQ(records, testing::kKnownRecords);
+}
+
+TEST(SessionFileTest, ReportsTheMalformedLineWithFileAndLineNumber) {
+  const SessionFileContents c = ReadSessionFile(KnownSessionPath());
+  EXPECT_EQ(c.malformed, 1u);
+  ASSERT_EQ(c.problems.size(), 1u);
+  EXPECT_EQ(c.problems[0].rfind(KnownSessionPath() + ":19: not a log record, skipped: '", 0), 0u)
+      << c.problems[0];
+  EXPECT_NE(c.problems[0].find("torn line without the other fields"), std::string::npos);
+}
+
+TEST(SessionFileTest, ReportsATornLastLineAndCapsTheProblemList) {
+  const std::string path = TempPath("torn.log");
+  {
+    std::ofstream out(path);
+    out << "# comment\n\n";
+    for (int i = 0; i < 30; ++i) out << "garbage " << i << "\n";
+    out << "2024-03-05T10:00:00.000000Z\tINFO\tcaliper.x";  // no newline: being written
+  }
+  const SessionFileContents c = ReadSessionFile(path);
+  EXPECT_TRUE(c.records.empty());
+  EXPECT_EQ(c.malformed, 31u);
+  ASSERT_EQ(c.problems.size(), SessionFileContents::kMaxProblems);
+  EXPECT_EQ(c.problems[0], path + ":3: not a log record, skipped: 'garbage 0'");
+  std::remove(path.c_str());
+  const std::string torn = TempPath("torn2.log");
+  {
+    std::ofstream out(torn);
+    out << "2024-03-05T10:00:00.000000Z\tINFO\tcaliper.x";
+  }
+  const SessionFileContents t = ReadSessionFile(torn);
+  ASSERT_EQ(t.problems.size(), 1u);
+  EXPECT_EQ(t.problems[0],
+            torn + ":1: incomplete last line (is the file still being written?), skipped");
+  std::remove(torn.c_str());
+}
+
+TEST(SessionFileTest, MissingFileThrowsNamingIt) {
+  try {
+    ReadSessionFile("/nonexistent/dir/caliper-x.log");
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "cannot open /nonexistent/dir/caliper-x.log: No such file or directory");
+  }
+}
+
+TEST(SessionFileTest, ExportedSelectionReadsBackIdentically) {
+  const SessionFileContents c = ReadSessionFile(KnownSessionPath());
+  std::vector<const logging::Record*> selection;
+  for (int i : {2, 6, 10, 15, 26, 29}) selection.push_back(&c.records[static_cast<size_t>(i)]);
+  const std::string path = TempPath("export.log");
+  WriteSessionFile(path, selection, "exported\tfrom a test");
+  const SessionFileContents back = ReadSessionFile(path);
+  EXPECT_EQ(back.malformed, 0u);
+  ASSERT_EQ(back.records.size(), selection.size());
+  for (size_t i = 0; i < selection.size(); ++i) {
+    const logging::Record& a = *selection[i];
+    const logging::Record& b = back.records[i];
+    EXPECT_EQ(a.time_us, b.time_us);
+    EXPECT_EQ(a.priority, b.priority);
+    EXPECT_EQ(a.category, b.category);
+    EXPECT_EQ(a.component, b.component);
+    EXPECT_EQ(a.host, b.host);
+    EXPECT_EQ(a.pid, b.pid);
+    EXPECT_EQ(a.source, b.source);
+    EXPECT_EQ(a.seq, b.seq);
+    EXPECT_EQ(a.message, b.message);
+  }
+  EXPECT_EQ(Slurp(path).rfind("# caliper session log; exported from a test\n", 0), 0u);
+  std::remove(path.c_str());
+}
+
+TEST(SessionFileTest, UnwritableExportThrowsNamingThePath) {
+  const SessionFileContents c = ReadSessionFile(KnownSessionPath());
+  try {
+    WriteSessionFile("/nonexistent/dir/out.log", {&c.records[0]});
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot write /nonexistent/dir/out.log"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace caliper::log_viewer
