@@ -123,8 +123,11 @@ QVariant LogModel::data(const QModelIndex& index, int role) const {
   const int row = index.row();
   switch (role) {
     case Qt::DisplayRole:
-      return CellText(row, index.column());
+      // the time of day in the table (the date in its tooltip, copies and exports)
+      return index.column() == kTimeColumn ? CellText(row, kTimeColumn).mid(11)
+                                           : CellText(row, index.column());
     case Qt::ToolTipRole:
+      if (index.column() == kTimeColumn) return CellText(row, kTimeColumn);
       return index.column() == kMessageColumn
                  ? QVariant(QString::fromStdString(RecordAt(row).message))
                  : QVariant();

@@ -142,9 +142,9 @@ LogViewerWindow::LogViewerWindow(Options options, QWidget* parent)
   const int pad = 2 * metrics.averageCharWidth();
   const int ch = table_->fontMetrics().averageCharWidth();
   header->resizeSection(LogModel::kTimeColumn,
-                        metrics.horizontalAdvance("0000-00-00 00:00:00.000") + pad);
+                        metrics.horizontalAdvance("00:00:00.000") + pad);
   header->resizeSection(LogModel::kPriorityColumn, metrics.horizontalAdvance("NOTICE") + pad);
-  header->resizeSection(LogModel::kCategoryColumn, 22 * ch);
+  header->resizeSection(LogModel::kCategoryColumn, 18 * ch);
   header->resizeSection(LogModel::kComponentColumn, 11 * ch);
   header->resizeSection(LogModel::kHostColumn, 8 * ch);
 

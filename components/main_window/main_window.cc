@@ -336,9 +336,8 @@ bool MainWindow::StartTool(const QString& name) {
   if (!gui_session::ReadToolWindow(SettingsPath(), name).geometry.isValid())
     args << "--geometry" << gui_session::FormatGeometry(ArrangedGeometry(name));
   args << tool_arguments_[name];
-  if (name == "plotter" && !default_plot_ids_.isEmpty() &&
-      !QSettings(SettingsPath(), QSettings::IniFormat).contains("plotter/layout"))
-    args << "--ids" << default_plot_ids_.join(',');
+  if (name == "plotter" && !QSettings(SettingsPath(), QSettings::IniFormat).contains("plotter/layout"))
+    for (const QString& plot : default_plots_) args << "--ids" << plot;
   auto* p = new QProcess(this);
   p->setProcessChannelMode(QProcess::ForwardedChannels);
   p->start(program, args);

@@ -51,8 +51,9 @@ class MainWindow : public QMainWindow {
   bool StartTool(const QString& name);
   /// Extra command line arguments for a tool, used whenever it starts.
   void SetToolArguments(const QString& name, const QStringList& arguments);
-  /// The ids the plotter shows when the session holds no plot layout of its own.
-  void SetDefaultPlotIds(const QStringList& ids) { default_plot_ids_ = ids; }
+  /// What the plotter shows when the session holds no plot layout of its own: one entry per
+  /// plot, each a comma-separated list of ids.
+  void SetDefaultPlots(const QStringList& plots) { default_plots_ = plots; }
   /// Tiles the screen: this window and the log viewer on the left, the renderer and the
   /// plotter on the right. Running tools are moved through their native windows.
   void ArrangeWindows();
@@ -101,7 +102,7 @@ class MainWindow : public QMainWindow {
   std::uint64_t components_version_ = 0;
   std::map<QString, QProcess*> tools_;             // tool name -> its process
   std::map<QString, QStringList> tool_arguments_;  // tool name -> extra arguments
-  QStringList default_plot_ids_;
+  QStringList default_plots_;
   QProcess* model_process_ = nullptr;              // a Model started by "Start a Model"
   QString last_model_;
   bool settings_applied_ = false;                  // saved simulation settings sent to the Model

@@ -1,12 +1,12 @@
 // caliper-main: the Main Window, a plain Qt client of the Model (no component lifecycle).
 //
 //   caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE] [--no-tools]
-//                [--tools renderer,plotter,log_viewer] [--plot ID,ID,...] [--arrange] [MODEL_FILE]
+//                [--tools renderer,plotter,log_viewer] [--plot ID,ID,...]... [--arrange] [MODEL_FILE]
 //
 // The session (window geometry, last model, simulation settings, open tools and their windows) is
 // kept in a per-user settings file, or in $CALIPER_MAIN_SETTINGS. --no-tools does not start the
-// tools that were open last time; --tools starts the ones named; --plot gives the plotter the ids
-// it shows when it has no layout of its own; --arrange tiles the windows once the tools are up.
+// tools that were open last time; --tools starts the ones named; each --plot is one plot the
+// plotter shows when it has no layout of its own; --arrange tiles the windows once the tools are up.
 #include <signal.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
   bool restore_tools = true;
   bool arrange = false;
   QStringList tools;
-  QStringList plot_ids;
+  QStringList plots;  // one entry per plot: comma-separated ids
   // --help needs no display: looked for before Qt starts (which then takes out its own options,
   // -geometry, -platform, ...)
   bool help = false;
@@ -59,8 +59,10 @@ int main(int argc, char** argv) {
       restore_tools = false;
     } else if (a == "--arrange") {
       arrange = true;
-    } else if ((a == "--tools" || a == "--plot") && i + 1 < args.size()) {
-      (a == "--tools" ? tools : plot_ids) = args[++i].split(',', Qt::SkipEmptyParts);
+    } else if (a == "--tools" && i + 1 < args.size()) {
+      tools = args[++i].split(',', Qt::SkipEmptyParts);
+    } else if (a == "--plot" && i + 1 < args.size()) {
+      plots << args[++i];
     } else if (a == "--help" || a == "-h") {
       std::cout
           << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE]\n"
@@ -72,7 +74,8 @@ int main(int argc, char** argv) {
              "  --tools LIST        open these tools (comma separated: "
           << caliper::main_window::MainWindow::ToolNames().join(",").toStdString()
           << ")\n"
-             "  --plot IDS          ids the plotter shows when it has no saved layout\n"
+             "  --plot IDS          one plot of these ids (comma separated) when the plotter has\n"
+             "                      no saved layout; give it again for each further plot\n"
              "  --arrange           tile the main window and the tools on the screen\n"
              "  MODEL_FILE          load this model into the Model\n"
              "  The session is kept in $CALIPER_MAIN_SETTINGS, or else in "
@@ -100,7 +103,7 @@ int main(int argc, char** argv) {
       link->LoadScene(path.toStdString());
     }
     caliper::main_window::MainWindow window(std::move(link), 5.0, nullptr, restore_tools);
-    window.SetDefaultPlotIds(plot_ids);
+    window.SetDefaultPlots(plots);
     if (arrange) window.setGeometry(window.ArrangedGeometry("main"));
     for (const QString& tool : tools) window.StartTool(tool);
     window.show();

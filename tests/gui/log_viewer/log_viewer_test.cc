@@ -7,6 +7,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QRegularExpression>
 #include <QBrush>
 #include <QCheckBox>
 #include <QClipboard>
@@ -140,6 +141,14 @@ TEST_F(LogViewerTest, KnownFileFilteredThroughTheWidgets) {
   ASSERT_TRUE(w->OpenFile(QString::fromStdString(k::KnownSessionPath())));
   EXPECT_EQ(w->model().rowCount(), k::kKnownRecords);
   EXPECT_FALSE(w->live());
+  // the time of day in the table, the full date and time in its tooltip
+  const QModelIndex first_time = w->model().index(0, 0);
+  const QString shown = w->model().data(first_time, Qt::DisplayRole).toString();
+  const QString full = w->model().data(first_time, Qt::ToolTipRole).toString();
+  EXPECT_TRUE(QRegularExpression(R"(^\d\d:\d\d:\d\d\.\d{3}$)").match(shown).hasMatch())
+      << shown.toStdString();
+  EXPECT_TRUE(QRegularExpression(R"(^\d{4}-\d\d-\d\d )").match(full).hasMatch()) << full.toStdString();
+  EXPECT_TRUE(full.endsWith(shown)) << full.toStdString();
   ASSERT_EQ(w->problems().size(), 1);
   EXPECT_TRUE(w->problems()[0].contains("known_session.log:19: not a log record"))
       << w->problems()[0].toStdString();
