@@ -306,6 +306,19 @@ void MainWindow::SetToolArguments(const QString& name, const QStringList& argume
   tool_arguments_[name] = arguments;
 }
 
+void MainWindow::ReportEnd(QProcess* process, const QString& what) {
+  connect(process, QOverload<int, QProcess::ExitStatus>::of(&QProcess::finished), this,
+          [this, what](int code, QProcess::ExitStatus status) {
+            if (status == QProcess::CrashExit)
+              ShowError(what + " crashed (see its output in the terminal or the session's files)");
+            else if (code != 0)
+              ShowError(what + " ended with exit code " + QString::number(code) +
+                        " (see its output in the terminal or the session's files)");
+            else
+              statusBar()->showMessage(what + " closed", 3000);
+          });
+}
+
 long long MainWindow::ToolPid(const QString& name) const {
   const auto it = tools_.find(name);
   if (it == tools_.end() || it->second->state() == QProcess::NotRunning) return 0;
@@ -340,6 +353,7 @@ bool MainWindow::StartTool(const QString& name) {
     for (const QString& plot : default_plots_) args << "--ids" << plot;
   auto* p = new QProcess(this);
   p->setProcessChannelMode(QProcess::ForwardedChannels);
+  ReportEnd(p, name);
   p->start(program, args);
   if (!p->waitForStarted(3000)) {
     ShowError("could not start " + program + ": " + p->errorString());
@@ -420,6 +434,7 @@ void MainWindow::StartModel(QString path) {
   if (model_process_ != nullptr) model_process_->deleteLater();
   model_process_ = new QProcess(this);
   model_process_->setProcessChannelMode(QProcess::ForwardedChannels);
+  ReportEnd(model_process_, "the Model started here");
   QStringList args = {"-o", "model.scene=" + path, "-o", "exec.auto_activate=true"};
   args << NameserviceArgs();
   model_process_->start(program, args);

@@ -79,6 +79,8 @@ class MainWindow : public QMainWindow {
   void SelectedComponentAction(const std::string& verb);
   QString BinPath(const QString& name) const;
   QStringList NameserviceArgs() const;
+  /// Says in the status bar when `process` ends, and why when it failed.
+  void ReportEnd(QProcess* process, const QString& what);
 
   std::unique_ptr<ModelLink> link_;
   QTimer* timer_ = nullptr;

@@ -1,18 +1,15 @@
 // caliper-main: the Main Window, a plain Qt client of the Model (no component lifecycle).
 //
 //   caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE] [--no-tools]
-//                [--tools renderer,plotter,log_viewer] [--plot ID,ID,...]... [--arrange] [MODEL_FILE]
+//                [--tools renderer,plotter,log_viewer] [--plot ID,ID,...]... [--arrange]
+//                [MODEL_FILE]
 //
 // The session (window geometry, last model, simulation settings, open tools and their windows) is
 // kept in a per-user settings file, or in $CALIPER_MAIN_SETTINGS. --no-tools does not start the
 // tools that were open last time; --tools starts the ones named; each --plot is one plot the
 // plotter shows when it has no layout of its own; --arrange tiles the windows once the tools are up.
-#include <signal.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <QApplication>
-#include <QSocketNotifier>
 #include <QFileInfo>
 #include <QTimer>
 #include <iostream>
@@ -20,17 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "caliper/rtc.hh"
+#include "caliper/gui_session/tool_window.h"
+#include "caliper/rtc/client_orb.h"
 #include "main_window.h"
 #include "model_link.h"
-
-namespace {
-int signal_pipe[2] = {-1, -1};
-void OnSignal(int) {
-  const char c = 1;
-  [[maybe_unused]] const auto n = ::write(signal_pipe[0], &c, 1);
-}
-}  // namespace
 
 int main(int argc, char** argv) {
   caliper::main_window::ModelLink::Options options;
@@ -89,11 +79,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::vector<std::string> orb_args = {"caliper-main", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  std::vector<char*> orb_argv;
-  for (auto& a : orb_args) orb_argv.push_back(a.data());
-  int orb_argc = static_cast<int>(orb_argv.size());
-  CORBA::ORB_var orb = CORBA::ORB_init(orb_argc, orb_argv.data());
+  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-main");
 
   int status = 0;
   {
@@ -110,22 +96,7 @@ int main(int argc, char** argv) {
     // the tools place themselves; arranging again once they are shown also moves restored ones
     if (arrange) QTimer::singleShot(3000, &window, [&window] { window.ArrangeWindows(); });
     // SIGTERM/SIGINT (launch/caliper ending the session) close the window, which saves the session
-    QSocketNotifier* notifier = nullptr;
-    if (::socketpair(AF_UNIX, SOCK_STREAM, 0, signal_pipe) == 0) {
-      notifier = new QSocketNotifier(signal_pipe[1], QSocketNotifier::Read, &window);
-      QObject::connect(notifier, &QSocketNotifier::activated, &window, [&window] {
-        char c;
-        [[maybe_unused]] const auto n = ::read(signal_pipe[1], &c, 1);
-        window.close();
-        QApplication::quit();
-      });
-      struct sigaction sa = {};
-      sa.sa_handler = OnSignal;
-      sigemptyset(&sa.sa_mask);
-      sa.sa_flags = SA_RESTART;
-      sigaction(SIGTERM, &sa, nullptr);
-      sigaction(SIGINT, &sa, nullptr);
-    }
+    caliper::gui_session::CloseOnTerminationSignals(&window);
     status = QApplication::exec();
   }
   orb->destroy();

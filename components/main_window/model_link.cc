@@ -6,6 +6,7 @@
 
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
 
@@ -16,16 +17,6 @@ namespace D = ::Caliper::Daq;
 namespace S = ::Caliper::Scene;
 namespace RTC = ::Caliper::RTC;
 using Clock = std::chrono::steady_clock;
-
-namespace {
-
-CORBA::ORB_ptr ProcessOrb() {
-  int argc = 0;
-  char* argv[] = {nullptr};
-  return CORBA::ORB_init(argc, argv);
-}
-
-}  // namespace
 
 /// The worker's CORBA state; touched by the worker thread only.
 struct ModelLink::Impl {
@@ -44,7 +35,7 @@ struct ModelLink::Impl {
 };
 
 ModelLink::ModelLink(Options options) : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
-  impl_->orb = ProcessOrb();
+  impl_->orb = rtc::ClientOrb();
   snapshot_.connection_message = "no Model: looking for " + options_.instance + " ...";
   worker_ = std::thread([this] { Run(); });
 }

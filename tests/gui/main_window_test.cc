@@ -56,30 +56,11 @@ class MainWindowTest : public ::testing::Test {
 
   std::unique_ptr<Process> StartModel() {
     const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
-    return std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-model"), "-o",
-                                 "model.scene=" + models + "/pendulum_tendon.dae", "-o",
-                                 "exec.auto_activate=true", "--nameservice", naming_->address(),
-                                 "-o", "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model.out");
+    return StartModelProcess(naming_->address(), models + "/pendulum_tendon.dae", dir_.path(),
+                             dir_.path() + "/model.out");
   }
 
-  M::Model_var WaitForModel() {
-    M::Model_var model;
-    WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming_->address());
-            model = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(model) && !model->_non_existent();
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20));
-    return model;
-  }
+  M::Model_var WaitForModel() { return testing::WaitForModel(naming_->address()); }
 
   std::unique_ptr<MainWindow> Window(const std::string& nameservice) {
     ModelLink::Options options;
@@ -292,6 +273,20 @@ TEST_F(MainWindowTest, SaysSoAndStaysResponsiveWithNoModelInReach) {
     w.reset();
     EXPECT_LT(closing.elapsed(), 3000) << "closing does not hang on the dead peer";
   }
+}
+
+TEST_F(MainWindowTest, AToolThatFailsIsReportedNotLostSilently) {
+  auto w = Window(naming_->address());
+  // a tool that refuses its arguments ends at once with exit code 2: the status bar says so
+  w->SetToolArguments("plotter", {"--no-such-option"});
+  ASSERT_TRUE(w->StartTool("plotter"));
+  EXPECT_TRUE(WaitInGui(
+      [&] { return w->statusBar()->currentMessage().contains("plotter ended with exit code 2"); },
+      seconds(10)))
+      << w->statusBar()->currentMessage().toStdString();
+  EXPECT_TRUE(WaitInGui([&] { return w->OpenTools().isEmpty(); }, seconds(5)));
+  EXPECT_FALSE(w->StartTool("no_such_tool"));
+  EXPECT_TRUE(w->statusBar()->currentMessage().contains("unknown tool 'no_such_tool'"));
 }
 
 }  // namespace

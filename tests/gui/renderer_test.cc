@@ -55,11 +55,8 @@ class Renderer : public ::testing::Test {
 
   std::unique_ptr<Process> StartModel(const std::string& log) {
     const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
-    std::vector<std::string> args = {Bin("caliper-model"), "-o",
-                                     "model.scene=" + models + "/ecce_arm.dae", "-o",
-                                     "exec.auto_activate=true"};
-    args.insert(args.end(), common_.begin(), common_.end());
-    return std::make_unique<Process>(args, dir_.path() + "/" + log);
+    return StartModelProcess(naming_->address(), models + "/ecce_arm.dae", dir_.path(),
+                             dir_.path() + "/" + log);
   }
 
   std::unique_ptr<Process> StartRenderer(const std::string& png, double after) {
@@ -76,21 +73,7 @@ class Renderer : public ::testing::Test {
     return std::make_unique<Process>(args, dir_.path() + "/viewer.out");
   }
 
-  M::Model_var WaitForModel(CORBA::ORB_ptr orb) {
-    M::Model_var model;
-    WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, naming_->address());
-            model = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(model) && !model->_non_existent();
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20));
-    return model;
-  }
+  M::Model_var WaitForModel() { return testing::WaitForModel(naming_->address()); }
 
   TempDir dir_;
   std::unique_ptr<NamingService> naming_;
@@ -99,10 +82,7 @@ class Renderer : public ::testing::Test {
 
 TEST_F(Renderer, DrawsTheArmAndItsTendonsIntoAScreenshot) {
   auto model = StartModel("model.out");
-  int argc = 3;
-  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
-  M::Model_var arm = WaitForModel(orb);
+  M::Model_var arm = WaitForModel();
   ASSERT_FALSE(CORBA::is_nil(arm)) << model->Output();
   arm->step(200);  // the arm settles a little and its tendons carry some tension
 
@@ -124,15 +104,11 @@ TEST_F(Renderer, DrawsTheArmAndItsTendonsIntoAScreenshot) {
 
   model->Signal(SIGTERM);
   EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
-  orb->destroy();
 }
 
 TEST_F(Renderer, ObservesARestartedModelAgain) {
   auto model = StartModel("model1.out");
-  int argc = 3;
-  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
-  ASSERT_FALSE(CORBA::is_nil(WaitForModel(orb))) << model->Output();
+  ASSERT_FALSE(CORBA::is_nil(WaitForModel())) << model->Output();
 
   const std::string png = dir_.path() + "/restarted.png";
   auto renderer = StartRenderer(png, 8.0);
@@ -158,16 +134,13 @@ TEST_F(Renderer, ObservesARestartedModelAgain) {
   EXPECT_GT(Count(image).arm, 2000) << "the new Model's scene is drawn";
   model->Signal(SIGTERM);
   EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
-  orb->destroy();
 }
 
 TEST_F(Renderer, TakesScreenshotsAndShowsConstraintAxesOverCorba) {
   namespace V = ::Caliper::Viewer;
   auto model = StartModel("model.out");
-  int argc = 3;
-  const char* args[] = {"test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
-  ASSERT_FALSE(CORBA::is_nil(WaitForModel(orb))) << model->Output();
+  CORBA::ORB_ptr orb = Orb();
+  ASSERT_FALSE(CORBA::is_nil(WaitForModel())) << model->Output();
   auto viewer = StartViewer();
 
   V::Renderer_var renderer;
@@ -241,7 +214,6 @@ TEST_F(Renderer, TakesScreenshotsAndShowsConstraintAxesOverCorba) {
   EXPECT_EQ(viewer->Wait(seconds(10)), 0) << viewer->Output();
   model->Signal(SIGTERM);
   EXPECT_EQ(model->Wait(seconds(10)), 0) << model->Output();
-  orb->destroy();
 }
 
 }  // namespace

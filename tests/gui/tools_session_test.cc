@@ -41,13 +41,8 @@ class ToolsSession : public ::testing::Test {
     settings_ = QString::fromStdString(dir_.path() + "/caliper-main.ini");
     qputenv("CALIPER_MAIN_SETTINGS", settings_.toLocal8Bit());
     const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
-    model_ = std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-model"), "-o",
-                                 "model.scene=" + models + "/pendulum_tendon.dae", "-o",
-                                 "exec.auto_activate=true", "--nameservice", naming_->address(),
-                                 "-o", "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model.out");
+    model_ = StartModelProcess(naming_->address(), models + "/pendulum_tendon.dae", dir_.path(),
+                               dir_.path() + "/model.out");
   }
 
   std::unique_ptr<MainWindow> Window(bool restore_tools) {

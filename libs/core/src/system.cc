@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <cstdio>
+#include <fstream>
 #include <stdexcept>
 
 namespace caliper::core {
@@ -58,6 +60,32 @@ void MakeDirectories(const std::string& path) {
 
 bool ProcessAlive(long pid) {
   return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+}
+
+void WriteFileReplacing(const std::string& path,
+                        const std::function<void(std::ostream&)>& write) {
+  const std::string temporary = path + ".part-" + std::to_string(::getpid());
+  const auto fail = [&](const char* what) {
+    const int error = errno;
+    std::remove(temporary.c_str());
+    throw std::runtime_error("cannot write " + path + ": " + what +
+                             (error != 0 ? std::string(" (") + std::strerror(error) + ")" : ""));
+  };
+  errno = 0;
+  std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+  if (!out) fail("cannot create a file there");
+  try {
+    write(out);
+  } catch (...) {
+    out.close();
+    std::remove(temporary.c_str());
+    throw;
+  }
+  out.flush();
+  if (!out) fail("write failed");
+  out.close();
+  if (out.fail()) fail("write failed on close");
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) fail("cannot replace it");
 }
 
 }  // namespace caliper::core

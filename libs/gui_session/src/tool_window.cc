@@ -1,9 +1,17 @@
 #include "caliper/gui_session/tool_window.h"
 
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+
+#include <QApplication>
 #include <QCoreApplication>
 #include <QEvent>
 #include <QRegularExpression>
 #include <QSettings>
+#include <QSocketNotifier>
 #include <QTimer>
 #include <QWidget>
 
@@ -55,12 +63,14 @@ QRect ToolWindow::Restore(const QRect& explicit_geometry) {
   return rect;
 }
 
-void ToolWindow::Save() {
+void ToolWindow::Save(bool closing) {
   if (session_file_.isEmpty()) return;
   QSettings st(session_file_, QSettings::IniFormat);
   st.beginGroup(tool_);
   st.setValue("geometry", FormatGeometry(window_->geometry()));
-  st.setValue("window_id", static_cast<qulonglong>(window_->isVisible() ? window_->winId() : 0));
+  // a closing window is no longer there to be moved
+  const bool shown = window_->isVisible() && !closing;
+  st.setValue("window_id", static_cast<qulonglong>(shown ? window_->winId() : 0));
   st.setValue("pid", QCoreApplication::applicationPid());
   st.endGroup();
   st.sync();
@@ -76,13 +86,46 @@ bool ToolWindow::eventFilter(QObject* watched, QEvent* event) {
         break;
       case QEvent::Close:
         save_timer_->stop();
-        Save();
+        Save(/*closing=*/true);
         break;
       default:
         break;
     }
   }
   return QObject::eventFilter(watched, event);
+}
+
+namespace {
+
+int signal_socket[2] = {-1, -1};  // [0] written by the handler, [1] read by the event loop
+
+void OnTerminationSignal(int) {
+  const int saved = errno;  // the interrupted code may be looking at errno
+  const char c = 1;
+  [[maybe_unused]] const auto n = ::write(signal_socket[0], &c, 1);  // non-blocking
+  errno = saved;
+}
+
+}  // namespace
+
+void CloseOnTerminationSignals(QWidget* window) {
+  if (signal_socket[0] >= 0 ||
+      ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, signal_socket) != 0)
+    return;
+  auto* notifier = new QSocketNotifier(signal_socket[1], QSocketNotifier::Read, window);
+  QObject::connect(notifier, &QSocketNotifier::activated, window, [window] {
+    char c;
+    [[maybe_unused]] const auto n = ::read(signal_socket[1], &c, 1);
+    window->close();
+    QApplication::quit();
+  });
+  struct sigaction sa = {};
+  sa.sa_handler = OnTerminationSignal;
+  sigemptyset(&sa.sa_mask);
+  // a second Ctrl-C while the first one's shutdown hangs ends the process the default way
+  sa.sa_flags = SA_RESTART | SA_RESETHAND;
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGINT, &sa, nullptr);
 }
 
 }  // namespace caliper::gui_session

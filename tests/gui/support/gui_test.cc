@@ -4,6 +4,8 @@
 #include <QTest>
 #include <cstdlib>
 
+#include "caliper/rtc/naming.h"
+
 namespace caliper::testing {
 
 QApplication& App() {
@@ -40,6 +42,33 @@ bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {
   const char* dir = std::getenv("CALIPER_ARTIFACT_DIR");
   return (dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir) + "/" + name;
+}
+
+std::unique_ptr<Process> StartModelProcess(const std::string& address, const std::string& scene,
+                                           const std::string& dir, const std::string& output) {
+  return std::make_unique<Process>(
+      std::vector<std::string>{Bin("caliper-model"), "-o", "model.scene=" + scene, "-o",
+                               "exec.auto_activate=true", "--nameservice", address, "-o",
+                               "log.service=none", "-o", "log.spool_dir=" + dir + "/spool"},
+      output);
+}
+
+::Caliper::Simulation::Model_ptr WaitForModel(const std::string& address,
+                                              const std::string& instance) {
+  namespace M = ::Caliper::Simulation;
+  M::Model_var model;
+  WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), address);
+          model = M::Model::_narrow(rtc::FindComponent(root, instance).object);
+          return !CORBA::is_nil(model) && !model->_non_existent();
+        } catch (...) {
+          return false;
+        }
+      },
+      std::chrono::seconds(20));
+  return model._retn();
 }
 
 }  // namespace caliper::testing

@@ -5,9 +5,12 @@
 #include <QApplication>
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 
+#include "caliper/model.hh"
 #include "caliper/rtc.hh"
+#include "support/process.h"
 
 namespace caliper::testing {
 
@@ -22,5 +25,14 @@ bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds
 
 /// `name` in $CALIPER_ARTIFACT_DIR (the screenshots kept by the test run), else in `fallback_dir`.
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir);
+
+/// caliper-model with `scene` loaded on the naming service at `address`, ACTIVE, logging to no
+/// service (its spool in `dir`/spool), its output in `output`.
+std::unique_ptr<Process> StartModelProcess(const std::string& address, const std::string& scene,
+                                           const std::string& dir, const std::string& output);
+
+/// The Model bound as `instance` that answers, or nil after 20 s.
+::Caliper::Simulation::Model_ptr WaitForModel(const std::string& address,
+                                              const std::string& instance = "model0");
 
 }  // namespace caliper::testing

@@ -75,6 +75,7 @@ TEST(ToolWindow, WritesTheShownWindowItsMovesAndItsClose) {
   widget.resize(410, 310);
   widget.close();  // written at once, without waiting for the timer
   EXPECT_EQ(ReadToolWindow(file, "plotter").geometry, QRect(50, 60, 410, 310));
+  EXPECT_EQ(ReadToolWindow(file, "plotter").window_id, 0u) << "a closed window cannot be moved";
   EXPECT_FALSE(ReadToolWindow(file, "renderer").geometry.isValid()) << "other tools untouched";
 
   // the next start restores it; an explicit geometry wins

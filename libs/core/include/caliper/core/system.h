@@ -2,6 +2,8 @@
 // Small facts about the process and the clock.
 
 #include <cstdint>
+#include <functional>
+#include <iosfwd>
 #include <string>
 
 namespace caliper::core {
@@ -23,5 +25,11 @@ void MakeDirectories(const std::string& path);
 
 /// True when a process with this pid exists.
 bool ProcessAlive(long pid);
+
+/// Writes a file whole or not at all: `write` fills a temporary file beside `path`, which then
+/// replaces `path` (an existing file stays as it was when anything fails). Throws
+/// std::runtime_error naming the path and the reason (the system's, e.g. "No space left on
+/// device"); exceptions from `write` leave `path` untouched and propagate.
+void WriteFileReplacing(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace caliper::core

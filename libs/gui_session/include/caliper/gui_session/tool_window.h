@@ -22,7 +22,7 @@ QString FormatGeometry(const QRect& rect);
 /// What a tool last wrote about its window into the session file.
 struct ToolWindowRecord {
   QRect geometry;            ///< the window's client area on the screen [px]; invalid when none
-  unsigned long long window_id = 0;  ///< native window (X11 window id); 0 when not shown
+  unsigned long long window_id = 0;  ///< native window (X11 window id); 0 when not shown or closed
   long long pid = 0;         ///< the tool's process id; 0 when it has not run
 };
 
@@ -40,8 +40,8 @@ class ToolWindow : public QObject {
   /// Call before showing the window: `explicit_geometry` when valid, else the stored geometry.
   /// Returns the geometry applied (invalid when there was none).
   QRect Restore(const QRect& explicit_geometry = QRect());
-  /// Writes the record now.
-  void Save();
+  /// Writes the record now; `closing` records that the window is going away (no window id).
+  void Save(bool closing = false);
 
   const QString& session_file() const { return session_file_; }
   const QString& tool() const { return tool_; }
@@ -55,5 +55,14 @@ class ToolWindow : public QObject {
   QString session_file_;
   QTimer* save_timer_;
 };
+
+}  // namespace caliper::gui_session
+
+namespace caliper::gui_session {
+
+/// SIGINT and SIGTERM close `window` (which saves what it saves when closed) and quit the event
+/// loop. The handlers only write a byte to a socket; the window is closed from the event loop, so
+/// a signal that arrives before the loop runs is acted upon once it does. Call once per process.
+void CloseOnTerminationSignals(QWidget* window);
 
 }  // namespace caliper::gui_session
