@@ -1,25 +1,11 @@
 #include "csv_export.h"
 
-#include <charconv>
-#include <cmath>
 #include <stdexcept>
 
+#include "caliper/core/system.h"
+#include "number_format.h"
+
 namespace caliper::plotter {
-
-namespace {
-
-// shortest decimal that reads back to the same double
-void AppendNumber(std::string* line, double v) {
-  if (std::isnan(v)) {
-    *line += "nan";
-    return;
-  }
-  char buffer[32];
-  const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
-  line->append(buffer, r.ptr);
-}
-
-}  // namespace
 
 std::string CsvHeader(const SampleStore& store, const std::vector<size_t>& series) {
   std::string header = "time [s]";
@@ -47,6 +33,13 @@ size_t WriteCsv(const SampleStore& store, const std::vector<size_t>& series, std
     out.write(line.data(), static_cast<std::streamsize>(line.size()));
   }
   return store.size();
+}
+
+size_t ExportCsvFile(const SampleStore& store, const std::vector<size_t>& series,
+                     const std::string& path) {
+  size_t rows = 0;
+  core::WriteFileReplacing(path, [&](std::ostream& out) { rows = WriteCsv(store, series, out); });
+  return rows;
 }
 
 }  // namespace caliper::plotter

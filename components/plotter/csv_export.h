@@ -20,4 +20,10 @@ std::string CsvHeader(const SampleStore& store, const std::vector<size_t>& serie
 /// rows written (store.size()). Throws std::out_of_range for an unknown series.
 size_t WriteCsv(const SampleStore& store, const std::vector<size_t>& series, std::ostream& out);
 
+/// WriteCsv into the file `path`, whole or not at all: an existing file is replaced only once
+/// the new one is complete. Returns the rows written; throws std::runtime_error naming the path
+/// and the reason (e.g. "No space left on device"), std::out_of_range for an unknown series.
+size_t ExportCsvFile(const SampleStore& store, const std::vector<size_t>& series,
+                     const std::string& path);
+
 }  // namespace caliper::plotter

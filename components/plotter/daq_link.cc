@@ -10,9 +10,11 @@
 #include <utility>
 
 #include "caliper/model.hh"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
 #include "data_consumer_servant.h"
+#include "stream_watch.h"
 
 namespace caliper::plotter {
 
@@ -25,12 +27,10 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr size_t kPendingBatches = 256;  // held while a subscribe call is under way
+constexpr size_t kHeldBatches = 256;     // held after a reset or reload until the layout is checked
 
-CORBA::ORB_ptr ProcessOrb() {
-  int argc = 0;
-  char* argv[] = {nullptr};
-  return CORBA::ORB_init(argc, argv);
-}
+// thrown between two calls of a poll when the link closes: the poll ends without further calls
+struct Closing {};
 
 bool Contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
@@ -50,7 +50,7 @@ bool Subset(const std::vector<std::string>& a, const std::vector<std::string>& b
 
 }  // namespace
 
-/// What the servant's ORB threads and the worker share.
+// What the servant's ORB threads and the worker share.
 struct DaqLink::Shared {
   std::mutex mutex;      // guards everything below
   uint64_t current = 0;  // the subscription whose batches are kept
@@ -59,14 +59,28 @@ struct DaqLink::Shared {
   std::map<uint64_t, std::deque<ReceivedBatch>> pending;
   size_t pending_count = 0;
   std::set<uint64_t> foreign;  // subscriptions not (or no longer) ours that still send
+  // the simulated time went back (a reset or a reload, which may have given the ids other shapes):
+  // the current subscription's batches wait in `held` until the worker has checked the layout
+  bool checking = false;
+  std::deque<ReceivedBatch> held;
   std::deque<ReceivedBatch> inbox;
   size_t inbox_capacity = 4096;
   uint64_t next_batch = 1;
   uint64_t received = 0;
   uint64_t missing = 0;
   uint64_t dropped = 0;
+  uint64_t discarded = 0;          // held batches of a layout that had changed
   double last_sample_time = kNaN;  // [s] of the current subscription
   Clock::time_point last_batch_wall{};
+
+  // with the mutex held
+  void Deliver(ReceivedBatch&& b) {
+    inbox.push_back(std::move(b));
+    while (inbox.size() > inbox_capacity) {
+      inbox.pop_front();
+      ++dropped;
+    }
+  }
 
   // with the mutex held
   void Accept(ReceivedBatch&& b) {
@@ -74,13 +88,34 @@ struct DaqLink::Shared {
     if (b.number > next_batch) missing += b.number - next_batch;
     if (b.number >= next_batch) next_batch = b.number + 1;
     ++received;
-    if (!b.times.empty()) last_sample_time = b.times.back();
+    if (!b.times.empty()) {
+      if (!std::isnan(last_sample_time) && b.times.front() < last_sample_time) checking = true;
+      last_sample_time = b.times.back();
+    }
     last_batch_wall = Clock::now();
-    inbox.push_back(std::move(b));
-    while (inbox.size() > inbox_capacity) {
-      inbox.pop_front();
+    if (!checking) {
+      Deliver(std::move(b));
+      return;
+    }
+    held.push_back(std::move(b));
+    while (held.size() > kHeldBatches) {
+      held.pop_front();
       ++dropped;
     }
+  }
+
+  // with the mutex held: the layout still holds, the held batches go to the GUI
+  void Release() {
+    checking = false;
+    for (auto& b : held) Deliver(std::move(b));
+    held.clear();
+  }
+
+  // with the mutex held: the subscription ends, what it holds cannot be read
+  void Discard() {
+    checking = false;
+    discarded += held.size();
+    held.clear();
   }
 
   void Receive(ReceivedBatch&& b) {
@@ -96,11 +131,13 @@ struct DaqLink::Shared {
   }
 };
 
-/// The worker's CORBA state; touched by the worker thread only (and the constructor).
+// The worker's CORBA state; touched by the worker thread only (and the constructor), but for
+// `servant`, whose counter status() reads.
 struct DaqLink::Impl {
   CORBA::ORB_var orb;
   PortableServer::POA_var poa;
   PortableServer::ObjectId_var oid;
+  DataConsumerServant* servant = nullptr;  // owned by the POA while activated
   D::DataConsumer_var consumer;
   M::Model_var model;
   Clock::time_point last_lookup{};
@@ -111,8 +148,7 @@ struct DaqLink::Impl {
   std::vector<ChannelEntry> channels;
   std::vector<std::string> subscribed;  // ids of the current subscription
   uint32_t subscribed_every = 0;
-  double watch_time = 0;           // [s] simulated time of the last sign of life of the stream
-  Clock::time_point watch_wall{};  // and when it was seen
+  std::unique_ptr<StreamWatch> watch;  // of the current subscription
 };
 
 DaqLink::DaqLink(Options options)
@@ -123,15 +159,18 @@ DaqLink::DaqLink(Options options)
   status_.instance = options_.instance;
   status_.message = "no Model: looking for " + options_.instance + " ...";
   Impl& i = *impl_;
-  i.orb = ProcessOrb();
+  i.watch = std::make_unique<StreamWatch>(options_.silence_s);
+  i.orb = rtc::ClientOrb();
   CORBA::Object_var obj = i.orb->resolve_initial_references("RootPOA");
   i.poa = PortableServer::POA::_narrow(obj);
-  i.poa->the_POAManager()->activate();
+  PortableServer::POAManager_var manager = i.poa->the_POAManager();
+  manager->activate();
   std::shared_ptr<Shared> shared = shared_;
   auto* servant =
       new DataConsumerServant([shared](ReceivedBatch&& b) { shared->Receive(std::move(b)); });
   PortableServer::ServantBase_var owner = servant;  // the POA keeps its own reference
   i.oid = i.poa->activate_object(servant);
+  i.servant = servant;
   CORBA::Object_var ref = i.poa->id_to_reference(i.oid);
   i.consumer = D::DataConsumer::_narrow(ref);
   worker_ = std::thread([this] { Run(); });
@@ -154,10 +193,12 @@ DaqLink::~DaqLink() {
 LinkStatus DaqLink::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   LinkStatus s = status_;
+  s.consumer_failures = impl_->servant->failures();
   std::lock_guard<std::mutex> shared_lock(shared_->mutex);
   s.batches_received = shared_->received;
   s.batches_missing = shared_->missing;
   s.batches_dropped = shared_->dropped;
+  s.batches_discarded = shared_->discarded;
   return s;
 }
 
@@ -189,6 +230,17 @@ void DaqLink::Relist() {
   wake_.notify_all();
 }
 
+void DaqLink::Resubscribe(uint64_t subscription, const std::string& why) {
+  if (subscription == 0) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (resubscribe_ == subscription) return;
+    resubscribe_ = subscription;
+    resubscribe_why_ = why;
+  }
+  wake_.notify_all();
+}
+
 void DaqLink::Run() {
   // per-thread call timeouts need an omni_thread
   omni_thread* self = omni_thread::create_dummy();
@@ -200,6 +252,13 @@ void DaqLink::Run() {
   const auto period = std::chrono::milliseconds(options_.poll_period_ms);
   auto next_poll = Clock::now();
   uint64_t seen_version = 0;
+  uint64_t layout_resubscriptions = 0;
+
+  // before each call of a poll: a closing link makes no further call
+  auto check_closing = [&] {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_) throw Closing{};
+  };
 
   auto set_message = [&](const std::string& message) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -216,6 +275,7 @@ void DaqLink::Run() {
       sh.current = 0;
       sh.layout.reset();
       sh.subscribing = false;
+      sh.Discard();
     }
     std::lock_guard<std::mutex> lock(mutex_);
     status_.connected = false;
@@ -226,8 +286,27 @@ void DaqLink::Run() {
     status_.message = "no Model reachable: " + why;
   };
 
-  // ends the current subscription and makes one for `ids` (none when empty); a system exception
-  // propagates (the Model is gone)
+  // the Model's channels now; true when they differ from the last listing
+  auto list_channels = [&](const std::string& scene) {
+    check_closing();
+    D::ChannelInfoSeq_var infos = i.model->channels("*");
+    std::vector<ChannelEntry> channels;
+    channels.reserve(infos->length());
+    for (CORBA::ULong k = 0; k < infos->length(); ++k) {
+      const D::ChannelInfo& c = infos[k];
+      channels.push_back(ChannelEntry{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.is_static),
+                                      c.description.in()});
+    }
+    const bool changed = !i.channels_listed || !SameChannels(channels, i.channels);
+    i.channels = std::move(channels);
+    i.channels_listed = true;
+    i.scene = scene;
+    i.last_listing = Clock::now();
+    return changed;
+  };
+
+  // ends the current subscription and makes one for `ids` (none when empty) laid out as the
+  // channels listed last say; a system exception propagates (the Model is gone)
   auto resubscribe = [&](const std::vector<std::string>& ids, uint32_t every, double sim_time) {
     uint64_t old = 0;
     {
@@ -235,9 +314,11 @@ void DaqLink::Run() {
       old = sh.current;
       sh.current = 0;
       sh.layout.reset();
+      sh.Discard();
     }
     i.subscribed.clear();
     if (old != 0) {
+      check_closing();
       try {
         i.model->unsubscribe(old);
       } catch (const CORBA::UserException&) {
@@ -245,19 +326,12 @@ void DaqLink::Run() {
       }
     }
     if (ids.empty()) return;
+    check_closing();
 
-    auto layout = std::make_shared<std::vector<SubscribedId>>();
-    size_t offset = 0;
+    auto layout = std::make_shared<const std::vector<SubscribedId>>(LayoutOf(ids, i.channels));
     S::StringSeq seq;
     seq.length(static_cast<CORBA::ULong>(ids.size()));
-    for (size_t k = 0; k < ids.size(); ++k) {
-      const auto c = std::find_if(i.channels.begin(), i.channels.end(),
-                                  [&](const ChannelEntry& e) { return e.id == ids[k]; });
-      SubscribedId s{ids[k], c->unit, c->rows, c->cols, offset};
-      offset += static_cast<size_t>(c->rows) * c->cols;
-      layout->push_back(s);
-      seq[static_cast<CORBA::ULong>(k)] = ids[k].c_str();
-    }
+    for (size_t k = 0; k < ids.size(); ++k) seq[static_cast<CORBA::ULong>(k)] = ids[k].c_str();
     {
       std::lock_guard<std::mutex> lock(sh.mutex);
       sh.subscribing = true;
@@ -308,8 +382,7 @@ void DaqLink::Run() {
     settle(id);
     i.subscribed = ids;
     i.subscribed_every = every;
-    i.watch_time = sim_time;
-    i.watch_wall = Clock::now();
+    i.watch->Start(sim_time, every, Clock::now());
     std::lock_guard<std::mutex> lock(mutex_);
     ++status_.subscriptions_made;
     status_.message.clear();
@@ -319,10 +392,13 @@ void DaqLink::Run() {
     std::vector<std::string> wanted;
     uint32_t every = 1;
     bool relist_asked = false;
+    uint64_t renew_asked = 0;  // a subscription whose batches the GUI cannot read
+    std::string renew_asked_why;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait_until(lock, next_poll, [&] {
-        return stopping_ || relist_ || (wanted_version_ != seen_version && !CORBA::is_nil(i.model));
+        return stopping_ || relist_ ||
+               ((wanted_version_ != seen_version || resubscribe_ != 0) && !CORBA::is_nil(i.model));
       });
       if (stopping_) break;
       wanted = wanted_;
@@ -330,33 +406,43 @@ void DaqLink::Run() {
       seen_version = wanted_version_;
       relist_asked = relist_;
       relist_ = false;
+      renew_asked = resubscribe_;
+      renew_asked_why = resubscribe_why_;
+      resubscribe_ = 0;
     }
     next_poll = Clock::now() + period;
     omniORB::setClientThreadCallTimeout(timeout_ms);
 
-    // look the Model up (not more often than the reconnect period)
-    if (CORBA::is_nil(i.model)) {
-      if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
-        continue;
-      i.last_lookup = Clock::now();
-      try {
-        CosNaming::NamingContext_var root =
-            rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-        M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
-        if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
-        i.model = model;
-        i.channels_listed = false;
-        i.steps = 0;
-      } catch (const CORBA::Exception& e) {
-        lost(rtc::Describe(e));
-        continue;
-      } catch (const std::exception& e) {
-        lost(e.what());
-        continue;
-      }
-    }
-
     try {
+      // look the Model up (not more often than the reconnect period)
+      if (CORBA::is_nil(i.model)) {
+        if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
+          continue;
+        i.last_lookup = Clock::now();
+        try {
+          CosNaming::NamingContext_var root =
+              rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
+          omniORB::setClientCallTimeout(root, timeout_ms);
+          check_closing();
+          M::Model_var model =
+              M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+          if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
+          // the reference's own timeout bounds every call to the Model (omniORB honours the
+          // per-thread one only with -ORBsupportPerThreadTimeOut 1)
+          omniORB::setClientCallTimeout(model, timeout_ms);
+          i.model = model;
+          i.channels_listed = false;
+          i.steps = 0;
+        } catch (const CORBA::Exception& e) {
+          lost(rtc::Describe(e));
+          continue;
+        } catch (const std::exception& e) {
+          lost(e.what());
+          continue;
+        }
+      }
+
+      check_closing();
       M::SimulationStatus_var s = i.model->status();
       const std::string scene = s->scene.in();
       const bool rewound = s->steps < i.steps;
@@ -369,71 +455,89 @@ void DaqLink::Run() {
           foreign.swap(sh.foreign);
           foreign.erase(sh.current);
         }
-        for (const uint64_t f : foreign) i.model->unsubscribe(f);
-      }
-
-      bool listed = false;
-      const bool due =
-          Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.relist_period_ms);
-      if (!i.channels_listed || scene != i.scene || rewound || relist_asked || due) {
-        D::ChannelInfoSeq_var infos = i.model->channels("*");
-        std::vector<ChannelEntry> channels;
-        channels.reserve(infos->length());
-        for (CORBA::ULong k = 0; k < infos->length(); ++k) {
-          const D::ChannelInfo& c = infos[k];
-          channels.push_back(ChannelEntry{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.is_static),
-                                          c.description.in()});
+        for (const uint64_t f : foreign) {
+          check_closing();
+          i.model->unsubscribe(f);
         }
-        // a periodic listing that finds nothing new changes nothing for the GUI
-        listed = !i.channels_listed || !SameChannels(channels, i.channels);
-        i.channels = std::move(channels);
-        i.channels_listed = true;
-        i.scene = scene;
-        i.last_listing = Clock::now();
       }
 
-      // the wanted ids the Model has (in the order wanted) and those it has not
-      std::vector<std::string> target, missing;
-      for (const auto& id : wanted) {
-        const bool known = std::any_of(i.channels.begin(), i.channels.end(),
-                                       [&](const ChannelEntry& c) { return c.id == id; });
-        (known ? target : missing).push_back(id);
-      }
       uint64_t current = 0;
+      std::shared_ptr<const std::vector<SubscribedId>> layout;
+      bool checking = false;
       double last_sample = kNaN;
       Clock::time_point last_batch_wall;
       {
         std::lock_guard<std::mutex> lock(sh.mutex);
         current = sh.current;
+        layout = sh.layout;
+        checking = sh.checking;
         last_sample = sh.last_sample_time;
         last_batch_wall = sh.last_batch_wall;
       }
+      const bool renew_asked_now = renew_asked != 0 && renew_asked == current;
+
+      // a new scene, a reset, a periodic listing, held batches or unreadable ones: list again
+      bool listed = false;  // the GUI gets the new list
+      bool fresh = false;   // listed in this poll
+      const bool due =
+          Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.relist_period_ms);
+      if (!i.channels_listed || scene != i.scene || rewound || relist_asked || due || checking ||
+          renew_asked_now) {
+        listed = list_channels(scene);
+        fresh = true;
+      }
+
+      // the wanted ids the Model has (in the order wanted) and those it has not
+      std::vector<std::string> target, missing;
+      auto split_wanted = [&] {
+        target.clear();
+        missing.clear();
+        for (const auto& id : wanted) {
+          const bool known = std::any_of(i.channels.begin(), i.channels.end(),
+                                         [&](const ChannelEntry& c) { return c.id == id; });
+          (known ? target : missing).push_back(id);
+        }
+      };
+      split_wanted();
       // ids that vanished stay subscribed (their values come as NaN, marked stale, and come back
       // when a scene has them again); a new wanted id, a removed one or a new rate subscribe anew
       bool renew = (current == 0 && !target.empty()) || !Subset(target, i.subscribed) ||
                    !Subset(i.subscribed, wanted) || (current != 0 && every != i.subscribed_every);
       std::string why;
-      // a stream gone quiet while the Model runs (e.g. the Model dropped us): subscribe again
-      if (current != 0) {
-        if (!std::isnan(last_sample) && last_sample <= s->sim_time &&
-            last_batch_wall > i.watch_wall) {
-          i.watch_time = last_sample;
-          i.watch_wall = last_batch_wall;
-        }
-        if (s->sim_time < i.watch_time) {  // rewound
-          i.watch_time = s->sim_time;
-          i.watch_wall = Clock::now();
-        }
-        const double quiet_wall =
-            std::chrono::duration<double>(Clock::now() - i.watch_wall).count();
-        if (s->state == M::RUNNING && s->sim_time - i.watch_time > options_.silence_s &&
-            quiet_wall > options_.silence_s) {
+      // the scene gave subscribed ids another shape or unit: the values moved within a sample
+      if (fresh && current != 0 && layout) {
+        const std::string change = LayoutChange(*layout, i.channels);
+        if (!change.empty()) {
           renew = true;
-          why = "no samples for " + std::to_string(s->sim_time - i.watch_time) +
-                " s of simulated time: subscribed again";
+          why = "the scene changed (" + change + "): subscribed again";
+          ++layout_resubscriptions;
+        } else if (checking) {
+          std::lock_guard<std::mutex> lock(sh.mutex);
+          if (sh.current == current) sh.Release();
         }
       }
-      if (renew) resubscribe(target, every, s->sim_time);
+      if (renew_asked_now && why.empty()) {
+        renew = true;
+        why = renew_asked_why + ": subscribed again";
+      }
+      // a stream gone quiet while the Model runs (e.g. the Model dropped us): subscribe again
+      if (current != 0 &&
+          i.watch->Quiet(s->state == M::RUNNING, s->sim_time, s->time_step, last_sample,
+                         last_batch_wall, Clock::now()) &&
+          !renew) {
+        renew = true;
+        why = "no samples for " + std::to_string(i.watch->quiet_for()) +
+              " s of simulated time: subscribed again";
+      }
+      if (renew) {
+        // the layout comes from a listing of now
+        if (!fresh) {
+          listed |= list_channels(scene);
+          fresh = true;
+          split_wanted();
+        }
+        resubscribe(target, every, s->sim_time);
+      }
 
       std::lock_guard<std::mutex> lock(mutex_);
       status_.connected = true;
@@ -449,29 +553,38 @@ void DaqLink::Run() {
       }
       status_.subscribed = i.subscribed;
       status_.missing = missing;
+      status_.layout_resubscriptions = layout_resubscriptions;
       {
         std::lock_guard<std::mutex> shared_lock(sh.mutex);
         status_.subscription = sh.current;
       }
-    } catch (const CORBA::SystemException& e) {
-      lost(rtc::Describe(e));
+    } catch (const Closing&) {
+      break;
     } catch (const CORBA::Exception& e) {
       lost(rtc::Describe(e));
+    } catch (const std::exception& e) {
+      set_message(e.what());
     }
   }
 
-  // closing: end the subscription so that the Model stops sending
+  // closing: one short call ends the subscription so that the Model stops sending; none when the
+  // Model was found gone (a Model drops a consumer that no longer answers anyway)
   uint64_t current = 0;
   {
     std::lock_guard<std::mutex> lock(sh.mutex);
     current = sh.current;
     sh.current = 0;
+    sh.Discard();
   }
   if (current != 0 && !CORBA::is_nil(i.model)) {
+    const auto final_ms = static_cast<CORBA::ULong>(
+        std::clamp(options_.final_call_timeout_ms, 1, options_.call_timeout_ms));
+    omniORB::setClientThreadCallTimeout(final_ms);
+    omniORB::setClientCallTimeout(i.model, final_ms);
     try {
       i.model->unsubscribe(current);
     } catch (const CORBA::Exception&) {
-      // the Model is gone: it sends nothing more either way
+      // the Model is gone or slow: it drops us when its next batch finds no consumer
     }
   }
   i.model = M::Model::_nil();

@@ -2,10 +2,12 @@
 // The Graph Plotter's connection to the Model's data acquisition: a worker thread that finds the
 // Model (`model0`) in the naming service, lists its channels, keeps one DAQ subscription for the
 // ids being plotted and re-makes it when the ids change, when the Model is restarted or reloaded,
-// or when batches stop coming while the Model runs. The Model pushes sample batches to a
-// DataConsumer servant in this process; they wait in an inbox until the GUI takes them. The GUI
-// only reads status snapshots, takes batches and says which ids it wants, so a dead or slow Model
-// never blocks it. No Qt here; CORBA stays in the .cc files.
+// when batches stop coming while the Model runs, and when a reloaded scene gives subscribed ids
+// other shapes or units (which moves values within a sample). The Model pushes sample batches to
+// a DataConsumer servant in this process; they wait in an inbox until the GUI takes them (after a
+// reset or reload they are held until the worker has checked the layout against a fresh channel
+// listing). The GUI only reads status snapshots, takes batches and says which ids it wants, so a
+// dead or slow Model never blocks it. No Qt here; CORBA stays in the .cc files.
 
 #include <condition_variable>
 #include <cstdint>
@@ -16,26 +18,9 @@
 #include <thread>
 #include <vector>
 
+#include "channel_layout.h"
+
 namespace caliper::plotter {
-
-/// One of the Model's DAQ channels.
-struct ChannelEntry {
-  std::string id;     ///< e.g. pendulum_tendon.pivot.position
-  std::string unit;   ///< SI unit, "" for none
-  unsigned rows = 1;  ///< shape of the value
-  unsigned cols = 1;
-  bool is_static = false;  ///< a parameter (true) or a state changing every step (false)
-  std::string description;
-};
-
-/// Where one subscribed id's values sit within a sample of the subscription's batches.
-struct SubscribedId {
-  std::string id;
-  std::string unit;
-  unsigned rows = 1;
-  unsigned cols = 1;
-  size_t offset = 0;  ///< index of its first value within a sample
-};
 
 /// A batch of samples of the current subscription, without CORBA.
 struct ReceivedBatch {
@@ -66,6 +51,9 @@ struct LinkStatus {
   uint64_t batches_received = 0;        ///< of the current subscriptions, since start
   uint64_t batches_missing = 0;         ///< batch numbers skipped (the Model dropped them)
   uint64_t batches_dropped = 0;         ///< dropped here: the GUI took none for too long
+  uint64_t batches_discarded = 0;  ///< held after a reset or reload, of a layout that had changed
+  uint64_t layout_resubscriptions = 0;  ///< subscribed again: ids changed shape or unit
+  uint64_t consumer_failures = 0;       ///< batches the consumer servant could not take in
 };
 
 /// The worker, its subscription and its inbox. Every method returns at once.
@@ -74,19 +62,26 @@ class DaqLink {
   struct Options {
     std::string nameservice;          ///< corbaname::HOST:PORT; "" for the default
     std::string instance = "model0";  ///< the Model's instance name
-    int call_timeout_ms = 1500;       ///< every call to the Model and the naming service
+    /// Every call to the Model (set on its reference) and to the naming service's root context;
+    /// the naming service's other contexts follow the ORB's own call timeout.
+    int call_timeout_ms = 1500;
     int poll_period_ms = 250;         ///< status (and channels when the scene changed)
     int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
     int relist_period_ms = 5000;      ///< listing the channels again (also on a new scene)
-    /// Re-subscribe when the Model runs and this much simulated time passed without a batch [s].
+    /// Re-subscribe when the Model runs and this much simulated (and wall) time passed without a
+    /// batch [s]; longer when samples are sparse (see QuietThreshold).
     double silence_s = 2.0;
+    /// The unsubscribe call when closing (none when the Model was found gone) [ms].
+    int final_call_timeout_ms = 300;
     size_t inbox_batches = 4096;  ///< batches kept for the GUI before the oldest are dropped
   };
 
   /// Uses the process's ORB (initialises one when there is none), activates the consumer servant
   /// in its RootPOA and starts the worker.
   explicit DaqLink(Options options);
-  /// Ends the subscription (at most the call timeout) and stops the worker.
+  /// Ends the subscription and stops the worker: waits for a call under way (at most the call
+  /// timeout), makes no further call but the unsubscribe (at most final_call_timeout_ms, none
+  /// when the Model was found gone).
   ~DaqLink();
   DaqLink(const DaqLink&) = delete;
   DaqLink& operator=(const DaqLink&) = delete;
@@ -100,6 +95,9 @@ class DaqLink {
   std::vector<ReceivedBatch> TakeBatches();
   /// Lists the channels again at the next poll.
   void Relist();
+  /// Lists the channels and subscribes anew at the next poll, if `subscription` is still the
+  /// current one: its batches do not fit its layout (`why` goes into the status message).
+  void Resubscribe(uint64_t subscription, const std::string& why);
 
   /// The options it was made with.
   const Options& options() const { return options_; }
@@ -117,6 +115,8 @@ class DaqLink {
   std::condition_variable wake_;
   bool stopping_ = false;
   bool relist_ = false;
+  uint64_t resubscribe_ = 0;  // the subscription to replace (0: none)
+  std::string resubscribe_why_;
   std::vector<std::string> wanted_;
   uint32_t every_n_steps_ = 1;
   uint64_t wanted_version_ = 0;

@@ -2,6 +2,8 @@
 
 #include <exception>
 
+#include "caliper/logging/log.h"
+
 namespace caliper::plotter {
 
 DataConsumerServant::DataConsumerServant(std::function<void(ReceivedBatch&&)> sink)
@@ -21,8 +23,22 @@ void DataConsumerServant::on_samples(const Caliper::Daq::SampleBatch& batch) {
     if (b.values_per_sample > 0 && b.data.size() < b.times.size() * b.values_per_sample)
       b.times.resize(b.data.size() / b.values_per_sample);
     sink_(std::move(b));
-  } catch (const std::exception&) {
-    // out of memory or a failing sink: this batch is lost, the next one may not be
+  } catch (const std::exception& e) {
+    Failed(e.what());
+  } catch (...) {
+    Failed("an exception of unknown type");
+  }
+}
+
+void DataConsumerServant::Failed(const char* what) noexcept {
+  // this batch is lost, the next one may not be; the log gets the first and every 100th loss
+  const uint64_t n = ++failures_;
+  if (n != 1 && n % 100 != 0) return;
+  try {
+    logging::Get("plotter").error("a DAQ sample batch was lost (%llu so far): %s",
+                                  static_cast<unsigned long long>(n), what);
+  } catch (...) {
+    // logging failed too: the count stays
   }
 }
 

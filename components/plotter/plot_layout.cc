@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
+
+#include "caliper/core/system.h"
+#include "number_format.h"
 
 namespace caliper::plotter {
 
@@ -29,13 +31,6 @@ std::vector<std::string> Words(const std::string& s) {
   return words;
 }
 
-// shortest text that reads back to the same double
-std::string Number(double v) {
-  char buffer[32];
-  const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
-  return std::string(buffer, r.ptr);
-}
-
 bool IsColor(const std::string& s) {
   return s.size() == 7 && s[0] == '#' && std::all_of(s.begin() + 1, s.end(), [](char c) {
            return std::isxdigit(static_cast<unsigned char>(c)) != 0;
@@ -43,6 +38,25 @@ bool IsColor(const std::string& s) {
 }
 
 }  // namespace
+
+size_t BufferBytes(size_t samples, size_t curves) {
+  return samples * (curves + 1) * sizeof(double);
+}
+
+size_t MaxBufferSamples(size_t curves) {
+  return std::clamp(kBufferBudgetBytes / ((curves + 1) * sizeof(double)), kMinBuffer, kMaxBuffer);
+}
+
+std::string BufferBudgetProblem(size_t samples, size_t curves) {
+  if (samples <= MaxBufferSamples(curves)) return "";
+  constexpr size_t kMiB = size_t{1} << 20;
+  return std::to_string(curves) + (curves == 1 ? " curve" : " curves") + " of " +
+         std::to_string(samples) + " samples would need " +
+         std::to_string((BufferBytes(samples, curves) + kMiB - 1) / kMiB) + " MiB, more than the " +
+         std::to_string(kBufferBudgetBytes / kMiB) + " MiB all buffers may take (at most " +
+         std::to_string(MaxBufferSamples(curves)) + " samples for " + std::to_string(curves) +
+         (curves == 1 ? " curve)" : " curves)");
+}
 
 const char* Name(CurveStyle style) { return style == CurveStyle::kLine ? "line" : "scatter"; }
 
@@ -59,13 +73,14 @@ std::string FormatLayout(const Layout& layout) {
   std::ostringstream out;
   out << "# caliper-plotter layout\n"
       << "version = 1\n"
-      << "window_s = " << Number(layout.window_s) << "\n"
+      << "window_s = " << FormatNumber(layout.window_s) << "\n"
       << "buffer_samples = " << layout.buffer_samples << "\n"
       << "every_n_steps = " << layout.every_n_steps << "\n";
   for (const auto& p : layout.plots) {
     out << "\n[plot]\n"
         << "autoscale = " << (p.autoscale ? "true" : "false") << "\n";
-    if (!p.autoscale) out << "y_range = " << Number(p.y_min) << " " << Number(p.y_max) << "\n";
+    if (!p.autoscale)
+      out << "y_range = " << FormatNumber(p.y_min) << " " << FormatNumber(p.y_max) << "\n";
     for (const auto& c : p.curves) {
       out << "curve = " << c.key << " " << Name(c.style);
       if (!c.color.empty()) out << " " << c.color;
@@ -81,6 +96,7 @@ Layout ParseLayout(const std::string& text, const std::string& origin) {
   std::string raw;
   int line_no = 0;
   bool y_range_seen = false;
+  int buffer_line = 0;  // where buffer_samples was set
   auto fail = [&](const std::string& why) -> LayoutError {
     return LayoutError(origin + ":" + std::to_string(line_no) + ": " + why);
   };
@@ -127,11 +143,12 @@ Layout ParseLayout(const std::string& text, const std::string& origin) {
       } else if (key == "window_s") {
         const double w = parse_double(key, value);
         if (w < kMinWindow || w > kMaxWindow)
-          throw fail("window_s = " + value + " s is out of range [" + Number(kMinWindow) + ", " +
-                     Number(kMaxWindow) + "]");
+          throw fail("window_s = " + value + " s is out of range [" + FormatNumber(kMinWindow) +
+                     ", " + FormatNumber(kMaxWindow) + "]");
         layout.window_s = w;
       } else if (key == "buffer_samples") {
         layout.buffer_samples = parse_count(key, value, kMinBuffer, kMaxBuffer);
+        buffer_line = line_no;
       } else if (key == "every_n_steps") {
         layout.every_n_steps = static_cast<uint32_t>(parse_count(key, value, 1, kMaxEveryNSteps));
       } else if (key == "curve" || key == "autoscale" || key == "y_range") {
@@ -182,15 +199,22 @@ Layout ParseLayout(const std::string& text, const std::string& origin) {
     ++line_no;
     throw fail("the last plot has autoscale = false but no y_range");
   }
+  // all buffers together stay within the budget
+  const std::string budget = BufferBudgetProblem(layout.buffer_samples, layout.Keys().size());
+  if (!budget.empty()) {
+    if (buffer_line > 0) line_no = buffer_line;
+    throw fail("buffer_samples: " + budget);
+  }
   return layout;
 }
 
 void SaveLayout(const Layout& layout, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw LayoutError("cannot write " + path + ": " + std::strerror(errno));
-  out << FormatLayout(layout);
-  out.flush();
-  if (!out) throw LayoutError("write error on " + path);
+  const std::string text = FormatLayout(layout);
+  try {
+    core::WriteFileReplacing(path, [&](std::ostream& out) { out << text; });
+  } catch (const std::runtime_error& e) {
+    throw LayoutError(e.what());
+  }
 }
 
 Layout LoadLayout(const std::string& path) {

@@ -82,18 +82,31 @@ struct Layout {
 };
 
 /// Bounds the settings are checked against.
-constexpr double kMinWindow = 0.001;        ///< [s]
-constexpr double kMaxWindow = 86400.0;      ///< [s]
-constexpr size_t kMinBuffer = 100;          ///< samples
-constexpr size_t kMaxBuffer = 200'000'000;  ///< samples
+constexpr double kMinWindow = 0.001;       ///< [s]
+constexpr double kMaxWindow = 86400.0;     ///< [s]
+constexpr size_t kMinBuffer = 100;         ///< samples per curve
+constexpr size_t kMaxBuffer = 50'000'000;  ///< samples per curve (400 MB of values)
 constexpr uint32_t kMaxEveryNSteps = 1'000'000;
+/// What the sample buffers of all curves may take together: the time line and one value per
+/// curve, 8 bytes each, per sample [bytes].
+constexpr size_t kBufferBudgetBytes = size_t{1} << 30;
+
+/// Bytes the buffers of `curves` curves take when they hold `samples` samples.
+size_t BufferBytes(size_t samples, size_t curves);
+/// The most samples per curve that `curves` curves may keep within kBufferBudgetBytes (never more
+/// than kMaxBuffer, never less than kMinBuffer).
+size_t MaxBufferSamples(size_t curves);
+/// "" when `curves` curves may keep `samples` samples each; otherwise why not, with the numbers.
+std::string BufferBudgetProblem(size_t samples, size_t curves);
 
 /// The layout as text (the format above).
 std::string FormatLayout(const Layout& layout);
 /// Parses the text; `origin` (a file name) goes into error messages. Throws LayoutError naming
-/// the line for unknown keys, bad values, curves before the first [plot] and out-of-range settings.
+/// the line for unknown keys, bad values, curves before the first [plot], out-of-range settings
+/// and a buffer that its curves would make larger than kBufferBudgetBytes.
 Layout ParseLayout(const std::string& text, const std::string& origin = "layout");
-/// Writes `layout` to `path`; throws LayoutError when the file cannot be written.
+/// Writes `layout` to `path`, whole or not at all (an existing file is replaced only once the new
+/// one is complete); throws LayoutError naming the path and the reason.
 void SaveLayout(const Layout& layout, const std::string& path);
 /// Reads a layout file; throws LayoutError.
 Layout LoadLayout(const std::string& path);

@@ -4,30 +4,21 @@
 //                   [--ids ID,ID,...]... [--geometry WxH+X+Y] [--session FILE]
 //
 // SIGINT and SIGTERM close the window cleanly (the subscription ends, the session is written).
-#include <signal.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <QApplication>
-#include <QSocketNotifier>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "caliper/gui_session/tool_window.h"
-#include "caliper/rtc.hh"
+#include "caliper/logging/log.h"
+#include "caliper/rtc/client_orb.h"
 #include "daq_link.h"
 #include "plot_layout.h"
 #include "plotter_window.h"
 
 namespace {
-
-int signal_pipe[2] = {-1, -1};
-void OnSignal(int) {
-  const char c = 1;
-  [[maybe_unused]] const auto n = ::write(signal_pipe[0], &c, 1);
-}
 
 constexpr const char* kUsage = R"(usage: caliper-plotter [OPTIONS]
 
@@ -46,13 +37,24 @@ options:
   --session FILE        the GUI session file shared with the Main Window (INI): the window's
                         geometry (plotter/geometry, unless --geometry) and the last layout
                         (plotter/layout, unless --layout or --ids) are restored from it and
-                        written back when the window moves, is resized or closes
+                        written back when the window moves, is resized or closes; a layout
+                        there that does not parse is kept as plotter/layout.rejected
   -h, --help            this text
+  -platform NAME, -style NAME, ...  Qt's own options
 
 The time window is 10 s and the buffer keeps 1,000,000 samples per curve (CSV export writes all
 of them) unless a layout says otherwise; the Model samples every step and sends batches.
 SIGINT and SIGTERM close the window cleanly.
 )";
+
+// Qt's command-line options that take a value
+bool QtOptionWithValue(const std::string& option) {
+  for (const char* o : {"-platform", "-platformpluginpath", "-platformtheme", "-plugin",
+                        "-qwindowgeometry", "-qwindowicon", "-qwindowtitle", "-style",
+                        "-stylesheet", "-display", "-geometry", "-title", "-name"})
+    if (option == o) return true;
+  return false;
+}
 
 }  // namespace
 
@@ -79,7 +81,9 @@ int main(int argc, char** argv) {
         std::cerr << "caliper-plotter: unknown option '" << a << "' (--help lists them)\n";
         return 2;
       }
-      qt_argv.push_back(argv[i]);  // -platform, -style, ... are Qt's
+      // Qt's own (-platform offscreen, -style fusion ...); what Qt does not take is refused below
+      qt_argv.push_back(argv[i]);
+      if (QtOptionWithValue(a) && i + 1 < argc) qt_argv.push_back(argv[++i]);
       continue;
     }
     if (i + 1 >= argc) {
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  // the layout: --layout and --ids, else the session's
+  // the layout of --layout and --ids
   Layout layout;
   bool have_layout = false;
   if (!layout_file.empty()) {
@@ -126,13 +130,6 @@ int main(int argc, char** argv) {
     caliper::plotter::AddPlot(&layout, ids);
     have_layout = true;
   }
-  if (!have_layout && !session.isEmpty()) {
-    QString error;
-    have_layout = caliper::plotter::PlotterWindow::SessionLayout(session, &layout, &error);
-    if (!error.isEmpty())
-      std::cerr << "caliper-plotter: ignoring the session's layout: " << error.toStdString()
-                << "\n";
-  }
 
   int qt_argc = static_cast<int>(qt_argv.size());
   qt_argv.push_back(nullptr);
@@ -143,11 +140,12 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  std::vector<std::string> orb_args = {"caliper-plotter", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  std::vector<char*> orb_argv;
-  for (auto& a : orb_args) orb_argv.push_back(a.data());
-  int orb_argc = static_cast<int>(orb_argv.size());
-  CORBA::ORB_var orb = CORBA::ORB_init(orb_argc, orb_argv.data());
+  // what the data consumer logs goes to stderr (the launcher's session log)
+  caliper::logging::Initialize("plotter", caliper::logging::kWarn);
+  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-plotter");
+  // no call of this process waits longer than the link's call timeout (the naming service's
+  // included; the link bounds its calls to the Model itself)
+  omniORB::setClientCallTimeout(static_cast<CORBA::ULong>(options.call_timeout_ms));
 
   int status = 0;
   {
@@ -160,29 +158,24 @@ int main(int argc, char** argv) {
       return 1;
     }
     caliper::plotter::PlotterWindow window(std::move(link));
-    if (have_layout) window.ApplyLayout(layout);
+    // the layout: --layout and --ids, else the session's (kept aside when it does not parse,
+    // before anything writes the session)
+    if (have_layout) {
+      window.ApplyLayout(layout);
+    } else if (!session.isEmpty()) {
+      QString error;
+      if (!window.RestoreSessionLayout(session, &error) && !error.isEmpty())
+        std::cerr << "caliper-plotter: " << error.toStdString() << "\n";
+    }
     window.SetSessionFile(session);
     auto* tool = new caliper::gui_session::ToolWindow(&window, "plotter", session);
     tool->Restore(geometry);
     window.show();
     // SIGTERM/SIGINT close the window: the session is written, the subscription ends
-    if (::socketpair(AF_UNIX, SOCK_STREAM, 0, signal_pipe) == 0) {
-      auto* notifier = new QSocketNotifier(signal_pipe[1], QSocketNotifier::Read, &window);
-      QObject::connect(notifier, &QSocketNotifier::activated, &window, [&window] {
-        char c;
-        [[maybe_unused]] const auto n = ::read(signal_pipe[1], &c, 1);
-        window.close();
-        QApplication::quit();
-      });
-      struct sigaction sa = {};
-      sa.sa_handler = OnSignal;
-      sigemptyset(&sa.sa_mask);
-      sa.sa_flags = SA_RESTART;
-      sigaction(SIGTERM, &sa, nullptr);
-      sigaction(SIGINT, &sa, nullptr);
-    }
+    caliper::gui_session::CloseOnTerminationSignals(&window);
     status = QApplication::exec();
   }
   orb->destroy();
+  caliper::logging::Shutdown();
   return status;
 }

@@ -2,6 +2,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QBuffer>
 #include <QCheckBox>
 #include <QCloseEvent>
 #include <QComboBox>
@@ -33,16 +34,15 @@
 #include <QTreeWidget>
 #include <QVBoxLayout>
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <fstream>
+#include <ostream>
 #include <set>
 
 #include <qwt_plot_renderer.h>
 #include <qwt_scale_draw.h>
 #include <qwt_scale_widget.h>
 
+#include "caliper/core/system.h"
 #include "csv_export.h"
 #include "plot_view.h"
 
@@ -53,8 +53,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr int kKeyRole = Qt::UserRole;       // channels: the series key (or the whole id)
 constexpr int kPlotRole = Qt::UserRole + 1;  // curves: the plot index
-constexpr size_t kMaxElements = 64;          // larger values are not offered element by element
 constexpr int kStatusEveryTicks = 8;
+constexpr int kStatusMessageMs = 10000;
 
 bool Contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
@@ -199,7 +199,7 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   tools->addWidget(new QLabel(" buffer "));
   buffer_spin_ = new QSpinBox;
   buffer_spin_->setObjectName("buffer_samples");
-  buffer_spin_->setRange(static_cast<int>(kMinBuffer), static_cast<int>(kMaxBuffer));
+  buffer_spin_->setRange(static_cast<int>(kMinBuffer), static_cast<int>(MaxBufferSamples(0)));
   buffer_spin_->setSingleStep(100'000);
   buffer_spin_->setGroupSeparatorShown(true);
   buffer_spin_->setValue(static_cast<int>(store_.capacity()));
@@ -259,6 +259,7 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   NewPlot();
   UpdateTargets();
   RebuildCurves();
+  UpdateBufferLimit();
   RefreshStatus();
   resize(1280, 800);
 
@@ -293,13 +294,17 @@ PlotView* PlotterWindow::NewPlot() {
 
 void PlotterWindow::RemovePlot(int index) {
   if (index < 0 || index >= plot_count()) return;
+  RemovePlotView(index);
+  DropUnusedSeries();
+}
+
+void PlotterWindow::RemovePlotView(int index) {
   delete plots_[static_cast<size_t>(index)];
   plots_.erase(plots_.begin() + index);
   for (size_t k = 0; k < plots_.size(); ++k) {
     plots_[k]->setObjectName(QString("plot%1").arg(k));
     plots_[k]->ShowTimeTitle(k + 1 == plots_.size());
   }
-  DropUnusedSeries();
 }
 
 std::string PlotterWindow::UnitOf(const std::string& key) const {
@@ -311,6 +316,15 @@ std::string PlotterWindow::UnitOf(const std::string& key) const {
 
 bool PlotterWindow::AddCurve(int plot, const std::string& key, CurveStyle style) {
   if (plot < 0 || plot > plot_count() || key.empty()) return false;
+  if (store_.Find(key) < 0) {
+    // one more series must fit the memory budget at the buffer's size
+    const std::string problem = BufferBudgetProblem(store_.capacity(), store_.series_count() + 1);
+    if (!problem.empty()) {
+      ShowStatus(QString::fromStdString("cannot add " + key + ": " + problem +
+                                        "; make the buffer smaller first"));
+      return false;
+    }
+  }
   PlotView* p = plot == plot_count() ? NewPlot() : plots_[static_cast<size_t>(plot)];
   if (!p->AddCurve(CurveSpec{key, style, ""})) return false;
   if (store_.Find(key) < 0) {
@@ -344,23 +358,36 @@ void PlotterWindow::DropUnusedSeries() {
 
 void PlotterWindow::ApplyLayout(const Layout& layout) {
   applying_ = true;
-  while (!plots_.empty()) RemovePlot(plot_count() - 1);
-  window_s_ = std::clamp(layout.window_s, kMinWindow, kMaxWindow);
-  window_spin_->setValue(window_s_);
-  store_.SetCapacity(std::clamp(layout.buffer_samples, kMinBuffer, kMaxBuffer));
-  buffer_spin_->setValue(static_cast<int>(store_.capacity()));
-  every_n_steps_ = std::clamp<uint32_t>(layout.every_n_steps, 1, kMaxEveryNSteps);
-  every_spin_->setValue(static_cast<int>(every_n_steps_));
+  // new plots; the series of curves in both layouts keep their samples, the others go
+  while (!plots_.empty()) RemovePlotView(plot_count() - 1);
   for (const PlotSpec& spec : layout.plots) {
     PlotView* p = NewPlot();
     p->SetYRange(spec.y_min, spec.y_max);
     p->SetAutoscale(spec.autoscale);
-    for (const CurveSpec& c : spec.curves) {
-      if (!p->AddCurve(c)) continue;
-      if (store_.Find(c.key) < 0) store_.AddSeries(c.key, UnitOf(c.key));
-    }
+    for (const CurveSpec& c : spec.curves) p->AddCurve(c);
   }
+  DropUnusedSeries();
+  // the buffer within the memory budget for these curves; made smaller before new series come,
+  // so that the buffers never take more than the budget meanwhile
+  const std::vector<std::string> keys = CurrentLayout().Keys();
+  size_t buffer = std::clamp(layout.buffer_samples, kMinBuffer, kMaxBuffer);
+  const std::string problem = BufferBudgetProblem(buffer, keys.size());
+  if (!problem.empty()) {
+    buffer = MaxBufferSamples(keys.size());
+    ShowStatus(QString::fromStdString(problem + ": the buffer keeps " + std::to_string(buffer) +
+                                      " samples per curve"));
+  }
+  if (buffer < store_.capacity()) store_.SetCapacity(buffer);
+  for (const std::string& key : keys)
+    if (store_.Find(key) < 0) store_.AddSeries(key, UnitOf(key));
+  store_.SetCapacity(buffer);
   ++series_epoch_;
+  window_s_ = std::clamp(layout.window_s, kMinWindow, kMaxWindow);
+  window_spin_->setValue(window_s_);
+  UpdateBufferLimit();
+  buffer_spin_->setValue(static_cast<int>(store_.capacity()));
+  every_n_steps_ = std::clamp<uint32_t>(layout.every_n_steps, 1, kMaxEveryNSteps);
+  every_spin_->setValue(static_cast<int>(every_n_steps_));
   applying_ = false;
   LayoutChanged();
   Redraw(true);
@@ -386,10 +413,23 @@ void PlotterWindow::UpdateWanted() {
 
 void PlotterWindow::LayoutChanged() {
   if (applying_) return;
+  UpdateBufferLimit();
   UpdateWanted();
   RebuildCurves();
   UpdateTargets();
   SaveLayoutToSession();
+}
+
+void PlotterWindow::UpdateBufferLimit() {
+  const size_t curves = store_.series_count();
+  const size_t most = MaxBufferSamples(curves);
+  buffer_spin_->setMaximum(static_cast<int>(std::max(most, store_.capacity())));
+  buffer_spin_->setToolTip(
+      QString("Samples kept per curve: what CSV export writes (the oldest go first); at most %1 "
+              "for %2 curve(s), as all buffers together take at most %3 MiB")
+          .arg(Grouped(most))
+          .arg(curves)
+          .arg(kBufferBudgetBytes >> 20));
 }
 
 void PlotterWindow::UpdateTargets() {
@@ -451,9 +491,11 @@ void PlotterWindow::BuildChannels(const LinkStatus& s) {
     item->setData(0, kKeyRole, id);
     QString tip = QString::fromStdString(c.description);
     if (c.is_static) tip += (tip.isEmpty() ? "" : " ") + QString("(a parameter)");
+    const std::string why = WhyNotPlottable(c);
+    if (!why.empty()) tip += (tip.isEmpty() ? "" : "\n") + QString::fromStdString(why);
     if (!tip.isEmpty()) item->setToolTip(0, tip);
     const size_t n = static_cast<size_t>(c.rows) * c.cols;
-    if (n > 1 && n <= kMaxElements) {
+    if (n > 1 && n <= kMaxElementCurves) {
       const bool vector = c.rows == 1 || c.cols == 1;
       for (unsigned r = 0; r < (vector ? 1u : c.rows); ++r) {
         for (unsigned k = 0; k < (vector ? n : c.cols); ++k) {
@@ -487,6 +529,7 @@ void PlotterWindow::FilterChannels() {
 
 void PlotterWindow::AddSelected() {
   std::vector<std::string> keys;
+  QStringList refused;
   for (QTreeWidgetItem* item : channels_tree_->selectedItems()) {
     if (item->isHidden() || (item->parent() != nullptr && item->parent()->isHidden())) continue;
     if (item->childCount() > 0) {
@@ -502,10 +545,15 @@ void PlotterWindow::AddSelected() {
     const std::string id = SplitKey(key).id;
     const auto c = std::find_if(channels_.begin(), channels_.end(),
                                 [&](const ChannelEntry& e) { return e.id == id; });
-    // too large to offer element by element
-    if (item->parent() == nullptr && c != channels_.end() && c->rows * c->cols != 1) continue;
+    // too large to offer element by element: say so
+    if (item->parent() == nullptr && c != channels_.end() && c->rows * c->cols != 1) {
+      const std::string why = WhyNotPlottable(*c);
+      if (!why.empty()) refused << QString::fromStdString(why);
+      continue;
+    }
     keys.push_back(key);
   }
+  if (!refused.isEmpty()) ShowStatus(refused.join("; "));
   if (keys.empty()) return;
   int target = std::min(target_->currentIndex(), plot_count());
   if (target < 0) target = plot_count();
@@ -522,9 +570,7 @@ void PlotterWindow::Ingest(const ReceivedBatch& b) {
     // which value of a sample belongs to which series
     mapped_columns_.clear();
     mapped_ids_.clear();
-    mapped_width_ = 0;
-    for (const SubscribedId& id : *b.layout)
-      mapped_width_ += static_cast<size_t>(id.rows) * id.cols;
+    mapped_width_ = Width(*b.layout);
     for (size_t s = 0; s < store_.series_count(); ++s) {
       const KeyParts key = SplitKey(store_.series(s).key);
       for (const SubscribedId& id : *b.layout) {
@@ -541,8 +587,15 @@ void PlotterWindow::Ingest(const ReceivedBatch& b) {
     mapped_layout_ = b.layout;
     mapped_series_epoch_ = series_epoch_;
   }
-  // a batch laid out otherwise (shapes changed with a reload) cannot be read
-  if (b.values_per_sample != mapped_width_) return;
+  // a batch laid out otherwise (shapes changed with a reload) cannot be read: counted, shown,
+  // and the link lists the channels and subscribes anew
+  if (b.values_per_sample != mapped_width_) {
+    ++unreadable_batches_;
+    link_->Resubscribe(b.subscription, "batches of " + std::to_string(b.values_per_sample) +
+                                           " values per sample came for a layout of " +
+                                           std::to_string(mapped_width_));
+    return;
+  }
   bool newly_stale = false;
   for (const auto& [s, id] : mapped_ids_) {
     const bool stale = Contains(b.stale_ids, id) || Contains(missing_, id);
@@ -620,8 +673,11 @@ void PlotterWindow::RefreshStatus() {
   connection_->setText(text);
   connection_->setToolTip(text);
   QString rate = QString("%1 samples/s").arg(Grouped(std::llround(sample_rate())));
-  if (s.batches_missing + s.batches_dropped > 0)
-    rate += QString(", %1 batches lost").arg(s.batches_missing + s.batches_dropped);
+  const uint64_t lost =
+      s.batches_missing + s.batches_dropped + s.batches_discarded + s.consumer_failures;
+  if (lost > 0) rate += QString(", %1 batches lost").arg(lost);
+  if (unreadable_batches_ > 0)
+    rate += QString(", %1 batches unreadable (ids changed shape)").arg(unreadable_batches_);
   if (paused_) rate += " - paused (view frozen, still recording)";
   rate_->setText(rate);
   held_->setText(
@@ -722,7 +778,9 @@ void PlotterWindow::SetWindow(double seconds) {
 }
 
 void PlotterWindow::SetBufferSamples(size_t samples) {
-  samples = std::clamp(samples, kMinBuffer, kMaxBuffer);
+  const std::string problem = BufferBudgetProblem(samples, store_.series_count());
+  if (!problem.empty()) ShowStatus(QString::fromStdString(problem));
+  samples = std::clamp(samples, kMinBuffer, MaxBufferSamples(store_.series_count()));
   if (samples != store_.capacity()) store_.SetCapacity(samples);
   if (buffer_spin_->value() != static_cast<int>(samples))
     buffer_spin_->setValue(static_cast<int>(samples));
@@ -754,55 +812,63 @@ void PlotterWindow::RenderPlots(QPainter* painter, const QRectF& target) {
 
 bool PlotterWindow::ExportPlot(const QString& path, QString* error) {
   const QString suffix = QFileInfo(path).suffix().toLower();
+  if (suffix != "png" && suffix != "svg" && suffix != "pdf") {
+    *error = "cannot export to '." + suffix + "': use .png, .svg or .pdf";
+    return false;
+  }
   QSize size = plot_splitter_->size();
   if (size.width() < 200 || size.height() < 100 * std::max(1, plot_count()))
     size = QSize(1000, 320 * std::max(1, plot_count()));
   const QRectF area(QPointF(0, 0), QSizeF(size));
-  QPainter painter;
+  // drawn into memory, then written to a temporary file beside `path` that replaces it once
+  // complete: a failed export leaves an existing file as it was (QSaveFile would take a short
+  // write for a whole one)
+  QBuffer drawing;
+  drawing.open(QIODevice::WriteOnly);
+  bool drawn = false;
   if (suffix == "png") {
     QImage image(size, QImage::Format_ARGB32);
     image.fill(Qt::white);
-    painter.begin(&image);
+    QPainter painter(&image);
     RenderPlots(&painter, area);
     painter.end();
-    if (!image.save(path, "PNG")) {
-      *error = "cannot write " + path;
-      return false;
-    }
-    return true;
-  }
-  if (suffix == "svg") {
+    drawn = image.save(&drawing, "PNG");
+  } else if (suffix == "svg") {
     QSvgGenerator svg;
-    svg.setFileName(path);
+    svg.setOutputDevice(&drawing);
     svg.setSize(size);
     svg.setViewBox(QRect(QPoint(0, 0), size));
     svg.setTitle("Caliper Graph Plotter");
-    if (!painter.begin(&svg)) {
-      *error = "cannot write " + path;
-      return false;
+    QPainter painter;
+    if (painter.begin(&svg)) {
+      RenderPlots(&painter, area);
+      drawn = painter.end();
     }
-    RenderPlots(&painter, area);
-    painter.end();
-  } else if (suffix == "pdf") {
-    QPdfWriter pdf(path);
+  } else {
+    QPdfWriter pdf(&drawing);
     constexpr double kDpi = 96;
     pdf.setResolution(static_cast<int>(kDpi));
     pdf.setPageMargins(QMarginsF(0, 0, 0, 0));
     pdf.setPageSize(QPageSize(QSizeF(size.width() * 25.4 / kDpi, size.height() * 25.4 / kDpi),
                               QPageSize::Millimeter));
     pdf.setTitle("Caliper Graph Plotter");
-    if (!painter.begin(&pdf)) {
-      *error = "cannot write " + path;
-      return false;
+    QPainter painter;
+    if (painter.begin(&pdf)) {
+      RenderPlots(&painter, QRectF(0, 0, pdf.width(), pdf.height()));
+      drawn = painter.end();
     }
-    RenderPlots(&painter, QRectF(0, 0, pdf.width(), pdf.height()));
-    painter.end();
-  } else {
-    *error = "cannot export to '." + suffix + "': use .png, .svg or .pdf";
+  }
+  const QByteArray& bytes = drawing.data();
+  if (!drawn || bytes.isEmpty()) {
+    *error = "nothing was drawn for " + path;
     return false;
   }
-  if (QFileInfo(path).size() == 0) {
-    *error = "nothing was written to " + path;
+  try {
+    core::WriteFileReplacing(path.toStdString(), [&](std::ostream& out) {
+      out.write(bytes.constData(), static_cast<std::streamsize>(bytes.size()));
+    });
+  } catch (const std::exception& e) {
+    *error = QString::fromStdString(e.what());
     return false;
   }
   return true;
@@ -814,15 +880,10 @@ bool PlotterWindow::ExportCsv(const QString& path, QString* error) {
     const long s = store_.Find(key);
     if (s >= 0) series.push_back(static_cast<size_t>(s));
   }
-  std::ofstream out(path.toStdString());
-  if (!out) {
-    *error = "cannot write " + path + ": " + QString::fromLocal8Bit(std::strerror(errno));
-    return false;
-  }
-  WriteCsv(store_, series, out);
-  out.flush();
-  if (!out) {
-    *error = "write error on " + path;
+  try {
+    ExportCsvFile(store_, series, path.toStdString());
+  } catch (const std::exception& e) {
+    *error = QString::fromStdString(e.what());
     return false;
   }
   return true;
@@ -850,6 +911,27 @@ bool PlotterWindow::SessionLayout(const QString& path, Layout* layout, QString* 
   }
 }
 
+bool PlotterWindow::RestoreSessionLayout(const QString& path, QString* error) {
+  Layout layout;
+  QString why;
+  if (SessionLayout(path, &layout, &why)) {
+    ApplyLayout(layout);
+    return true;
+  }
+  if (why.isEmpty()) return false;  // the session holds no layout
+  // keep the text before anything writes the session (closing writes the layout shown)
+  QSettings st(path, QSettings::IniFormat);
+  st.setValue("plotter/layout.rejected", st.value("plotter/layout"));
+  st.sync();
+  QString message = "the session's layout was not applied: " + why;
+  message += st.status() == QSettings::NoError
+                 ? " (kept as plotter/layout.rejected in " + path + ")"
+                 : " (and it could not be kept as plotter/layout.rejected in " + path + ")";
+  ShowSessionProblem(message);
+  if (error != nullptr) *error = message;
+  return false;
+}
+
 void PlotterWindow::SaveLayoutToSession() {
   if (session_file_.isEmpty() || applying_) return;
   QSettings st(session_file_, QSettings::IniFormat);
@@ -860,6 +942,23 @@ void PlotterWindow::SaveLayoutToSession() {
 void PlotterWindow::closeEvent(QCloseEvent* event) {
   SaveLayoutToSession();
   QMainWindow::closeEvent(event);
+}
+
+void PlotterWindow::ShowStatus(const QString& message) {
+  statusBar()->showMessage(message, kStatusMessageMs);
+}
+
+void PlotterWindow::ShowSessionProblem(const QString& message) {
+  // stays in the status line until another message, and a box once the window is up
+  statusBar()->showMessage(message);
+  QTimer::singleShot(0, this, [this, message] {
+    auto* box =
+        new QMessageBox(QMessageBox::Warning, "Graph Plotter", message, QMessageBox::Ok, this);
+    box->setObjectName("session_problem");
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->setModal(false);
+    box->show();
+  });
 }
 
 void PlotterWindow::ShowError(const QString& message) {

@@ -45,12 +45,15 @@ class PlotterWindow : public QMainWindow {
                          QWidget* parent = nullptr);
   ~PlotterWindow() override;
 
-  /// Replaces the plots and settings with `layout`.
+  /// Replaces the plots and settings with `layout`. The samples of curves in both layouts stay,
+  /// those of curves it lacks go. A buffer too large for the memory budget is made smaller (the
+  /// status line says so).
   void ApplyLayout(const Layout& layout);
   /// The plots and settings now.
   Layout CurrentLayout() const;
   /// Adds a curve for `key` to plot `plot` (plot_count() makes a new plot); false when that
-  /// plot has it already or `plot` is out of range.
+  /// plot has it already, `plot` is out of range or one more curve would take the buffers past
+  /// kBufferBudgetBytes (the status line says so).
   bool AddCurve(int plot, const std::string& key, CurveStyle style = CurveStyle::kLine);
   /// Removes a curve from a plot; false when it has none.
   bool RemoveCurve(int plot, const std::string& key);
@@ -69,15 +72,18 @@ class PlotterWindow : public QMainWindow {
   void Autoscale();
   /// The span of simulated time drawn while live [s].
   void SetWindow(double seconds);
-  /// Samples kept per curve (the oldest go first); shrinking keeps the newest.
+  /// Samples kept per curve (the oldest go first); shrinking keeps the newest. At most what the
+  /// memory budget allows for the curves now (MaxBufferSamples; the status line says so).
   void SetBufferSamples(size_t samples);
   /// One sample every n simulation steps (subscribes anew).
   void SetEveryNSteps(uint32_t n);
 
-  /// Writes the stacked plots to `path`: PNG, SVG or PDF by its suffix. False with `error` set
-  /// when the suffix is unknown or the file cannot be written.
+  /// Writes the stacked plots to `path`: PNG, SVG or PDF by its suffix, whole or not at all (an
+  /// existing file is replaced once the new one is complete). False with `error` set (naming
+  /// the path and the reason) when the suffix is unknown or the file cannot be written.
   bool ExportPlot(const QString& path, QString* error);
-  /// Writes every sample held as CSV (time, then one column per curve with its unit).
+  /// Writes every sample held as CSV (time, then one column per curve with its unit), whole or
+  /// not at all as ExportPlot.
   bool ExportCsv(const QString& path, QString* error);
   /// Prints the stacked plots on `printer`, fitted to its page.
   void Print(QPrinter* printer);
@@ -87,6 +93,11 @@ class PlotterWindow : public QMainWindow {
   void SetSessionFile(const QString& path) { session_file_ = path; }
   /// The layout stored in a session file; false when it has none (or it does not parse).
   static bool SessionLayout(const QString& path, Layout* layout, QString* error);
+  /// Applies the layout stored in the session file `path`. One that does not parse is copied to
+  /// `plotter/layout.rejected` in the session first (closing writes the layout shown over
+  /// `plotter/layout`) and the reason is shown in the status line and a message; false then,
+  /// with `error` set, and false when the session holds no layout.
+  bool RestoreSessionLayout(const QString& path, QString* error);
 
   /// Takes in the received samples and redraws when there is something new (the timer calls it).
   void Tick();
@@ -99,6 +110,9 @@ class PlotterWindow : public QMainWindow {
   DaqLink& link() { return *link_; }
   /// Samples taken in per second of wall time, over the last two seconds.
   double sample_rate() const;
+  /// Batches whose width did not fit their subscription's layout (dropped; the link subscribes
+  /// anew).
+  uint64_t unreadable_batches() const { return unreadable_batches_; }
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -117,6 +131,8 @@ class PlotterWindow : public QMainWindow {
   void UpdateWanted();
   std::string UnitOf(const std::string& key) const;
   void RemovePlot(int index);
+  void RemovePlotView(int index);
+  void UpdateBufferLimit();
   void Ingest(const ReceivedBatch& b);
   void UserTimeRange(double t0, double t1);
   void DropUnusedSeries();
@@ -130,6 +146,8 @@ class PlotterWindow : public QMainWindow {
   void SaveLayoutDialog();
   void LoadLayoutDialog();
   void ShowError(const QString& message);
+  void ShowStatus(const QString& message);
+  void ShowSessionProblem(const QString& message);
 
   std::unique_ptr<DaqLink> link_;
   SampleStore store_;
@@ -151,6 +169,7 @@ class PlotterWindow : public QMainWindow {
   std::vector<SampleStore::Column> mapped_columns_;
   std::vector<std::pair<size_t, std::string>> mapped_ids_;  // series -> its DAQ id
   size_t mapped_width_ = 0;
+  uint64_t unreadable_batches_ = 0;
   std::deque<std::pair<std::chrono::steady_clock::time_point, size_t>> intake_;
   QString session_file_;
   bool applying_ = false;  // a layout is being applied: no session writes meanwhile

@@ -60,12 +60,14 @@ void SampleStore::SetCapacity(size_t samples) {
   // copy the newest samples out in time order
   const size_t keep = std::min(size_, samples);
   const size_t first = size_ - keep;
+  // room for the whole new capacity at once: the buffer never moves while it fills
+  const size_t room = keep > 0 ? samples : 0;
   std::vector<double> times;
-  times.reserve(keep);
+  times.reserve(room);
   for (size_t i = first; i < size_; ++i) times.push_back(time(i));
   std::vector<std::vector<double>> values(values_.size());
   for (size_t s = 0; s < values_.size(); ++s) {
-    values[s].reserve(keep);
+    values[s].reserve(room);
     for (size_t i = first; i < size_; ++i) values[s].push_back(value(s, i));
   }
   overwritten_ += first;
@@ -84,7 +86,10 @@ size_t SampleStore::AddSeries(const std::string& key, const std::string& unit) {
     return static_cast<size_t>(found);
   }
   series_.push_back(SeriesInfo{key, unit, false});
-  values_.emplace_back(times_.size(), kNaN);
+  std::vector<double> values;
+  values.reserve(times_.capacity());  // as much room as the time line
+  values.assign(times_.size(), kNaN);
+  values_.push_back(std::move(values));
   ++version_;
   return series_.size() - 1;
 }
@@ -120,7 +125,10 @@ void SampleStore::SetStale(size_t index, bool stale) {
 
 void SampleStore::PushBack(double t, const double* values_per_series) {
   if (times_.size() < capacity_) {
-    // still growing: append at the end (head_ stays 0)
+    // still growing: append at the end (head_ stays 0), into room for the whole capacity that
+    // the first sample reserves (address space: pages are taken as samples are written), so that
+    // no append ever copies the history
+    if (times_.size() == times_.capacity()) Reserve();
     times_.push_back(t);
     for (size_t s = 0; s < values_.size(); ++s) values_[s].push_back(values_per_series[s]);
     ++size_;
@@ -139,6 +147,11 @@ void SampleStore::PushBack(double t, const double* values_per_series) {
   for (size_t s = 0; s < values_.size(); ++s) values_[s][head_] = values_per_series[s];
   head_ = head_ + 1 == capacity_ ? 0 : head_ + 1;
   ++overwritten_;
+}
+
+void SampleStore::Reserve() {
+  times_.reserve(capacity_);
+  for (auto& v : values_) v.reserve(capacity_);
 }
 
 SampleStore::AppendResult SampleStore::Append(const double* times, size_t count, const double* data,

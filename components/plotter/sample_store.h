@@ -130,11 +130,12 @@ class SampleStore {
     return p < capacity_ ? p : p - capacity_;
   }
   void PushBack(double t, const double* values_per_series);
+  void Reserve();
 
   size_t capacity_;
   size_t head_ = 0;  // physical index of the oldest sample (0 until the buffer is full)
   size_t size_ = 0;
-  std::vector<double> times_;                // [s], physical order; grows up to capacity_
+  std::vector<double> times_;  // [s], physical order; grows up to capacity_ (reserved at once)
   std::vector<std::vector<double>> values_;  // per series, same physical order as times_
   std::vector<SeriesInfo> series_;
   uint64_t version_ = 0;

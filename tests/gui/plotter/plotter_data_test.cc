@@ -1,28 +1,37 @@
-// The Graph Plotter's data class on its own (no Qt, no CORBA): the ring buffer and its cap, time
-// window queries, rewinds, min/max thinning for drawing, CSV export of every sample with units,
-// layouts written and read back (and rejected with the line named), stale series.
+// The Graph Plotter's data classes on their own (no Qt, no CORBA): the ring buffer and its cap,
+// time window queries, rewinds, min/max thinning for drawing, CSV export of every sample with
+// units, layouts written and read back (and rejected with the line named, also for a buffer past
+// the memory budget), files that fail to be written leaving the old ones, stale series,
+// subscription layouts checked against a fresh channel listing, the quiet-stream watch.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "channel_layout.h"
 #include "csv_export.h"
 #include "decimate.h"
+#include "number_format.h"
 #include "plot_layout.h"
 #include "sample_store.h"
+#include "stream_watch.h"
 
 namespace caliper::plotter {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Appends samples t = first*dt ... with one value per series: value(series, i).
+// Appends samples t = first*dt ... with one value per series: value(series, i).
 template <typename F>
 void Fill(SampleStore* store, size_t first, size_t count, double dt, F value) {
   const size_t n = store->series_count();
@@ -49,6 +58,41 @@ std::vector<std::string> Fields(const std::string& line) {
   for (std::string x; std::getline(in, x, ',');) f.push_back(x);
   return f;
 }
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+}
+
+// While it lives, no file this process writes may grow past `bytes`: a write beyond fails with
+// EFBIG ("File too large"), the way a full disk fails it (SIGXFSZ is ignored meanwhile).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit saved_{};
+  void (*handler_)(int) = nullptr;
+};
 
 TEST(SampleStoreTest, KeepsTheNewestSamplesUpToItsCapacity) {
   SampleStore store(1000);
@@ -300,6 +344,51 @@ TEST(CsvExportTest, WritesTimeAndOneColumnPerCurveWithUnitsAndEverySample) {
   EXPECT_THROW(WriteCsv(late, {2}, two), std::out_of_range);
 }
 
+TEST(CsvExportTest, AFileIsWrittenWholeOrTheOldOneStays) {
+  SampleStore store(5000);
+  store.AddSeries("pendulum.angle", "rad");
+  Fill(&store, 1, 3000, 0.001, [](size_t, size_t i) { return 0.25 * i; });
+  const std::string path = ::testing::TempDir() + "/plotter_export_test.csv";
+  EXPECT_EQ(ExportCsvFile(store, {0}, path), 3000u);
+  std::ostringstream expected;
+  WriteCsv(store, {0}, expected);
+  EXPECT_EQ(ReadText(path), expected.str());
+  // a write that fails half way (as on a full disk) leaves the file as it was and says why
+  WriteText(path, "the user's old data\n");
+  {
+    const FileSizeLimit limit(1000);
+    try {
+      ExportCsvFile(store, {0}, path);
+      ADD_FAILURE() << "a write past the file size limit succeeded";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("cannot write " + path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("File too large"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(ReadText(path), "the user's old data\n");
+  try {
+    ExportCsvFile(store, {0}, "/nonexistent/dir/data.csv");
+    ADD_FAILURE() << "wrote into a directory that does not exist";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("cannot write /nonexistent/dir/data.csv", 0), 0u)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
+        << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+TEST(NumberFormatTest, WritesTheShortestTextThatReadsBackTheSameDouble) {
+  EXPECT_EQ(FormatNumber(0.1), "0.1");
+  EXPECT_EQ(FormatNumber(-0.125), "-0.125");
+  EXPECT_EQ(FormatNumber(86400), "86400");
+  EXPECT_EQ(FormatNumber(1.0 / 3), "0.3333333333333333");
+  EXPECT_EQ(FormatNumber(-std::numeric_limits<double>::quiet_NaN()), "nan");
+  std::string line = "t=";
+  AppendNumber(&line, 0.001);
+  EXPECT_EQ(line, "t=0.001");
+}
+
 // ------------------------------------------------------------------------ layouts
 
 Layout Example() {
@@ -345,7 +434,9 @@ TEST(LayoutTest, RejectsMalformedLayoutsNamingTheLine) {
       {"window_s = 10\nwindow = 3\n", "f:2: unknown key 'window'"},
       {"window_s = -1\n", "f:1: window_s = -1 s is out of range"},
       {"window_s = abc\n", "f:1: window_s wants a number, not 'abc'"},
-      {"buffer_samples = 10\n", "f:1: buffer_samples = 10 is out of range [100, 200000000]"},
+      {"buffer_samples = 10\n", "f:1: buffer_samples = 10 is out of range [100, 50000000]"},
+      {"buffer_samples = 200000000\n",
+       "f:1: buffer_samples = 200000000 is out of range [100, 50000000]"},
       {"every_n_steps = 0\n", "f:1: every_n_steps = 0 is out of range"},
       {"version = 2\n", "f:1: unsupported layout version 2"},
       {"curve = a\n", "f:1: curve before the first [plot]"},
@@ -370,6 +461,62 @@ TEST(LayoutTest, RejectsMalformedLayoutsNamingTheLine) {
   EXPECT_THROW(SaveLayout(Example(), "/nonexistent/x.layout"), LayoutError);
 }
 
+TEST(LayoutTest, RejectsABufferThatItsCurvesWouldMakeLargerThanTheMemoryBudget) {
+  // 8 bytes for the time and for each curve per sample, 1 GiB for all
+  EXPECT_EQ(BufferBytes(1000, 3), 32'000u);
+  EXPECT_EQ(MaxBufferSamples(0), kMaxBuffer);
+  EXPECT_EQ(MaxBufferSamples(1), kMaxBuffer);
+  EXPECT_EQ(MaxBufferSamples(3), kBufferBudgetBytes / 32);
+  EXPECT_EQ(MaxBufferSamples(100'000'000), kMinBuffer);
+  EXPECT_EQ(BufferBudgetProblem(33'554'432, 3), "");
+  EXPECT_EQ(BufferBudgetProblem(40'000'000, 3),
+            "3 curves of 40000000 samples would need 1221 MiB, more than the 1024 MiB all "
+            "buffers may take (at most 33554432 samples for 3 curves)");
+  // two curves fit 40 million samples, three do not: the buffer_samples line is named
+  const std::string two = "buffer_samples = 40000000\n[plot]\ncurve = a\ncurve = b\n";
+  EXPECT_EQ(ParseLayout(two, "f").buffer_samples, 40'000'000u);
+  try {
+    ParseLayout(two + "curve = c\n", "f");
+    ADD_FAILURE() << "a 1.28 GB buffer was accepted";
+  } catch (const LayoutError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "f:1: buffer_samples: 3 curves of 40000000 samples would need 1221 MiB, more than "
+              "the 1024 MiB all buffers may take (at most 33554432 samples for 3 curves)");
+  }
+  // the default buffer with very many curves: the last line is named
+  std::string many = "[plot]\n";
+  for (int k = 0; k < 200; ++k) many += "curve = c" + std::to_string(k) + "\n";
+  try {
+    ParseLayout(many, "f");
+    ADD_FAILURE() << "200 curves of a million samples were accepted";
+  } catch (const LayoutError& e) {
+    EXPECT_EQ(
+        std::string(e.what()).rfind("f:201: buffer_samples: 200 curves of 1000000 samples", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(LayoutTest, ASaveThatFailsLeavesTheOldFileAndSaysWhy) {
+  const std::string path = ::testing::TempDir() + "/plotter_layout_failing.layout";
+  WriteText(path, "# the user's layout\n");
+  Layout big = Example();
+  AddPlot(&big, std::vector<std::string>(40, "pendulum_tendon.some.rather.long.channel.id"));
+  {
+    const FileSizeLimit limit(200);
+    try {
+      SaveLayout(big, path);
+      ADD_FAILURE() << "a write past the file size limit succeeded";
+    } catch (const LayoutError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("cannot write " + path, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("File too large"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(ReadText(path), "# the user's layout\n");
+  SaveLayout(big, path);
+  EXPECT_EQ(LoadLayout(path), big);
+  std::remove(path.c_str());
+}
+
 TEST(LayoutTest, IdsFromTheCommandLineMakeAPlot) {
   EXPECT_EQ(SplitIds(" a.b, c ,,d[1]"), (std::vector<std::string>{"a.b", "c", "d[1]"}));
   Layout l;
@@ -378,6 +525,123 @@ TEST(LayoutTest, IdsFromTheCommandLineMakeAPlot) {
   ASSERT_EQ(l.plots.size(), 1u);
   EXPECT_EQ(l.plots[0].curves.size(), 2u);
   EXPECT_EQ(l.plots[0].curves[1].key, "b");
+}
+
+// ------------------------------------------------------------------------ subscription layouts
+
+std::vector<ChannelEntry> PendulumChannels() {
+  return {{"p.pivot.position", "rad", 1, 1, false, ""},
+          {"p.motor.current", "A", 1, 1, false, ""},
+          {"p.pendulum.position", "m", 3, 1, false, ""},
+          {"p.frame.rotation", "", 3, 3, false, ""}};
+}
+
+TEST(ChannelLayoutTest, LaysTheIdsOutOneAfterTheOtherWithTheirShapes) {
+  const auto layout =
+      LayoutOf({"p.pendulum.position", "p.motor.current", "p.frame.rotation"}, PendulumChannels());
+  ASSERT_EQ(layout.size(), 3u);
+  EXPECT_EQ(layout[0].offset, 0u);
+  EXPECT_EQ(layout[1].offset, 3u);
+  EXPECT_EQ(layout[1].unit, "A");
+  EXPECT_EQ(layout[2].offset, 4u);
+  EXPECT_EQ(layout[2].rows, 3u);
+  EXPECT_EQ(Width(layout), 13u);
+  EXPECT_THROW(LayoutOf({"p.nothing"}, PendulumChannels()), std::invalid_argument);
+}
+
+TEST(ChannelLayoutTest, AReloadThatGivesAnIdAnotherShapeOrUnitIsAChange) {
+  const auto layout =
+      LayoutOf({"p.pivot.position", "p.motor.current", "p.pendulum.position"}, PendulumChannels());
+  EXPECT_EQ(LayoutChange(layout, PendulumChannels()), "");
+  // the body and the hinge swap names: same width (5), the current moves from 1 to 3
+  auto swapped = PendulumChannels();
+  swapped[0] = {"p.pivot.position", "m", 3, 1, false, ""};
+  swapped[2] = {"p.pendulum.position", "rad", 1, 1, false, ""};
+  EXPECT_EQ(
+      Width(LayoutOf({"p.pivot.position", "p.motor.current", "p.pendulum.position"}, swapped)),
+      Width(layout));
+  EXPECT_EQ(LayoutChange(layout, swapped),
+            "p.pivot.position is 3x1 [m] now, was 1x1 [rad], "
+            "p.pendulum.position is 1x1 [rad] now, was 3x1 [m]");
+  // a unit alone
+  auto milliamps = PendulumChannels();
+  milliamps[1].unit = "mA";
+  EXPECT_EQ(LayoutChange(layout, milliamps), "p.motor.current is 1x1 [mA] now, was 1x1 [A]");
+  // an id the scene no longer has keeps its place (NaN): no change
+  auto no_motor = PendulumChannels();
+  no_motor.erase(no_motor.begin() + 1);
+  EXPECT_EQ(LayoutChange(layout, no_motor), "");
+}
+
+TEST(ChannelLayoutTest, SaysWhyAMatrixOfMoreThan64ElementsGivesNoCurve) {
+  EXPECT_EQ(WhyNotPlottable({"p.pivot.position", "rad", 1, 1, false, ""}), "");
+  EXPECT_EQ(WhyNotPlottable({"p.frame.rotation", "", 3, 3, false, ""}), "");
+  EXPECT_EQ(WhyNotPlottable({"p.wide", "", 1, 64, false, ""}), "");
+  EXPECT_EQ(WhyNotPlottable({"p.contact.map", "N", 10, 10, false, ""}),
+            "p.contact.map is 10x10: 100 values are too many to plot one curve each (at most 64)");
+  EXPECT_EQ(WhyNotPlottable({"p.empty", "", 0, 3, false, ""}),
+            "p.empty is 0x3: it has no values to plot");
+}
+
+// ------------------------------------------------------------------------ quiet streams
+
+TEST(StreamWatchTest, WaitsLongerThanTheGapBetweenSparseSamples) {
+  // every step: the configured silence; sparse samples: three intervals and a batch
+  EXPECT_DOUBLE_EQ(QuietThreshold(2.0, 1, 0.001), 2.0);
+  EXPECT_DOUBLE_EQ(QuietThreshold(2.0, 100, 0.001), 2.0);
+  EXPECT_DOUBLE_EQ(QuietThreshold(2.0, 1000, 0.001), 4.0);
+  EXPECT_DOUBLE_EQ(QuietThreshold(2.0, 5000, 0.001), 20.0);
+  EXPECT_DOUBLE_EQ(QuietThreshold(0.5, 100, 0.002), 0.8);
+}
+
+TEST(StreamWatchTest, ASparseStreamThatDeliversIsNeverQuiet) {
+  // one sample every 5 s of simulated time, the Model at real time
+  using Clock = StreamWatch::Clock;
+  const Clock::time_point t0 = Clock::now();
+  auto at = [&](double s) {
+    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  StreamWatch watch(2.0);
+  watch.Start(0.0, 5000, at(0));
+  // polls every 250 ms for 60 s; a sample at 5, 10, ... arrives 50 ms later
+  double last_sample = nan;
+  Clock::time_point last_batch{};
+  for (double t = 0.25; t <= 60; t += 0.25) {
+    const double due = std::floor((t - 0.05) / 5) * 5;
+    if (due >= 5 && (std::isnan(last_sample) || due > last_sample)) {
+      last_sample = due;
+      last_batch = at(due + 0.05);
+    }
+    ASSERT_FALSE(watch.Quiet(true, t, 0.001, last_sample, last_batch, at(t))) << "at " << t;
+  }
+  // the samples stop: quiet once 20 s of simulated and of wall time have passed without one
+  EXPECT_FALSE(watch.Quiet(true, 74.0, 0.001, last_sample, last_batch, at(74.0)));
+  EXPECT_TRUE(watch.Quiet(true, 80.5, 0.001, last_sample, last_batch, at(80.5)));
+  EXPECT_NEAR(watch.quiet_for(), 25.5, 1e-9);
+  // paused: never quiet
+  EXPECT_FALSE(watch.Quiet(false, 90.0, 0.001, last_sample, last_batch, at(90.0)));
+}
+
+TEST(StreamWatchTest, ADenseStreamThatStopsIsQuietAfterTheSilenceAndAResetRestartsTheWatch) {
+  using Clock = StreamWatch::Clock;
+  const Clock::time_point t0 = Clock::now();
+  auto at = [&](double s) {
+    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  StreamWatch watch(2.0);
+  watch.Start(1.0, 1, at(0));
+  EXPECT_FALSE(watch.Quiet(true, 2.0, 0.001, 1.95, at(1.0), at(1.0)));
+  EXPECT_FALSE(watch.Quiet(true, 3.9, 0.001, 1.95, at(1.0), at(2.9)));
+  EXPECT_TRUE(watch.Quiet(true, 4.0, 0.001, 1.95, at(1.0), at(3.1)));
+  // not while the wall clock says the last batch came a moment ago (a Model faster than real time)
+  StreamWatch fast(2.0);
+  fast.Start(0.0, 1, at(0));
+  EXPECT_FALSE(fast.Quiet(true, 10.0, 0.001, 0.5, at(0.1), at(1.0)));
+  // a reset: the simulated time went back, the watch starts from there
+  EXPECT_FALSE(watch.Quiet(true, 0.5, 0.001, 1.95, at(1.0), at(3.2)));
+  EXPECT_FALSE(watch.Quiet(true, 2.4, 0.001, 1.95, at(1.0), at(5.1)));
+  EXPECT_TRUE(watch.Quiet(true, 2.6, 0.001, 1.95, at(1.0), at(5.3)));
 }
 
 }  // namespace

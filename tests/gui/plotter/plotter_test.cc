@@ -1,12 +1,17 @@
 // The Graph Plotter in the test process against a real caliper-model (pendulum_tendon.dae):
 // the search box filters the channel list, ids go into two stacked plots, the curves fill while
 // the simulation runs, pause freezes the view (recording goes on) and resume follows again, clear
-// empties, exports (CSV with units and every sample, SVG, PDF, PNG) are well formed; a Model that
+// empties, exports (CSV with units and every sample, SVG, PDF, PNG) are well formed and a failed
+// one leaves the old file, loading a layout keeps the samples of the curves it keeps; a Model that
 // is killed and started again is subscribed to again, a reload without an id marks its curve
-// stale (and a reload with it brings it back). The real program is run for --help, bad options
-// and the session file. Widgets run on QT_QPA_PLATFORM=offscreen.
+// stale (and a reload with it brings it back), a reload that gives plotted ids other shapes keeps
+// every curve on its own values; closing does not wait for a hung Model; the buffers stay within
+// their memory budget; the data consumer lets no exception into the ORB. The real program is run
+// for --help, bad options, Qt's options and the session file (a layout there that does not parse
+// is kept aside). Widgets run on QT_QPA_PLATFORM=offscreen.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <QApplication>
 #include <QComboBox>
@@ -15,20 +20,26 @@
 #include <QImage>
 #include <QLabel>
 #include <QLineEdit>
+#include <QMessageBox>
 #include <QMouseEvent>
 #include <QPrinter>
 #include <QPushButton>
 #include <QSettings>
+#include <QSpinBox>
+#include <QStatusBar>
 #include <QSvgRenderer>
 #include <QTest>
 #include <QToolBar>
 #include <QTreeWidget>
 #include <QXmlStreamReader>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include <qwt_plot_curve.h>
@@ -37,6 +48,7 @@
 #include "caliper/model.hh"
 #include "caliper/rtc/naming.h"
 #include "daq_link.h"
+#include "data_consumer_servant.h"
 #include "plot_view.h"
 #include "plotter_window.h"
 #include "support/gui_test.h"
@@ -49,8 +61,10 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 namespace M = ::Caliper::Simulation;
 namespace D = ::Caliper::Daq;
+namespace S = ::Caliper::Scene;
 using plotter::DaqLink;
 using plotter::Layout;
+using plotter::LinkStatus;
 using plotter::PlotterWindow;
 
 constexpr const char* kAngle = "pendulum_tendon.pivot.position";
@@ -68,7 +82,7 @@ std::string TestData() {
   return std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/tests/data/plotter";
 }
 
-/// The channel row (or element row) whose key is `key`, or nullptr.
+// The channel row (or element row) whose key is `key`, or nullptr.
 QTreeWidgetItem* ChannelItem(PlotterWindow& w, const QString& key) {
   auto* tree = w.findChild<QTreeWidget*>("channels");
   for (int k = 0; k < tree->topLevelItemCount(); ++k) {
@@ -88,7 +102,7 @@ QStringList VisibleChannels(PlotterWindow& w) {
   return ids;
 }
 
-/// Clicks the tool bar button of an action.
+// Clicks the tool bar button of an action.
 void ClickAction(PlotterWindow& w, const char* name) {
   auto* action = w.findChild<QAction*>(name);
   ASSERT_NE(action, nullptr) << name;
@@ -97,8 +111,8 @@ void ClickAction(PlotterWindow& w, const char* name) {
   QTest::mouseClick(button, Qt::LeftButton);
 }
 
-/// Drags with the left button from `from` to `to` (Qt 5's QTest::mouseMove only moves the cursor,
-/// which sends no event on the offscreen platform: the moves are sent here).
+// Drags with the left button from `from` to `to` (Qt 5's QTest::mouseMove only moves the cursor,
+// which sends no event on the offscreen platform: the moves are sent here).
 void Drag(QWidget* widget, QPoint from, QPoint to, Qt::KeyboardModifiers modifiers) {
   QTest::mousePress(widget, Qt::LeftButton, modifiers, from);
   for (int k = 1; k <= 4; ++k) {
@@ -110,7 +124,7 @@ void Drag(QWidget* widget, QPoint from, QPoint to, Qt::KeyboardModifiers modifie
   QTest::mouseRelease(widget, Qt::LeftButton, modifiers, to);
 }
 
-/// The newest value of a series held (NaN when none).
+// The newest value of a series held (NaN when none).
 double Newest(const PlotterWindow& w, const std::string& key) {
   const auto& s = w.store();
   const long i = s.Find(key);
@@ -129,6 +143,59 @@ std::vector<std::string> Split(const std::string& s, char sep) {
   return out;
 }
 
+// Every value of a series held, oldest first.
+std::vector<double> Values(const PlotterWindow& w, const std::string& key) {
+  std::vector<double> v;
+  const long s = w.store().Find(key);
+  if (s < 0) return v;
+  w.store().ForEach(static_cast<size_t>(s), 0, w.store().size(),
+                    [&](double, double x) { v.push_back(x); });
+  return v;
+}
+
+// Element `k` of the Model's value of `id` now.
+double Get(M::Model_ptr model, const std::string& id, CORBA::ULong k = 0) {
+  S::StringSeq ids;
+  ids.length(1);
+  ids[0] = id.c_str();
+  D::ValueSeq_var values = model->get(ids);
+  return values[0].data[k];
+}
+
+// The newest sample held is the Model's state now (the Model is not running).
+bool UpToDate(const PlotterWindow& w, M::Model_ptr model) {
+  M::SimulationStatus_var s = model->status();
+  return !w.store().empty() && std::abs(w.store().last_time() - s->sim_time) < 1e-9;
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// While it lives, no file this process writes may grow past `bytes`: a write beyond fails with
+// EFBIG ("File too large"), the way a full disk fails it (SIGXFSZ is ignored meanwhile).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit saved_{};
+  void (*handler_)(int) = nullptr;
+};
+
 class PlotterTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -138,36 +205,26 @@ class PlotterTest : public ::testing::Test {
   }
 
   std::unique_ptr<Process> StartModel(const std::string& scene) {
-    return std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-model"), "-o", "model.scene=" + scene, "-o",
-                                 "exec.auto_activate=true", "--nameservice", naming_->address(),
-                                 "-o", "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model" + std::to_string(++models_) + ".out");
+    return StartModelProcess(naming_->address(), scene, dir_.path(),
+                             dir_.path() + "/model" + std::to_string(++models_) + ".out");
   }
 
-  /// The Model bound as model0 that answers.
-  M::Model_var WaitForModel() {
-    M::Model_var model;
-    WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming_->address());
-            model = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(model) && !model->_non_existent();
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20));
-    return model;
-  }
+  // The Model bound as model0 that answers.
+  M::Model_var WaitForModel() { return testing::WaitForModel(naming_->address()); }
 
-  std::unique_ptr<PlotterWindow> Window(const std::string& nameservice) {
+  static DaqLink::Options LinkOptions(const std::string& nameservice) {
     DaqLink::Options options;
     options.nameservice = nameservice;
     options.reconnect_period_ms = 300;
     options.poll_period_ms = 100;
+    return options;
+  }
+
+  std::unique_ptr<PlotterWindow> Window(const std::string& nameservice) {
+    return Window(LinkOptions(nameservice));
+  }
+
+  std::unique_ptr<PlotterWindow> Window(const DaqLink::Options& options) {
     auto w = std::make_unique<PlotterWindow>(std::make_unique<DaqLink>(options));
     w->resize(1280, 800);
     w->show();
@@ -440,12 +497,31 @@ TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
   EXPECT_LT(w->store().Find(kHeight), 0);
   EXPECT_EQ(curves->topLevelItem(1)->childCount(), 1);
 
-  // the layout round trip through the window
+  // the layout round trip through the window: the recorded samples stay
   const Layout layout = w->CurrentLayout();
   ASSERT_EQ(layout.plots.size(), 2u);
   EXPECT_EQ(layout.Keys(), (std::vector<std::string>{kAngle, kCurrent, kTension}));
+  const size_t held_now = w->store().size();
+  const std::vector<double> angles = Values(*w, kAngle);
+  const std::vector<double> currents = Values(*w, kCurrent);
+  ASSERT_GT(held_now, 1000u);
   w->ApplyLayout(layout);
   EXPECT_EQ(w->CurrentLayout(), layout);
+  EXPECT_EQ(w->store().size(), held_now);
+  EXPECT_EQ(Values(*w, kAngle), angles) << "loading a layout keeps the recorded data";
+  EXPECT_EQ(Values(*w, kCurrent), currents);
+  // another layout: the angle keeps its samples, the curves it lacks go, a new one has none yet
+  Layout other;
+  plotter::AddPlot(&other, {kAngle});
+  plotter::AddPlot(&other, {kHeight});
+  w->ApplyLayout(other);
+  EXPECT_EQ(w->CurrentLayout(), other);
+  EXPECT_EQ(Values(*w, kAngle), angles);
+  EXPECT_LT(w->store().Find(kCurrent), 0);
+  EXPECT_LT(w->store().Find(kTension), 0);
+  const std::vector<double> heights = Values(*w, kHeight);
+  ASSERT_EQ(heights.size(), held_now);
+  EXPECT_TRUE(std::all_of(heights.begin(), heights.end(), [](double v) { return std::isnan(v); }));
 
   model->pause();
   w.reset();
@@ -533,13 +609,20 @@ TEST_F(PlotterTest, TheProgramTakesItsOptionsAndKeepsItsSession) {
       RunCommand({Bin("caliper-plotter"), "--layout", "/nonexistent.layout"}, seconds(10));
   EXPECT_EQ(layout.exit_code, 2);
   EXPECT_NE(layout.err.find("cannot read /nonexistent.layout"), std::string::npos) << layout.err;
+  // Qt's options pass, values and all: the first unknown one is ours to refuse
+  const CommandResult qt_option =
+      RunCommand({Bin("caliper-plotter"), "-platform", "offscreen", "-style", "fusion", "--bogus"},
+                 seconds(10));
+  EXPECT_EQ(qt_option.exit_code, 2);
+  EXPECT_NE(qt_option.err.find("unknown option '--bogus'"), std::string::npos) << qt_option.err;
 
   // --ids and --geometry go into the session file when the plotter ends on SIGTERM
   const std::string session = dir_.path() + "/session.ini";
   {
-    Process p({Bin("caliper-plotter"), "--nameservice", naming_->address(), "--session", session,
-               "--geometry", "640x480+30+40", "--ids", "a.b, c.d[1]", "--ids", "e"},
-              dir_.path() + "/plotter1.out");
+    Process p(
+        {Bin("caliper-plotter"), "-platform", "offscreen", "--nameservice", naming_->address(),
+         "--session", session, "--geometry", "640x480+30+40", "--ids", "a.b, c.d[1]", "--ids", "e"},
+        dir_.path() + "/plotter1.out");
     std::this_thread::sleep_for(milliseconds(1500));
     p.Signal(SIGTERM);
     EXPECT_EQ(p.Wait(seconds(10)), 0) << p.Output();
@@ -570,6 +653,60 @@ TEST_F(PlotterTest, TheProgramTakesItsOptionsAndKeepsItsSession) {
                 .value("plotter/geometry")
                 .toString(),
             "640x480+30+40");
+
+  // a session layout that does not parse: said on stderr, kept as plotter/layout.rejected
+  const QString rejected = "version = 1\nwindow = 3\n[plot]\ncurve = a.b\n";
+  QSettings(QString::fromStdString(session), QSettings::IniFormat)
+      .setValue("plotter/layout", rejected);
+  {
+    Process p({Bin("caliper-plotter"), "--nameservice", naming_->address(), "--session", session},
+              dir_.path() + "/plotter3.out");
+    std::this_thread::sleep_for(milliseconds(1500));
+    p.Signal(SIGTERM);
+    EXPECT_EQ(p.Wait(seconds(10)), 0) << p.Output();
+    EXPECT_NE(p.Output().find("unknown key 'window'"), std::string::npos) << p.Output();
+  }
+  QSettings after(QString::fromStdString(session), QSettings::IniFormat);
+  EXPECT_EQ(after.value("plotter/layout.rejected").toString(), rejected);
+  EXPECT_NE(after.value("plotter/layout").toString(), rejected) << "the window's layout is written";
+}
+
+TEST_F(PlotterTest, KeepsARejectedSessionLayoutAsideAndSaysWhy) {
+  const QString session = QString::fromStdString(dir_.path() + "/session.ini");
+  const QString bad = "buffer_samples = 10\n[plot]\ncurve = a.b\n";
+  {
+    QSettings st(session, QSettings::IniFormat);
+    st.setValue("plotter/layout", bad);
+    st.setValue("plotter/geometry", "640x480+30+40");
+  }
+  auto w = Window(naming_->address());
+  QString error;
+  EXPECT_FALSE(w->RestoreSessionLayout(session, &error));
+  EXPECT_TRUE(error.contains("buffer_samples = 10 is out of range")) << error.toStdString();
+  EXPECT_TRUE(error.contains("plotter/layout.rejected")) << error.toStdString();
+  EXPECT_EQ(w->statusBar()->currentMessage(), error);
+  EXPECT_EQ(QSettings(session, QSettings::IniFormat).value("plotter/layout.rejected").toString(),
+            bad)
+      << "kept before anything writes the session";
+  ASSERT_TRUE(WaitInGui([&] { return w->findChild<QMessageBox*>("session_problem") != nullptr; },
+                        seconds(2)));
+  auto* box = w->findChild<QMessageBox*>("session_problem");
+  EXPECT_TRUE(box->isVisible());
+  EXPECT_FALSE(box->isModal()) << "the window stays usable";
+  EXPECT_EQ(box->text(), error);
+  // closing writes the layout shown; the rejected text stays aside
+  w->SetSessionFile(session);
+  w->close();
+  QSettings st(session, QSettings::IniFormat);
+  EXPECT_EQ(st.value("plotter/layout.rejected").toString(), bad);
+  EXPECT_NE(st.value("plotter/layout").toString(), bad);
+  EXPECT_EQ(st.value("plotter/geometry").toString(), "640x480+30+40");
+  // a session without a layout: nothing to say
+  const QString empty = QString::fromStdString(dir_.path() + "/empty.ini");
+  error.clear();
+  auto w2 = Window(naming_->address());
+  EXPECT_FALSE(w2->RestoreSessionLayout(empty, &error));
+  EXPECT_TRUE(error.isEmpty());
 }
 
 TEST_F(PlotterTest, SaysSoAndStaysResponsiveWithNoModelInReach) {
@@ -597,6 +734,201 @@ TEST_F(PlotterTest, SaysSoAndStaysResponsiveWithNoModelInReach) {
   closing.start();
   w.reset();
   EXPECT_LT(closing.elapsed(), 3000) << "closing does not hang";
+}
+
+TEST_F(PlotterTest, KeepsEachCurveOnItsOwnValuesWhenAReloadChangesTheShapesOfItsIds) {
+  // the scene at a path of the test's own, so that the same path can hold another scene
+  const std::string scene = dir_.path() + "/scene.dae";
+  WriteText(scene, ReadFile(Models() + "/pendulum_tendon.dae"));
+  auto process = StartModel(scene);
+  M::Model_var model = WaitForModel();
+  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
+  // no periodic listing: only what the plotter does about a changed layout brings the new one
+  DaqLink::Options options = LinkOptions(naming_->address());
+  options.relist_period_ms = 600'000;
+  auto w = Window(options);
+  Layout layout;
+  plotter::AddPlot(&layout, {kAngle, kCurrent});
+  w->ApplyLayout(layout);
+  ASSERT_TRUE(WaitInGui([&] { return w->link().status().subscription != 0; }, seconds(10)));
+
+  // the same path loaded again with the body and the hinge swapping names, before the Model ever
+  // ran: nothing says the scene changed but the batches, 4 values a sample ([pivot.position is
+  // the body's position now, 3x1] and the current) for a subscription laid out for 2
+  WriteText(scene, ReadFile(TestData() + "/pendulum_swapped_names.dae"));
+  model->load_scene(scene.c_str());
+  SetCommand(model, 12.0);
+  const uint64_t made = w->link().status().subscriptions_made;
+  model->step(200);
+  ASSERT_TRUE(WaitInGui(
+      [&] {
+        return w->unreadable_batches() > 0 && w->link().status().subscriptions_made > made &&
+               w->link().status().subscription != 0;
+      },
+      seconds(10)))
+      << "unreadable " << w->unreadable_batches() << ", "
+      << w->findChild<QLabel*>("connection")->text().toStdString();
+  w->RefreshStatus();
+  EXPECT_TRUE(w->findChild<QLabel*>("rate")->text().contains("batches unreadable"))
+      << w->findChild<QLabel*>("rate")->text().toStdString();
+  // subscribed anew: the current where the Model has it, the angle's key no longer fits its id
+  model->step(200);
+  ASSERT_TRUE(WaitInGui([&] { return UpToDate(*w, model); }, seconds(10)))
+      << w->store().last_time();
+  EXPECT_DOUBLE_EQ(Newest(*w, kCurrent), Get(model, kCurrent));
+  EXPECT_TRUE(std::isnan(Newest(*w, kAngle)));
+  EXPECT_TRUE(WaitInGui([&] { return Stale(*w, kAngle); }, seconds(5)));
+
+  // the hinge angle by its name in this scene, then pendulum_tendon.dae from its own path: the
+  // ids [pivot.position, current, pendulum.position] take 3+1+1 values here and 1+1+3 there,
+  // the same width, with the current moving from value 3 to value 1
+  const std::string hinge = "pendulum_tendon.pendulum.position";
+  ASSERT_TRUE(w->AddCurve(0, hinge));
+  ASSERT_TRUE(WaitInGui([&] { return w->link().status().subscribed.size() == 3; }, seconds(10)));
+  model->step(200);
+  ASSERT_TRUE(WaitInGui([&] { return UpToDate(*w, model); }, seconds(10)));
+  EXPECT_DOUBLE_EQ(Newest(*w, hinge), Get(model, hinge));
+  EXPECT_DOUBLE_EQ(Newest(*w, kCurrent), Get(model, kCurrent));
+  const LinkStatus before = w->link().status();
+  model->load_scene((Models() + "/pendulum_tendon.dae").c_str());
+  ASSERT_TRUE(WaitInGui(
+      [&] {
+        const LinkStatus s = w->link().status();
+        return s.subscriptions_made > before.subscriptions_made && s.subscription != 0;
+      },
+      seconds(10)))
+      << "a new scene with other shapes is subscribed to anew";
+  EXPECT_GT(w->link().status().layout_resubscriptions, before.layout_resubscriptions);
+  EXPECT_NE(w->link().status().message.find("pendulum_tendon.pivot.position is 1x1 [rad] now"),
+            std::string::npos)
+      << w->link().status().message;
+  model->step(200);
+  ASSERT_TRUE(WaitInGui([&] { return UpToDate(*w, model); }, seconds(10)));
+  EXPECT_DOUBLE_EQ(Newest(*w, kAngle), Get(model, kAngle));
+  EXPECT_DOUBLE_EQ(Newest(*w, kCurrent), Get(model, kCurrent));
+  EXPECT_TRUE(std::isnan(Newest(*w, hinge))) << "a 3x1 position in this scene";
+  // never a value of the other layout: every current held is a current (within its limit)
+  for (const double a : Values(*w, kCurrent)) ASSERT_LE(std::abs(a), 3.5);
+  EXPECT_TRUE(WaitInGui([&] { return !Stale(*w, kAngle) && Stale(*w, hinge); }, seconds(5)));
+
+  w.reset();
+  process->Signal(SIGTERM);
+  EXPECT_EQ(process->Wait(seconds(10)), 0) << process->Output();
+}
+
+TEST_F(PlotterTest, ClosingWaitsOnlyBrieflyForAHungModel) {
+  auto process = StartModel(Models() + "/pendulum_tendon.dae");
+  M::Model_var model = WaitForModel();
+  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
+  model->start();
+  // long calls allowed, the next poll far away: closing finds the link between polls
+  DaqLink::Options options = LinkOptions(naming_->address());
+  options.call_timeout_ms = 4000;
+  options.poll_period_ms = 10'000;
+  auto link = std::make_unique<DaqLink>(options);
+  link->Want({kAngle}, 1);
+  ASSERT_TRUE(WaitInGui([&] { return !link->TakeBatches().empty(); }, seconds(10)))
+      << process->Output();
+  // the Model hangs; the link closes with one short unsubscribe call, not a whole call timeout
+  process->Signal(SIGSTOP);
+  QElapsedTimer closing;
+  closing.start();
+  link.reset();
+  const qint64 ms = closing.elapsed();
+  process->Signal(SIGCONT);
+  EXPECT_LT(ms, 1500) << "closing blocked the GUI thread for " << ms << " ms";
+  process->Signal(SIGTERM);
+  EXPECT_EQ(process->Wait(seconds(10)), 0) << process->Output();
+}
+
+TEST_F(PlotterTest, KeepsTheBuffersWithinTheMemoryBudget) {
+  auto w = Window(naming_->address());
+  Layout layout;
+  plotter::AddPlot(&layout, {kAngle, kCurrent});
+  w->ApplyLayout(layout);
+  auto* spin = w->findChild<QSpinBox*>("buffer_samples");
+  EXPECT_EQ(static_cast<size_t>(spin->maximum()), plotter::MaxBufferSamples(2));
+  // as many samples as a curve may have: two curves get what the budget leaves them
+  w->SetBufferSamples(plotter::kMaxBuffer);
+  EXPECT_EQ(w->store().capacity(), plotter::MaxBufferSamples(2));
+  EXPECT_TRUE(w->statusBar()->currentMessage().contains("MiB all buffers may take"))
+      << w->statusBar()->currentMessage().toStdString();
+  // one more curve would take the buffers past the budget: refused, and said
+  EXPECT_FALSE(w->AddCurve(0, kTension));
+  EXPECT_FALSE(w->plot(0)->HasCurve(kTension));
+  EXPECT_LT(w->store().Find(kTension), 0);
+  EXPECT_TRUE(w->statusBar()->currentMessage().startsWith(
+      "cannot add pendulum_tendon.motor.tension: 3 curves of 44739242 samples would need"))
+      << w->statusBar()->currentMessage().toStdString();
+  // a smaller buffer makes room
+  w->SetBufferSamples(1'000'000);
+  EXPECT_TRUE(w->AddCurve(0, kTension));
+  EXPECT_EQ(static_cast<size_t>(spin->maximum()), plotter::MaxBufferSamples(3));
+  // a layout that asks for more than its curves may have gets the most they may have
+  Layout big = layout;
+  big.buffer_samples = plotter::kMaxBuffer;
+  plotter::AddPlot(&big, {kTension, kHeight});
+  w->ApplyLayout(big);
+  EXPECT_EQ(w->store().capacity(), plotter::MaxBufferSamples(4));
+  EXPECT_EQ(static_cast<size_t>(spin->value()), plotter::MaxBufferSamples(4));
+  EXPECT_TRUE(w->statusBar()->currentMessage().contains("the buffer keeps"))
+      << w->statusBar()->currentMessage().toStdString();
+}
+
+TEST_F(PlotterTest, AnExportThatFailsLeavesTheOldFileAndSaysWhy) {
+  auto w = Window(naming_->address());
+  Layout layout;
+  plotter::AddPlot(&layout, {kAngle, kCurrent});
+  w->ApplyLayout(layout);
+  for (const char* name : {"plot.png", "plot.svg", "plot.pdf", "data.csv"}) {
+    const std::string path = dir_.path() + "/" + name;
+    WriteText(path, "the user's old file\n");
+    QString error;
+    bool written = false;
+    {
+      // as on a full disk: writes fail after 8 bytes
+      const FileSizeLimit limit(8);
+      written = QString(name).endsWith(".csv")
+                    ? w->ExportCsv(QString::fromStdString(path), &error)
+                    : w->ExportPlot(QString::fromStdString(path), &error);
+    }
+    EXPECT_FALSE(written) << name;
+    EXPECT_TRUE(error.startsWith(QString::fromStdString("cannot write " + path)))
+        << name << ": " << error.toStdString();
+    EXPECT_TRUE(error.contains("File too large")) << name << ": " << error.toStdString();
+    EXPECT_EQ(ReadFile(path), "the user's old file\n") << name;
+    EXPECT_EQ(ListFiles(dir_.path(), std::string(name) + ".").size(), 0u)
+        << "no temporary file is left beside " << name;
+    // and without the limit the export replaces it
+    EXPECT_TRUE(QString(name).endsWith(".csv")
+                    ? w->ExportCsv(QString::fromStdString(path), &error)
+                    : w->ExportPlot(QString::fromStdString(path), &error))
+        << error.toStdString();
+    EXPECT_NE(ReadFile(path), "the user's old file\n") << name;
+  }
+}
+
+TEST(DataConsumerServantTest, LetsNoExceptionIntoTheOrb) {
+  Orb();
+  int calls = 0;
+  plotter::DataConsumerServant servant([&](plotter::ReceivedBatch&& b) {
+    ++calls;
+    if (b.number == 1) throw 42;  // not a std::exception
+    if (b.number == 2) throw std::runtime_error("the inbox is full");
+  });
+  D::SampleBatch batch;
+  batch.subscription = 7;
+  batch.values_per_sample = 1;
+  batch.times.length(1);
+  batch.times[0] = 0.001;
+  batch.data.length(1);
+  batch.data[0] = 1.5;
+  for (CORBA::ULongLong n = 1; n <= 3; ++n) {
+    batch.batch = n;
+    EXPECT_NO_THROW(servant.on_samples(batch)) << "batch " << n;
+  }
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(servant.failures(), 2u);
 }
 
 }  // namespace

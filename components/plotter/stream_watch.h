@@ -1,0 +1,52 @@
+#pragma once
+// Whether a DAQ stream has gone quiet: the Model runs but no sample of the subscription has come
+// for a while (e.g. the Model dropped the subscriber), so the plotter subscribes again. How long
+// "a while" is depends on the subscription: one sample every n steps may leave seconds of
+// simulated time between samples. No Qt, no CORBA.
+
+#include <chrono>
+#include <cstdint>
+
+namespace caliper::plotter {
+
+/// The Model sends a subscription's samples in batches of about this much simulated time, or of
+/// one sample when samples are further apart [s].
+constexpr double kModelBatchPeriod = 0.05;
+
+/// Simulated (and wall) time without a sample after which a running Model's stream counts as
+/// quiet [s]: `silence_s`, or three sample intervals (`every_n_steps` * `time_step`) plus a batch
+/// period when that is longer.
+double QuietThreshold(double silence_s, uint32_t every_n_steps, double time_step);
+
+/// Watches the stream of one subscription from poll to poll of the Model's status.
+class StreamWatch {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// `silence_s`: the shortest quiet spell that counts [s] (see QuietThreshold).
+  explicit StreamWatch(double silence_s) : silence_s_(silence_s) {}
+
+  /// A subscription sampling every `every_n_steps` steps was made at simulated time `sim_time`
+  /// [s] and wall time `now`.
+  void Start(double sim_time, uint32_t every_n_steps, Clock::time_point now);
+
+  /// One poll: the Model `running` at `sim_time` with steps of `time_step` [s]; `last_sample` is
+  /// the time of the newest sample received (NaN when none), received at `last_batch`. True when
+  /// the stream is quiet: the Model runs and both the simulated and the wall time since the last
+  /// sign of life exceed QuietThreshold. A simulated time that went back (a reset) restarts the
+  /// watch.
+  bool Quiet(bool running, double sim_time, double time_step, double last_sample,
+             Clock::time_point last_batch, Clock::time_point now);
+
+  /// Simulated time since the last sign of life, as of the last poll [s].
+  double quiet_for() const { return quiet_for_; }
+
+ private:
+  double silence_s_;
+  uint32_t every_n_steps_ = 1;
+  double watch_time_ = 0;           // [s] simulated time of the last sign of life of the stream
+  Clock::time_point watch_wall_{};  // and when it was seen
+  double quiet_for_ = 0;            // [s]
+};
+
+}  // namespace caliper::plotter
