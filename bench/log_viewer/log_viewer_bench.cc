@@ -10,8 +10,11 @@
 //   append     a live batch of 1,000 records appended to the 100,000 (beginInsertRows)
 //   paint      QTableView::grab() of a 1280x720 table scrolled to the end
 // Each figure is the median of --repeats runs (default 5) in milliseconds, then a RATIO line per
-// operation: its share of the 100 ms budget (target < 1). Options: --records N, --repeats N.
+// operation: its share of the 100 ms budget (target < 1). Then the heap a RecordStore and a
+// LogModel hold per record (glibc's mallinfo2, in-use bytes before and after). Options:
+// --records N, --repeats N.
 // Runs on QT_QPA_PLATFORM=offscreen (set when unset).
+#include <malloc.h>
 #include <unistd.h>
 
 #include <QApplication>
@@ -23,12 +26,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "log_filter.h"
 #include "log_model.h"
+#include "record_store.h"
 #include "session_file.h"
 
 namespace caliper::bench {
@@ -47,7 +52,7 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-/// Median over `repeats` of one call of `measured` [ms]; `before` runs untimed ahead of each.
+// Median over `repeats` of one call of `measured` [ms]; `before` runs untimed ahead of each.
 double TimeMs(const std::function<void()>& before, const std::function<void()>& measured) {
   std::vector<double> runs;
   for (int r = 0; r < repeats; ++r) {
@@ -59,8 +64,8 @@ double TimeMs(const std::function<void()>& before, const std::function<void()>& 
   return Median(runs);
 }
 
-/// A session of `n` records from 8 components over 40 categories, priorities weighted like a
-/// real run (mostly DEBUG and INFO), messages of 20 to 80 characters.
+// A session of `n` records from 8 components over 40 categories, priorities weighted like a
+// real run (mostly DEBUG and INFO), messages of 20 to 80 characters.
 std::vector<logging::Record> Session(int n, uint64_t first_seq) {
   std::mt19937 rng(42 + static_cast<unsigned>(first_seq));
   const char* components[] = {"model0",    "model1", "pd0",      "pd1",
@@ -115,6 +120,19 @@ std::vector<logging::Record> Session(int n, uint64_t first_seq) {
     out.push_back(std::move(r));
   }
   return out;
+}
+
+// heap bytes in use
+size_t HeapInUse() { return mallinfo2().uordblks; }
+
+// heap held per record by what `fill` builds from `n` records (freed again before returning)
+template <typename T>
+double BytesPerRecord(int n, const std::function<void(T&, std::vector<logging::Record>)>& fill) {
+  malloc_trim(0);
+  const size_t before = HeapInUse();
+  auto holder = std::make_unique<T>();
+  fill(*holder, Session(n, 1));
+  return (static_cast<double>(HeapInUse()) - static_cast<double>(before)) / n;
 }
 
 void Report(const char* name, double ms) { std::printf("log_viewer_%s_ms %.2f\n", name, ms); }
@@ -212,6 +230,15 @@ int Run(int argc, char** argv) {
   Report("model_reset", reset_ms);
   Report("append_1000", append_ms);
   Report("paint", paint_ms);
+  const double store_bytes = BytesPerRecord<log_viewer::RecordStore>(
+      records,
+      [](log_viewer::RecordStore& s, std::vector<logging::Record> r) { s.Append(std::move(r)); });
+  const double model_bytes = BytesPerRecord<LogModel>(
+      records, [](LogModel& m, std::vector<logging::Record> r) { m.Append(std::move(r)); });
+  std::printf("log_viewer_store_bytes_per_record %.1f\n", store_bytes);
+  std::printf("log_viewer_model_bytes_per_record %.1f (store, filter bits and rows)\n",
+              model_bytes);
+  std::printf("# at the 1,000,000-record cap: %.0f MB\n", model_bytes * 1e6 / 1048576);
   Ratio("load", load);
   Ratio("regex_filter", regex_ms);
   Ratio("text_filter", text_ms);

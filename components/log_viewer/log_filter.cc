@@ -98,6 +98,12 @@ void LogView::Compile() {
     if (s.regex) {
       try {
         auto flags = std::regex::ECMAScript | std::regex::nosubs | std::regex::optimize;
+#if defined(__GLIBCXX__)
+        // libstdc++'s default matcher recurses once per character and overflows an 8 MB stack
+        // after 8 to 26 KB of message with a pattern like (a|b)*; its polynomial matcher keeps a
+        // set of states instead (back-references, which nosubs excludes anyway, need the other)
+        flags |= std::regex_constants::__polynomial;
+#endif
         if (!s.case_sensitive) flags |= std::regex::icase;
         regex_ = std::regex(s.text, flags);
         needle_ = RequiredLiteral(s.text);
@@ -147,7 +153,12 @@ bool LogView::ContainsNeedle(const std::string& message) const {
 bool LogView::TextMatches(const std::string& message) const {
   // a regular expression runs only where its required literal is (std::regex is slow)
   if (!ContainsNeedle(message)) return false;
-  return !settings_.regex || std::regex_search(message, regex_);
+  if (!settings_.regex) return true;
+  if (message.size() <= kRegexSearchBytes) return std::regex_search(message, regex_);
+  // only the start of a very long message; `$` does not match where it is cut
+  return std::regex_search(message.begin(),
+                           message.begin() + static_cast<std::ptrdiff_t>(kRegexSearchBytes), regex_,
+                           std::regex_constants::match_not_eol);
 }
 
 void LogView::Classify(const RecordStore& store, size_t begin, size_t end, uint8_t kinds) {
@@ -158,13 +169,13 @@ void LogView::Classify(const RecordStore& store, size_t begin, size_t end, uint8
   for (size_t i = begin; i < end; ++i) {
     const Entry& e = store.entry(i);
     uint8_t b = static_cast<uint8_t>((bits_[i] & ~kinds) | fixed);
-    if (active & Bit(kPriority) && e.record.priority <= s.max_priority) b |= Bit(kPriority);
+    if (active & Bit(kPriority) && e.priority <= s.max_priority) b |= Bit(kPriority);
     if (active & Bit(kCategory) && category_ok_[e.category]) b |= Bit(kCategory);
     if (active & Bit(kComponent) && component_ok_[e.component]) b |= Bit(kComponent);
-    if (active & Bit(kTime) && (s.from_time_us == 0 || e.record.time_us >= s.from_time_us) &&
-        (s.to_time_us == 0 || e.record.time_us <= s.to_time_us))
+    if (active & Bit(kTime) && (s.from_time_us == 0 || e.time_us >= s.from_time_us) &&
+        (s.to_time_us == 0 || e.time_us <= s.to_time_us))
       b |= Bit(kTime);
-    if (active & Bit(kText) && TextMatches(e.record.message)) b |= Bit(kText);
+    if (active & Bit(kText) && TextMatches(e.message)) b |= Bit(kText);
     bits_[i] = b;
   }
 }

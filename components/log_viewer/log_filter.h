@@ -40,7 +40,9 @@ struct FilterSettings {
   std::set<std::string> excluded_components;
   /// Searched in the message; empty: off.
   std::string text;
-  bool regex = false;  ///< `text` is an ECMAScript regular expression
+  /// `text` is an ECMAScript regular expression, matched against the first kRegexSearchBytes of
+  /// each message (plain text is searched in the whole message).
+  bool regex = false;
   bool case_sensitive = false;
   int64_t from_time_us = 0;  ///< earliest matching time [us since 1970 UTC]; 0: unbounded
   int64_t to_time_us = 0;    ///< latest matching time [us since 1970 UTC]; 0: unbounded
@@ -50,6 +52,10 @@ struct FilterSettings {
   bool operator==(const FilterSettings& o) const;
   bool operator!=(const FilterSettings& o) const { return !(*this == o); }
 };
+
+/// How much of a message a regular expression looks at [bytes]: std::regex's cost grows with the
+/// length searched (quadratically for a search that fails), so a message of megabytes is cut.
+constexpr size_t kRegexSearchBytes = 64 * 1024;
 
 /// True when `category` is `prefix` or lies below it in the dotted hierarchy
 /// (`caliper.model.rtc` is under `caliper.model`, `caliper.modeller` is not).

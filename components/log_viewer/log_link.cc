@@ -1,10 +1,15 @@
 #include "log_link.h"
 
+#include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <utility>
 
 #include "caliper/logging.hh"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "listener_servant.h"
 
@@ -12,12 +17,50 @@ namespace caliper::log_viewer {
 
 namespace L = ::Caliper::Logging;
 using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
 
-/// The worker's CORBA state; touched by the worker thread only (after construction).
+// The worker's state. The CORBA part is set up by the constructor and then touched by the
+// worker thread only; the rest is guarded by `mutex`.
 struct LogLink::Impl {
+  explicit Impl(LogLink::Options o)
+      : options(std::move(o)),
+        inbox(std::make_shared<LiveInbox>()),
+        short_ms(static_cast<CORBA::ULong>(options.call_timeout_ms)),
+        query_ms(static_cast<CORBA::ULong>(options.query_timeout_ms)) {}
+
+  void Run();
+  bool FetchAfter(uint64_t after_serial, std::vector<LiveRecord>* out);
+  void Connect();
+  bool Check();
+  void FillGap();
+  void Drop(const std::string& why);
+  // every call the worker makes from now on waits at most `ms`: per thread (the naming service's
+  // objects; needs -ORBsupportPerThreadTimeOut 1) and on the logger's reference (always works)
+  void Limit(CORBA::ULong ms, CORBA::Object_ptr target = CORBA::Object::_nil()) {
+    omniORB::setClientThreadCallTimeout(ms);
+    if (!CORBA::is_nil(target)) omniORB::setClientCallTimeout(target, ms);
+  }
+  bool Stopping() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return stop;
+  }
+
+  const LogLink::Options options;
+  const std::shared_ptr<LiveInbox> inbox;
+  const CORBA::ULong short_ms;
+  const CORBA::ULong query_ms;
+
+  std::mutex mutex;
+  std::condition_variable wake;  // the worker: stop or a gap; the destructor: finished
+  bool stop = false;
+  bool finished = false;  // the worker has unregistered and ends
+  LinkStatus status;
+
   CORBA::ORB_var orb;
   PortableServer::POA_var poa;
   PortableServer::ObjectId_var servant_id;
+  PortableServer::ServantBase_var servant;  // one reference: status() reads its counters
+  ListenerServant* listener_servant = nullptr;
   L::LogListener_var listener;
   L::LogService_var logger;  // nil while not registered
   CORBA::Object_var bound;   // what the name was bound to when we registered
@@ -30,12 +73,6 @@ struct LogLink::Impl {
 };
 
 namespace {
-
-CORBA::ORB_ptr ProcessOrb() {
-  int argc = 0;
-  char* argv[] = {nullptr};
-  return CORBA::ORB_init(argc, argv);
-}
 
 L::RecordFilter Everything(uint64_t after_serial) {
   L::RecordFilter q;
@@ -50,165 +87,309 @@ L::RecordFilter Everything(uint64_t after_serial) {
   return q;
 }
 
+// A time range of records, inclusive; the extremes stand for "no bound". Split points avoid 0
+// and 1, so that no bound is ever 0 (which a RecordFilter reads as "no bound").
+struct TimeWindow {
+  int64_t from = std::numeric_limits<int64_t>::min();
+  int64_t to = std::numeric_limits<int64_t>::max();
+};
+
+// A time that splits the records with `times` into two non-empty parts, about a quarter of them
+// before it; false when there is none (they all have the same time, or they are all -1, 0, 1).
+bool SplitTime(std::vector<int64_t> times, int64_t* split) {
+  std::sort(times.begin(), times.end());
+  const int64_t lo = times.front();
+  const int64_t hi = times.back();
+  if (lo == hi) return false;
+  int64_t s = times[times.size() / 4];
+  if (s == lo) s = *std::upper_bound(times.begin(), times.end(), lo);
+  if (s == 0 || s == 1) {
+    if (hi >= 2) {
+      s = 2;
+    } else if (lo <= -2) {
+      s = -1;
+    } else {
+      return false;
+    }
+  }
+  *split = s;
+  return true;
+}
+
 }  // namespace
 
 LogLink::LogLink(Options options)
-    : options_(std::move(options)),
-      inbox_(std::make_shared<LiveInbox>()),
-      impl_(std::make_unique<Impl>()) {
+    : options_(std::move(options)), impl_(std::make_shared<Impl>(options_)) {
   Impl& i = *impl_;
-  i.orb = ProcessOrb();
+  i.status.message = "looking for " + options_.instance + " ...";
+  // a gap in the pushed serials wakes the worker to query it
+  std::weak_ptr<Impl> weak = impl_;
+  i.inbox->set_on_gap([weak] {
+    if (auto impl = weak.lock()) {
+      { std::lock_guard<std::mutex> lock(impl->mutex); }
+      impl->wake.notify_all();
+    }
+  });
+  i.orb = rtc::ClientOrb();
   CORBA::Object_var obj = i.orb->resolve_initial_references("RootPOA");
   i.poa = PortableServer::POA::_narrow(obj);
   PortableServer::POAManager_var manager = i.poa->the_POAManager();
   manager->activate();
-  auto* servant = new ListenerServant(inbox_);
-  i.servant_id = i.poa->activate_object(servant);
-  servant->_remove_ref();  // the POA owns it
+  i.listener_servant = new ListenerServant(
+      [inbox = i.inbox](std::vector<LiveRecord> records) { inbox->Push(std::move(records)); });
+  i.servant = i.listener_servant;  // ours; activation adds the POA's reference
+  i.servant_id = i.poa->activate_object(i.listener_servant);
   CORBA::Object_var ref = i.poa->id_to_reference(i.servant_id);
   i.listener = L::LogListener::_narrow(ref);
-  status_.message = "looking for " + options_.instance + " ...";
-  worker_ = std::thread([this] { Run(); });
+  worker_ = std::thread([impl = impl_] { impl->Run(); });
 }
 
 LogLink::~LogLink() {
+  Impl& i = *impl_;
+  bool finished = false;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
+    std::unique_lock<std::mutex> lock(i.mutex);
+    i.stop = true;
+    i.wake.notify_all();
+    finished =
+        i.wake.wait_for(lock, milliseconds(options_.stop_timeout_ms), [&] { return i.finished; });
   }
-  wake_.notify_all();
-  worker_.join();
+  if (finished) {
+    worker_.join();
+  } else {
+    // inside a call to a logger that stopped answering: it ends when the call times out (the
+    // state it needs is shared with it); nothing it takes in reaches anyone now
+    worker_.detach();
+  }
+  i.inbox->Stop();
   try {
-    impl_->poa->deactivate_object(impl_->servant_id);
+    i.poa->deactivate_object(i.servant_id);
   } catch (const CORBA::Exception&) {
     // the ORB is already shutting down: nothing left to deactivate
   }
 }
 
-std::vector<logging::Record> LogLink::Take() { return inbox_->Take(); }
+std::vector<logging::Record> LogLink::Take() { return impl_->inbox->Take(); }
 
 LinkStatus LogLink::status() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return status_;
+  LinkStatus s;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    s = impl_->status;
+  }
+  s.lost = impl_->inbox->lost();
+  s.listener_failures = impl_->listener_servant->failures();
+  if (s.listener_failures > 0) s.listener_failure = impl_->listener_servant->last_failure();
+  return s;
 }
 
-void LogLink::Run() {
-  // per-thread call timeouts need an omni_thread
-  omni_thread* self = omni_thread::create_dummy();
-  Impl& i = *impl_;
-  const auto short_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
-  omniORB::setClientThreadCallTimeout(short_ms);
-
-  // unregisters (best effort) and records why the connection is gone
-  auto drop = [&](const std::string& why) {
-    inbox_->Stop();
-    if (!CORBA::is_nil(i.logger)) {
-      try {
-        i.logger->remove_listener(i.listener_id);
-      } catch (const CORBA::Exception&) {
-        // a logger that is gone has forgotten its listeners already
-      }
-    }
-    i.logger = L::LogService::_nil();
-    i.bound = CORBA::Object::_nil();
-    std::lock_guard<std::mutex> lock(mutex_);
-    status_.connected = false;
-    status_.message = why;
-  };
-
-  auto connect = [&] {
+void LogLink::Impl::Drop(const std::string& why) {
+  inbox->Stop();
+  // unregistering never waits a query's timeout
+  Limit(short_ms, logger);
+  if (!CORBA::is_nil(logger)) {
     try {
-      omniORB::setClientThreadCallTimeout(short_ms);
-      CosNaming::NamingContext_var root =
-          rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-      rtc::ComponentEntry entry = rtc::FindComponent(root, options_.instance);
-      L::LogService_var logger = L::LogService::_narrow(entry.object);
-      if (CORBA::is_nil(logger))
-        throw std::runtime_error(entry.path + " is not a Logging component");
-      CORBA::String_var file = logger->session_file();
-      // listen first, then ask for the backlog: nothing falls between the two
-      inbox_->BeginSync(file.in());
-      const uint64_t after = inbox_->last_serial();
-      i.listener_id = logger->add_listener(i.listener);
-      i.logger = logger;
-      i.bound = entry.object;
-      i.session_file = file.in();
-      i.path = entry.path;
-      i.waiting_since = Impl::kNone;
-      omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.query_timeout_ms));
-      L::StoredRecordSeq_var backlog = logger->query(Everything(after));
-      inbox_->Synced(FromIdl(backlog.in()));
-      std::lock_guard<std::mutex> lock(mutex_);
-      status_.connected = true;
-      status_.message = "following " + options_.instance + " (" + i.path + ")";
-      status_.session_file = i.session_file;
-      ++status_.registrations;
-    } catch (const L::InvalidQuery& e) {
-      drop("no connection to " + options_.instance + ": " + e.reason.in());
-    } catch (const CORBA::Exception& e) {
-      drop("no connection to " + options_.instance + ": " + rtc::Describe(e));
-    } catch (const std::exception& e) {
-      drop("no connection to " + options_.instance + ": " + e.what());
+      logger->remove_listener(listener_id);
+    } catch (const CORBA::Exception&) {
+      // a logger that is gone has forgotten its listeners already
     }
-  };
+  }
+  logger = L::LogService::_nil();
+  bound = CORBA::Object::_nil();
+  std::lock_guard<std::mutex> lock(mutex);
+  status.connected = false;
+  status.message = why;
+}
 
-  // true while the registered logger answers and is still the one bound under its name
-  auto check = [&]() -> bool {
+bool LogLink::Impl::FetchAfter(uint64_t after_serial, std::vector<LiveRecord>* out) {
+  // a reply of 200,000 records exceeds omniORB's 2 MB message limit, and the logger's `limit`
+  // keeps the newest matches (it cannot page by serial): time windows instead, each split until
+  // its records fit in a page; the stop flag is checked between pages
+  constexpr CORBA::ULong kMinPage = 100;
+  CORBA::ULong page = static_cast<CORBA::ULong>(std::max(options.page_records, 1));
+  std::vector<TimeWindow> windows(1);
+  while (!windows.empty()) {
+    if (Stopping()) return false;
+    const TimeWindow w = windows.back();
+    L::RecordFilter q = Everything(after_serial);
+    q.from_time_us = w.from == std::numeric_limits<int64_t>::min() ? 0 : w.from;
+    q.to_time_us = w.to == std::numeric_limits<int64_t>::max() ? 0 : w.to;
+    q.limit = page + 1;
+    L::StoredRecordSeq_var answer;
     try {
-      omniORB::setClientThreadCallTimeout(short_ms);
-      CORBA::String_var file = i.logger->session_file();
-      if (i.session_file != file.in()) {
-        drop(options_.instance + " started a new session log; registering again");
-        return false;
-      }
-      // the logger drops a listener it failed to reach once: records that wait a whole period
-      // while none arrive mean that happened
-      const uint64_t last = inbox_->last_serial();
-      L::RecordFilter newest = Everything(last);
-      newest.limit = 1;
-      L::StoredRecordSeq_var waiting = i.logger->query(newest);
-      if (waiting->length() == 0) {
-        i.waiting_since = Impl::kNone;
-      } else if (i.waiting_since == last) {
-        drop(options_.instance + " stopped sending records; registering again");
-        return false;
-      } else {
-        i.waiting_since = last;
-      }
-    } catch (const CORBA::Exception& e) {
-      drop("no connection to " + options_.instance + ": " + rtc::Describe(e) +
-           " (the logger may have died); retrying");
+      answer = logger->query(q);
+    } catch (const CORBA::SystemException& e) {
+      // too large a reply breaks the connection, too slow a one times out: smaller pages (a
+      // logger that is gone or stopped fails those too)
+      const bool retry = CORBA::COMM_FAILURE::_downcast(&e) != nullptr ||
+                         CORBA::MARSHAL::_downcast(&e) != nullptr ||
+                         CORBA::TIMEOUT::_downcast(&e) != nullptr;
+      if (!retry || page <= kMinPage) throw;
+      page /= 2;
+      continue;
+    }
+    windows.pop_back();
+    std::vector<LiveRecord> records = FromIdl(answer.in());
+    std::vector<int64_t> times;
+    int64_t split = 0;
+    if (records.size() > page) {
+      for (const auto& r : records) times.push_back(r.record.time_us);
+    }
+    if (records.size() <= page || !SplitTime(std::move(times), &split)) {
+      // the whole window; or more than a page with one time stamp: its newest (the inbox counts
+      // the older ones as lost)
+      out->insert(out->end(), std::make_move_iterator(records.begin()),
+                  std::make_move_iterator(records.end()));
+      continue;
+    }
+    windows.push_back({w.from, split - 1});
+    windows.push_back({split, w.to});
+  }
+  return true;
+}
+
+void LogLink::Impl::Connect() {
+  const std::string& name = options.instance;
+  try {
+    Limit(short_ms);
+    CosNaming::NamingContext_var root =
+        rtc::ResolveRoot(orb, rtc::NamingAddress(options.nameservice));
+    rtc::ComponentEntry entry = rtc::FindComponent(root, name);
+    Limit(short_ms, entry.object);
+    L::LogService_var found = L::LogService::_narrow(entry.object);
+    if (CORBA::is_nil(found)) throw std::runtime_error(entry.path + " is not a Logging component");
+    Limit(short_ms, found);
+    CORBA::String_var file = found->session_file();
+    if (Stopping()) return;
+    // listen first, then ask for the backlog: nothing falls between the two
+    inbox->BeginSync(file.in());
+    const uint64_t after = inbox->last_serial();
+    listener_id = found->add_listener(listener);
+    logger = found;
+    bound = entry.object;
+    session_file = file.in();
+    path = entry.path;
+    waiting_since = kNone;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (stop) return;  // the loop ends and unregisters
+      status.message = "reading the records " + name + " holds ...";
+      status.session_file = session_file;
+    }
+    Limit(query_ms, logger);
+    std::vector<LiveRecord> backlog;
+    if (!FetchAfter(after, &backlog)) return;
+    Limit(short_ms, logger);
+    inbox->Synced(std::move(backlog));
+    std::lock_guard<std::mutex> lock(mutex);
+    status.connected = true;
+    status.message = "following " + name + " (" + path + ")";
+    status.session_file = session_file;
+    ++status.registrations;
+  } catch (const L::InvalidQuery& e) {
+    Drop("no connection to " + name + ": " + e.reason.in());
+  } catch (const CORBA::Exception& e) {
+    Drop("no connection to " + name + ": " + rtc::Describe(e));
+  } catch (const std::exception& e) {
+    Drop("no connection to " + name + ": " + e.what());
+  }
+}
+
+bool LogLink::Impl::Check() {
+  const std::string& name = options.instance;
+  try {
+    Limit(short_ms, logger);
+    CORBA::String_var file = logger->session_file();
+    if (session_file != file.in()) {
+      Drop(name + " started a new session log; registering again");
       return false;
     }
-    try {
-      CosNaming::NamingContext_var root =
-          rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-      rtc::ComponentEntry entry = rtc::FindComponent(root, options_.instance);
-      if (!entry.object->_is_equivalent(i.bound)) {
-        drop(options_.instance + " was started again; registering again");
-        return false;
-      }
-    } catch (const CORBA::Exception&) {
-      // the naming service being away does not disturb a logger that answers
-    } catch (const std::exception&) {
+    if (Stopping()) return true;
+    // the logger drops a listener it failed to reach once: records that wait a whole period
+    // while none arrive mean that happened
+    const uint64_t last = inbox->last_serial();
+    L::RecordFilter newest = Everything(last);
+    newest.limit = 1;
+    L::StoredRecordSeq_var waiting = logger->query(newest);
+    if (waiting->length() == 0) {
+      waiting_since = kNone;
+    } else if (waiting_since == last) {
+      Drop(name + " stopped sending records; registering again");
+      return false;
+    } else {
+      waiting_since = last;
     }
-    return true;
-  };
+  } catch (const CORBA::Exception& e) {
+    Drop("no connection to " + name + ": " + rtc::Describe(e) +
+         " (the logger may have died); retrying");
+    return false;
+  }
+  if (Stopping()) return true;
+  try {
+    CosNaming::NamingContext_var root =
+        rtc::ResolveRoot(orb, rtc::NamingAddress(options.nameservice));
+    rtc::ComponentEntry entry = rtc::FindComponent(root, name);
+    if (!entry.object->_is_equivalent(bound)) {
+      Drop(name + " was started again; registering again");
+      return false;
+    }
+  } catch (const CORBA::Exception&) {
+    // the naming service being away does not disturb a logger that answers
+  } catch (const std::exception&) {
+  }
+  return true;
+}
 
+void LogLink::Impl::FillGap() {
+  // pushed serials jumped: everything after the last one taken in, the duplicates dropped
+  const std::string& name = options.instance;
+  const uint64_t after = inbox->last_serial();
+  try {
+    Limit(query_ms, logger);
+    std::vector<LiveRecord> records;
+    if (!FetchAfter(after, &records)) return;
+    Limit(short_ms, logger);
+    inbox->GapAnswered(after, std::move(records));
+  } catch (const L::InvalidQuery& e) {
+    Drop("no connection to " + name + ": " + e.reason.in());
+  } catch (const CORBA::Exception& e) {
+    Drop("no connection to " + name + ": " + rtc::Describe(e) +
+         " (the logger may have died); retrying");
+  } catch (const std::exception& e) {
+    Drop("no connection to " + name + ": " + e.what() + "; retrying");
+  }
+}
+
+void LogLink::Impl::Run() {
+  // per-thread call timeouts need an omni_thread
+  omni_thread* self = omni_thread::create_dummy();
+  Limit(short_ms);
   auto next = Clock::now();
   for (;;) {
     {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait_until(lock, next, [&] { return stopping_; });
-      if (stopping_) break;
+      std::unique_lock<std::mutex> lock(mutex);
+      const bool registered = !CORBA::is_nil(logger);
+      wake.wait_until(lock, next, [&] { return stop || (registered && inbox->gap_pending()); });
+      if (stop) break;
     }
-    if (CORBA::is_nil(i.logger) || !check()) connect();
-    next = Clock::now() + std::chrono::milliseconds(CORBA::is_nil(i.logger)
-                                                        ? options_.retry_period_ms
-                                                        : options_.check_period_ms);
+    if (!CORBA::is_nil(logger) && inbox->gap_pending()) {
+      FillGap();
+      continue;
+    }
+    if (Clock::now() < next) continue;
+    if (CORBA::is_nil(logger) || !Check()) {
+      if (Stopping()) break;
+      Connect();
+    }
+    next = Clock::now() +
+           milliseconds(CORBA::is_nil(logger) ? options.retry_period_ms : options.check_period_ms);
   }
-  omniORB::setClientThreadCallTimeout(short_ms);
-  drop("stopped");
+  Drop("stopped");
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    finished = true;
+  }
+  wake.notify_all();
   if (self != nullptr) omni_thread::release_dummy();
 }
 

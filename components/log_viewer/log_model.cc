@@ -67,33 +67,37 @@ void LogModel::SetFilter(const FilterSettings& settings) {
   endResetModel();
 }
 
-const logging::Record& LogModel::RecordAt(int row) const {
+const Entry& LogModel::EntryAt(int row) const {
+  return store_.entry(view_.rows()[static_cast<size_t>(row)]);
+}
+
+logging::Record LogModel::RecordAt(int row) const {
   return store_.record(view_.rows()[static_cast<size_t>(row)]);
 }
 
-std::vector<const logging::Record*> LogModel::RecordsAt(const std::vector<int>& rows) const {
-  std::vector<const logging::Record*> out;
+std::vector<logging::Record> LogModel::RecordsAt(const std::vector<int>& rows) const {
+  std::vector<logging::Record> out;
   out.reserve(rows.size());
   for (int row : rows)
-    if (row >= 0 && row < shown_) out.push_back(&RecordAt(row));
+    if (row >= 0 && row < shown_) out.push_back(RecordAt(row));
   return out;
 }
 
 QString LogModel::CellText(int row, int column) const {
-  const logging::Record& r = RecordAt(row);
+  const Entry& e = EntryAt(row);
   switch (column) {
     case kTimeColumn:
-      return QString::fromStdString(core::FormatTime(r.time_us));
+      return QString::fromStdString(core::FormatTime(e.time_us));
     case kPriorityColumn:
-      return QString::fromStdString(logging::PriorityName(r.priority));
+      return QString::fromStdString(logging::PriorityName(e.priority));
     case kCategoryColumn:
-      return Flat(r.category);
+      return Flat(store_.category(e));
     case kComponentColumn:
-      return Flat(r.component);
+      return Flat(store_.component(e));
     case kHostColumn:
-      return Flat(r.host);
+      return Flat(store_.host(e));
     case kMessageColumn:
-      return Flat(r.message);
+      return Flat(e.message);
     default:
       return QString();
   }
@@ -129,10 +133,10 @@ QVariant LogModel::data(const QModelIndex& index, int role) const {
     case Qt::ToolTipRole:
       if (index.column() == kTimeColumn) return CellText(row, kTimeColumn);
       return index.column() == kMessageColumn
-                 ? QVariant(QString::fromStdString(RecordAt(row).message))
+                 ? QVariant(QString::fromStdString(EntryAt(row).message))
                  : QVariant();
     case Qt::ForegroundRole: {
-      const int p = RecordAt(row).priority;
+      const int p = EntryAt(row).priority;
       if (p <= logging::kError) return QBrush(QColor(200, 0, 0));      // errors: red
       if (p <= logging::kWarn) return QBrush(QColor(215, 110, 0));     // warnings: orange
       if (p >= logging::kDebug) return QBrush(QColor(110, 110, 110));  // debug: grey
@@ -142,7 +146,7 @@ QVariant LogModel::data(const QModelIndex& index, int role) const {
       return view_.highlighted(static_cast<size_t>(row)) ? QBrush(QColor(255, 236, 120))
                                                          : QVariant();
     case Qt::FontRole:
-      if (RecordAt(row).priority <= logging::kCrit) {
+      if (EntryAt(row).priority <= logging::kCrit) {
         QFont bold;
         bold.setBold(true);
         return bold;

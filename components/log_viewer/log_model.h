@@ -37,10 +37,12 @@ class LogModel : public QAbstractTableModel {
 
   const RecordStore& store() const { return store_; }
   const LogView& view() const { return view_; }
-  /// The record shown in `row`.
-  const logging::Record& RecordAt(int row) const;
+  /// The record shown in `row`, as the store keeps it.
+  const Entry& EntryAt(int row) const;
+  /// The record shown in `row` (a copy with its names).
+  logging::Record RecordAt(int row) const;
   /// The records shown in `rows` (indices of this model), in the given order.
-  std::vector<const logging::Record*> RecordsAt(const std::vector<int>& rows) const;
+  std::vector<logging::Record> RecordsAt(const std::vector<int>& rows) const;
   /// The shown columns of `rows` as tab-separated lines (tabs and newlines in fields as spaces).
   QString CopyText(const std::vector<int>& rows) const;
 

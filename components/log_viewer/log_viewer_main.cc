@@ -1,11 +1,7 @@
 // caliper-logviewer: the Log Viewer, a plain Qt client of the Logging component (no component
 // lifecycle of its own). See kUsage.
-#include <signal.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <QApplication>
-#include <QSocketNotifier>
 #include <QTimer>
 #include <cstring>
 #include <iostream>
@@ -13,7 +9,7 @@
 #include <vector>
 
 #include "caliper/gui_session/tool_window.h"
-#include "caliper/rtc.hh"
+#include "caliper/rtc/client_orb.h"
 #include "log_viewer_window.h"
 
 namespace {
@@ -40,12 +36,6 @@ constexpr const char* kUsage =
     "\n"
     "Ctrl+C copies the selected rows (tab-separated); File > Export writes them as a session log.\n"
     "SIGINT and SIGTERM close the window cleanly (the live listener is unregistered).\n";
-
-int signal_pipe[2] = {-1, -1};
-void OnSignal(int) {
-  const char c = 1;
-  [[maybe_unused]] const auto n = ::write(signal_pipe[0], &c, 1);
-}
 
 // Qt's command-line options that take a value
 bool QtOptionWithValue(const std::string& option) {
@@ -109,27 +99,14 @@ int main(int argc, char** argv) {
   const QStringList rest = QApplication::arguments();
   if (rest.size() > 1) return UsageError("unexpected argument '" + rest[1].toStdString() + "'");
 
-  // SIGTERM/SIGINT close the window, which saves the session and unregisters the listener: caught
-  // from now on (a file may take a while to open), acted upon once the event loop runs
-  const bool catching = ::socketpair(AF_UNIX, SOCK_STREAM, 0, signal_pipe) == 0;
-  if (catching) {
-    struct sigaction sa = {};
-    sa.sa_handler = OnSignal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART;
-    sigaction(SIGTERM, &sa, nullptr);
-    sigaction(SIGINT, &sa, nullptr);
-  }
-
-  std::vector<std::string> orb_args = {"caliper-logviewer", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  std::vector<char*> orb_argv;
-  for (auto& a : orb_args) orb_argv.push_back(a.data());
-  int orb_argc = static_cast<int>(orb_argv.size());
-  CORBA::ORB_var orb = CORBA::ORB_init(orb_argc, orb_argv.data());
+  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-logviewer");
 
   int status = 0;
   {
     LogViewerWindow window(options);
+    // SIGTERM/SIGINT close the window, which saves the session and unregisters the listener:
+    // caught from now on (a file may take a while to open), acted upon once the event loop runs
+    caliper::gui_session::CloseOnTerminationSignals(&window);
     if (!log_file.isEmpty()) {
       QString error;
       if (!window.OpenFile(log_file, &error)) {
@@ -155,15 +132,6 @@ int main(int argc, char** argv) {
         shown = s;
       });
       if (window.live()) watch->start(200);
-      if (catching) {
-        auto* notifier = new QSocketNotifier(signal_pipe[1], QSocketNotifier::Read, &window);
-        QObject::connect(notifier, &QSocketNotifier::activated, &window, [&window] {
-          char c;
-          [[maybe_unused]] const auto n = ::read(signal_pipe[1], &c, 1);
-          window.close();
-          QApplication::quit();
-        });
-      }
       status = QApplication::exec();
     }
   }

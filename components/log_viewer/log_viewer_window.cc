@@ -33,7 +33,9 @@
 #include <QTreeWidget>
 #include <QVBoxLayout>
 #include <algorithm>
+#include <filesystem>
 #include <stdexcept>
+#include <system_error>
 
 #include "caliper/core/system.h"
 #include "session_file.h"
@@ -218,6 +220,13 @@ QWidget* LogViewerWindow::BuildFilterPanel() {
   text_->setClearButtonEnabled(true);
   regex_ = new QCheckBox("Regular expression");
   regex_->setObjectName("regex");
+  const QString regex_help =
+      QString(
+          "An ECMAScript regular expression, matched against the first %1 KiB of each message "
+          "(plain text is searched in the whole message)")
+          .arg(kRegexSearchBytes / 1024);
+  regex_->setToolTip(regex_help);
+  text_->setToolTip("Records whose message contains this text match.\n" + regex_help + ".");
   case_sensitive_ = new QCheckBox("Match case");
   case_sensitive_->setObjectName("case_sensitive");
   text_mode_ = ModeCombo("text_mode");
@@ -382,7 +391,8 @@ void LogViewerWindow::FollowLive(bool keep) {
   if (!keep) {
     file_.clear();
     problems_.clear();
-    problems_label_->clear();
+    malformed_ = 0;
+    ShowProblems();
     model_->Replace({});
     ResetSources();
   }
@@ -411,19 +421,8 @@ bool LogViewerWindow::OpenFile(const QString& path, QString* error) {
   if (contents.malformed > contents.problems.size())
     problems_ << QString("... %1 more malformed lines")
                      .arg(contents.malformed - contents.problems.size());
-  if (contents.malformed > 0) {
-    // the full paths in the tooltip, the file's name on the status line
-    QString first = problems_.front();
-    first.replace(path, QFileInfo(path).fileName());
-    problems_label_->setText(QString("%1 malformed line%2 skipped: %3")
-                                 .arg(contents.malformed)
-                                 .arg(contents.malformed == 1 ? "" : "s")
-                                 .arg(first));
-    problems_label_->setToolTip(problems_.join('\n'));
-  } else {
-    problems_label_->clear();
-    problems_label_->setToolTip(QString());
-  }
+  malformed_ = contents.malformed;
+  ShowProblems();
   model_->Replace(std::move(contents.records));
   ResetSources();
   UpdateSources();
@@ -433,6 +432,27 @@ bool LogViewerWindow::OpenFile(const QString& path, QString* error) {
   UpdateStatus();
   UpdateCounts();
   return true;
+}
+
+void LogViewerWindow::ShowProblems() {
+  QStringList shown;
+  QStringList all;
+  if (malformed_ > 0 && !problems_.isEmpty()) {
+    // the full paths in the tooltip, the file's name on the status line
+    QString first = problems_.front();
+    first.replace(file_, QFileInfo(file_).fileName());
+    shown << QString("%1 malformed line%2 skipped: %3")
+                 .arg(malformed_)
+                 .arg(malformed_ == 1 ? "" : "s")
+                 .arg(first);
+    all << problems_;
+  }
+  if (!session_problem_.isEmpty()) {
+    shown << session_problem_;
+    all << session_problem_;
+  }
+  problems_label_->setText(shown.join("; "));
+  problems_label_->setToolTip(all.join('\n'));
 }
 
 void LogViewerWindow::Poll() {
@@ -471,6 +491,12 @@ void LogViewerWindow::UpdateStatus() {
       text = QString("Live: not connected - %1").arg(QString::fromStdString(s.message));
       colour = "#b00000";
     }
+    if (s.lost > 0)
+      text += QString("; %1 records missed (the logger no longer held them)").arg(s.lost);
+    if (s.listener_failures > 0)
+      text += QString("; %1 pushed batches not taken in (%2)")
+                  .arg(s.listener_failures)
+                  .arg(QString::fromStdString(s.listener_failure));
   } else if (!file_.isEmpty()) {
     text = QString("File: %1 (not live)").arg(QFileInfo(file_).fileName());
   } else {
@@ -495,10 +521,10 @@ void LogViewerWindow::SetTimeDefaults() {
   if (store.empty()) return;
   updating_ = true;
   if (!from_enabled_->isChecked())
-    from_->setDateTime(QDateTime::fromMSecsSinceEpoch(store.record(0).time_us / 1000));
+    from_->setDateTime(QDateTime::fromMSecsSinceEpoch(store.entry(0).time_us / 1000));
   if (!to_enabled_->isChecked())
     to_->setDateTime(
-        QDateTime::fromMSecsSinceEpoch(store.record(store.size() - 1).time_us / 1000 + 1));
+        QDateTime::fromMSecsSinceEpoch(store.entry(store.size() - 1).time_us / 1000 + 1));
   updating_ = false;
 }
 
@@ -652,20 +678,41 @@ void LogViewerWindow::CopySelection() {
 }
 
 bool LogViewerWindow::ExportTo(const QString& path, QString* error) {
+  auto fail = [&](const QString& message) {
+    if (error != nullptr) *error = message;
+    statusBar()->showMessage(message, 10000);
+    return false;
+  };
+  // a selection written over the file it came from, or over the session log the logger appends
+  // to, would lose every record not selected
+  auto same_file = [&path](const std::string& other) {
+    std::error_code ec;
+    return !other.empty() && std::filesystem::equivalent(path.toStdString(), other, ec);
+  };
+  if (same_file(file_.toStdString()))
+    return fail(
+        QString("will not export to %1: it is the file shown (choose another file)").arg(path));
+  const std::string live_log = link_status().session_file;
+  if (same_file(live_log))
+    return fail(QString("will not export to %1: it is the session log %2 is writing (choose "
+                        "another file)")
+                    .arg(path, QString::fromStdString(options_.link.instance)));
   std::vector<int> rows = SelectedRows();
   if (rows.empty()) {
     rows.resize(static_cast<size_t>(model_->rowCount()));
     for (size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
   }
   const QString from = file_.isEmpty() ? QString::fromStdString(options_.link.instance) : file_;
+  const std::vector<logging::Record> records = model_->RecordsAt(rows);
+  std::vector<const logging::Record*> pointers;
+  pointers.reserve(records.size());
+  for (const auto& r : records) pointers.push_back(&r);
   try {
-    WriteSessionFile(path.toStdString(), model_->RecordsAt(rows),
+    WriteSessionFile(path.toStdString(), pointers,
                      "exported by caliper-logviewer from " + from.toStdString() + "; " +
                          std::to_string(rows.size()) + " records");
   } catch (const std::exception& e) {
-    if (error != nullptr) *error = QString::fromStdString(e.what());
-    statusBar()->showMessage(QString::fromStdString(e.what()), 10000);
-    return false;
+    return fail(QString::fromStdString(e.what()));
   }
   statusBar()->showMessage(QString("exported %1 records to %2").arg(rows.size()).arg(path), 5000);
   return true;
@@ -702,14 +749,42 @@ void LogViewerWindow::RestoreSession() {
   if (options_.session_file.isEmpty()) return;
   QSettings st(options_.session_file, QSettings::IniFormat);
   st.beginGroup(kGroup);
+  // a value this version does not understand keeps the default and is reported, not dropped
+  // silently
+  QStringList ignored;
+  auto ignore = [&ignored, &st](const char* key) {
+    ignored << QString("%1=%2").arg(key, st.value(key).toString());
+  };
   FilterSettings s;
   const QString priority = st.value("min_priority", "all").toString();
   int p = logging::kDebug;
-  if (priority != "all" && logging::ParsePriority(priority.toStdString(), &p)) s.max_priority = p;
-  auto mode = [&st](const char* key) {
+  if (priority == "all") {
+    s.max_priority = logging::kDebug;
+  } else if (logging::ParsePriority(priority.toStdString(), &p)) {
+    s.max_priority = p;
+  } else {
+    ignore("min_priority");
+  }
+  auto mode = [&](const char* key) {
     FilterMode m = FilterMode::kHide;
-    ParseMode(st.value(key, "hide").toString().toStdString(), &m);
+    if (st.contains(key) && !ParseMode(st.value(key).toString().toStdString(), &m)) ignore(key);
     return m;
+  };
+  auto flag = [&](const char* key, bool fallback) {
+    if (!st.contains(key)) return fallback;
+    const QString v = st.value(key).toString();
+    if (v == "true") return true;
+    if (v == "false") return false;
+    ignore(key);
+    return fallback;
+  };
+  auto time = [&](const char* key) -> int64_t {
+    if (!st.contains(key)) return 0;
+    bool ok = false;
+    const qlonglong v = st.value(key).toString().toLongLong(&ok);
+    if (ok) return v;
+    ignore(key);
+    return 0;
   };
   s.mode[kPriority] = mode("priority_mode");
   for (const QString& c : st.value("excluded_categories").toStringList())
@@ -719,13 +794,13 @@ void LogViewerWindow::RestoreSession() {
     s.excluded_components.insert(c.toStdString());
   s.mode[kComponent] = mode("component_mode");
   s.text = st.value("text").toString().toStdString();
-  s.regex = st.value("regex", false).toBool();
-  s.case_sensitive = st.value("case_sensitive", false).toBool();
+  s.regex = flag("regex", false);
+  s.case_sensitive = flag("case_sensitive", false);
   s.mode[kText] = mode("text_mode");
-  s.from_time_us = st.value("from_time_us", 0).toLongLong();
-  s.to_time_us = st.value("to_time_us", 0).toLongLong();
+  s.from_time_us = time("from_time_us");
+  s.to_time_us = time("to_time_us");
   s.mode[kTime] = mode("time_mode");
-  follow_tail_->setChecked(st.value("follow_tail", true).toBool());
+  follow_tail_->setChecked(flag("follow_tail", true));
   splitter_->restoreState(st.value("splitter").toByteArray());
   filter_splitter_->restoreState(st.value("filter_splitter").toByteArray());
   table_->horizontalHeader()->restoreState(st.value("columns").toByteArray());
@@ -733,6 +808,12 @@ void LogViewerWindow::RestoreSession() {
   ShowFilter(s);
   ApplyFilters();
   save_timer_->stop();  // nothing changed yet
+  if (!ignored.isEmpty()) {
+    session_problem_ =
+        QString("%1 [%2]: ignored %3 (not understood; the defaults stay)")
+            .arg(QFileInfo(options_.session_file).fileName(), kGroup, ignored.join(", "));
+    ShowProblems();
+  }
 }
 
 void LogViewerWindow::SaveSession() {

@@ -13,7 +13,8 @@
 //   text, regex, case_sensitive, text_mode
 //   from_time_us, to_time_us, time_mode     (0: unbounded)
 //   follow_tail, splitter, filter_splitter, columns
-// Modes are `hide` or `highlight`.
+// Modes are `hide` or `highlight`. A value that is not understood keeps the default and is named
+// on the status line (session_problem()).
 
 #include <QMainWindow>
 #include <QRect>
@@ -68,7 +69,9 @@ class LogViewerWindow : public QMainWindow {
   /// problems(); false with `*error` set when the file cannot be read (the table is unchanged).
   bool OpenFile(const QString& path, QString* error = nullptr);
   /// Writes the selected rows (every shown row when none is selected) as a session log that
-  /// OpenFile reads back; false with `*error` set on failure.
+  /// OpenFile reads back; false with `*error` set on failure. Refuses to write over the file
+  /// shown or the live logger's session log (a selection would replace what is not selected);
+  /// a failed write leaves an existing file as it was.
   bool ExportTo(const QString& path, QString* error = nullptr);
   /// Copies the selected rows, tab-separated (time, priority, category, component, host,
   /// message), to the clipboard.
@@ -92,6 +95,9 @@ class LogViewerWindow : public QMainWindow {
   const QString& file() const { return file_; }
   /// Messages about the malformed lines of the file opened last (`PATH:LINE: ...`).
   const QStringList& problems() const { return problems_; }
+  /// What the session file held that was ignored (`FILE [log_viewer]: ignored KEY=VALUE, ...`),
+  /// or ""; shown on the status line with the file's malformed lines.
+  const QString& session_problem() const { return session_problem_; }
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -110,6 +116,7 @@ class LogViewerWindow : public QMainWindow {
   QTreeWidgetItem* CategoryItem(const std::string& prefix);
   void UpdateCounts();
   void UpdateStatus();
+  void ShowProblems();
   void AfterAppend(size_t added);
   void SetTimeDefaults();
   std::vector<int> SelectedRows() const;
@@ -121,6 +128,8 @@ class LogViewerWindow : public QMainWindow {
   LogModel* model_ = nullptr;
   QString file_;
   QStringList problems_;
+  size_t malformed_ = 0;  ///< malformed lines in the file shown
+  QString session_problem_;
   FilterSettings filter_;  ///< what the widgets last said (exclusions without a node included)
   bool updating_ = false;  ///< widgets are being set by the program, not the user
 

@@ -4,37 +4,64 @@
 
 namespace caliper::log_viewer {
 
-uint32_t RecordStore::Intern(const std::string& name, std::vector<std::string>* names,
-                             std::unordered_map<std::string, uint32_t>* ids) {
-  auto [it, added] = ids->try_emplace(name, static_cast<uint32_t>(names->size()));
-  if (added) names->push_back(name);
+uint32_t NameTable::Intern(const std::string& name) {
+  auto [it, added] = ids_.try_emplace(name, static_cast<uint32_t>(names_.size()));
+  if (added) names_.push_back(name);
   return it->second;
+}
+
+void NameTable::Clear() {
+  names_.clear();
+  ids_.clear();
 }
 
 size_t RecordStore::Append(std::vector<logging::Record> records) {
   size_t added = 0;
   for (auto& r : records) {
+    const uint32_t source = sources_.Intern(r.source);
+    if (source >= last_seq_.size()) last_seq_.resize(source + 1, 0);
     if (r.seq != 0) {
-      uint64_t& last = last_seq_[r.source];
+      uint64_t& last = last_seq_[source];
       if (r.seq <= last) continue;  // delivered before (a file and the live service overlap)
       last = r.seq;
     }
     Entry e;
-    e.category = Intern(r.category, &categories_, &category_ids_);
-    e.component = Intern(r.component, &components_, &component_ids_);
-    e.record = std::move(r);
+    e.time_us = r.time_us;
+    e.seq = r.seq;
+    e.pid = r.pid;
+    e.message = std::move(r.message);
+    e.priority = r.priority;
+    e.category = categories_.Intern(r.category);
+    e.component = components_.Intern(r.component);
+    e.host = hosts_.Intern(r.host);
+    e.source = source;
     entries_.push_back(std::move(e));
     ++added;
   }
   return added;
 }
 
+logging::Record RecordStore::record(size_t i) const {
+  const Entry& e = entries_[i];
+  logging::Record r;
+  r.time_us = e.time_us;
+  r.priority = e.priority;
+  r.category = category(e);
+  r.component = component(e);
+  r.host = host(e);
+  r.pid = e.pid;
+  r.source = source(e);
+  r.seq = e.seq;
+  r.message = e.message;
+  return r;
+}
+
 void RecordStore::Clear() {
   entries_.clear();
-  categories_.clear();
-  category_ids_.clear();
-  components_.clear();
-  component_ids_.clear();
+  categories_.Clear();
+  components_.Clear();
+  hosts_.Clear();
+  sources_.Clear();
   last_seq_.clear();
 }
 

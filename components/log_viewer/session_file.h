@@ -23,12 +23,15 @@ struct SessionFileContents {
 };
 
 /// Reads a session log. Comment lines (`#`) and blank lines are skipped silently; any other line
-/// that logging::ParseLine rejects is skipped and reported with the file's path and the line's
-/// number. Throws std::runtime_error naming the path when the file cannot be read.
+/// that logging::ParseLine rejects is skipped and reported with the file's path, the line's
+/// number and, where it is clear, the field that is wrong (too few fields, the time stamp, the
+/// priority, the pid or the seq). Throws std::runtime_error naming the path when the file cannot
+/// be read.
 SessionFileContents ReadSessionFile(const std::string& path);
 
 /// Writes `records` as a session log: a `#` header (with `comment` when not empty) and one
-/// logging::FormatLine per record. Throws std::runtime_error naming the path on failure.
+/// logging::FormatLine per record. The file is written whole or not at all (an existing file
+/// stays as it was on failure). Throws std::runtime_error naming the path and the reason.
 void WriteSessionFile(const std::string& path, const std::vector<const logging::Record*>& records,
                       const std::string& comment = "");
 

@@ -1,6 +1,7 @@
 // The viewer's filters on the known session: each alone and combined gives exactly the expected
 // rows; highlighting keeps every row and marks exactly the matches; a bad regular expression is
-// reported; appended records are classified like the others.
+// reported; appended records are classified like the others; a regular expression on a message
+// of megabytes neither overflows the stack nor looks past kRegexSearchBytes.
 #include "log_filter.h"
 
 #include <gtest/gtest.h>
@@ -23,13 +24,13 @@ class LogFilterTest : public ::testing::Test {
     view_.Apply(FilterSettings{}, store_);
   }
 
-  /// Rows shown under `s`.
+  // Rows shown under `s`.
   size_t Shown(const FilterSettings& s) {
     view_.Apply(s, store_);
     return view_.rows().size();
   }
 
-  /// The messages of the highlighted rows.
+  // The messages of the highlighted rows.
   std::vector<std::string> Highlighted() const {
     std::vector<std::string> out;
     for (size_t row = 0; row < view_.rows().size(); ++row)
@@ -270,6 +271,33 @@ TEST_F(LogFilterTest, RegularExpressionsMatchLikeStdRegexOnEveryMessage) {
       EXPECT_EQ(Shown(s), expected) << pattern << (case_sensitive ? " (case)" : "");
     }
   }
+}
+
+TEST_F(LogFilterTest, RegularExpressionsOnHugeMessagesKeepToTheirStart) {
+  // std::regex's default matcher recursed once per character here and overflowed the stack
+  logging::Record huge;
+  huge.source = "huge";
+  huge.seq = 1;
+  for (int i = 0; i < (1 << 19); ++i) huge.message += "ab";  // 1 MiB
+  logging::Record needle_after_cut = huge;
+  needle_after_cut.seq = 2;
+  needle_after_cut.message = std::string(kRegexSearchBytes, 'x') + " needle";
+  store_.Append({huge, needle_after_cut});
+  FilterSettings s;
+  s.regex = true;
+  s.text = "^(a|b)*";
+  EXPECT_EQ(Shown(s), static_cast<size_t>(k::kKnownRecords + 2))
+      << "every message matches, the huge one too";
+  EXPECT_TRUE(view_.error().empty()) << view_.error();
+  // where a message is cut is not its end
+  s.text = "x$";
+  EXPECT_EQ(Shown(s), 0u);
+  // a match that starts past the first kRegexSearchBytes is not found; plain text is
+  s.text = "need+le";
+  EXPECT_EQ(Shown(s), 0u);
+  s.regex = false;
+  s.text = "needle";
+  EXPECT_EQ(Shown(s), 1u);
 }
 
 TEST_F(LogFilterTest, ModeNamesRoundTrip) {

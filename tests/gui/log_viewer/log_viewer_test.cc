@@ -1,6 +1,8 @@
 // The Log Viewer in the test process (widgets on QT_QPA_PLATFORM=offscreen): the known session
-// file filtered through the widgets, copy and export of a selection, the session settings shared
-// with the Main Window, following a real caliper-logger live across a restart, and the
+// file filtered through the widgets, copy and export of a selection (never over the file shown
+// or the live session log), the session settings shared with the Main Window (values not
+// understood reported), the listener servant keeping every exception in, following a real
+// caliper-logger live across a restart, closing while that logger is stopped mid-query, and the
 // caliper-logviewer program itself (usage, errors, SIGTERM unregistering its listener).
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -26,6 +28,7 @@
 #include <QTreeWidget>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -38,6 +41,7 @@
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
 #include "known_session.h"
+#include "listener_servant.h"
 #include "log_viewer_window.h"
 #include "session_file.h"
 #include "support/gui_test.h"
@@ -58,7 +62,7 @@ using caliper::testing::WaitFor;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-/// Processes events until `condition` holds or `timeout` (5 s unless given) passes.
+// Processes events until `condition` holds or `timeout` (5 s unless given) passes.
 bool WaitInGui(const std::function<bool()>& condition, milliseconds timeout = seconds(5)) {
   return caliper::testing::WaitInGui(condition, timeout);
 }
@@ -70,7 +74,7 @@ W* Child(QWidget& window, const char* name) {
   return w;
 }
 
-/// A node of the sources tree by its text under a top-level node ("Categories", "Components").
+// A node of the sources tree by its text under a top-level node ("Categories", "Components").
 QTreeWidgetItem* SourceItem(QTreeWidget* tree, const QString& top, const QString& text) {
   for (int i = 0; i < tree->topLevelItemCount(); ++i) {
     QTreeWidgetItem* root = tree->topLevelItem(i);
@@ -81,7 +85,7 @@ QTreeWidgetItem* SourceItem(QTreeWidget* tree, const QString& top, const QString
   return nullptr;
 }
 
-/// Clicks the check box of a tree item as a user would.
+// Clicks the check box of a tree item as a user would.
 void ClickCheckBox(QTreeWidget* tree, QTreeWidgetItem* item) {
   tree->scrollToItem(item);
   QStyleOptionViewItem option;
@@ -93,7 +97,7 @@ void ClickCheckBox(QTreeWidget* tree, QTreeWidgetItem* item) {
   QTest::mouseClick(tree->viewport(), Qt::LeftButton, Qt::NoModifier, box.center());
 }
 
-/// Replaces the text of a line edit by typing.
+// Replaces the text of a line edit by typing.
 void Type(QLineEdit* edit, const QString& text) {
   edit->setFocus();
   edit->selectAll();
@@ -101,7 +105,7 @@ void Type(QLineEdit* edit, const QString& text) {
   QTest::keyClicks(edit, text);
 }
 
-/// Shown rows, waited for: the filters apply after a short pause.
+// Shown rows, waited for: the filters apply after a short pause.
 bool ShowsRows(LogViewerWindow& w, int rows) {
   const bool reached = WaitInGui([&] { return w.model().rowCount() == rows; });
   QTest::qWait(350);  // and it stays there once the typing pause is over
@@ -280,11 +284,14 @@ TEST_F(LogViewerTest, CopiesAndExportsTheSelection) {
   EXPECT_EQ(w->model().rowCount(), 3);
   EXPECT_TRUE(w->problems().isEmpty());
 
-  // nothing selected: every shown row is exported; a bad path is an error, not a crash
-  ASSERT_TRUE(w->ExportTo(path, &error));
-  EXPECT_EQ(ReadSessionFile(path.toStdString()).records.size(), 3u);
+  // nothing selected: every shown row is exported; a bad path is an error naming the reason,
+  // not a crash
+  const QString again = QString::fromStdString(dir_.path() + "/again.log");
+  ASSERT_TRUE(w->ExportTo(again, &error)) << error.toStdString();
+  EXPECT_EQ(ReadSessionFile(again.toStdString()).records.size(), 3u);
   EXPECT_FALSE(w->ExportTo("/nonexistent/dir/x.log", &error));
   EXPECT_TRUE(error.startsWith("cannot write /nonexistent/dir/x.log")) << error.toStdString();
+  EXPECT_TRUE(error.contains("No such file or directory")) << error.toStdString();
   EXPECT_FALSE(w->OpenFile("/nonexistent/dir/x.log", &error));
   EXPECT_EQ(w->model().rowCount(), 3) << "a failed open leaves the table as it was";
 }
@@ -358,6 +365,98 @@ TEST_F(LogViewerTest, SessionFileKeepsGeometryAndFilters) {
   EXPECT_EQ(placed->geometry().size(), QSize(640, 400));
 }
 
+TEST_F(LogViewerTest, ExportRefusesToWriteOverTheFileShown) {
+  // a copy of the known file, shown; exporting a selection over it would lose the rest
+  const std::string shown = dir_.path() + "/shown.log";
+  std::filesystem::copy_file(k::KnownSessionPath(), shown);
+  const std::string before = ReadFile(shown);
+  auto w = Window();
+  ASSERT_TRUE(w->OpenFile(QString::fromStdString(shown)));
+  w->table()->selectRow(0);
+  QString error;
+  EXPECT_FALSE(w->ExportTo(QString::fromStdString(shown), &error));
+  EXPECT_EQ(error.toStdString(),
+            "will not export to " + shown + ": it is the file shown (choose another file)");
+  // also under another name
+  const std::string link = dir_.path() + "/link.log";
+  std::filesystem::create_symlink(shown, link);
+  EXPECT_FALSE(w->ExportTo(QString::fromStdString(link), &error));
+  EXPECT_TRUE(error.contains("it is the file shown")) << error.toStdString();
+  EXPECT_EQ(ReadFile(shown), before) << "the file shown is untouched";
+  // anywhere else is fine
+  EXPECT_TRUE(w->ExportTo(QString::fromStdString(dir_.path() + "/other.log"), &error))
+      << error.toStdString();
+}
+
+TEST_F(LogViewerTest, SessionValuesNotUnderstoodAreReportedAndKeepTheDefaults) {
+  const QString ini = QString::fromStdString(dir_.path() + "/caliper-main.ini");
+  {
+    QSettings st(ini, QSettings::IniFormat);
+    st.beginGroup("log_viewer");
+    st.setValue("min_priority", "LOUD");
+    st.setValue("priority_mode", "highlight");  // understood
+    st.setValue("text", "tendon");              // understood
+    st.setValue("text_mode", "blink");
+    st.setValue("regex", "perhaps");
+    st.setValue("from_time_us", "yesterday");
+    st.setValue("to_time_us", "1709632810000000");  // understood
+    st.endGroup();
+  }
+  LogViewerWindow::Options options;
+  options.session_file = ini;
+  auto w = Window(options);
+  const std::string problem = w->session_problem().toStdString();
+  for (const char* ignored :
+       {"min_priority=LOUD", "text_mode=blink", "regex=perhaps", "from_time_us=yesterday"})
+    EXPECT_NE(problem.find(ignored), std::string::npos) << ignored << " in: " << problem;
+  for (const char* understood : {"priority_mode", "text=", "to_time_us"})
+    EXPECT_EQ(problem.find(understood), std::string::npos) << understood << " in: " << problem;
+  EXPECT_EQ(problem.rfind("caliper-main.ini [log_viewer]: ignored ", 0), 0u) << problem;
+  EXPECT_TRUE(Child<QLabel>(*w, "problems")->text().contains("min_priority=LOUD"))
+      << "on the status line";
+  // the defaults stay where a value was not understood, the rest is restored
+  EXPECT_EQ(Child<QComboBox>(*w, "priority")->currentText(), "DEBUG (all)");
+  EXPECT_EQ(Child<QComboBox>(*w, "priority_mode")->currentText(), "Highlight");
+  EXPECT_EQ(Child<QComboBox>(*w, "text_mode")->currentText(), "Hide others");
+  EXPECT_FALSE(Child<QCheckBox>(*w, "regex")->isChecked());
+  EXPECT_EQ(Child<QLineEdit>(*w, "text")->text(), "tendon");
+  EXPECT_FALSE(Child<QCheckBox>(*w, "from_enabled")->isChecked());
+  EXPECT_TRUE(Child<QCheckBox>(*w, "to_enabled")->isChecked());
+  // opening a file keeps the report next to the file's own problems
+  ASSERT_TRUE(w->OpenFile(QString::fromStdString(k::KnownSessionPath())));
+  const QString shown = Child<QLabel>(*w, "problems")->text();
+  EXPECT_TRUE(shown.startsWith("1 malformed line skipped: ")) << shown.toStdString();
+  EXPECT_TRUE(shown.contains("min_priority=LOUD")) << shown.toStdString();
+
+  // a session the viewer wrote itself has nothing to report
+  w->close();
+  auto again = Window(options);
+  EXPECT_TRUE(again->session_problem().isEmpty()) << again->session_problem().toStdString();
+  EXPECT_EQ(Child<QLineEdit>(*again, "text")->text(), "tendon");
+}
+
+TEST_F(LogViewerTest, ListenerServantKeepsEveryExceptionIn) {
+  // a pushed batch that cannot be taken in must not reach the logger as UNKNOWN (it would drop
+  // the listener): it is counted instead
+  Caliper::Logging::StoredRecordSeq batch;
+  batch.length(1);
+  batch[0].serial = 1;
+  batch[0].rec.message = "pushed";
+  int thrown = 0;
+  auto* servant = new ListenerServant([&thrown](std::vector<LiveRecord> records) {
+    EXPECT_EQ(records.size(), 1u);
+    if (++thrown == 1) throw std::runtime_error("inbox full");
+    throw 42;
+  });
+  EXPECT_NO_THROW(servant->on_records(batch));
+  EXPECT_EQ(servant->failures(), 1u);
+  EXPECT_EQ(servant->last_failure(), "inbox full");
+  EXPECT_NO_THROW(servant->on_records(batch));
+  EXPECT_EQ(servant->failures(), 2u);
+  EXPECT_EQ(servant->last_failure(), "an unknown exception");
+  servant->_remove_ref();
+}
+
 class LiveTest : public LogViewerTest {
  protected:
   void SetUp() override {
@@ -374,7 +473,7 @@ class LiveTest : public LogViewerTest {
         dir_.path() + "/logger.out");
   }
 
-  /// Records `first`..`last` of the test's source, sent until the logger takes them.
+  // Records `first`..`last` of the test's source, sent until the logger takes them.
   bool Send(uint64_t first, uint64_t last, int priority = logging::kInfo) {
     std::vector<logging::Record> batch;
     for (uint64_t seq = first; seq <= last; ++seq) {
@@ -403,6 +502,26 @@ class LiveTest : public LogViewerTest {
         seconds(15));
   }
 
+  // a session log of `n` records that the logger reads back when it starts (same session)
+  void WriteBacklog(int n) {
+    std::filesystem::create_directories(dir_.path() + "/logs");
+    std::vector<logging::Record> records(static_cast<size_t>(n));
+    std::vector<const logging::Record*> all;
+    for (int i = 0; i < n; ++i) {
+      logging::Record& r = records[static_cast<size_t>(i)];
+      r.time_us = 1709632800LL * 1000000 + i;
+      r.category = "caliper.test.backlog";
+      r.component = "backlog0";
+      r.host = "testhost";
+      r.pid = 43;
+      r.source = "testhost:43:1";
+      r.seq = static_cast<uint64_t>(i) + 1;
+      r.message = "backlog record " + std::to_string(i + 1) + " with some text to carry";
+      all.push_back(&r);
+    }
+    WriteSessionFile(dir_.path() + "/logs/caliper-20240305-100000-test.log", all);
+  }
+
   std::string SessionLog() {
     const auto files = caliper::testing::ListFiles(dir_.path() + "/logs", "caliper-");
     return files.size() == 1 ? ReadFile(files[0]) : "";
@@ -425,6 +544,16 @@ TEST_F(LiveTest, FollowsTheLoggerAndRegistersAgainAfterItRestarts) {
   auto* connection = Child<QLabel>(*w, "connection");
   EXPECT_TRUE(connection->text().startsWith("Live: connected")) << connection->text().toStdString();
   EXPECT_TRUE(connection->text().contains("caliper-")) << "names the session log";
+  // exporting the selection over the session log the logger appends to is refused
+  const std::string live_log = w->link_status().session_file;
+  const std::string before = ReadFile(live_log);
+  w->table()->selectRow(0);
+  QString error;
+  EXPECT_FALSE(w->ExportTo(QString::fromStdString(live_log), &error));
+  EXPECT_EQ(error.toStdString(), "will not export to " + live_log +
+                                     ": it is the session log logger0 is writing (choose "
+                                     "another file)");
+  EXPECT_EQ(ReadFile(live_log), before);
 
   ASSERT_TRUE(Send(6, 15, logging::kError));  // pushed to the listener
   EXPECT_TRUE(WaitInGui([&] { return RowsOfComponent(*w, "live0") == 15; }));
@@ -493,6 +622,56 @@ TEST_F(LiveTest, FollowsTheLoggerAndRegistersAgainAfterItRestarts) {
   QTest::qWait(300);
   EXPECT_EQ(RowsOfComponent(*both, "live0"), 31);
   EXPECT_GE(both->model().store().size(), from_file + 1);
+}
+
+TEST_F(LiveTest, ABacklogLargerThanOneReplyArrivesCompleteAndInOrder) {
+  // some 6 MB of records: one reply would exceed omniORB's 2 MB message limit
+  constexpr int kBacklog = 60000;
+  WriteBacklog(kBacklog);
+  auto logger = StartLogger();
+  LogViewerWindow::Options options;
+  options.link.nameservice = naming_->address();
+  auto w = Window(options);
+  w->FollowLive();
+  ASSERT_TRUE(WaitInGui([&] { return w->link_status().connected; }, seconds(20)))
+      << w->link_status().message;
+  EXPECT_TRUE(WaitInGui([&] { return RowsOfComponent(*w, "backlog0") == kBacklog; }, seconds(10)))
+      << RowsOfComponent(*w, "backlog0");
+  uint64_t last = 0;
+  for (int row = 0; row < w->model().rowCount(); ++row) {
+    const logging::Record r = w->model().RecordAt(row);
+    if (r.component != "backlog0") continue;
+    ASSERT_EQ(r.seq, ++last) << "in order, none twice";
+  }
+  EXPECT_EQ(w->link_status().lost, 0u);
+  EXPECT_EQ(w->link_status().registrations, 1u);
+}
+
+TEST_F(LiveTest, ClosingWhileTheLoggerIsStoppedMidQueryReturnsWithinSeconds) {
+  WriteBacklog(200000);  // a first query that takes a while to answer
+  auto logger = StartLogger();
+  LogViewerWindow::Options options;
+  options.link.nameservice = naming_->address();
+  options.link.query_timeout_ms = 60000;  // the stalled query does not end by itself meanwhile
+  auto w = Window(options);
+  w->FollowLive();
+  // the logger stops (kill -STOP) while the viewer waits for its backlog
+  ASSERT_TRUE(WaitFor([&] { return w->link_status().message.rfind("reading the records", 0) == 0; },
+                      seconds(30)))
+      << w->link_status().message << "\n"
+      << logger->Output();
+  logger->Signal(SIGSTOP);
+  QTest::qWait(500);
+  ASSERT_FALSE(w->link_status().connected) << "the backlog arrived before the logger stopped";
+
+  QElapsedTimer closing;
+  closing.start();
+  w->close();
+  w.reset();
+  EXPECT_LT(closing.elapsed(), 5000) << "closing waited for the stalled query";
+  logger->Signal(SIGCONT);
+  logger->Signal(SIGKILL);
+  logger->Wait(seconds(5));
 }
 
 TEST_F(LogViewerTest, ModelKeepsAtMostMaxRecordsDroppingTheOldest) {

@@ -1,4 +1,5 @@
-// The viewer's record store: order, duplicates by (source, seq), interned names, trimming.
+// The viewer's record store: order, duplicates by (source, seq), interned names (each record
+// given back whole), trimming.
 #include "record_store.h"
 
 #include <gtest/gtest.h>
@@ -36,6 +37,22 @@ TEST(RecordStoreTest, KeepsOrderAndInternsCategoriesAndComponents) {
     EXPECT_EQ(store.components()[store.entry(i).component], store.record(i).component);
   }
   EXPECT_EQ(store.record(0).message.rfind("session log /var/log", 0), 0u);
+}
+
+TEST(RecordStoreTest, GivesEveryRecordBackWholeWithItsNamesInternedOnce) {
+  const auto records = ReadSessionFile(testing::KnownSessionPath()).records;
+  RecordStore store;
+  store.Append(records);
+  ASSERT_EQ(store.size(), records.size());
+  for (size_t i = 0; i < store.size(); ++i)
+    EXPECT_EQ(logging::FormatLine(store.record(i)), logging::FormatLine(records[i])) << i;
+  // hosts and sources are kept once each, like categories and components
+  EXPECT_EQ(store.hosts(), (std::vector<std::string>{"desk", "node1"}));
+  EXPECT_EQ(store.sources().size(), 4u);
+  for (size_t i = 0; i < store.size(); ++i) {
+    EXPECT_EQ(store.host(store.entry(i)), records[i].host);
+    EXPECT_EQ(store.source(store.entry(i)), records[i].source);
+  }
 }
 
 TEST(RecordStoreTest, DropsRecordsSeenBeforeBySourceAndSeq) {

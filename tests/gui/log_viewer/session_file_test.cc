@@ -1,4 +1,5 @@
-// Reading and writing session logs: the known file, its malformed line, and export round trips.
+// Reading and writing session logs: the known file, its malformed line, a malformed_* file per
+// field that can be wrong, export round trips and exports that fail without harm.
 #include "session_file.h"
 
 #include <gtest/gtest.h>
@@ -62,7 +63,11 @@ TEST(SessionFileTest, ReportsTheMalformedLineWithFileAndLineNumber) {
   const SessionFileContents c = ReadSessionFile(KnownSessionPath());
   EXPECT_EQ(c.malformed, 1u);
   ASSERT_EQ(c.problems.size(), 1u);
-  EXPECT_EQ(c.problems[0].rfind(KnownSessionPath() + ":19: not a log record, skipped: '", 0), 0u)
+  EXPECT_EQ(c.problems[0].rfind(KnownSessionPath() +
+                                    ":19: not a log record (only 4 of the 9 tab-separated "
+                                    "fields), skipped: '",
+                                0),
+            0u)
       << c.problems[0];
   EXPECT_NE(c.problems[0].find("torn line without the other fields"), std::string::npos);
 }
@@ -79,7 +84,10 @@ TEST(SessionFileTest, ReportsATornLastLineAndCapsTheProblemList) {
   EXPECT_TRUE(c.records.empty());
   EXPECT_EQ(c.malformed, 31u);
   ASSERT_EQ(c.problems.size(), SessionFileContents::kMaxProblems);
-  EXPECT_EQ(c.problems[0], path + ":3: not a log record, skipped: 'garbage 0'");
+  EXPECT_EQ(c.problems[0],
+            path +
+                ":3: not a log record (only 1 of the 9 tab-separated fields), skipped: "
+                "'garbage 0'");
   std::remove(path.c_str());
   const std::string torn = TempPath("torn2.log");
   {
@@ -91,6 +99,30 @@ TEST(SessionFileTest, ReportsATornLastLineAndCapsTheProblemList) {
   EXPECT_EQ(t.problems[0],
             torn + ":1: incomplete last line (is the file still being written?), skipped");
   std::remove(torn.c_str());
+}
+
+TEST(SessionFileTest, NamesTheWrongFieldOfAMalformedLine) {
+  const struct {
+    const char* file;
+    const char* why;
+  } cases[] = {
+      {"malformed_fields.log", "only 4 of the 9 tab-separated fields"},
+      {"malformed_time.log",
+       "the time stamp '2024-03-05 10:00:02' is not YYYY-mm-ddTHH:MM:SS.uuuuuuZ"},
+      {"malformed_priority.log", "the priority 'VERBOSE' is not FATAL..DEBUG or a number"},
+      {"malformed_pid.log", "the pid 'pid4101' is not a number"},
+      {"malformed_seq.log", "the seq '' is not a number"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = std::string(CALIPER_LOG_VIEWER_DATA_DIR) + "/" + c.file;
+    const SessionFileContents contents = ReadSessionFile(path);
+    EXPECT_EQ(contents.records.size(), 1u) << c.file;
+    ASSERT_EQ(contents.problems.size(), 1u) << c.file;
+    EXPECT_EQ(contents.problems[0].rfind(
+                  path + ":3: not a log record (" + c.why + "), skipped: '2024-03-05", 0),
+              0u)
+        << contents.problems[0];
+  }
 }
 
 TEST(SessionFileTest, MissingFileThrowsNamingIt) {
@@ -137,7 +169,30 @@ TEST(SessionFileTest, UnwritableExportThrowsNamingThePath) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("cannot write /nonexistent/dir/out.log"),
               std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
+        << e.what();
   }
+}
+
+TEST(SessionFileTest, AFailedExportLeavesTheExistingFileAsItWas) {
+  const SessionFileContents c = ReadSessionFile(KnownSessionPath());
+  const std::string path = TempPath("kept.log");
+  std::ofstream(path) << "# an earlier export\n";
+  // the export's temporary file beside the target is a full device: every write fails
+  const std::string temporary = path + ".part-" + std::to_string(getpid());
+  ASSERT_EQ(symlink("/dev/full", temporary.c_str()), 0);
+  std::vector<const logging::Record*> all;
+  for (const auto& r : c.records) all.push_back(&r);
+  try {
+    WriteSessionFile(path, all);
+    FAIL() << "an export to a full device succeeded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("cannot write " + path, 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(Slurp(path), "# an earlier export\n");
+  std::remove(temporary.c_str());
+  std::remove(path.c_str());
 }
 
 }  // namespace
