@@ -4,6 +4,7 @@
 #include <QTest>
 #include <cstdlib>
 
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::testing {
@@ -20,11 +21,7 @@ QApplication& App() {
 }
 
 CORBA::ORB_ptr Orb() {
-  static CORBA::ORB_ptr orb = [] {
-    int argc = 3;
-    const char* args[] = {"caliper_gui_test", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-    return CORBA::ORB_init(argc, const_cast<char**>(args));
-  }();
+  static CORBA::ORB_ptr orb = rtc::ClientOrb("caliper_gui_test");  // as the GUI programs have it
   return orb;
 }
 

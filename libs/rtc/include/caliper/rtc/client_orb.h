@@ -6,8 +6,9 @@
 
 namespace caliper::rtc {
 
-/// The process's ORB: initialised on the first call (endpoint giop:tcp:127.0.0.1, `program` names
-/// it), the same ORB afterwards (also when the process initialised one itself before).
+/// The process's ORB: initialised on the first call (endpoint giop:tcp:127.0.0.1, per-thread call
+/// timeouts enabled, `program` names it), the same ORB afterwards (also when the process
+/// initialised one itself before: then its options stand).
 CORBA::ORB_ptr ClientOrb(const char* program = "caliper");
 
 }  // namespace caliper::rtc

@@ -1,0 +1,103 @@
+// `launch/caliper session MODEL` on a desktop: the naming service, the logger, the Model and the
+// Main Window, which opens the renderer, the plotter and the log viewer in their places; Ctrl-C in
+// the launcher's terminal ends every process of the session, the naming service included.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <QSettings>
+#include <QStringList>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "caliper/gui_session/tool_window.h"
+#include "support/process.h"
+
+namespace caliper::testing {
+namespace {
+
+using std::chrono::seconds;
+
+bool Alive(long long pid) { return pid > 0 && ::kill(static_cast<pid_t>(pid), 0) == 0; }
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::vector<std::string> lines;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(LauncherSession, OpensTheToolsInTheirPlacesAndCtrlCEndsEveryProcess) {
+  if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0')
+    GTEST_SKIP() << "no DISPLAY: the session's windows need X (launch/caliper test starts Xvfb)";
+  TempDir dir;
+  const std::string run = dir.path() + "/run";
+  ASSERT_EQ(::mkdir(run.c_str(), 0700), 0);
+  const QString settings = QString::fromStdString(dir.path() + "/caliper-main.ini");
+  // the launcher's state, sessions and GUI session in the test's directory; what is built is used
+  ::setenv("XDG_RUNTIME_DIR", run.c_str(), 1);
+  ::setenv("CALIPER_SESSIONS_DIR", (dir.path() + "/sessions").c_str(), 1);
+  ::setenv("CALIPER_MAIN_SETTINGS", settings.toStdString().c_str(), 1);
+  ::setenv("CALIPER_NO_BUILD", "1", 1);
+  const std::string source = std::getenv("CALIPER_SOURCE_DIR");
+  Process launcher({source + "/launch/caliper", "session", source + "/models/pendulum_tendon.dae"},
+                   dir.path() + "/launcher.out");
+
+  // every tool shows its window, and they do not overlap
+  const QStringList tools = {"renderer", "plotter", "log_viewer"};
+  std::vector<gui_session::ToolWindowRecord> records;
+  const bool shown = WaitFor(
+      [&] {
+        records.clear();
+        for (const QString& tool : tools) {
+          records.push_back(gui_session::ReadToolWindow(settings, tool));
+          if (records.back().window_id == 0 || !Alive(records.back().pid)) return false;
+        }
+        return true;
+      },
+      seconds(90));
+  ASSERT_TRUE(shown) << launcher.Output();
+  for (size_t a = 0; a < records.size(); ++a)
+    for (size_t b = a + 1; b < records.size(); ++b)
+      EXPECT_FALSE(records[a].geometry.intersects(records[b].geometry))
+          << tools[a].toStdString() << " overlaps " << tools[b].toStdString();
+
+  // the session's components are in its naming service
+  const std::vector<std::string> latest =
+      Lines(run + "/caliper-" + std::to_string(::getuid()) + "/latest-session");
+  ASSERT_GE(latest.size(), 2u) << launcher.Output();
+  const std::string address = latest[0];
+  const long long naming_pid = std::atoll(latest[1].c_str());
+  const CommandResult ls = Ctl(address, {"ls"});
+  for (const char* name : {"logger0", "model0", "renderer0"})
+    EXPECT_NE(ls.out.find(name), std::string::npos) << name << " not listed:\n" << ls.out;
+  std::smatch m;
+  const std::string output = launcher.Output();
+  ASSERT_TRUE(std::regex_search(output, m, std::regex(R"(main window \(pid (\d+)\))"))) << output;
+  const long long main_pid = std::atoll(m[1].str().c_str());
+  EXPECT_TRUE(Alive(main_pid));
+
+  // Ctrl-C: every process of the session ends, the main window saved the open tools
+  launcher.Signal(SIGINT);
+  const int code = launcher.Wait(seconds(40));
+  EXPECT_TRUE(code == 130 || code == 0) << "exit code " << code << "\n" << launcher.Output();
+  EXPECT_EQ(launcher.Output().find("had to kill"), std::string::npos) << launcher.Output();
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        bool any = Alive(main_pid) || Alive(naming_pid);
+        for (const auto& r : records) any = any || Alive(r.pid);
+        return !any;
+      },
+      seconds(10)))
+      << "a process of the session outlived it";
+  QStringList open = QSettings(settings, QSettings::IniFormat).value("tools/open").toStringList();
+  open.sort();
+  EXPECT_EQ(open, QStringList({"log_viewer", "plotter", "renderer"}));
+}
+
+}  // namespace
+}  // namespace caliper::testing
