@@ -37,14 +37,6 @@ constexpr const char* kUsage =
     "Ctrl+C copies the selected rows (tab-separated); File > Export writes them as a session log.\n"
     "SIGINT and SIGTERM close the window cleanly (the live listener is unregistered).\n";
 
-// Qt's command-line options that take a value
-bool QtOptionWithValue(const std::string& option) {
-  for (const char* o : {"-platform", "-platformpluginpath", "-platformtheme", "-plugin",
-                        "-qwindowgeometry", "-qwindowicon", "-qwindowtitle", "-style",
-                        "-stylesheet", "-display", "-geometry", "-title", "-name"})
-    if (option == o) return true;
-  return false;
-}
 
 int UsageError(const std::string& message) {
   std::cerr << "caliper-logviewer: error: " << message << "\n"
@@ -88,7 +80,8 @@ int main(int argc, char** argv) {
     } else if (a.size() > 1 && a[0] == '-' && a[1] != '-') {
       // Qt's own (-platform offscreen, -style fusion ...); what Qt does not take is refused below
       qt_argv.push_back(argv[i]);
-      if (QtOptionWithValue(a) && i + 1 < argc) qt_argv.push_back(argv[++i]);
+      if (caliper::gui_session::IsQtOptionWithValue(a) && i + 1 < argc)
+        qt_argv.push_back(argv[++i]);
     } else {
       return UsageError("unexpected argument '" + a + "'");
     }

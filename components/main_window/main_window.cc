@@ -349,7 +349,9 @@ bool MainWindow::StartTool(const QString& name) {
   if (!gui_session::ReadToolWindow(SettingsPath(), name).geometry.isValid())
     args << "--geometry" << gui_session::FormatGeometry(ArrangedGeometry(name));
   args << tool_arguments_[name];
-  if (name == "plotter" && !QSettings(SettingsPath(), QSettings::IniFormat).contains("plotter/layout"))
+  const bool has_layout =
+      QSettings(SettingsPath(), QSettings::IniFormat).contains("plotter/layout");
+  if (name == "plotter" && !has_layout)
     for (const QString& plot : default_plots_) args << "--ids" << plot;
   auto* p = new QProcess(this);
   p->setProcessChannelMode(QProcess::ForwardedChannels);
@@ -366,7 +368,8 @@ bool MainWindow::StartTool(const QString& name) {
 }
 
 QRect MainWindow::ArrangedGeometry(const QString& name) const {
-  const QScreen* screen = this->screen() != nullptr ? this->screen() : QGuiApplication::primaryScreen();
+  const QScreen* screen =
+      this->screen() != nullptr ? this->screen() : QGuiApplication::primaryScreen();
   const QRect area = screen != nullptr ? screen->availableGeometry() : QRect(0, 0, 1280, 800);
   // left column: this window over the log viewer; right: the renderer over the plotter
   const int left_width =

@@ -7,7 +7,8 @@
 // The session (window geometry, last model, simulation settings, open tools and their windows) is
 // kept in a per-user settings file, or in $CALIPER_MAIN_SETTINGS. --no-tools does not start the
 // tools that were open last time; --tools starts the ones named; each --plot is one plot the
-// plotter shows when it has no layout of its own; --arrange tiles the windows once the tools are up.
+// plotter shows when it has no layout of its own; --arrange tiles the windows once the tools are
+// up.
 
 #include <QApplication>
 #include <QFileInfo>
@@ -32,7 +33,8 @@ int main(int argc, char** argv) {
   // --help needs no display: looked for before Qt starts (which then takes out its own options,
   // -geometry, -platform, ...)
   bool help = false;
-  for (int i = 1; i < argc; ++i) help |= std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h";
+  for (int i = 1; i < argc; ++i)
+    help |= std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h";
   std::unique_ptr<QApplication> app;
   if (!help) app = std::make_unique<QApplication>(argc, argv);
   QStringList args;
@@ -56,7 +58,8 @@ int main(int argc, char** argv) {
     } else if (a == "--help" || a == "-h") {
       std::cout
           << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE]\n"
-             "                    [--no-tools] [--tools LIST] [--plot IDS] [--arrange] [MODEL_FILE]\n"
+             "                    [--no-tools] [--tools LIST] [--plot IDS]... [--arrange]\n"
+             "                    [MODEL_FILE]\n"
              "  The Main Window: simulation control, parameters, components, and the other tools.\n"
              "  --nameservice ADDR  the naming service (default: omniORB's configuration)\n"
              "  --model INSTANCE    the Model's instance name (default model0)\n"

@@ -34,7 +34,8 @@ struct ModelLink::Impl {
   }
 };
 
-ModelLink::ModelLink(Options options) : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
+ModelLink::ModelLink(Options options)
+    : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
   impl_->orb = rtc::ClientOrb();
   snapshot_.connection_message = "no Model: looking for " + options_.instance + " ...";
   worker_ = std::thread([this] { Run(); });

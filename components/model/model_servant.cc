@@ -510,7 +510,9 @@ CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong e
   const double per_sample = (dt > 0 ? dt : 1e-3) * std::max<CORBA::ULong>(every_n_steps, 1);
   const size_t batch_steps = std::max<size_t>(1, static_cast<size_t>(0.05 / per_sample));
   const uint64_t id =
-      Guard<D::NotAvailable>([&] { return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps); });
+      Guard<D::NotAvailable>([&] {
+        return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps);
+      });
   std::lock_guard<std::mutex> lock(mutex_);
   DropDead();
   consumers_[id] = std::make_unique<ConsumerSender>(core_, id, consumer);

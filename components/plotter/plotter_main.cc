@@ -47,14 +47,6 @@ of them) unless a layout says otherwise; the Model samples every step and sends 
 SIGINT and SIGTERM close the window cleanly.
 )";
 
-// Qt's command-line options that take a value
-bool QtOptionWithValue(const std::string& option) {
-  for (const char* o : {"-platform", "-platformpluginpath", "-platformtheme", "-plugin",
-                        "-qwindowgeometry", "-qwindowicon", "-qwindowtitle", "-style",
-                        "-stylesheet", "-display", "-geometry", "-title", "-name"})
-    if (option == o) return true;
-  return false;
-}
 
 }  // namespace
 
@@ -83,7 +75,8 @@ int main(int argc, char** argv) {
       }
       // Qt's own (-platform offscreen, -style fusion ...); what Qt does not take is refused below
       qt_argv.push_back(argv[i]);
-      if (QtOptionWithValue(a) && i + 1 < argc) qt_argv.push_back(argv[++i]);
+      if (caliper::gui_session::IsQtOptionWithValue(a) && i + 1 < argc)
+        qt_argv.push_back(argv[++i]);
       continue;
     }
     if (i + 1 >= argc) {

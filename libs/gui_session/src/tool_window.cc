@@ -108,6 +108,14 @@ void OnTerminationSignal(int) {
 
 }  // namespace
 
+bool IsQtOptionWithValue(const std::string& option) {
+  for (const char* o : {"-platform", "-platformpluginpath", "-platformtheme", "-plugin",
+                        "-qwindowgeometry", "-qwindowicon", "-qwindowtitle", "-style",
+                        "-stylesheet", "-display", "-geometry", "-title", "-name"})
+    if (option == o) return true;
+  return false;
+}
+
 void CloseOnTerminationSignals(QWidget* window) {
   if (signal_socket[0] >= 0 ||
       ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, signal_socket) != 0)

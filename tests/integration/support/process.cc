@@ -1,3 +1,4 @@
+#include <csignal>
 #include "process.h"
 
 #include <dirent.h>
@@ -210,6 +211,19 @@ std::vector<std::string> ListFiles(const std::string& dir, const std::string& pr
   }
   closedir(d);
   return files;
+}
+
+FileSizeLimit::FileSizeLimit(rlim_t bytes) {
+  getrlimit(RLIMIT_FSIZE, &saved_);
+  handler_ = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limit = saved_;
+  limit.rlim_cur = bytes;
+  setrlimit(RLIMIT_FSIZE, &limit);
+}
+
+FileSizeLimit::~FileSizeLimit() {
+  setrlimit(RLIMIT_FSIZE, &saved_);
+  std::signal(SIGXFSZ, handler_);
 }
 
 }  // namespace caliper::testing

@@ -2,6 +2,7 @@
 // Helpers for tests that run real Caliper processes: child processes, a private omniNames on a
 // free loopback port, caliper-ctl runs, and waiting for conditions.
 
+#include <sys/resource.h>
 #include <sys/types.h>
 
 #include <chrono>
@@ -90,5 +91,19 @@ std::string ReadFile(const std::string& path);
 
 /// The files in `dir` whose names start with `prefix`.
 std::vector<std::string> ListFiles(const std::string& dir, const std::string& prefix);
+
+/// While it lives, no file this process writes may grow past `bytes`: a write beyond fails with
+/// EFBIG ("File too large"), the way a full disk fails it (SIGXFSZ is ignored meanwhile).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes);
+  ~FileSizeLimit();
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit saved_{};
+  void (*handler_)(int) = nullptr;
+};
 
 }  // namespace caliper::testing

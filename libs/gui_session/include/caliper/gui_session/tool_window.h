@@ -7,6 +7,7 @@
 #include <QObject>
 #include <QRect>
 #include <QString>
+#include <string>
 
 class QTimer;
 class QWidget;
@@ -59,6 +60,10 @@ class ToolWindow : public QObject {
 }  // namespace caliper::gui_session
 
 namespace caliper::gui_session {
+
+/// True for Qt's own command-line options that take a value (-platform, -style, -geometry, ...):
+/// a tool that reads its options before QApplication passes these, and their values, through.
+bool IsQtOptionWithValue(const std::string& option);
 
 /// SIGINT and SIGTERM close `window` (which saves what it saves when closed) and quit the event
 /// loop. The handlers only write a byte to a socket; the window is closed from the event loop, so
