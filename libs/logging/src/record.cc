@@ -4,7 +4,9 @@
 #include <cstdlib>
 #include <ctime>
 #include <strings.h>
-#include <vector>
+
+#include <cstdint>
+#include <string_view>
 
 namespace caliper::logging {
 
@@ -30,7 +32,7 @@ void AppendEscaped(const std::string& field, std::string* out) {
   }
 }
 
-std::string Unescape(const std::string& field) {
+std::string Unescape(std::string_view field) {
   std::string out;
   out.reserve(field.size());
   for (size_t i = 0; i < field.size(); ++i) {
@@ -44,18 +46,40 @@ std::string Unescape(const std::string& field) {
   return out;
 }
 
-bool ParseTime(const std::string& text, int64_t* time_us) {
-  int y, mo, d, h, mi, s, us;
-  if (std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d.%6dZ", &y, &mo, &d, &h, &mi, &s, &us) != 7)
+// the digits text[from, from + n) as a number; false when one is not a digit
+bool Digits(std::string_view text, size_t from, size_t n, int* value) {
+  int v = 0;
+  for (size_t i = from; i < from + n; ++i) {
+    if (text[i] < '0' || text[i] > '9') return false;
+    v = v * 10 + (text[i] - '0');
+  }
+  *value = v;
+  return true;
+}
+
+// days since 1970-01-01 of a date in the proleptic Gregorian calendar (H. Hinnant's algorithm)
+int64_t DaysFromCivil(int y, int m, int d) {
+  y -= m <= 2;
+  const int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const int64_t yoe = y - era * 400;
+  const int64_t doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const int64_t doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + doe - 719468;
+}
+
+// YYYY-mm-ddTHH:MM:SS.uuuuuuZ, exactly as FormatLine writes it
+bool ParseTime(std::string_view text, int64_t* time_us) {
+  if (text.size() != 27 || text[4] != '-' || text[7] != '-' || text[10] != 'T' ||
+      text[13] != ':' || text[16] != ':' || text[19] != '.' || text[26] != 'Z')
     return false;
-  struct tm t = {};
-  t.tm_year = y - 1900;
-  t.tm_mon = mo - 1;
-  t.tm_mday = d;
-  t.tm_hour = h;
-  t.tm_min = mi;
-  t.tm_sec = s;
-  *time_us = static_cast<int64_t>(timegm(&t)) * 1000000 + us;
+  int y, mo, d, h, mi, s, us;
+  if (!Digits(text, 0, 4, &y) || !Digits(text, 5, 2, &mo) || !Digits(text, 8, 2, &d) ||
+      !Digits(text, 11, 2, &h) || !Digits(text, 14, 2, &mi) || !Digits(text, 17, 2, &s) ||
+      !Digits(text, 20, 6, &us))
+    return false;
+  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || s > 60) return false;
+  const int64_t seconds = DaysFromCivil(y, mo, d) * 86400 + h * 3600 + mi * 60 + s;
+  *time_us = seconds * 1000000 + us;
   return true;
 }
 
@@ -108,26 +132,28 @@ std::string FormatLine(const Record& r) {
 
 bool ParseLine(const std::string& line, Record* r) {
   if (line.empty() || line[0] == '#') return false;
-  std::vector<std::string> fields;
+  std::string_view fields[9];
+  const std::string_view text(line);
   size_t start = 0;
   for (int i = 0; i < 8; ++i) {
-    const size_t tab = line.find('\t', start);
-    if (tab == std::string::npos) return false;
-    fields.push_back(line.substr(start, tab - start));
+    const size_t tab = text.find('\t', start);
+    if (tab == std::string_view::npos) return false;
+    fields[i] = text.substr(start, tab - start);
     start = tab + 1;
   }
-  fields.push_back(line.substr(start));
-  char* end = nullptr;
+  fields[8] = text.substr(start);
   if (!ParseTime(fields[0], &r->time_us)) return false;
-  if (!ParsePriority(fields[1], &r->priority)) return false;
+  if (!ParsePriority(std::string(fields[1]), &r->priority)) return false;
+  const std::string pid(fields[5]), seq(fields[7]);
+  char* end = nullptr;
+  r->pid = std::strtol(pid.c_str(), &end, 10);
+  if (*end != '\0') return false;
+  r->seq = std::strtoull(seq.c_str(), &end, 10);
+  if (*end != '\0' || seq.empty()) return false;
   r->category = Unescape(fields[2]);
   r->component = Unescape(fields[3]);
   r->host = Unescape(fields[4]);
-  r->pid = std::strtol(fields[5].c_str(), &end, 10);
-  if (*end != '\0') return false;
   r->source = Unescape(fields[6]);
-  r->seq = std::strtoull(fields[7].c_str(), &end, 10);
-  if (*end != '\0' || fields[7].empty()) return false;
   r->message = Unescape(fields[8]);
   return true;
 }

@@ -52,6 +52,24 @@ TEST(RecordTest, RoundTripsAPlainRecord) {
   ExpectSameRecord(parsed, Sample());
 }
 
+TEST(RecordTest, TimeStampsRoundTripOverCenturiesAndLeapDays) {
+  // the parser computes the calendar itself: it must agree with the C library's formatter
+  Record r = Sample();
+  for (int64_t t = 0; t < int64_t{4102444800} * 1000000; t += int64_t{133337} * 1000000 + 654321) {
+    r.time_us = t;
+    Record parsed;
+    ASSERT_TRUE(ParseLine(FormatLine(r), &parsed)) << FormatLine(r);
+    ASSERT_EQ(parsed.time_us, t) << FormatLine(r);
+  }
+  for (const char* stamp : {"2000-02-29T23:59:59.999999Z", "2100-03-01T00:00:00.000000Z",
+                            "1970-01-01T00:00:00.000000Z", "2024-12-31T12:00:00.500000Z"}) {
+    Record parsed;
+    const std::string line = std::string(stamp) + "\tINFO\tc\tm\th\t1\ts\t1\tx";
+    ASSERT_TRUE(ParseLine(line, &parsed)) << stamp;
+    EXPECT_EQ(FormatLine(parsed).substr(0, 27), stamp);
+  }
+}
+
 TEST(RecordTest, RoundTripsTabsNewlinesAndBackslashes) {
   Record r = Sample();
   r.message = "a\tb\nc\\d\\\\e\r\nf\\t literal \\n end\\";
@@ -120,6 +138,11 @@ TEST(RecordTest, RejectsMalformedFields) {
   ASSERT_TRUE(ParseLine(with_field(1, "350"), &r));  // or a number
   EXPECT_EQ(r.priority, 350);
   EXPECT_FALSE(ParseLine(with_field(0, "yesterday"), &r));
+  for (const char* stamp : {"2023-13-14T22:13:20.123456Z", "2023-11-14T24:13:20.123456Z",
+                            "2023-11-14 22:13:20.123456Z", "2023-11-14T22:13:20.12345Z",
+                            "2023-11-14T22:13:20.1234567Z", "2023-11-1xT22:13:20.123456Z",
+                            "2023-11-14T22:13:20.123456"})
+    EXPECT_FALSE(ParseLine(with_field(0, stamp), &r)) << stamp;
   EXPECT_FALSE(ParseLine(with_field(1, "LOUD"), &r));
   EXPECT_FALSE(ParseLine(with_field(5, "12x"), &r));
   EXPECT_FALSE(ParseLine(with_field(7, ""), &r));
