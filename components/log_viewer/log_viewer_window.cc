@@ -364,6 +364,16 @@ void LogViewerWindow::BuildMenus() {
     if (on) table_->scrollToBottom();
     ScheduleSave();
   });
+  show_filters_ = view->addAction("&Filters");
+  show_filters_->setObjectName("show_filters");
+  show_filters_->setCheckable(true);
+  show_filters_->setChecked(true);
+  show_filters_->setShortcut(QKeySequence("Ctrl+Shift+F"));
+  show_filters_->setToolTip("Show or hide the filter panel (the filters stay in force)");
+  connect(show_filters_, &QAction::toggled, this, [this](bool on) {
+    splitter_->widget(0)->setVisible(on);
+    ScheduleSave();
+  });
   QAction* clear = view->addAction("&Clear Filters", this, [this] {
     FilterSettings cleared;
     cleared.mode = CurrentFilter().mode;  // the hide/highlight choices stay
@@ -380,6 +390,7 @@ void LogViewerWindow::BuildMenus() {
   bar->addAction(live);
   bar->addAction(exp);
   bar->addAction(follow_tail_);
+  bar->addAction(show_filters_);
   bar->addAction(clear);
 }
 
@@ -801,6 +812,7 @@ void LogViewerWindow::RestoreSession() {
   s.to_time_us = time("to_time_us");
   s.mode[kTime] = mode("time_mode");
   follow_tail_->setChecked(flag("follow_tail", true));
+  show_filters_->setChecked(flag("filters_visible", true));
   splitter_->restoreState(st.value("splitter").toByteArray());
   filter_splitter_->restoreState(st.value("filter_splitter").toByteArray());
   table_->horizontalHeader()->restoreState(st.value("columns").toByteArray());
@@ -843,6 +855,7 @@ void LogViewerWindow::SaveSession() {
   st.setValue("to_time_us", static_cast<qlonglong>(s.to_time_us));
   st.setValue("time_mode", ModeName(s.mode[kTime]));
   st.setValue("follow_tail", follow_tail_->isChecked());
+  st.setValue("filters_visible", show_filters_->isChecked());
   st.setValue("splitter", splitter_->saveState());
   st.setValue("filter_splitter", filter_splitter_->saveState());
   st.setValue("columns", table_->horizontalHeader()->saveState());

@@ -161,6 +161,7 @@ class LogViewerWindow : public QMainWindow {
   QLabel* counts_ = nullptr;
   QLabel* problems_label_ = nullptr;
   QAction* follow_tail_ = nullptr;
+  QAction* show_filters_ = nullptr;  // the filter panel beside the table
   QTimer* poll_timer_ = nullptr;
   QTimer* apply_timer_ = nullptr;
   QTimer* save_timer_ = nullptr;  ///< filter changes; the window record saves itself

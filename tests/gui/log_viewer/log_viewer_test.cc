@@ -21,6 +21,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QSettings>
+#include <QSplitter>
 #include <QStyle>
 #include <QStyleOptionViewItem>
 #include <QTableView>
@@ -319,6 +320,11 @@ TEST_F(LogViewerTest, SessionFileKeepsGeometryAndFilters) {
     ClickCheckBox(Child<QTreeWidget>(*w, "sources"),
                   SourceItem(Child<QTreeWidget>(*w, "sources"), "Components", "renderer0"));
     w->ApplyFilters();
+    // the filter panel hidden: the table takes the window, the filters stay in force
+    auto* panel = Child<QSplitter>(*w, "splitter")->widget(0);
+    ASSERT_TRUE(panel->isVisible());
+    Child<QAction>(*w, "show_filters")->trigger();
+    EXPECT_FALSE(panel->isVisible());
     // a resize is saved after a pause, without closing
     w->resize(880, 480);
     EXPECT_TRUE(WaitInGui(
@@ -331,6 +337,7 @@ TEST_F(LogViewerTest, SessionFileKeepsGeometryAndFilters) {
   EXPECT_EQ(st.value("log_viewer/text").toString(), "tendon|lost");
   EXPECT_EQ(st.value("log_viewer/text_mode").toString(), "highlight");
   EXPECT_EQ(st.value("log_viewer/excluded_components").toStringList(), QStringList{"renderer0"});
+  EXPECT_FALSE(st.value("log_viewer/filters_visible").toBool());
 
   // a new viewer comes back as it was left
   auto again = Window(options);
@@ -343,6 +350,8 @@ TEST_F(LogViewerTest, SessionFileKeepsGeometryAndFilters) {
   EXPECT_EQ(
       SourceItem(Child<QTreeWidget>(*again, "sources"), "Components", "renderer0")->checkState(0),
       Qt::Unchecked);
+  EXPECT_FALSE(Child<QAction>(*again, "show_filters")->isChecked());
+  EXPECT_FALSE(Child<QSplitter>(*again, "splitter")->widget(0)->isVisible());
   // ERROR or worse without renderer0: records 11, 16, 19, 26, 29; 11 and 16 highlighted
   EXPECT_EQ(again->model().rowCount(), 5);
   EXPECT_EQ(again->model().view().highlighted_count(), 2u);
