@@ -99,5 +99,39 @@ TEST(LauncherSession, OpensTheToolsInTheirPlacesAndCtrlCEndsEveryProcess) {
   EXPECT_EQ(open, QStringList({"log_viewer", "plotter", "renderer"}));
 }
 
+TEST(LauncherSession, HeadlessSessionEndsAtOnceOnSigterm) {
+  // a process manager stops a server's session with SIGTERM: it must not wait for a sleep to end
+  TempDir dir;
+  const std::string run = dir.path() + "/run";
+  ASSERT_EQ(::mkdir(run.c_str(), 0700), 0);
+  ::setenv("XDG_RUNTIME_DIR", run.c_str(), 1);
+  ::setenv("CALIPER_SESSIONS_DIR", (dir.path() + "/sessions").c_str(), 1);
+  ::setenv("CALIPER_NO_BUILD", "1", 1);
+  const std::string source = std::getenv("CALIPER_SOURCE_DIR");
+  Process launcher({source + "/launch/caliper", "session", "--headless",
+                    source + "/models/pendulum_tendon.dae"},
+                   dir.path() + "/launcher.out");
+  const std::string latest = run + "/caliper-" + std::to_string(::getuid()) + "/latest-session";
+  std::string address;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const std::vector<std::string> lines = Lines(latest);
+        if (lines.empty()) return false;
+        address = lines[0];
+        return Ctl(address, {"status"}).exit_code == 0 &&
+               launcher.Output().find("session running") != std::string::npos;
+      },
+      seconds(60)))
+      << launcher.Output();
+  const long long naming_pid = std::atoll(Lines(latest)[1].c_str());
+  launcher.Signal(SIGTERM);
+  const int code = launcher.Wait(seconds(20));
+  EXPECT_NE(code, -1) << "still running 20 s after SIGTERM\n" << launcher.Output();
+  EXPECT_NE(launcher.Output().find("shutting the session down"), std::string::npos)
+      << launcher.Output();
+  EXPECT_TRUE(WaitFor([&] { return !Alive(naming_pid); }, seconds(10)));
+  EXPECT_NE(Ctl(address, {"status"}).exit_code, 0) << "the session's Model still answers";
+}
+
 }  // namespace
 }  // namespace caliper::testing
