@@ -332,6 +332,7 @@ void ConsumerSender::Run() {
       out.subscription = subscription_;
       out.batch = b.sequence;
       out.first_step = b.first_step;
+      out.layout = b.layout;
       out.times.length(static_cast<CORBA::ULong>(b.times.size()));
       for (CORBA::ULong i = 0; i < b.times.size(); ++i) out.times[i] = b.times[i];
       out.values_per_sample = static_cast<CORBA::ULong>(b.values_per_sample);

@@ -71,6 +71,7 @@ struct DaqLink::Shared {
   uint64_t dropped = 0;
   uint64_t discarded = 0;          // held batches of a layout that had changed
   double last_sample_time = kNaN;  // [s] of the current subscription
+  uint64_t model_layout = 0;       // the Model's layout number of its last batch (0: none yet)
   Clock::time_point last_batch_wall{};
 
   // with the mutex held
@@ -92,6 +93,9 @@ struct DaqLink::Shared {
       if (!std::isnan(last_sample_time) && b.times.front() < last_sample_time) checking = true;
       last_sample_time = b.times.back();
     }
+    // the Model moved the values within a sample (a reload changed shapes): check the layout
+    if (model_layout != 0 && b.model_layout != model_layout) checking = true;
+    model_layout = b.model_layout;
     last_batch_wall = Clock::now();
     if (!checking) {
       Deliver(std::move(b));
@@ -347,6 +351,7 @@ void DaqLink::Run() {
         sh.layout = layout;
         sh.next_batch = 1;
         sh.last_sample_time = kNaN;
+        sh.model_layout = 0;  // a new subscription starts at the Model's layout 1
         sh.last_batch_wall = Clock::now();
       }
       for (auto& [sub, batches] : sh.pending) {

@@ -31,6 +31,7 @@ struct ReceivedBatch {
   size_t values_per_sample = 0;
   std::vector<double> data;            ///< times.size() * values_per_sample values
   std::vector<std::string> stale_ids;  ///< subscribed ids the Model no longer has (NaN)
+  uint64_t model_layout = 1;  ///< the Model's layout number: grows when a reload moved the values
 };
 
 /// What the GUI reads: a copy of what the worker last learnt.

@@ -15,6 +15,7 @@ void DataConsumerServant::on_samples(const Caliper::Daq::SampleBatch& batch) {
     b.subscription = batch.subscription;
     b.number = batch.batch;
     b.values_per_sample = batch.values_per_sample;
+    b.model_layout = batch.layout;
     b.times.assign(batch.times.get_buffer(), batch.times.get_buffer() + batch.times.length());
     b.data.assign(batch.data.get_buffer(), batch.data.get_buffer() + batch.data.length());
     for (CORBA::ULong i = 0; i < batch.stale_ids.length(); ++i)

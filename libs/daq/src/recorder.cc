@@ -87,6 +87,7 @@ struct Recorder::Subscription {
   bool started = false;    // has taken a sample
   uint64_t last_step = 0;  // of the last sample
   uint64_t sequence = 0;   // of the last batch
+  uint64_t layout = 1;     // grows whenever the columns change shape, unit or staleness
   uint64_t samples = 0;
   std::string last_error;
   Batch pending;  // the batch being filled (step_count 0 when none)
@@ -168,6 +169,7 @@ void Recorder::Resolve(Subscription& s, bool initial) {
     if (same) return;
     // a batch has one layout: hand out what was sampled with the old one
     Emit(s);
+    ++s.layout;
   }
   s.columns = std::move(columns);
   s.values_per_sample = offset;
@@ -180,6 +182,7 @@ void Recorder::Sample(Subscription& s, uint64_t step, double sim_time) {
     b.first_step = step;
     b.every_n_steps = s.every_n_steps;
     b.columns = s.columns;
+    b.layout = s.layout;
     b.values_per_sample = s.values_per_sample;
     b.times.reserve(s.batch_steps);
     b.data.reserve(s.batch_steps * s.values_per_sample);

@@ -158,6 +158,29 @@ TEST_F(Fixture, ReportsIdsThatDisappearAsStaleAndPicksThemUpAgain) {
   EXPECT_TRUE(recorder.Stats(id).stale.empty());
 }
 
+TEST_F(Fixture, ALayoutNumberTellsWhenAReloadMovedTheValues) {
+  const SubscriptionId id = recorder.Subscribe(Options({"m.v", "m.x"}, 1, 10));
+  RunTo(2);
+  registry.Clear();  // reloaded with the same channels: the values stay where they were
+  Populate();
+  RunTo(4);
+  registry.Clear();  // reloaded with m.v two long: m.x moves from offset 3 to 2
+  registry.Add({"m.v", "m/s", Shape::Vector(2), false, false, "shorter"},
+               [this](double* out) { out[0] = out[1] = -static_cast<double>(step); });
+  registry.Add({"m.x", "m", Shape::Scalar(), false, false, "the step"},
+               [this](double* out) { out[0] = static_cast<double>(step); });
+  RunTo(6);
+  recorder.Flush();
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 2u) << "one batch per layout";
+  EXPECT_EQ(batches[0].layout, 1u);
+  EXPECT_EQ(batches[0].step_count, 4u) << "an unchanged reload keeps the layout and the batch";
+  EXPECT_EQ(batches[0].values_per_sample, 4u);
+  EXPECT_EQ(batches[1].layout, 2u);
+  EXPECT_EQ(batches[1].values_per_sample, 3u);
+  EXPECT_EQ(batches[1].Values("m.x"), (std::vector<double>{5, 6}));
+}
+
 TEST_F(Fixture, ARemovedIdOnlyAffectsItsColumn) {
   const SubscriptionId id = recorder.Subscribe(Options({"m.x", "m.v"}, 1, 2));
   registry.Remove("m.v");

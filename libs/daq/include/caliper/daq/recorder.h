@@ -50,6 +50,7 @@ struct Batch {
   std::shared_ptr<const std::vector<Column>> columns;  // shared by batches of the same layout
   size_t values_per_sample = 0;                        // sum of the columns' shape sizes
   std::vector<double> data;  // step_count * values_per_sample, sample after sample
+  uint64_t layout = 1;       // the subscription's layout: grows whenever its columns change
 
   /// The values of one column over the batch: step_count * shape.size() doubles, sample after
   /// sample.
