@@ -1,5 +1,9 @@
 #include "main_window.h"
 
+#include <signal.h>
+#include <sys/prctl.h>
+#include <unistd.h>
+
 #include <QCloseEvent>
 #include <QCoreApplication>
 #include <QDir>
@@ -42,6 +46,20 @@ QPushButton* Button(const QString& text, const char* name, QWidget* parent) {
 }
 
 QString Number(double v) { return QString::number(v, 'g', 7); }
+
+// A tool's process: in a process group of its own (a terminal's Ctrl-C reaches the Main Window,
+// which closes the tools in order and remembers them), and ended by the kernel when the Main
+// Window dies without closing it.
+class ToolProcess : public QProcess {
+ public:
+  using QProcess::QProcess;
+
+ protected:
+  void setupChildProcess() override {
+    ::setpgid(0, 0);
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  }
+};
 
 // the tools the Main Window opens: name, program, menu label
 struct ToolSpec {
@@ -267,13 +285,18 @@ void MainWindow::RestoreSettings(bool restore_tools) {
   saved_real_time_factor_ = st.value("simulation/real_time_factor", -1.0).toDouble();
   if (saved_time_step_ > 0) time_step_->setValue(saved_time_step_);
   if (saved_real_time_factor_ >= 0) real_time_factor_->setValue(saved_real_time_factor_);
-  if (restore_tools)
-    for (const QString& tool : st.value("tools/open").toStringList()) StartTool(tool);
+  if (restore_tools) ReopenTools();
 }
 
 void MainWindow::closeEvent(QCloseEvent* event) {
   SaveSettings();
   QMainWindow::closeEvent(event);
+}
+
+void MainWindow::ReopenTools() {
+  const QStringList open =
+      QSettings(SettingsPath(), QSettings::IniFormat).value("tools/open").toStringList();
+  for (const QString& tool : open) StartTool(tool);
 }
 
 QString MainWindow::BinPath(const QString& name) const {
@@ -353,7 +376,7 @@ bool MainWindow::StartTool(const QString& name) {
       QSettings(SettingsPath(), QSettings::IniFormat).contains("plotter/layout");
   if (name == "plotter" && !has_layout)
     for (const QString& plot : default_plots_) args << "--ids" << plot;
-  auto* p = new QProcess(this);
+  auto* p = new ToolProcess(this);
   p->setProcessChannelMode(QProcess::ForwardedChannels);
   ReportEnd(p, name);
   p->start(program, args);

@@ -61,6 +61,8 @@ class MainWindow : public QMainWindow {
   QRect ArrangedGeometry(const QString& name) const;
   /// Starts caliper-model with `path` (the last model when empty; asks when there is none).
   void StartModel(QString path = QString());
+  /// Starts the tools that were open when the session was saved.
+  void ReopenTools();
   /// The names of the tools started here and still running.
   QStringList OpenTools() const;
   /// The process id of a running tool started here, 0 when there is none.

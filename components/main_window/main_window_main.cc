@@ -91,15 +91,18 @@ int main(int argc, char** argv) {
       const QString path = QFileInfo(QString::fromStdString(model_file)).absoluteFilePath();
       link->LoadScene(path.toStdString());
     }
-    caliper::main_window::MainWindow window(std::move(link), 5.0, nullptr, restore_tools);
+    caliper::main_window::MainWindow window(std::move(link), 5.0, nullptr,
+                                            /*restore_tools=*/false);
+    // SIGTERM/SIGINT (launch/caliper ending the session) close the window, which saves the session
+    // and ends the tools: caught before any tool starts
+    caliper::gui_session::CloseOnTerminationSignals(&window);
     window.SetDefaultPlots(plots);
     if (arrange) window.setGeometry(window.ArrangedGeometry("main"));
+    if (restore_tools) window.ReopenTools();
     for (const QString& tool : tools) window.StartTool(tool);
     window.show();
     // the tools place themselves; arranging again once they are shown also moves restored ones
     if (arrange) QTimer::singleShot(3000, &window, [&window] { window.ArrangeWindows(); });
-    // SIGTERM/SIGINT (launch/caliper ending the session) close the window, which saves the session
-    caliper::gui_session::CloseOnTerminationSignals(&window);
     status = QApplication::exec();
   }
   orb->destroy();

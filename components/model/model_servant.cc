@@ -142,6 +142,9 @@ auto Guard(F&& f) -> decltype(f()) {
   } catch (const std::exception& e) {
     logging::Get("model").error("internal error: %s", e.what());
     throw Unavailable((std::string("internal error: ") + e.what()).c_str());
+  } catch (...) {
+    logging::Get("model").error("internal error: an exception of unknown type");
+    throw Unavailable("internal error: an exception of unknown type");
   }
 }
 
@@ -397,11 +400,11 @@ void ModelServant::stop() { Guard([&] { core_.Stop(); }); }
 void ModelServant::reset() { Guard([&] { core_.Reset(); }); }
 void ModelServant::step(CORBA::ULong n) { Guard([&] { core_.StepNow(n); }); }
 void ModelServant::set_time_step(CORBA::Double s) {
-  Guard<D::NotAvailable>([&] { core_.SetTimeStep(s); });
+  Guard([&] { core_.SetTimeStep(s); });
 }
 
 void ModelServant::set_real_time_factor(CORBA::Double f) {
-  Guard<D::NotAvailable>([&] { core_.SetRealTimeFactor(f); });
+  Guard([&] { core_.SetRealTimeFactor(f); });
 }
 
 M::SimulationStatus* ModelServant::status() {
@@ -455,14 +458,14 @@ M::ActuatorInfoSeq* ModelServant::actuators() {
 }
 
 void ModelServant::set_command(const char* actuator, CORBA::Double value) {
-  Guard<D::NotAvailable>([&] { core_.SetCommands({{actuator, value}}); });
+  Guard([&] { core_.SetCommands({{actuator, value}}); });
 }
 
 void ModelServant::set_commands(const M::CommandSeq& commands) {
   std::vector<std::pair<std::string, double>> list;
   for (CORBA::ULong i = 0; i < commands.length(); ++i)
     list.emplace_back(commands[i].actuator.in(), commands[i].value);
-  Guard<D::NotAvailable>([&] { core_.SetCommands(list); });
+  Guard([&] { core_.SetCommands(list); });
 }
 
 M::ActuatorStateSeq* ModelServant::actuator_states() {

@@ -459,7 +459,6 @@ TEST_F(ModelTest, WithoutASceneEveryCallRaisesItsDeclaredNotAvailableWithTheReas
     value.data[0] = 1.0;
     Model()->set(kMass, value);
   });
-  expect_daq_unavailable("set_command", [&] { Model()->set_command("motor", 1.0); });
   struct Discard : public virtual POA_Caliper::Daq::DataConsumer {
     void on_samples(const D::SampleBatch&) override {}
   };
@@ -470,12 +469,20 @@ TEST_F(ModelTest, WithoutASceneEveryCallRaisesItsDeclaredNotAvailableWithTheReas
   D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(consumer_obj);
   expect_daq_unavailable("subscribe", [&] { Model()->subscribe(ids, 1, consumer_ref); });
   OrbEnvironment::poa()->deactivate_object(oid);
-  try {
-    Model()->start();
-    ADD_FAILURE() << "start succeeded without a scene";
-  } catch (const M::NotAvailable& e) {
-    EXPECT_TRUE(Contains(e.reason.in(), "no scene is loaded")) << e.reason.in();
-  }
+  // the Simulation interfaces' operations raise Simulation's NotAvailable
+  const auto expect_unavailable = [](const char* what, const std::function<void()>& call) {
+    try {
+      call();
+      ADD_FAILURE() << what << " succeeded without a scene";
+    } catch (const M::NotAvailable& e) {
+      EXPECT_TRUE(Contains(e.reason.in(), "no scene is loaded")) << what << ": " << e.reason.in();
+    } catch (const CORBA::Exception& e) {
+      ADD_FAILURE() << what << " raised " << e._name() << ", not Simulation::NotAvailable";
+    }
+  };
+  expect_unavailable("start", [&] { Model()->start(); });
+  expect_unavailable("set_command", [&] { Model()->set_command("motor", 1.0); });
+  expect_unavailable("set_time_step", [&] { Model()->set_time_step(0.002); });
 }
 
 // ------------------------------------------------------------------------ loading

@@ -1,6 +1,7 @@
 #include "caliper/core/system.h"
 
 #include <signal.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -64,16 +65,35 @@ bool ProcessAlive(long pid) {
 
 void WriteFileReplacing(const std::string& path,
                         const std::function<void(std::ostream&)>& write) {
-  const std::string temporary = path + ".part-" + std::to_string(::getpid());
-  const auto fail = [&](const char* what) {
-    const int error = errno;
+  // a symbolic link keeps pointing where it did: the file it names is the one replaced
+  std::string target = path;
+  struct stat existing = {};
+  const bool exists = ::stat(path.c_str(), &existing) == 0;
+  if (exists) {
+    char* resolved = ::realpath(path.c_str(), nullptr);
+    if (resolved != nullptr) {
+      target = resolved;
+      std::free(resolved);
+    }
+  }
+  const std::string temporary = target + ".part-" + std::to_string(::getpid());
+  const auto fail = [&](const char* what, int error) {
     std::remove(temporary.c_str());
     throw std::runtime_error("cannot write " + path + ": " + what +
                              (error != 0 ? std::string(" (") + std::strerror(error) + ")" : ""));
   };
-  errno = 0;
+  // created here and now (never an existing file or a link planted under that name)
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC,
+                        exists ? (existing.st_mode & 07777) : 0666);
+  if (fd < 0) {
+    const int error = errno;
+    throw std::runtime_error("cannot write " + path + ": cannot create a file there (" +
+                             std::strerror(error) + ")");
+  }
+  ::close(fd);
   std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-  if (!out) fail("cannot create a file there");
+  if (!out) fail("cannot open the new file", errno);
+  errno = 0;
   try {
     write(out);
   } catch (...) {
@@ -81,11 +101,15 @@ void WriteFileReplacing(const std::string& path,
     std::remove(temporary.c_str());
     throw;
   }
+  if (!out) fail("write failed", errno);  // the stream's buffer was written out meanwhile
+  errno = 0;
   out.flush();
-  if (!out) fail("write failed");
+  if (!out) fail("write failed", errno);
+  errno = 0;
   out.close();
-  if (out.fail()) fail("write failed on close");
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) fail("cannot replace it");
+  if (out.fail()) fail("write failed on close", errno);
+  if (exists) ::chmod(temporary.c_str(), existing.st_mode & 07777);  // despite the umask
+  if (std::rename(temporary.c_str(), target.c_str()) != 0) fail("cannot replace it", errno);
 }
 
 }  // namespace caliper::core

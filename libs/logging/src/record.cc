@@ -5,6 +5,7 @@
 #include <ctime>
 #include <strings.h>
 
+#include <charconv>
 #include <cstdint>
 #include <string_view>
 
@@ -57,6 +58,14 @@ bool Digits(std::string_view text, size_t from, size_t n, int* value) {
   return true;
 }
 
+// a whole field of decimal digits (no sign, no spaces) that fits `T`
+template <class T>
+bool Number(std::string_view field, T* value) {
+  if (field.empty() || field[0] < '0' || field[0] > '9') return false;
+  const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), *value);
+  return error == std::errc() && end == field.data() + field.size();
+}
+
 // days since 1970-01-01 of a date in the proleptic Gregorian calendar (H. Hinnant's algorithm)
 int64_t DaysFromCivil(int y, int m, int d) {
   y -= m <= 2;
@@ -77,7 +86,10 @@ bool ParseTime(std::string_view text, int64_t* time_us) {
       !Digits(text, 11, 2, &h) || !Digits(text, 14, 2, &mi) || !Digits(text, 17, 2, &s) ||
       !Digits(text, 20, 6, &us))
     return false;
-  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || s > 60) return false;
+  static constexpr int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (mo < 1 || mo > 12 || h > 23 || mi > 59 || s > 60) return false;
+  const bool leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+  if (d < 1 || d > kDays[mo - 1] + (mo == 2 && leap ? 1 : 0)) return false;
   const int64_t seconds = DaysFromCivil(y, mo, d) * 86400 + h * 3600 + mi * 60 + s;
   *time_us = seconds * 1000000 + us;
   return true;
@@ -110,12 +122,19 @@ bool ParsePriority(const std::string& text, int* priority) {
 }
 
 std::string FormatLine(const Record& r) {
-  const time_t seconds = static_cast<time_t>(r.time_us / 1000000);
+  // floor division: a time before 1970 has a second below it and microseconds 0..999999
+  int64_t micros = r.time_us % 1000000;
+  int64_t whole = r.time_us / 1000000;
+  if (micros < 0) {
+    micros += 1000000;
+    whole -= 1;
+  }
+  const time_t seconds = static_cast<time_t>(whole);
   struct tm utc;
   gmtime_r(&seconds, &utc);
   char stamp[40];
   const size_t n = strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &utc);
-  std::snprintf(stamp + n, sizeof stamp - n, ".%06dZ", static_cast<int>(r.time_us % 1000000));
+  std::snprintf(stamp + n, sizeof stamp - n, ".%06dZ", static_cast<int>(micros));
   std::string line = stamp;
   line += '\t';
   line += PriorityName(r.priority);
@@ -144,12 +163,7 @@ bool ParseLine(const std::string& line, Record* r) {
   fields[8] = text.substr(start);
   if (!ParseTime(fields[0], &r->time_us)) return false;
   if (!ParsePriority(std::string(fields[1]), &r->priority)) return false;
-  const std::string pid(fields[5]), seq(fields[7]);
-  char* end = nullptr;
-  r->pid = std::strtol(pid.c_str(), &end, 10);
-  if (*end != '\0') return false;
-  r->seq = std::strtoull(seq.c_str(), &end, 10);
-  if (*end != '\0' || seq.empty()) return false;
+  if (!Number(fields[5], &r->pid) || !Number(fields[7], &r->seq)) return false;
   r->category = Unescape(fields[2]);
   r->component = Unescape(fields[3]);
   r->host = Unescape(fields[4]);

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "support/process.h"
+
 namespace caliper::core {
 namespace {
 
@@ -65,19 +67,42 @@ TEST_F(WriteFileReplacingTest, AnUnwritablePlaceIsNamedWithTheReason) {
   }
 }
 
-TEST_F(WriteFileReplacingTest, AFullDeviceIsReportedAndTheOldFileKept) {
-  // /dev/full accepts the open and fails every write with ENOSPC; a symlink beside the target
-  // is not needed: writing the temporary file itself must fail, so point the directory there
-  const std::string link = dir_ + "/full";
-  ASSERT_EQ(::symlink("/dev/full", (link + ".part-" + std::to_string(::getpid())).c_str()), 0);
-  std::ofstream(link) << "kept\n";
+TEST_F(WriteFileReplacingTest, AFailedWriteIsReportedWithItsReasonAndTheOldFileKept) {
   try {
-    WriteFileReplacing(link, [](std::ostream& out) { out << std::string(1 << 16, 'x'); });
-    FAIL() << "a write to a full device succeeded";
+    const testing::FileSizeLimit limit(1000);  // writes past 1000 bytes fail like a full disk
+    WriteFileReplacing(path_, [](std::ostream& out) { out << std::string(1 << 16, 'x'); });
+    FAIL() << "a write past the limit succeeded";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("File too large"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(Read(link), "kept\n");
+  EXPECT_EQ(Read(path_), "old contents\n");
+  EXPECT_FALSE(std::ifstream(path_ + ".part-" + std::to_string(::getpid())).good());
+}
+
+TEST_F(WriteFileReplacingTest, ASymlinkedTargetIsReplacedWhereItPoints) {
+  const std::string link = dir_ + "/link.csv";
+  ASSERT_EQ(::symlink(path_.c_str(), link.c_str()), 0);
+  WriteFileReplacing(link, [](std::ostream& out) { out << "new\n"; });
+  EXPECT_EQ(Read(path_), "new\n") << "the file the link names";
+  struct stat st = {};
+  ASSERT_EQ(::lstat(link.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode)) << "the link stays a link";
+}
+
+TEST_F(WriteFileReplacingTest, KeepsTheFilesPermissionsAndRefusesAPlantedTemporaryName) {
+  ASSERT_EQ(::chmod(path_.c_str(), 0600), 0);
+  WriteFileReplacing(path_, [](std::ostream& out) { out << "private\n"; });
+  struct stat st = {};
+  ASSERT_EQ(::stat(path_.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  // a link planted under the temporary's name is never written through
+  const std::string victim = dir_ + "/victim";
+  std::ofstream(victim) << "untouched\n";
+  ASSERT_EQ(::symlink(victim.c_str(), (path_ + ".part-" + std::to_string(::getpid())).c_str()), 0);
+  EXPECT_THROW(WriteFileReplacing(path_, [](std::ostream& out) { out << "x"; }),
+               std::runtime_error);
+  EXPECT_EQ(Read(victim), "untouched\n");
+  EXPECT_EQ(Read(path_), "private\n");
 }
 
 }  // namespace

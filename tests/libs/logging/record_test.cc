@@ -61,6 +61,11 @@ TEST(RecordTest, TimeStampsRoundTripOverCenturiesAndLeapDays) {
     ASSERT_TRUE(ParseLine(FormatLine(r), &parsed)) << FormatLine(r);
     ASSERT_EQ(parsed.time_us, t) << FormatLine(r);
   }
+  r.time_us = -1500000;  // before 1970: the second below and positive microseconds
+  EXPECT_EQ(FormatLine(r).substr(0, 27), "1969-12-31T23:59:58.500000Z");
+  Record before;
+  ASSERT_TRUE(ParseLine(FormatLine(r), &before));
+  EXPECT_EQ(before.time_us, -1500000);
   for (const char* stamp : {"2000-02-29T23:59:59.999999Z", "2100-03-01T00:00:00.000000Z",
                             "1970-01-01T00:00:00.000000Z", "2024-12-31T12:00:00.500000Z"}) {
     Record parsed;
@@ -138,7 +143,14 @@ TEST(RecordTest, RejectsMalformedFields) {
   ASSERT_TRUE(ParseLine(with_field(1, "350"), &r));  // or a number
   EXPECT_EQ(r.priority, 350);
   EXPECT_FALSE(ParseLine(with_field(0, "yesterday"), &r));
-  for (const char* stamp : {"2023-13-14T22:13:20.123456Z", "2023-11-14T24:13:20.123456Z",
+  EXPECT_FALSE(ParseLine(with_field(5, ""), &r)) << "an empty pid";
+  EXPECT_FALSE(ParseLine(with_field(5, "-3"), &r)) << "a signed pid";
+  EXPECT_FALSE(ParseLine(with_field(5, " 42"), &r)) << "a padded pid";
+  EXPECT_FALSE(ParseLine(with_field(7, "-1"), &r)) << "a negative seq would wrap";
+  EXPECT_FALSE(ParseLine(with_field(7, "18446744073709551616"), &r)) << "seq past 2^64";
+  for (const char* stamp : {"2023-02-29T10:00:00.000000Z", "2023-04-31T10:00:00.000000Z",
+                            "2100-02-29T10:00:00.000000Z", "2023-13-14T22:13:20.123456Z",
+                            "2023-11-14T24:13:20.123456Z",
                             "2023-11-14 22:13:20.123456Z", "2023-11-14T22:13:20.12345Z",
                             "2023-11-14T22:13:20.1234567Z", "2023-11-1xT22:13:20.123456Z",
                             "2023-11-14T22:13:20.123456"})
