@@ -51,44 +51,28 @@ int main(int argc, char** argv) {
   using caliper::log_viewer::LogViewerWindow;
   // our options come out before QApplication sees argv: Qt itself takes `--session VALUE` (X11
   // session management) and would swallow the shared session file
-  LogViewerWindow::Options options;
-  QString log_file;
-  bool live = false;
-  std::vector<char*> qt_argv = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return 0;
-    } else if (a == "--nameservice" || a == "--logger" || a == "--geometry" || a == "--session") {
-      if (i + 1 >= argc) return UsageError("option " + a + " needs a value");
-      const std::string value = argv[++i];
-      if (a == "--nameservice") {
-        options.link.nameservice = value;
-      } else if (a == "--logger") {
-        options.link.instance = value;
-      } else if (a == "--geometry") {
-        if (!caliper::gui_session::ParseGeometry(QString::fromStdString(value), &options.geometry))
-          return UsageError("--geometry needs WIDTHxHEIGHT+X+Y, not '" + value + "'");
-      } else {
-        options.session_file = QString::fromLocal8Bit(value.c_str());
-      }
-    } else if (a == "--live") {
-      live = true;
-    } else if (!a.empty() && a[0] != '-' && log_file.isEmpty()) {
-      log_file = QString::fromLocal8Bit(a.c_str());
-    } else if (a.size() > 1 && a[0] == '-' && a[1] != '-') {
-      // Qt's own (-platform offscreen, -style fusion ...); what Qt does not take is refused below
-      qt_argv.push_back(argv[i]);
-      if (caliper::gui_session::IsQtOptionWithValue(a) && i + 1 < argc)
-        qt_argv.push_back(argv[++i]);
-    } else {
-      return UsageError("unexpected argument '" + a + "'");
-    }
+  caliper::gui_session::ToolArguments args = caliper::gui_session::SplitToolArguments(
+      argc, argv, {"--nameservice", "--logger", "--geometry", "--session"}, {"--live"});
+  if (args.help) {
+    std::cout << kUsage;
+    return 0;
   }
-  int qt_argc = static_cast<int>(qt_argv.size());
-  qt_argv.push_back(nullptr);
-  QApplication app(qt_argc, qt_argv.data());
+  if (!args.error.empty()) return UsageError(args.error);
+  if (args.positional.size() > 1)
+    return UsageError("unexpected argument '" + args.positional[1] + "'");
+  LogViewerWindow::Options options;
+  options.link.nameservice = args.Value("--nameservice", options.link.nameservice);
+  options.link.instance = args.Value("--logger", options.link.instance);
+  const std::string geometry = args.Value("--geometry");
+  if (!geometry.empty() &&
+      !caliper::gui_session::ParseGeometry(QString::fromStdString(geometry), &options.geometry))
+    return UsageError("--geometry needs WIDTHxHEIGHT+X+Y, not '" + geometry + "'");
+  options.session_file = QString::fromLocal8Bit(args.Value("--session").c_str());
+  const QString log_file =
+      args.positional.empty() ? QString() : QString::fromLocal8Bit(args.positional[0].c_str());
+  const bool live = args.flags.count("--live") != 0;
+  int qt_argc = args.qt_argc();
+  QApplication app(qt_argc, args.qt_argv.data());
   const QStringList rest = QApplication::arguments();
   if (rest.size() > 1) return UsageError("unexpected argument '" + rest[1].toStdString() + "'");
 

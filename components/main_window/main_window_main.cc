@@ -24,62 +24,52 @@
 #include "model_link.h"
 
 int main(int argc, char** argv) {
-  caliper::main_window::ModelLink::Options options;
-  std::string model_file;
-  bool restore_tools = true;
-  bool arrange = false;
-  QStringList tools;
-  QStringList plots;  // one entry per plot: comma-separated ids
-  // --help needs no display: looked for before Qt starts (which then takes out its own options,
-  // -geometry, -platform, ...)
-  bool help = false;
-  for (int i = 1; i < argc; ++i)
-    help |= std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h";
-  std::unique_ptr<QApplication> app;
-  if (!help) app = std::make_unique<QApplication>(argc, argv);
-  QStringList args;
-  if (app) {
-    args = QApplication::arguments();
-  } else {
-    args << "caliper-main" << "--help";
+  // our options come out before Qt starts: --help needs no display; Qt takes its own (-geometry,
+  // -platform, ...)
+  caliper::gui_session::ToolArguments args = caliper::gui_session::SplitToolArguments(
+      argc, argv, {"--nameservice", "--model", "--tools", "--plot"}, {"--no-tools", "--arrange"});
+  if (args.help) {
+    std::cout
+        << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE]\n"
+           "                    [--no-tools] [--tools LIST] [--plot IDS]... [--arrange]\n"
+           "                    [MODEL_FILE]\n"
+           "  The Main Window: simulation control, parameters, components, and the other tools.\n"
+           "  --nameservice ADDR  the naming service (default: omniORB's configuration)\n"
+           "  --model INSTANCE    the Model's instance name (default model0)\n"
+           "  --no-tools          do not reopen the tools that were open last time\n"
+           "  --tools LIST        open these tools (comma separated: "
+        << caliper::main_window::MainWindow::ToolNames().join(",").toStdString()
+        << ")\n"
+           "  --plot IDS          one plot of these ids (comma separated) when the plotter has\n"
+           "                      no saved layout; give it again for each further plot\n"
+           "  --arrange           tile the main window and the tools on the screen\n"
+           "  MODEL_FILE          load this model into the Model\n"
+           "  The session is kept in $CALIPER_MAIN_SETTINGS, or else in "
+        << caliper::main_window::MainWindow::SettingsPath().toStdString() << "\n";
+    return 0;
   }
-  for (int i = 1; i < args.size(); ++i) {
-    const std::string a = args[i].toStdString();
-    if ((a == "--nameservice" || a == "--model") && i + 1 < args.size()) {
-      (a == "--nameservice" ? options.nameservice : options.instance) = args[++i].toStdString();
-    } else if (a == "--no-tools") {
-      restore_tools = false;
-    } else if (a == "--arrange") {
-      arrange = true;
-    } else if (a == "--tools" && i + 1 < args.size()) {
-      tools = args[++i].split(',', Qt::SkipEmptyParts);
-    } else if (a == "--plot" && i + 1 < args.size()) {
-      plots << args[++i];
-    } else if (a == "--help" || a == "-h") {
-      std::cout
-          << "usage: caliper-main [--nameservice corbaname::HOST:PORT] [--model INSTANCE]\n"
-             "                    [--no-tools] [--tools LIST] [--plot IDS]... [--arrange]\n"
-             "                    [MODEL_FILE]\n"
-             "  The Main Window: simulation control, parameters, components, and the other tools.\n"
-             "  --nameservice ADDR  the naming service (default: omniORB's configuration)\n"
-             "  --model INSTANCE    the Model's instance name (default model0)\n"
-             "  --no-tools          do not reopen the tools that were open last time\n"
-             "  --tools LIST        open these tools (comma separated: "
-          << caliper::main_window::MainWindow::ToolNames().join(",").toStdString()
-          << ")\n"
-             "  --plot IDS          one plot of these ids (comma separated) when the plotter has\n"
-             "                      no saved layout; give it again for each further plot\n"
-             "  --arrange           tile the main window and the tools on the screen\n"
-             "  MODEL_FILE          load this model into the Model\n"
-             "  The session is kept in $CALIPER_MAIN_SETTINGS, or else in "
-          << caliper::main_window::MainWindow::SettingsPath().toStdString() << "\n";
-      return 0;
-    } else if (!a.empty() && a[0] != '-') {
-      model_file = a;
-    } else {
-      std::cerr << "caliper-main: unknown option '" << a << "'\n";
-      return 2;
-    }
+  if (args.error.empty() && args.positional.size() > 1)
+    args.error = "unexpected argument '" + args.positional[1] + "'";
+  if (!args.error.empty()) {
+    std::cerr << "caliper-main: " << args.error << " (--help lists the options)\n";
+    return 2;
+  }
+  caliper::main_window::ModelLink::Options options;
+  options.nameservice = args.Value("--nameservice", options.nameservice);
+  options.instance = args.Value("--model", options.instance);
+  const std::string model_file = args.positional.empty() ? "" : args.positional[0];
+  const bool restore_tools = args.flags.count("--no-tools") == 0;
+  const bool arrange = args.flags.count("--arrange") != 0;
+  const QStringList tools =
+      QString::fromStdString(args.Value("--tools")).split(',', Qt::SkipEmptyParts);
+  QStringList plots;  // one entry per plot: comma-separated ids
+  for (const std::string& plot : args.values["--plot"]) plots << QString::fromStdString(plot);
+  int qt_argc = args.qt_argc();
+  QApplication app(qt_argc, args.qt_argv.data());
+  if (QApplication::arguments().size() > 1) {
+    std::cerr << "caliper-main: unknown option '" << QApplication::arguments().at(1).toStdString()
+              << "' (--help lists the options)\n";
+    return 2;
   }
 
   CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-main");

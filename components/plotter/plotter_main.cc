@@ -54,53 +54,32 @@ int main(int argc, char** argv) {
   using caliper::plotter::Layout;
   // our options come out of argv before Qt sees it: QGuiApplication takes --session (X11 session
   // management) for itself, and --help must work without a display
-  caliper::plotter::DaqLink::Options options;
-  std::string layout_file;
-  std::vector<std::string> id_lists;
-  QRect geometry;
-  QString session;
-  std::vector<char*> qt_argv = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return 0;
-    }
-    const bool ours = a == "--nameservice" || a == "--model" || a == "--layout" || a == "--ids" ||
-                      a == "--geometry" || a == "--session";
-    if (!ours) {
-      if (a.rfind("--", 0) == 0 || a.rfind("-", 0) != 0) {
-        std::cerr << "caliper-plotter: unknown option '" << a << "' (--help lists them)\n";
-        return 2;
-      }
-      // Qt's own (-platform offscreen, -style fusion ...); what Qt does not take is refused below
-      qt_argv.push_back(argv[i]);
-      if (caliper::gui_session::IsQtOptionWithValue(a) && i + 1 < argc)
-        qt_argv.push_back(argv[++i]);
-      continue;
-    }
-    if (i + 1 >= argc) {
-      std::cerr << "caliper-plotter: " << a << " needs a value (--help)\n";
-      return 2;
-    }
-    const std::string value = argv[++i];
-    if (a == "--nameservice") {
-      options.nameservice = value;
-    } else if (a == "--model") {
-      options.instance = value;
-    } else if (a == "--layout") {
-      layout_file = value;
-    } else if (a == "--ids") {
-      id_lists.push_back(value);
-    } else if (a == "--geometry") {
-      if (!caliper::gui_session::ParseGeometry(QString::fromStdString(value), &geometry)) {
-        std::cerr << "caliper-plotter: --geometry needs WIDTHxHEIGHT+X+Y, not '" << value << "'\n";
-        return 2;
-      }
-    } else {
-      session = QString::fromStdString(value);
-    }
+  caliper::gui_session::ToolArguments args = caliper::gui_session::SplitToolArguments(
+      argc, argv, {"--nameservice", "--model", "--layout", "--ids", "--geometry", "--session"}, {});
+  if (args.help) {
+    std::cout << kUsage;
+    return 0;
   }
+  if (args.error.empty() && !args.positional.empty())
+    args.error = "unexpected argument '" + args.positional[0] + "'";
+  if (!args.error.empty()) {
+    std::cerr << "caliper-plotter: " << args.error << " (--help lists the options)\n";
+    return 2;
+  }
+  caliper::plotter::DaqLink::Options options;
+  options.nameservice = args.Value("--nameservice", options.nameservice);
+  options.instance = args.Value("--model", options.instance);
+  const std::string layout_file = args.Value("--layout");
+  const std::vector<std::string> id_lists = args.values["--ids"];
+  QRect geometry;
+  const std::string geometry_text = args.Value("--geometry");
+  if (!geometry_text.empty() &&
+      !caliper::gui_session::ParseGeometry(QString::fromStdString(geometry_text), &geometry)) {
+    std::cerr << "caliper-plotter: --geometry needs WIDTHxHEIGHT+X+Y, not '" << geometry_text
+              << "'\n";
+    return 2;
+  }
+  const QString session = QString::fromStdString(args.Value("--session"));
 
   // the layout of --layout and --ids
   Layout layout;
@@ -124,9 +103,8 @@ int main(int argc, char** argv) {
     have_layout = true;
   }
 
-  int qt_argc = static_cast<int>(qt_argv.size());
-  qt_argv.push_back(nullptr);
-  QApplication app(qt_argc, qt_argv.data());
+  int qt_argc = args.qt_argc();
+  QApplication app(qt_argc, args.qt_argv.data());
   if (QApplication::arguments().size() > 1) {
     std::cerr << "caliper-plotter: unknown option '"
               << QApplication::arguments().at(1).toStdString() << "' (--help lists them)\n";

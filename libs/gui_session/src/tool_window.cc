@@ -116,6 +116,41 @@ bool IsQtOptionWithValue(const std::string& option) {
   return false;
 }
 
+std::string ToolArguments::Value(const std::string& option, const std::string& fallback) const {
+  const auto it = values.find(option);
+  return it == values.end() || it->second.empty() ? fallback : it->second.back();
+}
+
+ToolArguments SplitToolArguments(int argc, char** argv, const std::set<std::string>& valued,
+                                 const std::set<std::string>& flags) {
+  ToolArguments out;
+  out.qt_argv.push_back(argv[0]);
+  for (int i = 1; i < argc && out.error.empty(); ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      out.help = true;
+    } else if (valued.count(a) != 0) {
+      if (i + 1 < argc)
+        out.values[a].push_back(argv[++i]);
+      else
+        out.error = "option " + a + " needs a value";
+    } else if (flags.count(a) != 0) {
+      out.flags.insert(a);
+    } else if (a.rfind("--", 0) == 0) {
+      out.error = "unknown option '" + a + "'";
+    } else if (a.size() > 1 && a[0] == '-') {
+      // Qt's own (-platform offscreen, -style fusion ...): what Qt does not take stays in
+      // QApplication::arguments() for the tool to refuse
+      out.qt_argv.push_back(argv[i]);
+      if (IsQtOptionWithValue(a) && i + 1 < argc) out.qt_argv.push_back(argv[++i]);
+    } else {
+      out.positional.push_back(a);
+    }
+  }
+  out.qt_argv.push_back(nullptr);
+  return out;
+}
+
 void CloseOnTerminationSignals(QWidget* window) {
   if (signal_socket[0] >= 0 ||
       ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, signal_socket) != 0)

@@ -6,6 +6,7 @@
 #include <strings.h>
 
 #include <charconv>
+#include <ostream>
 #include <cstdint>
 #include <string_view>
 
@@ -96,6 +97,16 @@ bool ParseTime(std::string_view text, int64_t* time_us) {
 }
 
 }  // namespace
+
+bool operator==(const Record& a, const Record& b) {
+  return a.time_us == b.time_us && a.priority == b.priority && a.category == b.category &&
+         a.component == b.component && a.host == b.host && a.pid == b.pid &&
+         a.source == b.source && a.seq == b.seq && a.message == b.message;
+}
+
+std::ostream& operator<<(std::ostream& out, const Record& record) {
+  return out << FormatLine(record);
+}
 
 std::string PriorityName(int priority) {
   for (const auto& level : kLevels)

@@ -228,9 +228,7 @@ TEST_F(LogStoreTest, RestartRecoversRecordTimesAndFields) {
   LogStore store(dir_, "s1", 100);
   const auto all = store.Query({});
   ASSERT_EQ(all.size(), 1u);
-  EXPECT_EQ(all[0].record.message, r.message);
-  EXPECT_EQ(all[0].record.time_us, r.time_us);
-  EXPECT_EQ(all[0].record.priority, logging::kError);
+  EXPECT_EQ(all[0].record, r) << "every field read back from the file";
   EXPECT_EQ(all[0].serial, 1u);
 }
 

@@ -146,19 +146,7 @@ TEST(SessionFileTest, ExportedSelectionReadsBackIdentically) {
   const SessionFileContents back = ReadSessionFile(path);
   EXPECT_EQ(back.malformed, 0u);
   ASSERT_EQ(back.records.size(), selection.size());
-  for (size_t i = 0; i < selection.size(); ++i) {
-    const logging::Record& a = *selection[i];
-    const logging::Record& b = back.records[i];
-    EXPECT_EQ(a.time_us, b.time_us);
-    EXPECT_EQ(a.priority, b.priority);
-    EXPECT_EQ(a.category, b.category);
-    EXPECT_EQ(a.component, b.component);
-    EXPECT_EQ(a.host, b.host);
-    EXPECT_EQ(a.pid, b.pid);
-    EXPECT_EQ(a.source, b.source);
-    EXPECT_EQ(a.seq, b.seq);
-    EXPECT_EQ(a.message, b.message);
-  }
+  for (size_t i = 0; i < selection.size(); ++i) EXPECT_EQ(back.records[i], *selection[i]) << i;
   EXPECT_EQ(Slurp(path).rfind("# caliper session log; exported from a test\n", 0), 0u);
   std::remove(path.c_str());
 }

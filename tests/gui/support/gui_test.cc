@@ -1,6 +1,7 @@
 #include "support/gui_test.h"
 
 #include <QElapsedTimer>
+#include <algorithm>
 #include <QTest>
 #include <cstdlib>
 
@@ -34,6 +35,20 @@ bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds
     QTest::qWait(50);
   }
   return condition();
+}
+
+qint64 LongestEventLoopStall(std::chrono::milliseconds duration) {
+  QElapsedTimer t;
+  t.start();
+  qint64 longest = 0;
+  while (t.elapsed() < duration.count()) {
+    QElapsedTimer one;
+    one.start();
+    QApplication::processEvents(QEventLoop::AllEvents, 20);
+    longest = std::max(longest, one.elapsed());
+    QTest::qWait(20);
+  }
+  return longest;
 }
 
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {

@@ -23,6 +23,10 @@ CORBA::ORB_ptr Orb();
 /// Processes events until `condition` holds or `timeout` passes; returns its last value.
 bool WaitInGui(const std::function<bool()>& condition, std::chrono::milliseconds timeout);
 
+/// Turns the event loop for `duration` and returns the longest time one turn took [ms]: how long
+/// the GUI thread was blocked at worst.
+qint64 LongestEventLoopStall(std::chrono::milliseconds duration);
+
 /// `name` in $CALIPER_ARTIFACT_DIR (the screenshots kept by the test run), else in `fallback_dir`.
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir);
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <QApplication>
+#include <QDir>
 #include <QElapsedTimer>
 #include <QSettings>
 #include <QTemporaryDir>
@@ -111,8 +112,17 @@ TEST(ToolWindow, WithoutASessionFileOnlyAppliesTheGeometry) {
   ToolWindow tool(&widget, "renderer", QString(), 20);
   EXPECT_EQ(tool.Restore(QRect(3, 4, 100, 80)), QRect(3, 4, 100, 80));
   EXPECT_EQ(widget.geometry(), QRect(3, 4, 100, 80));
-  tool.Save();  // no file, no error
-  EXPECT_FALSE(ReadToolWindow(QString(), "renderer").geometry.isValid());
+  // nothing is written anywhere: not even a file with an empty name in the working directory
+  QTemporaryDir dir;
+  const QString before = QDir::currentPath();
+  ASSERT_TRUE(QDir::setCurrent(dir.path()));
+  tool.Save();
+  widget.show();
+  widget.close();
+  const QStringList written = QDir(dir.path()).entryList(QDir::AllEntries | QDir::NoDotAndDotDot |
+                                                          QDir::Hidden);
+  QDir::setCurrent(before);
+  EXPECT_TRUE(written.isEmpty()) << written.join(", ").toStdString();
 }
 
 }  // namespace

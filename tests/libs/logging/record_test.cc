@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
+#include <vector>
 #include <string>
 
 namespace caliper::logging {
@@ -22,17 +24,6 @@ Record Sample() {
   return r;
 }
 
-void ExpectSameRecord(const Record& a, const Record& b) {
-  EXPECT_EQ(a.time_us, b.time_us);
-  EXPECT_EQ(a.priority, b.priority);
-  EXPECT_EQ(a.category, b.category);
-  EXPECT_EQ(a.component, b.component);
-  EXPECT_EQ(a.host, b.host);
-  EXPECT_EQ(a.pid, b.pid);
-  EXPECT_EQ(a.source, b.source);
-  EXPECT_EQ(a.seq, b.seq);
-  EXPECT_EQ(a.message, b.message);
-}
 
 TEST(RecordTest, FormatsOneTabSeparatedLineInUtc) {
   EXPECT_EQ(FormatLine(Sample()),
@@ -46,10 +37,26 @@ TEST(RecordTest, PadsMicroseconds) {
   EXPECT_EQ(FormatLine(r).substr(0, 28), "2023-11-14T22:13:20.000007Z\t");
 }
 
+TEST(RecordTest, EqualityComparesEveryField) {
+  const Record a = Sample();
+  EXPECT_EQ(a, Sample());
+  const std::vector<std::function<void(Record*)>> changes = {
+      [](Record* r) { r->time_us += 1; },      [](Record* r) { r->priority = kError; },
+      [](Record* r) { r->category += "x"; },   [](Record* r) { r->component += "x"; },
+      [](Record* r) { r->host += "x"; },       [](Record* r) { r->pid += 1; },
+      [](Record* r) { r->source += "x"; },     [](Record* r) { r->seq += 1; },
+      [](Record* r) { r->message += "x"; }};
+  for (size_t i = 0; i < changes.size(); ++i) {
+    Record b = Sample();
+    changes[i](&b);
+    EXPECT_NE(a, b) << "field " << i;
+  }
+}
+
 TEST(RecordTest, RoundTripsAPlainRecord) {
   Record parsed;
   ASSERT_TRUE(ParseLine(FormatLine(Sample()), &parsed));
-  ExpectSameRecord(parsed, Sample());
+  EXPECT_EQ(parsed, Sample());
 }
 
 TEST(RecordTest, TimeStampsRoundTripOverCenturiesAndLeapDays) {
@@ -90,7 +97,7 @@ TEST(RecordTest, RoundTripsTabsNewlinesAndBackslashes) {
   EXPECT_NE(line.find("a\\tb\\nc\\\\d"), std::string::npos) << line;
   Record parsed;
   ASSERT_TRUE(ParseLine(line, &parsed));
-  ExpectSameRecord(parsed, r);
+  EXPECT_EQ(parsed, r);
 }
 
 TEST(RecordTest, RoundTripsEmptyFields) {
@@ -99,7 +106,7 @@ TEST(RecordTest, RoundTripsEmptyFields) {
   r.seq = 1;
   Record parsed;
   ASSERT_TRUE(ParseLine(FormatLine(r), &parsed));
-  ExpectSameRecord(parsed, r);
+  EXPECT_EQ(parsed, r);
 }
 
 TEST(RecordTest, RoundTripsEveryNamedPriority) {

@@ -7,7 +7,10 @@
 #include <QObject>
 #include <QRect>
 #include <QString>
+#include <map>
+#include <set>
 #include <string>
+#include <vector>
 
 class QTimer;
 class QWidget;
@@ -64,6 +67,25 @@ namespace caliper::gui_session {
 /// True for Qt's own command-line options that take a value (-platform, -style, -geometry, ...):
 /// a tool that reads its options before QApplication passes these, and their values, through.
 bool IsQtOptionWithValue(const std::string& option);
+
+/// A GUI tool's command line taken apart before QApplication sees it: Qt would take `--session`
+/// for itself, and `--help` must work without a display.
+struct ToolArguments {
+  std::map<std::string, std::vector<std::string>> values;  ///< --option VALUE, every occurrence
+  std::set<std::string> flags;                              ///< --flag given
+  std::vector<std::string> positional;                      ///< the other words, in order
+  std::vector<char*> qt_argv;  ///< argv[0] and Qt's own options (-platform NAME, ...), then null
+  bool help = false;           ///< --help or -h
+  std::string error;           ///< what is wrong with the line ("" when nothing)
+
+  int qt_argc() const { return static_cast<int>(qt_argv.size()) - 1; }
+  /// The last value of `option`, or `fallback`.
+  std::string Value(const std::string& option, const std::string& fallback = "") const;
+};
+
+/// Splits argv: `valued` options take the next word, `flags` none; single-dash words go to Qt.
+ToolArguments SplitToolArguments(int argc, char** argv, const std::set<std::string>& valued,
+                                 const std::set<std::string>& flags);
 
 /// SIGINT and SIGTERM close `window` (which saves what it saves when closed) and quit the event
 /// loop. The handlers only write a byte to a socket; the window is closed from the event loop, so

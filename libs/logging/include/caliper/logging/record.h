@@ -2,6 +2,7 @@
 // A log record as it travels between processes and as one line of a session log file.
 
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 
 namespace caliper::logging {
@@ -29,6 +30,12 @@ struct Record {
   uint64_t seq = 0;       ///< 1, 2, 3, ... per source
   std::string message;
 };
+
+/// Field by field equality (the session file's round trip keeps every field).
+bool operator==(const Record& a, const Record& b);
+inline bool operator!=(const Record& a, const Record& b) { return !(a == b); }
+/// The record as its session file line (FormatLine), e.g. for test failure messages.
+std::ostream& operator<<(std::ostream& out, const Record& record);
 
 /// `FATAL` ... `DEBUG` for a priority (the nearest level at or below it in severity).
 std::string PriorityName(int priority);
