@@ -149,6 +149,13 @@ LogViewerWindow::LogViewerWindow(Options options, QWidget* parent)
   header->resizeSection(LogModel::kCategoryColumn, 18 * ch);
   header->resizeSection(LogModel::kComponentColumn, 11 * ch);
   header->resizeSection(LogModel::kHostColumn, 8 * ch);
+  // the message right after who said it, so that a narrow window still shows it; category and
+  // host last (copies and exports keep the model's order)
+  header->moveSection(header->visualIndex(LogModel::kMessageColumn),
+                      header->visualIndex(LogModel::kCategoryColumn));
+  header->moveSection(header->visualIndex(LogModel::kComponentColumn),
+                      header->visualIndex(LogModel::kMessageColumn));
+  header->resizeSection(LogModel::kMessageColumn, 60 * ch);
 
   splitter_ = new QSplitter(Qt::Horizontal);
   splitter_->setObjectName("splitter");
