@@ -1,5 +1,7 @@
 #include "client.h"
 
+#include "caliper/rtc/client_orb.h"
+
 #include <cctype>
 
 namespace caliper::ctl {
@@ -70,18 +72,7 @@ const std::string& Client::address() {
 
 void Client::Connect() {
   if (!CORBA::is_nil(orb_)) return;
-  const std::string ms = std::to_string(static_cast<int>(options_.timeout_s * 1000));
-  std::vector<std::string> args = {"caliper-ctl",
-                                   "-ORBendPoint",
-                                   "giop:tcp:127.0.0.1:",
-                                   "-ORBclientCallTimeOutPeriod",
-                                   ms,
-                                   "-ORBclientConnectTimeOutPeriod",
-                                   ms};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  int argc = static_cast<int>(argv.size());
-  orb_ = CORBA::ORB_init(argc, argv.data());
+  orb_ = rtc::ClientOrb("caliper-ctl", options_.timeout_s);
   address_ = rtc::NamingAddress(options_.nameservice);
 }
 

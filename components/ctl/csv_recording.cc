@@ -59,7 +59,7 @@ bool CsvRecording::Add(uint64_t batch, const double* times, size_t count, const 
   // times within a part per billion of the end count as reaching it (sums of time steps)
   const double tolerance = 1e-9 * std::max(1.0, std::abs(end_time_));
   std::ostringstream rows;
-  rows << std::setprecision(12);
+  rows << std::setprecision(std::numeric_limits<double>::max_digits10);  // round trip
   for (size_t i = 0; i < count; ++i) {
     const double t = times[i];
     if (!std::isnan(last_time_) && t <= last_time_) {

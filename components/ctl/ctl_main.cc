@@ -22,7 +22,9 @@
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
 #include "client.h"
+#include "cluster_verbs.h"
 #include "inspect.h"
+#include "batch.h"
 #include "model_verbs.h"
 
 namespace caliper::ctl {
@@ -283,6 +285,8 @@ std::map<std::string, Verb> Verbs() {
                       "(no session needed); --export writes the imported scene back out",
                       Inspect, "files"};
   AddModelVerbs(&verbs);
+  AddClusterVerbs(&verbs);
+  AddBatchVerb(&verbs);
   return verbs;
 }
 
@@ -295,6 +299,7 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
   const std::pair<const char*, const char*> groups[] = {
       {"components", "Components"},
       {"model", "Model (model0, or --model NAME on each verb)"},
+      {"cluster", "Cluster (a manager per host starts and stops Models)"},
       {"files", "Files"}};
   for (const auto& [group, title] : groups) {
     std::cout << "\n" << title << ":\n";

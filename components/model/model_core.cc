@@ -3,7 +3,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <thread>
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
@@ -59,11 +66,201 @@ void ModelCore::Require(bool scene_needed) const {
   if (scene_needed && !loaded_) throw NotAvailable("no scene is loaded (load one first)");
 }
 
+void ModelCore::RequireIdle() const {
+  if (!experiment_.empty())
+    throw NotAvailable("experiment '" + experiment_ + "' is running; wait for it to end");
+}
+
 void ModelCore::Load(const std::string& path) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    RequireIdle();
+  }
   std::vector<std::string> warnings;
   sgal::Scene scene = collada::Import(path, &warnings);  // throws collada::ImportError
   for (const auto& w : warnings) logging::Get("model").warn("%s: %s", path.c_str(), w.c_str());
   LoadScene(scene, path);
+}
+
+namespace {
+
+/// A private directory, removed with everything in it when the object goes.
+class ScratchDirectory {
+ public:
+  ScratchDirectory() {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") +
+                          "/caliper-scene-XXXXXX";
+    if (mkdtemp(pattern.data()) == nullptr)
+      throw std::runtime_error("cannot make a scratch directory in " + pattern + ": " +
+                               std::strerror(errno));
+    path_ = pattern;
+  }
+  ~ScratchDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+}  // namespace
+
+sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::string& bytes) const {
+  // the importer reads files (Collada-DOM opens .zae archives itself): a private copy, gone after
+  const std::string base = std::filesystem::path(file_name).filename().string();
+  const std::string ending = base.size() > 4 ? base.substr(base.size() - 4) : "";
+  if (ending != ".dae" && ending != ".zae")
+    throw std::runtime_error(file_name + ": a scene sent by content must be named *.dae or *.zae");
+  if (bytes.empty()) throw std::runtime_error(file_name + ": the scene sent is empty");
+  ScratchDirectory scratch;
+  const std::string path = scratch.path() + "/" + base;
+  {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!out.flush()) throw std::runtime_error("cannot write the scene to " + path);
+  }
+  std::vector<std::string> warnings;
+  sgal::Scene scene = collada::Import(path, &warnings);
+  for (const auto& w : warnings) logging::Get("model").warn("%s", w.c_str());
+  return scene;
+}
+
+std::shared_ptr<const sgal::Scene> ModelCore::ImportCached(const std::string& file_name,
+                                                           const std::string& bytes) {
+  // the importer is deterministic, so an equal file gives an equal scene
+  if (!imported_ || file_name != imported_name_ || bytes != imported_bytes_) {
+    imported_.reset();
+    imported_ = std::make_shared<const sgal::Scene>(ImportBytes(file_name, bytes));
+    imported_name_ = file_name;
+    imported_bytes_ = bytes;
+  }
+  return imported_;
+}
+
+void ModelCore::LoadData(const std::string& file_name, const std::string& bytes) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    RequireIdle();
+  }
+  LoadScene(ImportBytes(file_name, bytes), file_name + " (sent by content)");
+}
+
+std::string ModelCore::ExportBytes() {
+  ScratchDirectory scratch;
+  const std::string path = scratch.path() + "/scene.dae";
+  Save(path);
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::string& file_name,
+                                   const std::string& scene_bytes) {
+  experiment::Validate(e);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    RequireIdle();
+    experiment_ = e.name;
+  }
+  struct EndRun {
+    ModelCore* core;
+    ~EndRun() {
+      std::lock_guard<std::mutex> lock(core->mutex_);
+      core->experiment_.clear();
+    }
+  } end_run{this};
+
+  RunResult result;
+  const auto load_begin = Clock::now();
+  const std::shared_ptr<const sgal::Scene> scene = ImportCached(file_name, scene_bytes);
+  // build outside the lock; a fresh world and no command carried over from the last scene
+  auto loaded = std::make_unique<Loaded>();
+  loaded->description = scene;
+  loaded->source = file_name + " (experiment " + e.name + ")";
+  loaded->name = IdSafe(scene->name.empty() ? "model" : scene->name);
+  loaded->physics = physics_bullet::MakeScene(*scene, options_);
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (loaded_) loaded_->commands.clear();
+  BuildLocked(std::move(loaded));
+  state_ = RunState::kPaused;
+  last_error_.clear();
+  result.load_wall_s = std::chrono::duration<double>(Clock::now() - load_begin).count();
+
+  // overrides, the recorded ids and the schedule's actuators are checked before any step
+  for (const auto& o : e.overrides) {
+    if (!registry_.Contains(o.id)) throw UnknownId("experiment '" + e.name + "': unknown id '" +
+                                                       o.id + "' in set", o.id);
+    try {
+      registry_.Set(o.id, o.values);
+    } catch (const std::exception& error) {
+      throw InvalidValue("experiment '" + e.name + "': set " + o.id + ": " + error.what());
+    }
+  }
+  loaded_->sampler->Refresh();
+  experiment::Recording& rec = result.recording;
+  for (const auto& id : e.record) {
+    if (!registry_.Contains(id))
+      throw UnknownId("experiment '" + e.name + "': unknown id '" + id + "' in record", id);
+    const daq::ChannelInfo& info = registry_.Info(id);
+    rec.channels.push_back({id, info.unit, info.shape.rows, info.shape.cols});
+    rec.values_per_sample += info.shape.size();
+  }
+  const auto& actuators = loaded_->description->actuators;
+  for (const auto& c : e.schedule)
+    if (std::none_of(actuators.begin(), actuators.end(),
+                     [&](const sgal::Actuator& a) { return a.name == c.actuator; }))
+      throw UnknownId("experiment '" + e.name + "': no actuator '" + c.actuator + "'", c.actuator);
+
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  const double dt = physics.description().settings.time_step;
+  const uint64_t steps = experiment::StepCount(e.duration_s, dt);
+  const uint64_t samples = steps / e.every_n_steps + 1;
+  rec.times.reserve(samples);
+  rec.data.reserve(samples * rec.values_per_sample);
+  auto sample = [&] {
+    rec.times.push_back(physics.time());
+    for (const auto& reading : registry_.Sample(e.record))
+      rec.data.insert(rec.data.end(), reading.values.begin(), reading.values.end());
+  };
+  const auto step_begin = Clock::now();
+  auto rate_wall = step_begin;
+  double rate_sim = physics.time();
+  size_t next_command = 0;
+  sample();
+  for (uint64_t k = 1; k <= steps; ++k) {
+    // commands due by the start of this step (a part per billion of a step counts as due)
+    const double now = physics.time() + 1e-9 * dt;
+    for (; next_command < e.schedule.size() && e.schedule[next_command].time_s <= now;
+         ++next_command) {
+      const auto& c = e.schedule[next_command];
+      pending_commands_.emplace_back(c.actuator, c.value);
+    }
+    StepLocked();
+    if (state_ == RunState::kFaulted)
+      throw RunFailed("experiment '" + e.name + "' faulted at t = " + std::to_string(physics.time()) +
+                      " s (step " + std::to_string(k) + "): " + last_error_);
+    if (k % e.every_n_steps == 0) sample();
+    if (k % 256 == 0) {
+      // let status() and readers in between; the experiment flag keeps control calls out
+      const auto wall = Clock::now();
+      const double span = std::chrono::duration<double>(wall - rate_wall).count();
+      if (span >= 0.5) {
+        achieved_rtf_ = (physics.time() - rate_sim) / span;
+        rate_wall = wall;
+        rate_sim = physics.time();
+      }
+      lock.unlock();
+      std::this_thread::yield();
+      lock.lock();
+    }
+  }
+  result.step_wall_s = std::chrono::duration<double>(Clock::now() - step_begin).count();
+  result.steps = steps;
+  logging::Get("model").info("experiment %s: %llu steps in %.3f s of wall time", e.name.c_str(),
+                             static_cast<unsigned long long>(steps), result.step_wall_s);
+  return result;
 }
 
 void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
@@ -121,6 +318,7 @@ void ModelCore::RewindLocked() {
 void ModelCore::Start() {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   if (state_ == RunState::kFaulted)
     throw NotAvailable("the simulation stopped on a fault (" + last_error_ +
                        "); reset or stop it first");
@@ -135,12 +333,14 @@ void ModelCore::Start() {
 void ModelCore::Pause() {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
 }
 
 void ModelCore::Stop() {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   RewindLocked();
   state_ = RunState::kStopped;
 }
@@ -148,6 +348,7 @@ void ModelCore::Stop() {
 void ModelCore::Reset() {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
   RewindLocked();
   state_ = keep;
@@ -161,6 +362,7 @@ void ModelCore::Reset() {
 void ModelCore::StepNow(uint64_t n) {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
   if (state_ == RunState::kFaulted)
     throw NotAvailable("the simulation stopped on a fault (" + last_error_ + "); reset it first");
@@ -173,6 +375,7 @@ void ModelCore::SetTimeStep(double seconds) {
     throw InvalidValue("time step " + std::to_string(seconds) + " s: must be in (0, 0.1] s");
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   loaded_->physics->SetParameter("simulation.time_step", seconds);
 }
 
@@ -191,9 +394,10 @@ void ModelCore::SetRealTimeFactor(double factor) {
 Status ModelCore::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   Status s;
-  s.state = state_;
-  s.real_time_factor = real_time_factor_;
-  s.achieved_real_time_factor = state_ == RunState::kRunning ? achieved_rtf_ : 0;
+  const bool running = state_ == RunState::kRunning || !experiment_.empty();
+  s.state = experiment_.empty() ? state_ : RunState::kRunning;
+  s.real_time_factor = experiment_.empty() ? real_time_factor_ : 0;
+  s.achieved_real_time_factor = running ? achieved_rtf_ : 0;
   s.last_error = last_error_;
   if (loaded_) {
     s.scene = loaded_->source;
@@ -319,6 +523,7 @@ std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
 void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& commands) {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   for (const auto& [name, value] : commands) {
     const auto& actuators = loaded_->description->actuators;
     if (std::none_of(actuators.begin(), actuators.end(),
@@ -370,6 +575,7 @@ std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids)
 void ModelCore::SetChannel(const std::string& id, const std::vector<double>& values) {
   std::lock_guard<std::mutex> lock(mutex_);
   Require(true);
+  RequireIdle();
   if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
   const daq::ChannelInfo& info = registry_.Info(id);
   if (!info.writable) throw InvalidValue(id + ": read-only (a state of the simulation)");

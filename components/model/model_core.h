@@ -16,6 +16,7 @@
 #include "caliper/daq/daq_scene.h"
 #include "caliper/daq/recorder.h"
 #include "caliper/daq/registry.h"
+#include "caliper/experiment/experiment.h"
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/sgal/physics_scene.h"
 
@@ -44,6 +45,20 @@ class UnknownId : public std::out_of_range {
 
  private:
   std::string id_;
+};
+
+/// A run that could not finish: its physics faulted (NaN, explosion); the message is the report.
+class RunFailed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What run_experiment returns: the recording and where the time went.
+struct RunResult {
+  experiment::Recording recording;
+  uint64_t steps = 0;
+  double load_wall_s = 0;  // importing and building the scene [s]
+  double step_wall_s = 0;  // stepping and sampling [s]
 };
 
 struct Status {
@@ -86,6 +101,17 @@ class ModelCore {
   void Load(const std::string& path);
   /// The same for a description built in memory (tests, generators).
   void LoadScene(const sgal::Scene& scene, const std::string& source);
+  /// Loads a scene sent by content: `file_name` (its ending: .dae or .zae) names it in messages.
+  void LoadData(const std::string& file_name, const std::string& bytes);
+  /// The scene with its current parameters as the bytes of a .dae file.
+  std::string ExportBytes();
+  /// Loads `scene_bytes` afresh (any earlier state or command is forgotten, so that the same
+  /// experiment gives the same bits on any host), applies the overrides, steps as fast as
+  /// possible with the schedule, sampling `record` at t = 0 and every N steps. Other control
+  /// calls get NotAvailable meanwhile; status() shows it RUNNING. Throws std::runtime_error (load),
+  /// UnknownId, InvalidValue, or RunFailed when the physics faults. Ends PAUSED at the last step.
+  RunResult RunExperiment(const experiment::Experiment& experiment, const std::string& file_name,
+                          const std::string& scene_bytes);
 
   void Start();
   void Pause();
@@ -147,6 +173,12 @@ class ModelCore {
   void PublishLocked();
   void RewindLocked();
   void Require(bool scene_needed) const;
+  /// NotAvailable while an experiment runs (the run owns the simulation).
+  void RequireIdle() const;
+  sgal::Scene ImportBytes(const std::string& file_name, const std::string& bytes) const;
+  /// ImportBytes, remembering the last result (only RunExperiment's thread calls it).
+  std::shared_ptr<const sgal::Scene> ImportCached(const std::string& file_name,
+                                                  const std::string& bytes);
 
   physics_bullet::Options options_;
   mutable std::mutex mutex_;
@@ -155,6 +187,10 @@ class ModelCore {
   std::unique_ptr<Loaded> loaded_;
   uint64_t generation_ = 0;
   RunState state_ = RunState::kEmpty;
+  std::string experiment_;  // the experiment running now ("" when none)
+  // the last scene imported from bytes: batches send the same file run after run
+  std::string imported_name_, imported_bytes_;
+  std::shared_ptr<const sgal::Scene> imported_;
   double real_time_factor_ = 1.0;
   std::string last_error_;
   std::vector<std::pair<std::string, double>> pending_commands_;

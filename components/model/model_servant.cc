@@ -430,6 +430,75 @@ S::Description* ModelServant::scene_description() {
   });
 }
 
+void ModelServant::load_scene_data(const char* file_name, const M::Octets& data) {
+  try {
+    core_.LoadData(file_name, std::string(reinterpret_cast<const char*>(data.get_buffer()),
+                                          data.length()));
+  } catch (const std::exception& e) {
+    logging::Get("model").error("load %s (sent by content) failed: %s", file_name, e.what());
+    throw M::LoadFailed(e.what());
+  }
+}
+
+M::Octets* ModelServant::export_scene() {
+  return Guard([&] {
+    const std::string bytes = core_.ExportBytes();
+    auto* out = new M::Octets(static_cast<CORBA::ULong>(bytes.size()));
+    out->length(static_cast<CORBA::ULong>(bytes.size()));
+    std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out->get_buffer()));
+    return out;
+  });
+}
+
+M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
+  experiment::Experiment e;
+  e.name = in.name.in();
+  e.scene = in.scene_file_name.in();
+  for (CORBA::ULong i = 0; i < in.overrides.length(); ++i) {
+    const D::Value& v = in.overrides[i].value;
+    e.overrides.push_back({in.overrides[i].id.in(),
+                           std::vector<double>(v.data.get_buffer(),
+                                               v.data.get_buffer() + v.data.length())});
+  }
+  for (CORBA::ULong i = 0; i < in.schedule.length(); ++i)
+    e.schedule.push_back(
+        {in.schedule[i].time, in.schedule[i].actuator.in(), in.schedule[i].value});
+  e.record = FromIdl(in.record);
+  e.every_n_steps = in.every_n_steps;
+  e.duration_s = in.duration;
+  const std::string bytes(reinterpret_cast<const char*>(in.scene_data.get_buffer()), in.scene_data.length());
+  RunResult result;
+  try {
+    result = Guard([&] { return core_.RunExperiment(e, e.scene, bytes); });
+  } catch (const experiment::FormatError& error) {
+    throw D::InvalidParameter(error.what());
+  } catch (const RunFailed& error) {
+    logging::Get("model").error("%s", error.what());
+    throw M::RunFailed(error.what());
+  }
+  const experiment::Recording& rec = result.recording;
+  auto* out = new M::Recording;
+  out->channels.length(static_cast<CORBA::ULong>(rec.channels.size()));
+  for (CORBA::ULong i = 0; i < rec.channels.size(); ++i) {
+    D::ChannelInfo& c = out->channels[i];
+    c.id = rec.channels[i].id.c_str();
+    c.unit = rec.channels[i].unit.c_str();
+    c.rows = rec.channels[i].rows;
+    c.cols = rec.channels[i].cols;
+    c.writable = false;
+    c.is_static = false;
+  }
+  out->times.length(static_cast<CORBA::ULong>(rec.times.size()));
+  std::copy(rec.times.begin(), rec.times.end(), out->times.get_buffer());
+  out->data.length(static_cast<CORBA::ULong>(rec.data.size()));
+  std::copy(rec.data.begin(), rec.data.end(), out->data.get_buffer());
+  out->values_per_sample = static_cast<CORBA::ULong>(rec.values_per_sample);
+  out->steps = result.steps;
+  out->load_wall_time = result.load_wall_s;
+  out->step_wall_time = result.step_wall_s;
+  return out;
+}
+
 void ModelServant::save_scene(const char* path) {
   Guard([&] {
     try {

@@ -70,6 +70,7 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
 
   // SimulationControl
   void load_scene(const char* path) override;
+  void load_scene_data(const char* file_name, const Caliper::Simulation::Octets& data) override;
   void start() override;
   void pause() override;
   void stop() override;
@@ -81,6 +82,10 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   // SceneManagement
   Caliper::Scene::Description* scene_description() override;
   void save_scene(const char* path) override;
+  Caliper::Simulation::Octets* export_scene() override;
+  // ExperimentRunner
+  Caliper::Simulation::Recording* run_experiment(
+      const Caliper::Simulation::Experiment& run) override;
   // MotorControl
   Caliper::Simulation::ActuatorInfoSeq* actuators() override;
   void set_command(const char* actuator, CORBA::Double value) override;

@@ -1,14 +1,40 @@
 #include "caliper/rtc/client_orb.h"
 
+#include <cstdlib>
+#include <stdexcept>
+#include <vector>
+
 namespace caliper::rtc {
 
-CORBA::ORB_ptr ClientOrb(const char* program) {
+std::string ListenEndpoint(const std::string& address) {
+  if (address.empty()) throw std::invalid_argument("empty listening address");
+  for (char c : address)
+    if (c == '/' || c == ' ' || c == ',')
+      throw std::invalid_argument("listening address '" + address +
+                                  "': expected a host name or an IP address");
+  const bool ipv6 = address.find(':') != std::string::npos && address.front() != '[';
+  return "giop:tcp:" + (ipv6 ? "[" + address + "]" : address) + ":";
+}
+
+CORBA::ORB_ptr ClientOrb(const char* program, double call_timeout_s) {
   // omniORB returns the existing ORB when there is one (its arguments are then ignored);
   // per-thread call timeouts (omniORB::setClientThreadCallTimeout) need supportPerThreadTimeOut
-  const char* args[] = {program, "-ORBendPoint", "giop:tcp:127.0.0.1:",
-                        "-ORBsupportPerThreadTimeOut", "1", nullptr};
-  int argc = 5;
-  return CORBA::ORB_init(argc, const_cast<char**>(args));
+  std::string endpoint = "giop:tcp:127.0.0.1:";
+  if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
+    endpoint = ListenEndpoint(listen);
+  const std::string max_message = std::to_string(kMaxMessageBytes);
+  std::vector<const char*> args = {program, "-ORBendPoint", endpoint.c_str(),
+                                   "-ORBsupportPerThreadTimeOut", "1",
+                                   "-ORBgiopMaxMsgSize", max_message.c_str()};
+  const std::string timeout_ms = std::to_string(static_cast<long>(call_timeout_s * 1000));
+  if (call_timeout_s > 0)
+    for (const char* option : {"-ORBclientCallTimeOutPeriod", "-ORBclientConnectTimeOutPeriod"}) {
+      args.push_back(option);
+      args.push_back(timeout_ms.c_str());
+    }
+  args.push_back(nullptr);
+  int argc = static_cast<int>(args.size()) - 1;
+  return CORBA::ORB_init(argc, const_cast<char**>(args.data()));
 }
 
 }  // namespace caliper::rtc

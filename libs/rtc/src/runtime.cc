@@ -11,6 +11,7 @@
 
 #include "caliper/core/system.h"
 #include "caliper/logging/batching_appender.h"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
@@ -29,7 +30,12 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
        "('' = $CALIPER_NAMESERVICE or corbaname::127.0.0.1:2809)"},
       {"naming.instance", Type::kString, type_name, "instance base name (bound as NAME0, NAME1, ...)"},
       {"naming.update.interval", Type::kDouble, "10", "re-registration period [s]", 0.05, 3600},
-      {"corba.endpoint", Type::kString, "giop:tcp:127.0.0.1:", "omniORB endpoint to listen on"},
+      {"corba.endpoint", Type::kString, "giop:tcp:127.0.0.1:",
+       "omniORB endpoint to listen on (loopback only by default; --listen ADDR or $CALIPER_LISTEN "
+       "make it giop:tcp:ADDR:, reachable from other hosts)"},
+      {"corba.max_message_size", Type::kDouble, "256",
+       "largest GIOP message sent or received [MiB] (scenes and recordings travel by content)",
+       1, 2047},
       {"corba.call_timeout", Type::kDouble, "5", "timeout of outgoing calls [s]", 0.01, 3600},
       {"exec.kind", Type::kString, "periodic", "execution context kind", 0, 0,
        {"periodic", "external"}},
@@ -58,6 +64,8 @@ void PrintUsage(const ComponentType& type, const core::Config& config) {
             << "  -o KEY=VALUE         set one configuration key (repeatable, applied last)\n"
             << "  --nameservice ADDR   naming service, e.g. corbaname::127.0.0.1:2809\n"
             << "  --instance NAME      instance base name (bound as NAME0, NAME1, ...)\n"
+            << "  --listen ADDR        network mode: listen on ADDR (an address of this host that\n"
+            << "                       the others reach) instead of loopback; also $CALIPER_LISTEN\n"
             << "  -h, --help           this text\n"
             << "  -ORB...              passed to omniORB\n\n"
             << "Configuration keys:\n"
@@ -238,6 +246,8 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     const std::string default_file = ConfigDirectory() + "/" + type.name + ".conf";
     if (access(default_file.c_str(), R_OK) == 0) config.LoadFile(default_file);
     std::vector<std::string> overrides;
+    if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
+      overrides.push_back("corba.endpoint=" + ListenEndpoint(listen));
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
       auto next = [&]() -> std::string {
@@ -253,6 +263,8 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
         overrides.push_back(next());
       } else if (arg == "--nameservice") {
         overrides.push_back("naming.service=" + next());
+      } else if (arg == "--listen") {
+        overrides.push_back("corba.endpoint=" + ListenEndpoint(next()));
       } else if (arg == "--instance") {
         overrides.push_back("naming.instance=" + next());
       } else if (arg.rfind("-ORB", 0) == 0) {
@@ -265,6 +277,9 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     for (const auto& o : overrides) config.SetAssignment(o, "-o");
   } catch (const core::ConfigError& e) {
     std::cerr << program << ": error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << program << ": error: --listen / CALIPER_LISTEN: " << e.what() << "\n";
     return 2;
   }
 
@@ -286,7 +301,10 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
   orb_args.insert(orb_args.end(),
                   {"-ORBendPoint", config.GetString("corba.endpoint"),
                    "-ORBclientCallTimeOutPeriod", std::to_string(timeout_ms),
-                   "-ORBclientConnectTimeOutPeriod", std::to_string(timeout_ms)});
+                   "-ORBclientConnectTimeOutPeriod", std::to_string(timeout_ms),
+                   "-ORBgiopMaxMsgSize",
+                   std::to_string(static_cast<long>(config.GetDouble("corba.max_message_size") *
+                                                    1024 * 1024))});
   std::vector<char*> orb_argv;
   for (auto& a : orb_args) orb_argv.push_back(a.data());
   int orb_argc = static_cast<int>(orb_argv.size());

@@ -8,7 +8,8 @@
 
 namespace caliper::core {
 
-/// Short host name (without domain), as used in naming contexts `<host>.host_cxt`.
+/// Short host name (without domain), as used in naming contexts `<host>.host_cxt`; $CALIPER_HOST
+/// when set (several simulated hosts on one machine).
 std::string HostName();
 
 /// Wall-clock time [us since 1970-01-01 UTC].

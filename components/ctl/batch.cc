@@ -1,0 +1,572 @@
+#include "batch.h"
+
+#include <fnmatch.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <iterator>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "batch_plan.h"
+#include "caliper/core/system.h"
+#include "caliper/experiment/experiment.h"
+#include "caliper/model.hh"
+#include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/naming.h"
+#include "csv_recording.h"
+
+namespace caliper::ctl {
+
+namespace {
+
+namespace M = ::Caliper::Simulation;
+namespace D = ::Caliper::Daq;
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct BatchOptions {
+  std::string file;
+  std::string out;
+  std::string models = "model*";  // instance glob
+  double stall_s = 5;             // a busy Model silent this long loses its run
+  double run_timeout_s = 3600;    // the longest a run call may take
+  int max_attempts = 5;
+  double wait_models_s = 10;      // how long to wait for a first Model
+};
+
+/// One Model the batch uses, and its worker thread.
+struct Slot {
+  std::string name;  // model1@hostb
+  std::string path;
+  std::mutex mutex;  // guards model, ticket, since, last_answer, sim_time
+  M::Model_var model;
+  std::optional<BatchPlan::Ticket> ticket;
+  Clock::time_point since, last_answer;
+  double sim_time = 0;  // of the run in flight, from the last status poll [s]
+  std::atomic<bool> down{false};
+  std::atomic<bool> in_call{false};
+  std::thread thread;
+};
+
+/// Makes the calling thread known to omniORB, which per-thread call timeouts need.
+class OmniThread {
+ public:
+  OmniThread() : self_(omni_thread::self() == nullptr ? omni_thread::create_dummy() : nullptr) {}
+  ~OmniThread() {
+    if (self_ != nullptr) omni_thread::release_dummy();
+  }
+
+ private:
+  omni_thread* self_;
+};
+
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+class BatchRun {
+ public:
+  BatchRun(Client& client, BatchOptions options, std::vector<experiment::Experiment> runs)
+      : client_(client), options_(std::move(options)), runs_(std::move(runs)),
+        plan_(runs_.size(), options_.max_attempts), written_(runs_.size(), false) {}
+
+  int Run();
+
+ private:
+  void LoadScenes();
+  M::Experiment ToIdl(const experiment::Experiment& e) const;
+  void Discover();
+  void Work(Slot* slot);
+  void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
+  void Watch();
+  void Progress(bool last);
+  void WriteRun(size_t run, const M::Recording& recording);
+  void WriteSummary(double wall_s);
+  bool Interrupted();
+
+  Client& client_;
+  BatchOptions options_;
+  std::vector<experiment::Experiment> runs_;
+  BatchPlan plan_;
+  std::map<std::string, std::string> scenes_;  // path -> bytes
+  std::mutex slots_mutex_;
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::mutex written_mutex_;
+  std::condition_variable written_cv_;
+  std::vector<bool> written_;
+  std::vector<std::string> write_errors_;
+  std::atomic<bool> stop_{false};
+  Clock::time_point begin_ = Clock::now();
+  Clock::time_point last_progress_;
+  double total_sim_s_ = 0;
+};
+
+void BatchRun::LoadScenes() {
+  const size_t limit = static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20);
+  for (const auto& e : runs_) {
+    if (scenes_.count(e.scene)) continue;
+    std::ifstream in(e.scene, std::ios::binary);
+    if (!in) throw Failure(options_.file + ": experiment '" + e.name + "': scene " + e.scene +
+                           " cannot be read");
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.size() > limit)
+      throw Failure(e.scene + " is " + std::to_string(bytes.size() >> 20) +
+                    " MiB: scenes travel in one CORBA message of at most " +
+                    std::to_string(limit >> 20) + " MiB");
+    scenes_[e.scene] = std::move(bytes);
+  }
+}
+
+M::Experiment BatchRun::ToIdl(const experiment::Experiment& e) const {
+  M::Experiment out;
+  out.name = e.name.c_str();
+  out.scene_file_name = fs::path(e.scene).filename().c_str();
+  const std::string& bytes = scenes_.at(e.scene);
+  out.scene_data.length(static_cast<CORBA::ULong>(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out.scene_data.get_buffer()));
+  out.overrides.length(static_cast<CORBA::ULong>(e.overrides.size()));
+  for (CORBA::ULong i = 0; i < e.overrides.size(); ++i) {
+    out.overrides[i].id = e.overrides[i].id.c_str();
+    const auto& v = e.overrides[i].values;
+    out.overrides[i].value.rows = static_cast<CORBA::ULong>(v.size());
+    out.overrides[i].value.cols = 1;
+    out.overrides[i].value.data.length(static_cast<CORBA::ULong>(v.size()));
+    std::copy(v.begin(), v.end(), out.overrides[i].value.data.get_buffer());
+  }
+  out.schedule.length(static_cast<CORBA::ULong>(e.schedule.size()));
+  for (CORBA::ULong i = 0; i < e.schedule.size(); ++i) {
+    out.schedule[i].time = e.schedule[i].time_s;
+    out.schedule[i].actuator = e.schedule[i].actuator.c_str();
+    out.schedule[i].value = e.schedule[i].value;
+  }
+  out.record.length(static_cast<CORBA::ULong>(e.record.size()));
+  for (CORBA::ULong i = 0; i < e.record.size(); ++i) out.record[i] = e.record[i].c_str();
+  out.every_n_steps = e.every_n_steps;
+  out.duration = e.duration_s;
+  return out;
+}
+
+void BatchRun::Discover() {
+  std::vector<rtc::ComponentEntry> entries;
+  try {
+    CosNaming::NamingContext_var root = client_.Root();
+    entries = rtc::ListComponents(root);
+  } catch (const std::exception&) {
+    return;  // the naming service is unreachable for now: the Models we have go on
+  } catch (const CORBA::Exception&) {
+    return;
+  }
+  std::lock_guard<std::mutex> lock(slots_mutex_);
+  for (auto& e : entries) {
+    if (fnmatch(options_.models.c_str(), e.instance.c_str(), 0) != 0) continue;
+    Slot* known = nullptr;
+    for (auto& s : slots_)
+      if (s->path == e.path) known = s.get();
+    if (known != nullptr) {
+      // a new process under a name whose Model died: use it
+      std::lock_guard<std::mutex> slot_lock(known->mutex);
+      if (known->down && !known->in_call && !e.object->_is_equivalent(known->model)) {
+        M::Model_var fresh = M::Model::_unchecked_narrow(e.object);
+        known->model = fresh;
+      }
+      continue;
+    }
+    auto slot = std::make_unique<Slot>();
+    slot->name = e.instance + "@" + e.host;
+    slot->path = e.path;
+    slot->model = M::Model::_unchecked_narrow(e.object);
+    Slot* raw = slot.get();
+    slots_.push_back(std::move(slot));
+    raw->thread = std::thread([this, raw] { Work(raw); });
+  }
+}
+
+void BatchRun::Work(Slot* slot) {
+  OmniThread omni;
+  // the run call may take long; a dead peer is found by the watcher's status polls
+  omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
+  while (!stop_ && !plan_.finished()) {
+    if (slot->down) {
+      M::Model_var model;
+      {
+        std::lock_guard<std::mutex> lock(slot->mutex);
+        model = M::Model::_duplicate(slot->model);
+      }
+      try {
+        omniORB::setClientThreadCallTimeout(2000);
+        M::SimulationStatus_var s = model->status();
+        slot->down = false;
+      } catch (const CORBA::Exception&) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      }
+      omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
+      continue;
+    }
+    const auto ticket = plan_.Next(slot->name, std::chrono::milliseconds(200));
+    if (ticket) Attempt(slot, *ticket);
+  }
+}
+
+void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
+  M::Model_var model;
+  {
+    std::lock_guard<std::mutex> lock(slot->mutex);
+    slot->ticket = ticket;
+    slot->since = slot->last_answer = Clock::now();
+    slot->sim_time = 0;
+    model = M::Model::_duplicate(slot->model);
+  }
+  const M::Experiment idl = ToIdl(runs_[ticket.run]);
+  const auto begin = Clock::now();
+  slot->in_call = true;
+  try {
+    M::Recording_var r = model->run_experiment(idl);
+    slot->in_call = false;
+    Outcome o;
+    o.model = slot->name;
+    o.wall_s = Since(begin);
+    o.load_wall_s = r->load_wall_time;
+    o.step_wall_s = r->step_wall_time;
+    o.steps = r->steps;
+    o.samples = r->times.length();
+    if (plan_.Complete(ticket, o)) WriteRun(ticket.run, r.in());
+  } catch (const M::RunFailed& e) {
+    plan_.Fail(ticket, e.reason.in());
+  } catch (const M::LoadFailed& e) {
+    plan_.Fail(ticket, e.reason.in());
+  } catch (const D::UnknownId& e) {
+    plan_.Fail(ticket, e.reason.in());
+  } catch (const D::InvalidParameter& e) {
+    plan_.Fail(ticket, e.reason.in());
+  } catch (const M::NotAvailable& e) {
+    plan_.Retry(ticket, slot->name + ": " + e.reason.in());
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  } catch (const CORBA::SystemException& e) {
+    plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
+    slot->down = true;
+  } catch (const CORBA::Exception& e) {
+    plan_.Fail(ticket, slot->name + ": " + rtc::Describe(e));
+  }
+  slot->in_call = false;
+  std::lock_guard<std::mutex> lock(slot->mutex);
+  slot->ticket.reset();
+}
+
+void BatchRun::WriteRun(size_t run, const M::Recording& r) {
+  std::vector<RecordedChannel> channels;
+  for (CORBA::ULong i = 0; i < r.channels.length(); ++i)
+    channels.push_back({r.channels[i].id.in(), r.channels[i].unit.in(), r.channels[i].rows,
+                        r.channels[i].cols});
+  const std::string path = options_.out + "/runs/" + runs_[run].name + ".csv";
+  std::string error;
+  try {
+    core::WriteFileReplacing(path, [&](std::ostream& out) {
+      CsvRecording csv(out, channels);
+      csv.Add(1, r.times.get_buffer(), r.times.length(), r.data.get_buffer(), r.values_per_sample);
+      if (!csv.error().empty()) throw std::runtime_error(csv.error());
+    });
+  } catch (const std::exception& e) {
+    error = path + ": " + e.what();
+  }
+  std::lock_guard<std::mutex> lock(written_mutex_);
+  written_[run] = true;
+  if (!error.empty()) write_errors_.push_back(error);
+  written_cv_.notify_all();
+}
+
+void BatchRun::Watch() {
+  // one status poll per busy Model; a Model silent for stall_s loses its run (it may still
+  // finish it: the first result counts)
+  omniORB::setClientThreadCallTimeout(1000);
+  std::vector<Slot*> slots;
+  {
+    std::lock_guard<std::mutex> lock(slots_mutex_);
+    for (auto& s : slots_) slots.push_back(s.get());
+  }
+  for (Slot* slot : slots) {
+    M::Model_var model;
+    std::optional<BatchPlan::Ticket> ticket;
+    Clock::time_point last;
+    {
+      std::lock_guard<std::mutex> lock(slot->mutex);
+      ticket = slot->ticket;
+      model = M::Model::_duplicate(slot->model);
+      last = slot->last_answer;
+    }
+    if (!ticket) continue;
+    std::string failure;
+    try {
+      M::SimulationStatus_var s = model->status();
+      std::lock_guard<std::mutex> lock(slot->mutex);
+      slot->last_answer = Clock::now();
+      if (slot->ticket && slot->ticket->token == ticket->token) slot->sim_time = s->sim_time;
+      continue;
+    } catch (const CORBA::Exception& e) {
+      failure = rtc::Describe(e);
+    }
+    const double silent = Since(last);
+    if (silent >= options_.stall_s) {
+      plan_.Retry(*ticket, slot->name + ": no answer for " + Fixed(silent, 1) + " s (" + failure +
+                               ")");
+      slot->down = true;
+    }
+  }
+}
+
+void BatchRun::Progress(bool last) {
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  if (!last && !tty && Since(last_progress_) < 5) return;
+  last_progress_ = Clock::now();
+  const size_t total = plan_.size(), done = plan_.done(), failed = plan_.failed();
+  double sim = 0;
+  for (const auto& o : plan_.outcomes())
+    if (o.state == Outcome::State::kDone) sim += static_cast<double>(o.steps);
+  // simulated seconds: steps of finished runs times their step, plus runs in flight
+  double sim_done = 0, sim_left = 0;
+  const auto outcomes = plan_.outcomes();
+  for (size_t i = 0; i < outcomes.size(); ++i) {
+    if (outcomes[i].state == Outcome::State::kDone) sim_done += runs_[i].duration_s;
+    else if (outcomes[i].state != Outcome::State::kFailed) sim_left += runs_[i].duration_s;
+  }
+  size_t busy = 0, models = 0;
+  {
+    std::lock_guard<std::mutex> lock(slots_mutex_);
+    for (auto& s : slots_) {
+      std::lock_guard<std::mutex> slot_lock(s->mutex);
+      models += s->down ? 0 : 1;
+      if (s->ticket) {
+        ++busy;
+        sim_done += s->sim_time;
+        sim_left -= s->sim_time;
+      }
+    }
+  }
+  const double wall = Since(begin_);
+  const double rate = wall > 0 ? sim_done / wall : 0;
+  const int width = 24;
+  const int filled = total ? static_cast<int>(width * (done + failed) / total) : width;
+  std::ostringstream line;
+  line << "[" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
+       << (done + failed) << "/" << total << " runs";
+  if (failed) line << " (" << failed << " failed)";
+  line << ", " << busy << "/" << models << " Models busy, " << Fixed(rate, 2) << " sim-s/s";
+  if (rate > 0 && sim_left > 0) line << ", ETA " << Fixed(std::max(0.0, sim_left) / rate, 0) << " s";
+  else if (last) line << ", " << Fixed(wall, 1) << " s";
+  std::cerr << (tty ? "\r\033[K" : "") << line.str() << (tty && !last ? "" : "\n") << std::flush;
+  (void)sim;
+}
+
+void BatchRun::WriteSummary(double wall_s) {
+  const auto outcomes = plan_.outcomes();
+  core::WriteFileReplacing(options_.out + "/summary.csv", [&](std::ostream& out) {
+    out << "name,status,model,attempts,duration [s],steps,samples,wall_time [s],"
+           "load_wall_time [s],step_wall_time [s],retries,reason\n";
+    out << std::setprecision(6);
+    for (size_t i = 0; i < outcomes.size(); ++i) {
+      const Outcome& o = outcomes[i];
+      std::string retries;
+      for (const auto& r : o.retries) retries += (retries.empty() ? "" : "; ") + r.reason;
+      out << CsvField(runs_[i].name) << "," << ToString(o.state) << "," << CsvField(o.model) << ","
+          << o.attempts << "," << runs_[i].duration_s << "," << o.steps << "," << o.samples << ","
+          << o.wall_s << "," << o.load_wall_s << "," << o.step_wall_s << "," << CsvField(retries)
+          << "," << CsvField(o.reason) << "\n";
+    }
+  });
+  size_t retries = 0;
+  double sim = 0, step_wall = 0, run_wall = 0;
+  for (size_t i = 0; i < outcomes.size(); ++i) {
+    const Outcome& o = outcomes[i];
+    retries += o.retries.size();
+    for (const auto& r : o.retries) std::cout << "retry: " << runs_[i].name << ": " << r.reason << "\n";
+    if (o.state == Outcome::State::kFailed)
+      std::cout << "failed: " << runs_[i].name << " on " << o.model << ": " << o.reason << "\n";
+    if (o.state == Outcome::State::kDone) {
+      sim += runs_[i].duration_s;
+      step_wall += o.step_wall_s;
+      run_wall += o.wall_s;
+    }
+  }
+  std::cout << plan_.done() << " of " << outcomes.size() << " runs done, " << plan_.failed()
+            << " failed, " << retries << " retr" << (retries == 1 ? "y" : "ies") << "; "
+            << Fixed(sim, 3) << " simulated s in " << Fixed(wall_s, 2) << " s of wall time ("
+            << Fixed(wall_s > 0 ? sim / wall_s : 0, 2) << " sim-s/s)";
+  if (step_wall > 0)
+    std::cout << "; per-run overhead " << Fixed(100 * (run_wall - step_wall) / step_wall, 1)
+              << " % over stepping";
+  std::cout << "\nresults: " << options_.out << "/runs/*.csv, summary: " << options_.out
+            << "/summary.csv\n";
+}
+
+bool BatchRun::Interrupted() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  const timespec none = {0, 0};
+  return sigtimedwait(&set, nullptr, &none) > 0;
+}
+
+int BatchRun::Run() {
+  OmniThread omni;
+  LoadScenes();
+  fs::create_directories(options_.out + "/runs");
+  client_.Root();  // fails early with the address when the naming service is not there
+  const auto waited = Clock::now();
+  while (true) {
+    Discover();
+    {
+      std::lock_guard<std::mutex> lock(slots_mutex_);
+      if (!slots_.empty()) break;
+    }
+    if (Since(waited) > options_.wait_models_s)
+      throw Failure("no Model matching '" + options_.models + "' in " + client_.address() +
+                    " after " + Fixed(options_.wait_models_s, 0) +
+                    " s (start some: launch/caliper node, caliper-ctl create --count N)");
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  {
+    std::lock_guard<std::mutex> lock(slots_mutex_);
+    std::cerr << runs_.size() << " runs on " << slots_.size() << " Model"
+              << (slots_.size() == 1 ? "" : "s") << " (more join as they appear); results in "
+              << options_.out << "\n";
+  }
+  begin_ = last_progress_ = Clock::now();
+  auto last_discovery = Clock::now(), last_watch = Clock::now();
+  bool interrupted = false;
+  while (!plan_.finished()) {
+    plan_.WaitForChange(std::chrono::milliseconds(100));
+    if (Interrupted()) {
+      interrupted = true;
+      break;
+    }
+    if (Since(last_watch) < 0.5) continue;
+    last_watch = Clock::now();
+    Watch();
+    if (Since(last_discovery) > 2) {
+      Discover();
+      last_discovery = Clock::now();
+    }
+    Progress(false);
+  }
+  stop_ = true;
+  {
+    // every run that ended well has its file before the summary says so
+    std::unique_lock<std::mutex> lock(written_mutex_);
+    const auto outcomes = plan_.outcomes();
+    written_cv_.wait_for(lock, std::chrono::seconds(30), [&] {
+      for (size_t i = 0; i < outcomes.size(); ++i)
+        if (outcomes[i].state == Outcome::State::kDone && !written_[i]) return false;
+      return true;
+    });
+  }
+  const double wall = Since(begin_);
+  Progress(true);
+  WriteSummary(wall);
+  for (const auto& e : write_errors_) std::cerr << "error: " << e << "\n";
+  const int rc = interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
+  bool stuck = false;
+  {
+    std::lock_guard<std::mutex> lock(slots_mutex_);
+    for (auto& s : slots_) {
+      if (s->in_call) {
+        stuck = true;  // a call to a Model that no longer answers: not worth waiting for
+        std::cerr << "note: " << s->name << " still has a call open; not waiting for it\n";
+        s->thread.detach();
+      } else {
+        s->thread.join();
+      }
+    }
+  }
+  if (stuck) {
+    std::cout.flush();
+    _exit(rc);
+  }
+  return rc;
+}
+
+int Batch(Client& client, std::vector<std::string>& args) {
+  BatchOptions options;
+  std::string value;
+  if (TakeOption(args, "--out", &value)) options.out = value;
+  TakeOption(args, "--models", &options.models);
+  auto number = [&](const std::string& flag, double* target, double low) {
+    if (!TakeOption(args, flag, &value)) return;
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !(v >= low))
+      throw UsageError(flag + " takes a number >= " + Fixed(low, 1));
+    *target = v;
+  };
+  double attempts = options.max_attempts;
+  number("--stall-timeout", &options.stall_s, 0.5);
+  number("--run-timeout", &options.run_timeout_s, 1);
+  number("--max-attempts", &attempts, 1);
+  number("--wait-models", &options.wait_models_s, 0);
+  options.max_attempts = static_cast<int>(attempts);
+  RejectOptions(args);
+  if (args.size() != 1) throw UsageError("expected one experiment FILE");
+  options.file = args[0];
+  std::vector<experiment::Experiment> runs;
+  try {
+    runs = experiment::LoadFile(options.file);
+  } catch (const experiment::FormatError& e) {
+    throw Failure(e.what());
+  }
+  if (options.out.empty()) {
+    const std::time_t now = std::time(nullptr);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+    options.out = fs::path(options.file).stem().string() + "-" + stamp;
+  }
+  BatchRun run(client, options, std::move(runs));
+  return run.Run();
+}
+
+}  // namespace
+
+void AddBatchVerb(std::map<std::string, Verb>* verbs) {
+  Verb verb{
+      "batch FILE [--out DIR] [--models GLOB] [--stall-timeout S] [--max-attempts N]\n"
+      "          [--run-timeout S] [--wait-models S]",
+      "run a file of experiments on every Model in the naming service, as fast as possible",
+      Batch, "cluster",
+      "  FILE is JSON: a scene, parameter overrides (\"set\"), a command schedule (\"commands\"\n"
+      "  or \"commands_csv\"), the ids to \"record\", \"duration_s\", \"every_n_steps\", a\n"
+      "  \"sweep\" over values, and a list of \"experiments\" (README: Batch runs). Scenes are\n"
+      "  sent by content: the Models need no shared disk. Each Model runs one experiment at a\n"
+      "  time from a fresh load, so results are bit-identical wherever they run.\n"
+      "  --models GLOB    instance names to use (model*); Models that appear later join in\n"
+      "  --stall-timeout  a busy Model that does not answer for S s (5) loses its run to another\n"
+      "  --max-attempts   tries per run before it is reported failed (5)\n"
+      "  --run-timeout    the longest one run may take [s] (3600)\n"
+      "  --wait-models    how long to wait for a first Model [s] (10)\n"
+      "  --out DIR        DIR/runs/NAME.csv (time [s] and the ids with units, 17 digits) and\n"
+      "                   DIR/summary.csv (status, Model, attempts, times, every retry with its\n"
+      "                   reason); default FILE-DATE-TIME. Progress goes to stderr.\n"
+      "  A physics fault fails its run with the Model's report (not retried). Exit 0 when every\n"
+      "  run is done, 1 when any failed, 130 on Ctrl-C (the summary is written first).\n",
+      true};
+  (*verbs)["batch"] = verb;
+}
+
+}  // namespace caliper::ctl
