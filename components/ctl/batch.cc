@@ -178,7 +178,10 @@ void BatchRun::Discover() {
   }
   std::lock_guard<std::mutex> lock(slots_mutex_);
   for (auto& e : entries) {
-    if (fnmatch(options_.models.c_str(), e.instance.c_str(), 0) != 0) continue;
+    const std::string name = e.instance + "@" + e.host;
+    if (fnmatch(options_.models.c_str(), e.instance.c_str(), 0) != 0 &&
+        fnmatch(options_.models.c_str(), name.c_str(), 0) != 0)
+      continue;
     Slot* known = nullptr;
     for (auto& s : slots_)
       if (s->path == e.path) known = s.get();
@@ -192,7 +195,7 @@ void BatchRun::Discover() {
       continue;
     }
     auto slot = std::make_unique<Slot>();
-    slot->name = e.instance + "@" + e.host;
+    slot->name = name;
     slot->path = e.path;
     slot->model = M::Model::_unchecked_narrow(e.object);
     Slot* raw = slot.get();
@@ -555,7 +558,8 @@ void AddBatchVerb(std::map<std::string, Verb>* verbs) {
       "  \"sweep\" over values, and a list of \"experiments\" (README: Batch runs). Scenes are\n"
       "  sent by content: the Models need no shared disk. Each Model runs one experiment at a\n"
       "  time from a fresh load, so results are bit-identical wherever they run.\n"
-      "  --models GLOB    instance names to use (model*); Models that appear later join in\n"
+      "  --models GLOB    Models to use, by instance (model*) or INSTANCE@HOST (*@nodeb);\n"
+      "                   Models that appear later join in\n"
       "  --stall-timeout  a busy Model that does not answer for S s (5) loses its run to another\n"
       "  --max-attempts   tries per run before it is reported failed (5)\n"
       "  --run-timeout    the longest one run may take [s] (3600)\n"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <iomanip>
 #include <iostream>
@@ -101,7 +102,7 @@ int ListManagers(Client& client, std::vector<std::string>& args) {
         for (CORBA::ULong i = 0; i < list->length(); ++i) {
           const C::Child& c = list[i];
           children << "  " << std::left << std::setw(12)
-                   << (std::strlen(c.instance) > 0 ? c.instance.in() : "(starting)") << "pid "
+                   << (std::strlen(c.instance) > 0 ? c.instance.in() : "-") << "pid "
                    << std::setw(9) << c.pid << std::setw(22) << c.state.in()
                    << Uptime(c.uptime) << "\n";
         }
@@ -138,7 +139,8 @@ int Create(Client& client, std::vector<std::string>& args) {
   RTC::NameValueList config;
   while (TakeOption(args, "-o", &value)) {
     const size_t eq = value.find('=');
-    if (eq == std::string::npos || eq == 0) throw UsageError("-o wants KEY=VALUE, got '" + value + "'");
+    if (eq == std::string::npos || eq == 0)
+      throw UsageError("-o wants KEY=VALUE, got '" + value + "'");
     config.length(config.length() + 1);
     config[config.length() - 1].name = value.substr(0, eq).c_str();
     config[config.length() - 1].value = value.substr(eq + 1).c_str();
@@ -167,12 +169,13 @@ int Create(Client& client, std::vector<std::string>& args) {
   unsigned long created = 0;
   while (created < count) {
     // the manager with the most free slots; a full one tells why (its count may be stale)
-    const auto next = std::max_element(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
-      return a.full.empty() != b.full.empty() ? !a.full.empty() : a.free < b.free;
-    });
+    const auto next =
+        std::max_element(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
+          return a.full.empty() != b.full.empty() ? !a.full.empty() : a.free < b.free;
+        });
     if (!next->full.empty()) break;
     const ManagerRef& m = *next->ref;
-    C::Child_var child = Call(m, [&]() -> C::Child* {
+    C::Child* created_child = Call(m, [&]() -> C::Child* {
       try {
         return m.manager->create("model", config);
       } catch (const C::CapacityReached& e) {
@@ -180,7 +183,8 @@ int Create(Client& client, std::vector<std::string>& args) {
         return nullptr;
       }
     });
-    if (child.ptr() == nullptr) continue;
+    if (created_child == nullptr) continue;
+    C::Child_var child = created_child;
     std::cout << "created " << child->instance.in() << " (pid " << child->pid << ") as "
               << child->naming_path.in() << " on " << m.entry.instance << "\n";
     --next->free;
@@ -221,7 +225,8 @@ int Destroy(Client& client, std::vector<std::string>& args) {
     std::string names;
     for (CORBA::ULong i = 0; i < list->length(); ++i) {
       const C::Child& c = list[i];
-      names += (names.empty() ? "" : ", ") + std::string(c.instance.in());
+      if (std::strlen(c.instance) > 0)
+        names += (names.empty() ? "" : ", ") + std::string(c.instance);
       if (wanted == c.instance.in() || wanted == c.naming_path.in())
         matches.push_back({&m, c.instance.in(), std::string(c.state) == "running", c.pid});
     }

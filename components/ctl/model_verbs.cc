@@ -12,9 +12,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -22,6 +24,8 @@
 #include <sstream>
 
 #include "caliper/model.hh"
+#include "caliper/core/system.h"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "csv_recording.h"
 
@@ -83,8 +87,14 @@ S::StringSeq ToSeq(const std::vector<std::string>& ids) {
 struct ModelRef {
   std::string name;
   std::string path;
+  std::string host;  // the host context it is bound under
   M::Model_var model;
 };
+
+/// Files go by content to a Model on another host (or with --send): it shares no disk with us.
+bool ByContent(const ModelRef& m, std::vector<std::string>& args) {
+  return TakeFlag(args, "--send") || m.host != core::HostName();
+}
 
 std::string TakeModel(std::vector<std::string>& args) {
   std::string name = kDefaultModel;
@@ -102,6 +112,7 @@ ModelRef Connect(Client& client, const std::string& name) {
   ModelRef ref;
   ref.name = name;
   ref.path = e.path;
+  ref.host = e.host;
   try {
     ref.model = M::Model::_narrow(e.object);
   } catch (const CORBA::Exception& ex) {
@@ -187,14 +198,30 @@ void Line(const std::string& label, const std::string& value) {
 
 int Load(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
+  ModelRef m = Connect(client, name);
+  const bool send = ByContent(m, args);
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
-  ModelRef m = Connect(client, name);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   Call(m, [&] {
     try {
-      m.model->load_scene(path.c_str());
+      if (send) {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw Failure(path + ": cannot be read");
+        const std::string bytes((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+        if (bytes.size() + (1u << 20) > static_cast<size_t>(rtc::kMaxMessageBytes))
+          throw Failure(path + " is " + std::to_string(bytes.size() >> 20) +
+                        " MiB: a scene travels in one CORBA message of at most " +
+                        std::to_string((rtc::kMaxMessageBytes >> 20) - 1) + " MiB");
+        M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
+        data.length(static_cast<CORBA::ULong>(bytes.size()));
+        std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
+        m.model->load_scene_data(std::filesystem::path(path).filename().c_str(), data);
+      } else {
+        m.model->load_scene(path.c_str());
+      }
     } catch (const M::LoadFailed& e) {
       std::string message = e.reason.in();
       M::SimulationStatus_var s = StatusOf(m);
@@ -204,7 +231,8 @@ int Load(Client& client, std::vector<std::string>& args) {
     }
   });
   M::SimulationStatus_var s = StatusOf(m);
-  std::cout << name << ": loaded " << path << " (" << rtc::Name(s->state) << ", time step "
+  std::cout << name << ": loaded " << path << (send ? " (sent by content)" : "") << " ("
+            << rtc::Name(s->state) << ", time step "
             << Num(s->time_step) << " s)\n";
   return 0;
 }
@@ -273,12 +301,24 @@ int Status(Client& client, std::vector<std::string>& args) {
 
 int Save(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
+  ModelRef m = Connect(client, name);
+  const bool fetch = ByContent(m, args);
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
-  ModelRef m = Connect(client, name);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
-  Call(m, [&] { m.model->save_scene(path.c_str()); });
+  if (fetch) {
+    M::Octets_var data = Call(m, [&] { return m.model->export_scene(); });
+    try {
+      core::WriteFileReplacing(path, [&](std::ostream& out) {
+        out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
+      });
+    } catch (const std::exception& e) {
+      throw Failure(e.what());
+    }
+  } else {
+    Call(m, [&] { m.model->save_scene(path.c_str()); });
+  }
   std::cout << name << ": saved the scene with its current parameters to " << path << "\n";
   return 0;
 }
@@ -591,9 +631,10 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
     verb.takes_interrupt = takes_interrupt;
     (*verbs)[name] = verb;
   };
-  add("load", "load FILE [--model NAME]", "load a COLLADA scene into a Model", Load,
+  add("load", "load FILE [--send] [--model NAME]", "load a COLLADA scene into a Model", Load,
       "  On failure the Model keeps (and runs) the scene it had, and the importer's message\n"
-      "  (file, line, element, problem) is printed. FILE is sent as an absolute path.\n");
+      "  (file, line, element, problem) is printed. FILE is sent as an absolute path to a Model\n"
+      "  on this host, by content (its bytes) to one on another host or with --send.\n");
   for (const std::string v : {"start", "pause", "stop"}) {
     const std::string summary = v == "start"   ? "run the simulation (at the real-time factor)"
                                 : v == "pause" ? "pause the simulation"
@@ -645,8 +686,10 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "  per scalar element (`time [s],arm.hand.position[0] [m],...`). Progress goes to stderr;\n"
       "  at the end it reports the samples written and any gaps in batch numbers.\n",
       true);
-  add("save", "save FILE [--model NAME]", "export the scene with its current parameters as COLLADA",
-      Save, "  FILE is written by the Model's process (sent as an absolute path).\n");
+  add("save", "save FILE [--send] [--model NAME]", "export the scene with its current parameters as COLLADA",
+      Save,
+      "  FILE is written by the Model's process (sent as an absolute path); for a Model on\n"
+      "  another host, or with --send, the export comes back by content and is written here.\n");
 }
 
 }  // namespace caliper::ctl

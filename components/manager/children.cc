@@ -100,8 +100,7 @@ void Supervisor::Run() {
       requests_.pop_front();
       try {
         if (closed_) throw StartFailed("the manager is shutting down");
-        const size_t now_running = std::count_if(children_.begin(), children_.end(),
-                                                 [](const auto& c) { return c.second.status.running; });
+        const size_t now_running = RunningLocked();
         if (now_running >= options_.max_running)
           throw CapacityReached(std::to_string(now_running) + " of " +
                                 std::to_string(options_.max_running) + " children run (" +
@@ -181,8 +180,9 @@ pid_t Supervisor::Spawn(const std::string& type, const std::vector<std::string>&
   close(report[0]);
   if (n == static_cast<ssize_t>(sizeof e)) {
     waitpid(pid, nullptr, 0);
-    throw StartFailed(e.stage == 0 ? "cannot write " + prefix + "<pid>.out: " + std::strerror(e.error)
-                                   : "cannot run " + argv[0] + ": " + std::strerror(e.error));
+    throw StartFailed((e.stage == 0 ? "cannot write " + prefix + "<pid>.out: "
+                                    : "cannot run " + argv[0] + ": ") +
+                      std::strerror(e.error));
   }
   return pid;
 }
@@ -272,7 +272,8 @@ pid_t Supervisor::PidOf(const std::string& instance) const {
   for (const auto& [pid, child] : children_)
     if (child.status.instance == instance && (found == nullptr || child.status.running))
       found = &child;
-  if (found == nullptr) throw UnknownComponent("no child named '" + instance + "' (" + NamesLocked() + ")");
+  if (found == nullptr)
+    throw UnknownComponent("no child named '" + instance + "' (" + NamesLocked() + ")");
   return found->status.pid;
 }
 
@@ -298,6 +299,10 @@ std::vector<ChildStatus> Supervisor::List() const {
 
 size_t Supervisor::running() const {
   std::lock_guard<std::mutex> lock(mutex_);
+  return RunningLocked();
+}
+
+size_t Supervisor::RunningLocked() const {
   return std::count_if(children_.begin(), children_.end(),
                        [](const auto& c) { return c.second.status.running; });
 }

@@ -113,6 +113,7 @@ class Supervisor {
   /// TERM, then KILL after the grace period, to the running ones of `pids`; waits for their end.
   void Terminate(const std::vector<pid_t>& pids, std::unique_lock<std::mutex>& lock);
   ChildStatus StatusLocked(const Child& child) const;
+  size_t RunningLocked() const;
   std::string NamesLocked() const;
 
   const SupervisorOptions options_;

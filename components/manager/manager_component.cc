@@ -110,7 +110,7 @@ ChildStatus ManagerComponent::Create(
 ChildStatus ManagerComponent::AwaitRegistration(pid_t pid) {
   const auto deadline = std::chrono::steady_clock::now() + start_timeout_;
   const std::string host = core::HostName(), wanted = std::to_string(pid);
-  std::vector<CORBA::Object_var> others;  // bound objects that are not this child
+  std::vector<CORBA::Object_var> others;  // bound objects that answered with another pid
   auto failure = [&](const ChildStatus& s, const std::string& what) {
     return StartFailed("caliper-" + s.type + " (pid " + wanted + ") " + what + "; the end of " +
                        s.output_file + ":\n" + TailOfFile(s.output_file, 10));
@@ -130,12 +130,11 @@ ChildStatus ManagerComponent::AwaitRegistration(pid_t pid) {
         std::string child_pid;
         try {
           RTC::LightweightRTObject_var comp = RTC::LightweightRTObject::_narrow(e.object);
-          if (!CORBA::is_nil(comp)) {
-            RTC::ComponentProfile_var profile = comp->get_component_profile();
-            child_pid = Property(profile.in(), "pid");
-          }
+          if (CORBA::is_nil(comp)) continue;
+          RTC::ComponentProfile_var profile = comp->get_component_profile();
+          child_pid = Property(profile.in(), "pid");
         } catch (const CORBA::Exception&) {
-          // a stale name of a process that died
+          continue;  // a stale name of a process that died, asked again next time
         }
         if (child_pid == wanted) {
           supervisor_->SetRegistered(pid, e.instance, e.path);
@@ -162,7 +161,7 @@ void ManagerComponent::Destroy(const std::string& instance) {
   const pid_t pid = supervisor_->PidOf(instance);
   supervisor_->Stop(pid);
   logging::Get("manager").info("destroyed %s (pid %d)", instance.c_str(), static_cast<int>(pid));
-  // a child that had to be killed leaves its name behind
+  // a child that was killed (by us, or before) leaves its name behind
   try {
     CosNaming::NamingContext_var root = rtc::ResolveRoot(runtime_.orb(), runtime_.naming_address());
     const CosNaming::Name name = rtc::ComponentName(core::HostName(), instance);

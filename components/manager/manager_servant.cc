@@ -56,8 +56,9 @@ C::Child* ManagerServant::create(const char* type, const Caliper::RTC::NameValue
     std::vector<std::pair<std::string, std::string>> entries;
     for (CORBA::ULong i = 0; i < config.length(); ++i)
       entries.emplace_back(config[i].name.in(), config[i].value.in());
+    const ChildStatus child = component_.Create(type, entries);
     auto* out = new C::Child;
-    ToIdl(component_.Create(type, entries), out);
+    ToIdl(child, out);
     return out;
   });
 }
