@@ -1,6 +1,7 @@
 #include "csv_recording.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -59,7 +60,12 @@ bool CsvRecording::Add(uint64_t batch, const double* times, size_t count, const 
   // times within a part per billion of the end count as reaching it (sums of time steps)
   const double tolerance = 1e-9 * std::max(1.0, std::abs(end_time_));
   std::ostringstream rows;
-  rows << std::setprecision(std::numeric_limits<double>::max_digits10);  // round trip
+  // the shortest text that reads back as the same double: files compare bit for bit
+  auto put = [&rows](double v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    rows.write(text, end - text);
+  };
   for (size_t i = 0; i < count; ++i) {
     const double t = times[i];
     if (!std::isnan(last_time_) && t <= last_time_) {
@@ -74,8 +80,11 @@ bool CsvRecording::Add(uint64_t batch, const double* times, size_t count, const 
       done_ = true;
       break;
     }
-    rows << t;
-    for (size_t k = 0; k < width_; ++k) rows << "," << data[i * width_ + k];
+    put(t);
+    for (size_t k = 0; k < width_; ++k) {
+      rows << ",";
+      put(data[i * width_ + k]);
+    }
     rows << "\n";
     if (std::isnan(first_time_)) first_time_ = t;
     last_time_ = t;

@@ -92,8 +92,8 @@ struct ModelRef {
 };
 
 /// Files go by content to a Model on another host (or with --send): it shares no disk with us.
-bool ByContent(const ModelRef& m, std::vector<std::string>& args) {
-  return TakeFlag(args, "--send") || m.host != core::HostName();
+bool ByContent(const ModelRef& m, bool send_flag) {
+  return send_flag || m.host != core::HostName();
 }
 
 std::string TakeModel(std::vector<std::string>& args) {
@@ -198,11 +198,12 @@ void Line(const std::string& label, const std::string& value) {
 
 int Load(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
-  ModelRef m = Connect(client, name);
-  const bool send = ByContent(m, args);
+  const bool send_flag = TakeFlag(args, "--send");
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
+  ModelRef m = Connect(client, name);
+  const bool send = ByContent(m, send_flag);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   Call(m, [&] {
     try {
@@ -301,11 +302,12 @@ int Status(Client& client, std::vector<std::string>& args) {
 
 int Save(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
-  ModelRef m = Connect(client, name);
-  const bool fetch = ByContent(m, args);
+  const bool send_flag = TakeFlag(args, "--send");
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
+  ModelRef m = Connect(client, name);
+  const bool fetch = ByContent(m, send_flag);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   if (fetch) {
     M::Octets_var data = Call(m, [&] { return m.model->export_scene(); });
