@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <thread>
 
 #include "batch_plan.h"
+#include "cluster_verbs.h"
 #include "caliper/core/system.h"
 #include "caliper/experiment/experiment.h"
 #include "caliper/model.hh"
@@ -43,6 +45,7 @@ struct BatchOptions {
   double run_timeout_s = 3600;    // the longest a run call may take
   int max_attempts = 5;
   double wait_models_s = 10;      // how long to wait for a first Model
+  unsigned long spawn = 0;        // Models to ask the managers for (0: use those bound)
 };
 
 /// One Model the batch uses, and its worker thread.
@@ -116,6 +119,7 @@ class BatchRun {
   std::vector<bool> written_;
   std::vector<std::string> write_errors_;
   std::atomic<bool> stop_{false};
+  std::vector<SpawnedModel> spawned_;  // asked of the managers; only these are used
   Clock::time_point begin_ = Clock::now();
   Clock::time_point last_progress_;
   double total_sim_s_ = 0;
@@ -181,6 +185,10 @@ void BatchRun::Discover() {
     const std::string name = e.instance + "@" + e.host;
     if (fnmatch(options_.models.c_str(), e.instance.c_str(), 0) != 0 &&
         fnmatch(options_.models.c_str(), name.c_str(), 0) != 0)
+      continue;
+    if (!spawned_.empty() && std::none_of(spawned_.begin(), spawned_.end(), [&](const auto& m) {
+          return m.path == e.path;
+        }))
       continue;
     Slot* known = nullptr;
     for (auto& s : slots_)
@@ -434,6 +442,14 @@ int BatchRun::Run() {
   LoadScenes();
   fs::create_directories(options_.out + "/runs");
   client_.Root();  // fails early with the address when the naming service is not there
+  if (options_.spawn > 0) {
+    std::string why;
+    spawned_ = SpawnModels(client_, options_.spawn, std::cerr, &why);
+    if (spawned_.empty()) throw Failure("no Model could be started: " + why);
+    if (!why.empty())
+      std::cerr << "started " << spawned_.size() << " of " << options_.spawn << " Models; " << why
+                << "\n";
+  }
   const auto waited = Clock::now();
   while (true) {
     Discover();
@@ -487,6 +503,7 @@ int BatchRun::Run() {
   WriteSummary(wall);
   for (const auto& e : write_errors_) std::cerr << "error: " << e << "\n";
   const int rc = interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
+  StopModels(client_, spawned_, std::cerr);
   bool stuck = false;
   {
     std::lock_guard<std::mutex> lock(slots_mutex_);
@@ -525,6 +542,11 @@ int Batch(Client& client, std::vector<std::string>& args) {
   number("--run-timeout", &options.run_timeout_s, 1);
   number("--max-attempts", &attempts, 1);
   number("--wait-models", &options.wait_models_s, 0);
+  double spawn = 0;
+  number("--spawn", &spawn, 1);
+  if (spawn != std::floor(spawn) || spawn > 10000)
+    throw UsageError("--spawn takes a whole number of Models from 1 to 10000");
+  options.spawn = static_cast<unsigned long>(spawn);
   options.max_attempts = static_cast<int>(attempts);
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one experiment FILE");
@@ -549,8 +571,8 @@ int Batch(Client& client, std::vector<std::string>& args) {
 
 void AddBatchVerb(std::map<std::string, Verb>* verbs) {
   Verb verb{
-      "batch FILE [--out DIR] [--models GLOB] [--stall-timeout S] [--max-attempts N]\n"
-      "          [--run-timeout S] [--wait-models S]",
+      "batch FILE [--out DIR] [--models GLOB] [--spawn N] [--stall-timeout S]\n"
+      "          [--max-attempts N] [--run-timeout S] [--wait-models S]",
       "run a file of experiments on every Model in the naming service, as fast as possible",
       Batch, "cluster",
       "  FILE is JSON: a scene, parameter overrides (\"set\"), a command schedule (\"commands\"\n"
@@ -560,6 +582,8 @@ void AddBatchVerb(std::map<std::string, Verb>* verbs) {
       "  time from a fresh load, so results are bit-identical wherever they run.\n"
       "  --models GLOB    Models to use, by instance (model*) or INSTANCE@HOST (*@nodeb);\n"
       "                   Models that appear later join in\n"
+      "  --spawn N        ask the managers for N Models (the freest first), use only those and\n"
+      "                   stop them at the end\n"
       "  --stall-timeout  a busy Model that does not answer for S s (5) loses its run to another\n"
       "  --max-attempts   tries per run before it is reported failed (5)\n"
       "  --run-timeout    the longest one run may take [s] (3600)\n"

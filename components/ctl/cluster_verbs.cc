@@ -126,6 +126,63 @@ struct Slot {
   std::string full;
 };
 
+/// Starts up to `count` Models through `managers`, the freest first, printing each on `report`;
+/// returns those that started and puts why the others did not into `*why`. Failure when no
+/// manager answers.
+std::vector<SpawnedModel> SpawnOn(Client& client, const std::vector<ManagerRef>& managers,
+                                  unsigned long count, const RTC::NameValueList& config,
+                                  std::ostream& report, std::string* why) {
+  std::vector<Slot> slots;
+  std::string away;
+  for (const auto& m : managers) {
+    try {
+      if (!m.error.empty()) throw Failure(m.error);
+      const long capacity = Call(m, [&] { return m.manager->capacity(); });
+      const long running = Call(m, [&] { return m.manager->running(); });
+      slots.push_back({&m, capacity - running, ""});
+      omniORB::setClientCallTimeout(m.manager, kLongCallMs);
+    } catch (const Failure& e) {
+      away += std::string("\n  ") + e.what();
+    }
+  }
+  if (slots.empty())
+    throw Failure("no manager answers in " + client.address() +
+                  (away.empty() ? " (none is bound: start caliper-manager on each host)" : away));
+
+  std::vector<SpawnedModel> created;
+  while (created.size() < count) {
+    // the manager with the most free slots; a full one tells why (its count may be stale)
+    const auto next =
+        std::max_element(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
+          return a.full.empty() != b.full.empty() ? !a.full.empty() : a.free < b.free;
+        });
+    if (!next->full.empty()) break;
+    const ManagerRef& m = *next->ref;
+    C::Child* created_child = Call(m, [&]() -> C::Child* {
+      try {
+        return m.manager->create("model", config);
+      } catch (const C::CapacityReached& e) {
+        next->full = m.entry.instance + ": " + e.reason.in();
+        return nullptr;
+      }
+    });
+    if (created_child == nullptr) continue;
+    C::Child_var child = created_child;
+    report << "created " << child->instance.in() << " (pid " << child->pid << ") as "
+           << child->naming_path.in() << " on " << m.entry.instance << "\n";
+    created.push_back({child->instance.in(), child->naming_path.in(), m.entry.path});
+    --next->free;
+  }
+  why->clear();
+  if (created.size() < count) {
+    std::string reasons;
+    for (const auto& slot : slots)
+      if (!slot.full.empty()) reasons += "\n  " + slot.full;
+    *why = "every manager is full:" + reasons + away;
+  }
+  return created;
+}
+
 int Create(Client& client, std::vector<std::string>& args) {
   std::string value;
   unsigned long count = 1;
@@ -148,56 +205,13 @@ int Create(Client& client, std::vector<std::string>& args) {
   const std::vector<ManagerRef> managers = Targets(client, args);
   RejectOptions(args);
   if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
-
-  std::vector<Slot> slots;
-  std::string away;
-  for (const auto& m : managers) {
-    try {
-      if (!m.error.empty()) throw Failure(m.error);
-      const long capacity = Call(m, [&] { return m.manager->capacity(); });
-      const long running = Call(m, [&] { return m.manager->running(); });
-      slots.push_back({&m, capacity - running, ""});
-      omniORB::setClientCallTimeout(m.manager, kLongCallMs);
-    } catch (const Failure& e) {
-      away += std::string("\n  ") + e.what();
-    }
-  }
-  if (slots.empty())
-    throw Failure("no manager answers in " + client.address() +
-                  (away.empty() ? " (none is bound: start caliper-manager on each host)" : away));
-
-  unsigned long created = 0;
-  while (created < count) {
-    // the manager with the most free slots; a full one tells why (its count may be stale)
-    const auto next =
-        std::max_element(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
-          return a.full.empty() != b.full.empty() ? !a.full.empty() : a.free < b.free;
-        });
-    if (!next->full.empty()) break;
-    const ManagerRef& m = *next->ref;
-    C::Child* created_child = Call(m, [&]() -> C::Child* {
-      try {
-        return m.manager->create("model", config);
-      } catch (const C::CapacityReached& e) {
-        next->full = m.entry.instance + ": " + e.reason.in();
-        return nullptr;
-      }
-    });
-    if (created_child == nullptr) continue;
-    C::Child_var child = created_child;
-    std::cout << "created " << child->instance.in() << " (pid " << child->pid << ") as "
-              << child->naming_path.in() << " on " << m.entry.instance << "\n";
-    --next->free;
-    ++created;
-  }
-  if (created == count) return 0;
-  std::string reasons;
-  for (const auto& s : slots)
-    if (!s.full.empty()) reasons += "\n  " + s.full;
-  throw Failure((created > 0 ? "created " + std::to_string(created) + " of " +
-                                   std::to_string(count) + "; "
-                             : std::string()) +
-                "every manager is full:" + reasons + away);
+  std::string why;
+  const auto created = SpawnOn(client, managers, count, config, std::cout, &why);
+  if (created.size() == count) return 0;
+  throw Failure((created.empty() ? std::string()
+                                 : "created " + std::to_string(created.size()) + " of " +
+                                       std::to_string(count) + "; ") +
+                why);
 }
 
 int Destroy(Client& client, std::vector<std::string>& args) {
@@ -250,6 +264,28 @@ int Destroy(Client& client, std::vector<std::string>& args) {
 }
 
 }  // namespace
+
+std::vector<SpawnedModel> SpawnModels(Client& client, unsigned long count, std::ostream& report,
+                                      std::string* why) {
+  return SpawnOn(client, Managers(client), count, RTC::NameValueList(), report, why);
+}
+
+void StopModels(Client& client, const std::vector<SpawnedModel>& models, std::ostream& report) {
+  for (const auto& model : models) {
+    try {
+      ManagerRef m;
+      m.entry = client.Find(model.manager_path);
+      m.manager = C::Manager::_narrow(m.entry.object);
+      omniORB::setClientCallTimeout(m.manager, kLongCallMs);
+      Call(m, [&] { m.manager->destroy(model.instance.c_str()); });
+      report << "destroyed " << model.path << "\n";
+    } catch (const std::exception& e) {
+      report << "could not stop " << model.path << ": " << e.what() << "\n";
+    } catch (const CORBA::Exception& e) {
+      report << "could not stop " << model.path << ": " << rtc::Describe(e) << "\n";
+    }
+  }
+}
 
 void AddClusterVerbs(std::map<std::string, Verb>* verbs) {
   (*verbs)["managers"] = {

@@ -225,8 +225,8 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
       rec.data.insert(rec.data.end(), reading.values.begin(), reading.values.end());
   };
   const auto step_begin = Clock::now();
-  auto rate_wall = step_begin;
-  double rate_sim = physics.time();
+  rate_wall_ = step_begin;
+  rate_sim_ = physics.time();
   size_t next_command = 0;
   sample();
   for (uint64_t k = 1; k <= steps; ++k) {
@@ -244,13 +244,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
     if (k % e.every_n_steps == 0) sample();
     if (k % 256 == 0) {
       // let status() and readers in between; the experiment flag keeps control calls out
-      const auto wall = Clock::now();
-      const double span = std::chrono::duration<double>(wall - rate_wall).count();
-      if (span >= 0.5) {
-        achieved_rtf_ = (physics.time() - rate_sim) / span;
-        rate_wall = wall;
-        rate_sim = physics.time();
-      }
+      MeasureRateLocked(0.5);
       lock.unlock();
       std::this_thread::yield();
       lock.lock();
@@ -475,13 +469,16 @@ void ModelCore::Advance(Clock::duration budget) {
       StepLocked();
     } while (Clock::now() - begin < budget && state_ == RunState::kRunning);
   }
+  MeasureRateLocked(1.0);
+}
+
+void ModelCore::MeasureRateLocked(double min_span_s) {
   const auto now = Clock::now();
   const double span = std::chrono::duration<double>(now - rate_wall_).count();
-  if (span >= 1.0) {
-    achieved_rtf_ = (physics.time() - rate_sim_) / span;
-    rate_wall_ = now;
-    rate_sim_ = physics.time();
-  }
+  if (span < min_span_s) return;
+  achieved_rtf_ = (loaded_->physics->time() - rate_sim_) / span;
+  rate_wall_ = now;
+  rate_sim_ = loaded_->physics->time();
 }
 
 void ModelCore::Tick() {

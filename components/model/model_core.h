@@ -172,6 +172,9 @@ class ModelCore {
   void StepLocked();
   void PublishLocked();
   void RewindLocked();
+  /// The achieved real-time factor over the wall time since the last measurement, once at least
+  /// `min_span_s` has passed.
+  void MeasureRateLocked(double min_span_s);
   void Require(bool scene_needed) const;
   /// NotAvailable while an experiment runs (the run owns the simulation).
   void RequireIdle() const;

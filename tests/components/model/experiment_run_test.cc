@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "corpus.h"
 #include "model_core.h"
 
 namespace caliper::model {
@@ -164,6 +165,26 @@ TEST(ExperimentRun, ExportedBytesLoadAgain) {
   // Bullet keeps masses in float
   EXPECT_NEAR(other.Sample({"ecce_arm.forearm.mass"})[0].values[0], 0.77, 1e-6);
   EXPECT_NE(other.status().scene.find("tuned.dae"), std::string::npos);
+}
+
+TEST(ExperimentRun, ZaeArchiveLoadsByContent) {
+  CALIPER_REQUIRE_CORPUS();
+  const std::string zae =
+      ReadFile(caliper::testing::CorpusDir() + "/collada/collada_robots/barrett-hand.zae");
+  ASSERT_GT(zae.size(), 1000u);
+  ModelCore core;
+  core.LoadData("barrett-hand.zae", zae);
+  ASSERT_NE(core.description(), nullptr);
+  EXPECT_GT(core.description()->bodies.size(), 3u);
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+  // a .zae named .dae is read as XML and fails with the name given
+  try {
+    core.LoadData("hand.dae", zae);
+    FAIL() << "a zip archive loaded as .dae";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("hand.dae"), std::string::npos) << e.what();
+  }
+  EXPECT_NE(core.status().scene.find("barrett-hand.zae"), std::string::npos);
 }
 
 }  // namespace
