@@ -22,12 +22,24 @@ BatchPlan::BatchPlan(size_t runs, int max_attempts)
 std::optional<BatchPlan::Ticket> BatchPlan::Next(const std::string& model,
                                                  std::chrono::milliseconds wait) {
   std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait_for(lock, wait, [&] { return !waiting_.empty() || ended_ == outcomes_.size(); });
-  while (!waiting_.empty()) {
+  const auto deadline = std::chrono::steady_clock::now() + wait;
+  // entries of runs that ended meanwhile (a late result) are dropped on the way
+  auto skip_ended = [this] {
+    while (!waiting_.empty()) {
+      const Outcome& o = outcomes_[waiting_.front()];
+      if (o.state != Outcome::State::kDone && o.state != Outcome::State::kFailed) return;
+      waiting_.pop_front();
+    }
+  };
+  skip_ended();
+  while (waiting_.empty() && ended_ != outcomes_.size() &&
+         changed_.wait_until(lock, deadline) != std::cv_status::timeout)
+    skip_ended();
+  skip_ended();
+  if (!waiting_.empty()) {
     const size_t run = waiting_.front();
     waiting_.pop_front();
     Outcome& o = outcomes_[run];
-    if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) continue;
     o.state = Outcome::State::kRunning;
     ++o.attempts;
     const Ticket ticket{run, next_token_++};
@@ -58,6 +70,8 @@ bool BatchPlan::Complete(const Ticket& ticket, Outcome result) {
 
 void BatchPlan::Fail(const Ticket& ticket, const std::string& reason) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // an attempt already given up on does not decide the run: the one under way does
+  if (!Live(ticket)) return;
   Outcome& o = outcomes_[ticket.run];
   Release(ticket);
   if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
@@ -75,7 +89,6 @@ void BatchPlan::Retry(const Ticket& ticket, const std::string& reason) {
   Release(ticket);
   if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
   o.retries.push_back({live_model_[ticket.run], reason});
-  if (!live_[ticket.run].empty()) return;  // another attempt is under way
   if (o.attempts >= max_attempts_) {
     o.state = Outcome::State::kFailed;
     o.reason = "gave up after " + std::to_string(o.attempts) + " attempts";

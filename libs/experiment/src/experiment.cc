@@ -22,9 +22,11 @@ struct Where {
   std::string file;
   std::string experiment;
   [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    std::string where = file;
-    if (!experiment.empty()) where += ": experiment '" + experiment + "'";
-    if (!key.empty()) where += ": " + key;
+    std::string where;
+    auto add = [&where](const std::string& part) { where += (where.empty() ? "" : ": ") + part; };
+    if (!file.empty()) add(file);
+    if (!experiment.empty()) add("experiment '" + experiment + "'");
+    if (!key.empty()) add(key);
     throw FormatError(where + ": " + what);
   }
 };
@@ -66,8 +68,9 @@ std::vector<std::string> Strings(const ptree& node, const Where& where, const st
 }
 
 std::string Resolve(const std::string& path, const std::string& relative_to) {
-  if (path.empty() || fs::path(path).is_absolute()) return path;
-  return (fs::path(relative_to).parent_path() / path).lexically_normal().string();
+  if (path.empty()) return path;
+  if (fs::path(path).is_absolute()) return fs::path(path).lexically_normal().string();
+  return (fs::absolute(relative_to).parent_path() / path).lexically_normal().string();
 }
 
 /// What one JSON object says; absent keys leave `out` as it is.
@@ -77,12 +80,22 @@ void Apply(const ptree& node, const Where& where, Experiment* out,
                                               "every_n_steps", "record", "set",
                                               "commands",    "commands_csv", "sweep",
                                               "experiments"};
+  if (node.empty() && !node.data().empty()) where.Fail("", "expected an object, not a value");
+  std::set<std::string> seen;
   for (const auto& [key, child] : node) {
     if (key.empty()) where.Fail("", "expected an object with keys, not a list");
     if (!kKeys.count(key))
       where.Fail(key, "unknown key (known: name, scene, duration_s, every_n_steps, record, set, "
                       "commands, commands_csv, sweep, experiments)");
+    if (!seen.insert(key).second) where.Fail(key, "given twice");
   }
+  // objects and lists where they belong (an empty list reads as an empty value)
+  for (const char* key : {"set", "sweep"})
+    if (auto v = node.get_child_optional(key); v && !v->data().empty())
+      where.Fail(key, "expected an object {\"id\": ...}");
+  if (auto v = node.get_child_optional("commands");
+      v && (!v->data().empty() || (!v->empty() && !IsList(*v))))
+    where.Fail("commands", "expected a list of [time_s, \"actuator\", value]");
   if (auto v = node.get_child_optional("name")) out->name = v->data();
   if (auto v = node.get_child_optional("scene")) out->scene = Resolve(v->data(), where.file);
   if (auto v = node.get_child_optional("duration_s"))
@@ -106,15 +119,24 @@ void Apply(const ptree& node, const Where& where, Experiment* out,
     out->schedule.clear();
     for (const auto& [k, row] : *v) {
       std::vector<const ptree*> fields;
-      for (const auto& [k2, f] : row) fields.push_back(&f);
-      if (!k.empty() || fields.size() != 3 || !fields[1]->empty())
+      bool keyed = false;
+      for (const auto& [k2, f] : row) {
+        fields.push_back(&f);
+        keyed = keyed || !k2.empty();
+      }
+      if (!k.empty() || keyed || fields.size() != 3 || !fields[1]->empty())
         where.Fail("commands", "expected a list of [time_s, \"actuator\", value]");
       out->schedule.push_back({Number(fields[0]->data(), where, "commands"), fields[1]->data(),
                                Number(fields[2]->data(), where, "commands")});
     }
   }
-  if (auto v = node.get_child_optional("commands_csv"))
-    out->schedule = LoadScheduleCsv(Resolve(v->data(), where.file));
+  if (auto v = node.get_child_optional("commands_csv")) {
+    try {
+      out->schedule = LoadScheduleCsv(Resolve(v->data(), where.file));
+    } catch (const FormatError& e) {
+      where.Fail("commands_csv", e.what());
+    }
+  }
   if (auto v = node.get_child_optional("sweep")) {
     sweep->clear();
     for (const auto& [id, values] : *v) {
@@ -140,12 +162,15 @@ void Expand(const Experiment& base,
   const size_t width = std::to_string(total - 1).size();
   for (size_t k = 0; k < total; ++k) {
     Experiment e = base;
+    // the first key varies slowest; overrides keep the keys' order
+    std::vector<size_t> choice(sweep.size());
     size_t rest = k;
-    for (auto it = sweep.rbegin(); it != sweep.rend(); ++it) {
-      const auto& [id, options] = *it;
-      e.overrides.push_back({id, options[rest % options.size()]});
-      rest /= options.size();
+    for (size_t i = sweep.size(); i-- > 0;) {
+      choice[i] = rest % sweep[i].second.size();
+      rest /= sweep[i].second.size();
     }
+    for (size_t i = 0; i < sweep.size(); ++i)
+      e.overrides.push_back({sweep[i].first, sweep[i].second[choice[i]]});
     std::string index = std::to_string(k);
     e.name += "-" + std::string(width - index.size(), '0') + index;
     out->push_back(std::move(e));
@@ -155,11 +180,14 @@ void Expand(const Experiment& base,
 }  // namespace
 
 uint64_t StepCount(double duration_s, double time_step_s) {
+  if (!(time_step_s > 0) || !(duration_s >= 0) || !std::isfinite(duration_s / time_step_s))
+    throw FormatError("duration " + std::to_string(duration_s) + " s at a time step of " +
+                      std::to_string(time_step_s) + " s is no number of steps");
   return static_cast<uint64_t>(std::llround(duration_s / time_step_s));
 }
 
 void Validate(const Experiment& e) {
-  const Where where{"experiment", e.name};
+  const Where where{"", e.name};
   if (e.name.empty()) where.Fail("name", "missing");
   for (char c : e.name)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-')
@@ -195,6 +223,10 @@ std::vector<Command> LoadScheduleCsv(const std::string& path) {
     } catch (const boost::escaped_list_error& e) {
       where.Fail("line " + std::to_string(number), e.what());
     }
+    for (auto& f : fields) {
+      const auto first = f.find_first_not_of(" \t"), last = f.find_last_not_of(" \t");
+      f = first == std::string::npos ? "" : f.substr(first, last - first + 1);
+    }
     const std::string at = "line " + std::to_string(number);
     if (fields.size() != 3) where.Fail(at, "expected time [s],actuator,value");
     out.push_back({Number(fields[0], where, at), fields[1], Number(fields[2], where, at)});
@@ -222,6 +254,8 @@ std::vector<Experiment> LoadFile(const std::string& path) {
     if (!list->empty() && !IsList(*list)) where.Fail("experiments", "expected a list of objects");
     int index = 0;
     for (const auto& [k, entry] : *list) {
+      if (entry.empty() && !entry.data().empty())
+        where.Fail("experiments", "expected a list of objects, found '" + entry.data() + "'");
       Experiment e = defaults;
       e.name = "run" + std::to_string(++index);
       if (auto name = entry.get_child_optional("name")) e.name = name->data();

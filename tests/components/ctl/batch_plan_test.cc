@@ -431,8 +431,7 @@ TEST(BatchPlan, EveryRunCompletesExactlyOnceUnderConcurrentWorkers) {
           ++wins[t->run];
           winner[t->run] = model;
         }
-        if (percent(random) < 10 && plan.Complete(*t, Result(model, t->run)))
-          ++duplicates_accepted;
+        if (percent(random) < 10 && plan.Complete(*t, Result(model, t->run))) ++duplicates_accepted;
       }
     });
   }
@@ -503,6 +502,21 @@ TEST(BatchPlan, EveryRunEndsExactlyOnceWhenWorkersGiveUp) {
     }
   }
   EXPECT_GT(gave_up, 0u);
+}
+
+TEST(BatchPlan, FailureOfARetriedAttemptDoesNotEndTheRun) {
+  BatchPlan plan(1, 3);
+  const auto first = plan.Next("model0@a", kNoWait);
+  ASSERT_TRUE(first);
+  plan.Retry(*first, "model0@a: no answer for 5 s");
+  const auto second = plan.Next("model1@b", kNoWait);
+  ASSERT_TRUE(second);
+  plan.Fail(*first, "late failure from the Model given up on");
+  EXPECT_FALSE(plan.finished());
+  EXPECT_TRUE(plan.Complete(*second, Result("model1@b", 100)));
+  const Outcome o = plan.outcomes()[0];
+  EXPECT_EQ(o.state, State::kDone);
+  EXPECT_EQ(o.model, "model1@b");
 }
 
 }  // namespace

@@ -127,8 +127,8 @@ TEST_F(ExperimentFileTest, TopLevelNameReplacesTheFileName) {
 }
 
 TEST_F(ExperimentFileTest, ReadsASingleStringAsOneRecordedId) {
-  const auto runs = LoadFile(Write(
-      "a.json", R"({"scene": "arm.dae", "duration_s": 1, "record": "arm.elbow.position"})"));
+  const auto runs = LoadFile(
+      Write("a.json", R"({"scene": "arm.dae", "duration_s": 1, "record": "arm.elbow.position"})"));
   ASSERT_EQ(runs.size(), 1u);
   EXPECT_EQ(runs[0].record, (std::vector<std::string>{"arm.elbow.position"}));
 }
@@ -232,8 +232,8 @@ TEST_F(ExperimentFileTest, SweepsTheCartesianProductWithTheFirstKeySlowest) {
   const auto runs = LoadFile(Write("grid.json", std::string("{") + kRequired + R"(,
     "sweep": {"a": [1, 2], "b": [10, 20, 30]}
   })"));
-  ASSERT_EQ(Names(runs), (std::vector<std::string>{"grid-0", "grid-1", "grid-2", "grid-3",
-                                                   "grid-4", "grid-5"}));
+  ASSERT_EQ(Names(runs),
+            (std::vector<std::string>{"grid-0", "grid-1", "grid-2", "grid-3", "grid-4", "grid-5"}));
   const double a[] = {1, 1, 1, 2, 2, 2};
   const double b[] = {10, 20, 30, 10, 20, 30};
   for (size_t k = 0; k < runs.size(); ++k) {
@@ -362,8 +362,7 @@ TEST_F(ExperimentFileTest, RejectsUnknownKey) {
   const std::string inner = Write("inner.json", std::string("{") + kRequired + R"(,
     "experiments": [{"name": "flex", "sceen": "arm.dae"}]
   })");
-  EXPECT_EQ(ErrorOf([&] { LoadFile(inner); }),
-            inner + ": experiment 'flex': sceen: " + kKnownKeys);
+  EXPECT_EQ(ErrorOf([&] { LoadFile(inner); }), inner + ": experiment 'flex': sceen: " + kKnownKeys);
 }
 
 TEST_F(ExperimentFileTest, NamesFileAndExperimentInErrors) {
@@ -411,8 +410,8 @@ TEST_F(ExperimentFileTest, RejectsNamesThatCannotNameFiles) {
 
 TEST_F(ExperimentFileTest, RejectsBadEveryNSteps) {
   for (const std::string bad : {"0", "-2", "1.5", "1e10"}) {
-    const std::string path = Write("n.json", std::string("{") + kRequired +
-                                                 ", \"every_n_steps\": " + bad + "}");
+    const std::string path =
+        Write("n.json", std::string("{") + kRequired + ", \"every_n_steps\": " + bad + "}");
     EXPECT_EQ(ErrorOf([&] { LoadFile(path); }),
               path + ": every_n_steps: must be a whole number >= 1")
         << bad;
@@ -432,8 +431,7 @@ TEST_F(ExperimentFileTest, RejectsDuplicateNames) {
   const std::string path = Write("dup.json", std::string("{") + kRequired + R"(,
     "experiments": [{"name": "a"}, {"name": "b"}, {"name": "a", "duration_s": 2}]
   })");
-  EXPECT_EQ(ErrorOf([&] { LoadFile(path); }),
-            path + ": experiment 'a': the name is used twice");
+  EXPECT_EQ(ErrorOf([&] { LoadFile(path); }), path + ": experiment 'a': the name is used twice");
 
   const std::string swept = Write("swept.json", std::string("{") + kRequired + R"(,
     "experiments": [{"name": "m-1"}, {"name": "m", "sweep": {"mass": [1, 2]}}]
@@ -502,7 +500,9 @@ TEST_F(ExperimentFileTest, RejectsNestedExperiments) {
             path + ": experiment 'outer': experiments: experiments do not nest");
 }
 
-TEST(Validate, AcceptsAValidExperiment) { EXPECT_EQ(ErrorOf([] { Validate(Valid()); }), ""); }
+TEST(Validate, AcceptsAValidExperiment) {
+  EXPECT_EQ(ErrorOf([] { Validate(Valid()); }), "");
+}
 
 TEST(Validate, RejectsEachMissingOrBadField) {
   struct Case {
@@ -526,7 +526,9 @@ TEST(Validate, RejectsEachMissingOrBadField) {
       {"no actuator", [](Experiment* e) { e->schedule[0].actuator.clear(); },
        "commands: a command without an actuator"},
       {"negative time",
-       [](Experiment* e) { e->schedule.push_back({-0.1, "elbow_extensor", 1}); },
+       [](Experiment* e) {
+         e->schedule.push_back({-0.1, "elbow_extensor", 1});
+       },
        "commands: command 2 for 'elbow_extensor': time must be >= 0 s and the value finite"},
       {"infinite value",
        [](Experiment* e) { e->schedule[0].value = std::numeric_limits<double>::infinity(); },
@@ -560,6 +562,60 @@ TEST(StepCount, RoundsToTheNearestStep) {
   EXPECT_EQ(StepCount(0.75, 0.5), 2u);
   EXPECT_EQ(StepCount(0.2, 0.5), 0u);
   EXPECT_EQ(StepCount(0, 0.001), 0u);
+}
+
+TEST_F(ExperimentFileTest, RejectsKeysGivenTwice) {
+  const std::string path = Write("twice.json", std::string("{") + kRequired +
+                                                   R"(, "duration_s": 9})");
+  const std::string error = ErrorOf([&] { LoadFile(path); });
+  EXPECT_TRUE(Contains(error, path + ": duration_s: given twice")) << error;
+}
+
+TEST_F(ExperimentFileTest, RejectsValuesWhereObjectsOrListsBelong) {
+  for (const std::string bad :
+       {R"("experiments": ["oops", 7])", R"("set": 5)", R"("sweep": 3)", R"("commands": 5)",
+        R"("commands": [{"t": 0, "a": "x", "v": 1}])"}) {
+    const std::string path = Write("bad.json", std::string("{") + kRequired + ", " + bad + "}");
+    EXPECT_FALSE(ErrorOf([&] { LoadFile(path); }).empty()) << bad << " was accepted";
+  }
+}
+
+TEST_F(ExperimentFileTest, ScenePathIsAbsoluteWhenTheFileIsGivenRelative) {
+  Write("rel/exp.json", std::string("{") + kRequired + "}");
+  const fs::path here = fs::current_path();
+  fs::current_path(dir_);
+  const auto runs = LoadFile("rel/exp.json");
+  fs::current_path(here);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_TRUE(fs::path(runs[0].scene).is_absolute()) << runs[0].scene;
+  EXPECT_EQ(runs[0].scene, dir_ + "/rel/arm.dae");
+}
+
+TEST_F(ExperimentFileTest, SweepOverridesKeepTheKeysOrder) {
+  const auto runs = LoadFile(Write("order.json", std::string("{") + kRequired + R"(,
+    "sweep": {"a.x": [1, 2], "b.y": [3]}})"));
+  ASSERT_EQ(runs.size(), 2u);
+  ASSERT_EQ(runs[1].overrides.size(), 2u);
+  EXPECT_EQ(runs[1].overrides[0].id, "a.x");
+  EXPECT_EQ(runs[1].overrides[0].values, std::vector<double>{2});
+  EXPECT_EQ(runs[1].overrides[1].id, "b.y");
+}
+
+TEST_F(ExperimentFileTest, ScheduleCsvFieldsAreTrimmedAndErrorsNameTheExperimentFile) {
+  const std::string csv = Write("s.csv", "time [s],actuator,value\n0.5, elbow_flexor , 3\n");
+  const auto schedule = LoadScheduleCsv(csv);
+  ASSERT_EQ(schedule.size(), 1u);
+  EXPECT_EQ(schedule[0].actuator, "elbow_flexor");
+  const std::string path = Write("uses_csv.json", std::string("{") + kRequired +
+                                                      R"(, "commands_csv": "missing.csv"})");
+  const std::string error = ErrorOf([&] { LoadFile(path); });
+  EXPECT_TRUE(Contains(error, path + ": commands_csv: ")) << error;
+  EXPECT_TRUE(Contains(error, "missing.csv")) << error;
+}
+
+TEST(StepCount, RejectsAZeroTimeStep) {
+  EXPECT_THROW(StepCount(1.0, 0.0), FormatError);
+  EXPECT_THROW(StepCount(1.0, -0.001), FormatError);
 }
 
 }  // namespace
