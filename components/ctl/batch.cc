@@ -1,6 +1,5 @@
 #include "batch.h"
 
-#include <fnmatch.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -25,6 +24,7 @@
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "csv_recording.h"
+#include "model_runs.h"
 
 namespace caliper::ctl {
 
@@ -62,18 +62,6 @@ struct Slot {
   std::thread thread;
 };
 
-/// Makes the calling thread known to omniORB, which per-thread call timeouts need.
-class OmniThread {
- public:
-  OmniThread() : self_(omni_thread::self() == nullptr ? omni_thread::create_dummy() : nullptr) {}
-  ~OmniThread() {
-    if (self_ != nullptr) omni_thread::release_dummy();
-  }
-
- private:
-  omni_thread* self_;
-};
-
 std::string CsvField(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -97,7 +85,6 @@ class BatchRun {
 
  private:
   void LoadScenes();
-  M::Experiment ToIdl(const experiment::Experiment& e) const;
   void Discover();
   void Work(Slot* slot);
   void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
@@ -126,55 +113,21 @@ class BatchRun {
 };
 
 void BatchRun::LoadScenes() {
-  const size_t limit = static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20);
   for (const auto& e : runs_) {
     if (scenes_.count(e.scene)) continue;
-    std::ifstream in(e.scene, std::ios::binary);
-    if (!in) throw Failure(options_.file + ": experiment '" + e.name + "': scene " + e.scene +
-                           " cannot be read");
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.size() > limit)
-      throw Failure(e.scene + " is " + std::to_string(bytes.size() >> 20) +
-                    " MiB: scenes travel in one CORBA message of at most " +
-                    std::to_string(limit >> 20) + " MiB");
-    scenes_[e.scene] = std::move(bytes);
+    try {
+      scenes_[e.scene] = ReadScene(e.scene);
+    } catch (const std::runtime_error& error) {
+      throw Failure(options_.file + ": experiment '" + e.name + "': " + error.what());
+    }
   }
-}
-
-M::Experiment BatchRun::ToIdl(const experiment::Experiment& e) const {
-  M::Experiment out;
-  out.name = e.name.c_str();
-  out.scene_file_name = fs::path(e.scene).filename().c_str();
-  const std::string& bytes = scenes_.at(e.scene);
-  out.scene_data.length(static_cast<CORBA::ULong>(bytes.size()));
-  std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out.scene_data.get_buffer()));
-  out.overrides.length(static_cast<CORBA::ULong>(e.overrides.size()));
-  for (CORBA::ULong i = 0; i < e.overrides.size(); ++i) {
-    out.overrides[i].id = e.overrides[i].id.c_str();
-    const auto& v = e.overrides[i].values;
-    out.overrides[i].value.rows = static_cast<CORBA::ULong>(v.size());
-    out.overrides[i].value.cols = 1;
-    out.overrides[i].value.data.length(static_cast<CORBA::ULong>(v.size()));
-    std::copy(v.begin(), v.end(), out.overrides[i].value.data.get_buffer());
-  }
-  out.schedule.length(static_cast<CORBA::ULong>(e.schedule.size()));
-  for (CORBA::ULong i = 0; i < e.schedule.size(); ++i) {
-    out.schedule[i].time = e.schedule[i].time_s;
-    out.schedule[i].actuator = e.schedule[i].actuator.c_str();
-    out.schedule[i].value = e.schedule[i].value;
-  }
-  out.record.length(static_cast<CORBA::ULong>(e.record.size()));
-  for (CORBA::ULong i = 0; i < e.record.size(); ++i) out.record[i] = e.record[i].c_str();
-  out.every_n_steps = e.every_n_steps;
-  out.duration = e.duration_s;
-  return out;
 }
 
 void BatchRun::Discover() {
-  std::vector<rtc::ComponentEntry> entries;
+  std::vector<ModelEntry> entries;
   try {
     CosNaming::NamingContext_var root = client_.Root();
-    entries = rtc::ListComponents(root);
+    entries = FindModels(root, options_.models);
   } catch (const std::exception&) {
     return;  // the naming service is unreachable for now: the Models we have go on
   } catch (const CORBA::Exception&) {
@@ -182,10 +135,6 @@ void BatchRun::Discover() {
   }
   std::lock_guard<std::mutex> lock(slots_mutex_);
   for (auto& e : entries) {
-    const std::string name = e.instance + "@" + e.host;
-    if (fnmatch(options_.models.c_str(), e.instance.c_str(), 0) != 0 &&
-        fnmatch(options_.models.c_str(), name.c_str(), 0) != 0)
-      continue;
     if (!spawned_.empty() && std::none_of(spawned_.begin(), spawned_.end(), [&](const auto& m) {
           return m.path == e.path;
         }))
@@ -203,7 +152,7 @@ void BatchRun::Discover() {
       continue;
     }
     auto slot = std::make_unique<Slot>();
-    slot->name = name;
+    slot->name = e.name;
     slot->path = e.path;
     slot->model = M::Model::_unchecked_narrow(e.object);
     Slot* raw = slot.get();
@@ -247,7 +196,7 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
     slot->sim_time = 0;
     model = M::Model::_duplicate(slot->model);
   }
-  const M::Experiment idl = ToIdl(runs_[ticket.run]);
+  const M::Experiment idl = ToIdl(runs_[ticket.run], scenes_.at(runs_[ticket.run].scene));
   const auto begin = Clock::now();
   slot->in_call = true;
   try {

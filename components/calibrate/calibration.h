@@ -1,0 +1,112 @@
+#pragma once
+// What a calibration is, without CORBA, Qt or an optimiser: the parameters to fit with their
+// bounds and scaling, the experiments (libs/experiment) and what the real robot measured in
+// each, and the cost of a simulated recording against the measurements.
+//
+// Calibration files are JSON (Boost.PropertyTree), paths relative to the file:
+//   {
+//     "experiments": "runs.json",        experiment file (libs/experiment): scene, schedules,
+//                                        recorded ids, durations
+//     "measured": {"steps": "steps.csv"} per experiment: CSV with `time [s]` and columns named
+//                                        like recordings (`id [unit]`, `id[k] [unit]`); any rate
+//     "parameters": [{"id": "arm.elbow_flexor.stiffness", "lower": 1500, "upper": 6000,
+//                     "scale": "log"}],  linear (default) or log
+//     "channels": [{"id": "arm.elbow.position", "weight": 2, "window_s": [0.5, 4]}],
+//                                        optional: weights and time windows (default 1, all)
+//     "optimiser": {"algorithm": "cmaes", "generations": 60, "population": 10, "sigma0": 0.25},
+//     "seed": 7
+//   }
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "caliper/experiment/experiment.h"
+
+namespace caliper::calibrate {
+
+/// A file or value that cannot be used: the message names the file and what is wrong.
+class SpecError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Parameter {
+  std::string id;
+  double lower = 0, upper = 0;  // bounds, in the parameter's unit
+  bool log_scale = false;       // search log(value) uniformly
+  /// The value at `u` in [0, 1] of the search space, and back.
+  double FromUnit(double u) const;
+  double ToUnit(double value) const;
+};
+
+/// A measured table: times [s] and named columns (`id` or `id[k]`, unit stripped).
+struct Measured {
+  std::string file;
+  std::vector<double> times;
+  std::vector<std::string> columns;
+  std::vector<std::string> units;
+  std::vector<std::vector<double>> values;  // per column, per time
+  /// Linear interpolation of column `c` at `t` (t within the table's time span).
+  double At(size_t c, double t) const;
+};
+
+struct ChannelWeight {
+  double weight = 1;
+  double from_s = -1e300, to_s = 1e300;  // time window [s]
+};
+
+struct Optimiser {
+  std::string algorithm = "cmaes";  // cmaes or xnes (pagmo)
+  unsigned generations = 40;
+  unsigned population = 10;  // per island
+  double sigma0 = 0.25;      // initial step in the unit search space
+};
+
+struct Spec {
+  std::string file;
+  std::vector<experiment::Experiment> experiments;
+  std::vector<Measured> measured;  // one per experiment, same order
+  std::vector<Parameter> parameters;
+  std::map<std::string, ChannelWeight> channels;  // by column name; absent: weight 1, all times
+  Optimiser optimiser;
+  uint64_t seed = 1;
+};
+
+/// Reads a calibration file and the files it names; throws SpecError naming the file.
+Spec LoadSpec(const std::string& path);
+
+/// A measured CSV: a header `time [s],name [unit],...` then numbers; throws SpecError.
+Measured LoadMeasured(const std::string& path);
+
+/// The column names of a recording of `channels`: `id` for a scalar, `id[k]` for an element
+/// (row-major), as in recording CSVs.
+std::vector<std::string> ColumnNames(const std::vector<experiment::Channel>& channels);
+
+/// What one experiment contributes to the cost: per compared column, the RMS of (simulated -
+/// measured) over the measured range of that column, at the simulated sample times inside the
+/// measured time span and the column's window.
+struct ChannelCost {
+  std::string column;
+  double weight = 1;
+  double rms = 0;    // [column unit]
+  double range = 1;  // measured max - min [column unit]
+  size_t samples = 0;
+};
+std::vector<ChannelCost> CompareRecording(const experiment::Recording& simulated,
+                                          const Measured& measured,
+                                          const std::map<std::string, ChannelWeight>& weights);
+
+/// The weighted mean of (rms / range)^2 over every channel of every experiment, square-rooted:
+/// 0 for a perfect fit, about 1 for an error as large as the signal. SpecError when no channel
+/// of the recordings is in the measurements.
+double Cost(const std::vector<ChannelCost>& channels);
+
+/// The experiment with the parameter values as overrides (after its own).
+experiment::Experiment WithParameters(const experiment::Experiment& e,
+                                      const std::vector<Parameter>& parameters,
+                                      const std::vector<double>& values);
+
+}  // namespace caliper::calibrate

@@ -1,0 +1,50 @@
+#pragma once
+// What every client that runs experiments on Models shares (caliper-ctl batch,
+// caliper-calibrate): finding the Models, sending a scene by content, converting experiments and
+// recordings, and making a std::thread known to omniORB.
+
+#include <omniORB4/CORBA.h>
+
+#include <string>
+#include <vector>
+
+#include "caliper/experiment/experiment.h"
+#include "caliper/model.hh"
+#include "caliper/rtc/naming.h"
+
+namespace caliper::ctl {
+
+/// Makes the calling thread known to omniORB, which per-thread call timeouts need.
+class OmniThread {
+ public:
+  OmniThread();
+  ~OmniThread();
+  OmniThread(const OmniThread&) = delete;
+  OmniThread& operator=(const OmniThread&) = delete;
+
+ private:
+  bool dummy_;
+};
+
+/// A Model bound in the naming service.
+struct ModelEntry {
+  std::string name;  // model1@hostb
+  std::string path;  // hostb.host_cxt/model1.rtc
+  CORBA::Object_var object;
+};
+
+/// The Models whose instance (model1) or INSTANCE@HOST matches the glob.
+std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std::string& glob);
+
+/// A scene file's bytes; std::runtime_error when it cannot be read or exceeds what one message
+/// carries (rtc::kMaxMessageBytes less 1 MiB), naming the file and the sizes.
+std::string ReadScene(const std::string& path);
+
+/// The experiment as the Model's run_experiment takes it, with the scene's bytes.
+::Caliper::Simulation::Experiment ToIdl(const experiment::Experiment& e,
+                                        const std::string& scene_bytes);
+
+/// The recording a run returned.
+experiment::Recording FromIdl(const ::Caliper::Simulation::Recording& r);
+
+}  // namespace caliper::ctl
