@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# The calibration example in one command: builds Caliper if needed, starts a private naming
+# service and one Model per core, records the "real robot" (the shipped arm with true parameters
+# 30-50 % away from the file's, optionally with Gaussian noise), calibrates the six parameters
+# from the file's values, and prints each fitted value against the truth. Stops everything at the
+# end. Usage: examples/calibration/run.sh [--noise 0.01] [--out DIR] [extra caliper-calibrate args]
+set -euo pipefail
+HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+ROOT=$(cd "$HERE/../.." && pwd)
+NOISE=0
+OUT=$HERE/results
+EXTRA=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --noise) NOISE=$2; shift 2 ;;
+    --out) OUT=$2; shift 2 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    *) EXTRA+=("$1"); shift ;;
+  esac
+done
+[ "${CALIPER_NO_BUILD:-}" = 1 ] || "$ROOT/launch/caliper" build >/dev/null
+BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
+WORK=$(mktemp -d)
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$WORK"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+PORT=$((20000 + RANDOM % 20000))
+omniNames -start "$PORT" -always -nohostname -datadir "$WORK" \
+  -ORBendPoint "giop:tcp:127.0.0.1:$PORT" >"$WORK/ns.log" 2>&1 &
+PIDS+=($!)
+export CALIPER_NAMESERVICE=corbaname::127.0.0.1:$PORT
+for _ in $(seq 1 50); do nameclt -ORBInitRef "NameService=$CALIPER_NAMESERVICE" list >/dev/null 2>&1 && break; sleep 0.1; done
+MODELS=$(nproc)
+for i in $(seq 0 $((MODELS - 1))); do
+  "$BIN/caliper-model" -o "log.spool_dir=$WORK/spool" -o log.level=warn >"$WORK/model$i.out" 2>&1 &
+  PIDS+=($!)
+done
+for i in $(seq 0 $((MODELS - 1))); do
+  for _ in $(seq 1 100); do "$BIN/caliper-ctl" state "model$i" >/dev/null 2>&1 && break; sleep 0.1; done
+done
+echo "$MODELS Models on $CALIPER_NAMESERVICE"
+CALIPER_CTL="$BIN/caliper-ctl" "$HERE/make_measurements.sh" "$NOISE"
+begin=$(date +%s)
+rc=0
+"$BIN/caliper-calibrate" "$HERE/calibration.json" --out "$OUT" "${EXTRA[@]}" || rc=$?
+echo "wall time: $(( $(date +%s) - begin )) s"
+# the truth, as make_measurements.sh used it
+python3 - "$OUT/parameters.csv" <<'PY'
+import csv, sys
+truth = {"ecce_arm.elbow_flexor.stiffness": 4200, "ecce_arm.elbow_extensor.stiffness": 2000,
+         "ecce_arm.elbow_flexor.resistance": 0.75, "ecce_arm.elbow.spring_damping": 0.2,
+         "ecce_arm.forearm.mass": 1.4, "ecce_arm.elbow_flexor.spool_radius": 0.006}
+print(f"{'parameter':44} {'truth':>10} {'initial':>10} {'fitted':>10} {'error':>8}")
+for row in csv.DictReader(open(sys.argv[1])):
+    t = truth[row["id"]]
+    f = float(row["fitted"])
+    print(f"{row['id']:44} {t:10.5g} {float(row['initial']):10.5g} {f:10.5g} {100 * (f - t) / t:7.2f}%")
+PY
+exit $rc
