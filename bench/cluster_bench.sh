@@ -6,28 +6,11 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
 WORK=$(mktemp -d)
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
-
-PORT=$((20000 + RANDOM % 20000))
-omniNames -start "$PORT" -always -nohostname -datadir "$WORK" \
-  -ORBendPoint "giop:tcp:127.0.0.1:$PORT" >"$WORK/ns.log" 2>&1 &
-PIDS+=($!)
-NS=corbaname::127.0.0.1:$PORT
-for _ in $(seq 1 50); do nameclt -ORBInitRef "NameService=$NS" list >/dev/null 2>&1 && break; sleep 0.1; done
-for i in 0 1; do
-  "$BIN/caliper-model" --nameservice "$NS" -o "log.spool_dir=$WORK/spool" -o log.level=warn \
-    >"$WORK/model$i.out" 2>&1 &
-  PIDS+=($!)
-done
-for i in 0 1; do
-  for _ in $(seq 1 100); do "$BIN/caliper-ctl" --nameservice "$NS" state "model$i" >/dev/null 2>&1 && break; sleep 0.1; done
-done
+# shellcheck source=../launch/local_models.sh
+source "$ROOT/launch/local_models.sh"
+trap 'local_models_stop; rm -rf "$WORK"' EXIT
+local_models_start "$WORK" 2
+NS=$CALIPER_NAMESERVICE
 
 # the shipped arm bending its elbow, 8 runs of 3 s (a sweep over the forearm mass)
 cat >"$WORK/throughput.json" <<JSON

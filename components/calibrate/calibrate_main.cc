@@ -57,15 +57,6 @@ std::string Duration(double s) {
   return Format(s / 3600, 2) + " h";
 }
 
-bool Interrupted() {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  const timespec none = {0, 0};
-  return sigtimedwait(&set, nullptr, &none) > 0;
-}
-
 struct Options {
   std::string file, out, models = "model*", nameservice;
   bool dry_run = false, resume = false;
@@ -291,7 +282,7 @@ int Run(const Options& o) {
   const unsigned first_generation = search->progress().generation;
   bool interrupted = false;
   while (search->progress().generation < spec.optimiser.generations) {
-    interrupted = !search->Generation(Interrupted);
+    interrupted = !search->Generation(ctl::InterruptPending);
     search->Save(checkpoint);
     const Progress& p = search->progress();
     const double wall =

@@ -92,7 +92,6 @@ class BatchRun {
   void Progress(bool last);
   void WriteRun(size_t run, const M::Recording& recording);
   void WriteSummary(double wall_s);
-  bool Interrupted();
 
   Client& client_;
   BatchOptions options_;
@@ -377,15 +376,6 @@ void BatchRun::WriteSummary(double wall_s) {
             << "/summary.csv\n";
 }
 
-bool BatchRun::Interrupted() {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  const timespec none = {0, 0};
-  return sigtimedwait(&set, nullptr, &none) > 0;
-}
-
 int BatchRun::Run() {
   OmniThread omni;
   LoadScenes();
@@ -423,7 +413,7 @@ int BatchRun::Run() {
   bool interrupted = false;
   while (!plan_.finished()) {
     plan_.WaitForChange(std::chrono::milliseconds(100));
-    if (Interrupted()) {
+    if (InterruptPending()) {
       interrupted = true;
       break;
     }

@@ -1,6 +1,7 @@
 #include "model_runs.h"
 
 #include <fnmatch.h>
+#include <signal.h>
 
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,15 @@ OmniThread::OmniThread() : dummy_(omni_thread::self() == nullptr) {
 
 OmniThread::~OmniThread() {
   if (dummy_) omni_thread::release_dummy();
+}
+
+bool InterruptPending() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  const timespec none = {0, 0};
+  return sigtimedwait(&set, nullptr, &none) > 0;
 }
 
 std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std::string& glob) {

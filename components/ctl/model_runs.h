@@ -26,6 +26,10 @@ class OmniThread {
   bool dummy_;
 };
 
+/// True when SIGINT or SIGTERM is pending (for programs that block both in every thread and
+/// look between steps of their work); takes the signal.
+bool InterruptPending();
+
 /// A Model bound in the naming service.
 struct ModelEntry {
   std::string name;  // model1@hostb

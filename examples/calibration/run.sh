@@ -21,28 +21,12 @@ done
 [ "${CALIPER_NO_BUILD:-}" = 1 ] || "$ROOT/launch/caliper" build >/dev/null
 BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
 WORK=$(mktemp -d)
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
+# shellcheck source=../../launch/local_models.sh
+source "$ROOT/launch/local_models.sh"
+trap 'local_models_stop; rm -rf "$WORK"' EXIT
 trap 'exit 130' INT TERM
-PORT=$((20000 + RANDOM % 20000))
-omniNames -start "$PORT" -always -nohostname -datadir "$WORK" \
-  -ORBendPoint "giop:tcp:127.0.0.1:$PORT" >"$WORK/ns.log" 2>&1 &
-PIDS+=($!)
-export CALIPER_NAMESERVICE=corbaname::127.0.0.1:$PORT
-for _ in $(seq 1 50); do nameclt -ORBInitRef "NameService=$CALIPER_NAMESERVICE" list >/dev/null 2>&1 && break; sleep 0.1; done
 MODELS=$(nproc)
-for i in $(seq 0 $((MODELS - 1))); do
-  "$BIN/caliper-model" -o "log.spool_dir=$WORK/spool" -o log.level=warn >"$WORK/model$i.out" 2>&1 &
-  PIDS+=($!)
-done
-for i in $(seq 0 $((MODELS - 1))); do
-  for _ in $(seq 1 100); do "$BIN/caliper-ctl" state "model$i" >/dev/null 2>&1 && break; sleep 0.1; done
-done
+local_models_start "$WORK" "$MODELS"
 echo "$MODELS Models on $CALIPER_NAMESERVICE"
 CALIPER_CTL="$BIN/caliper-ctl" "$HERE/make_measurements.sh" "$NOISE"
 begin=$(date +%s)

@@ -8,31 +8,12 @@ BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 WORK=$(mktemp -d)
 FAILS=0
-PIDS=()
 fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
 pass() { echo "ok: $*"; }
-cleanup() {
-  for p in "${PIDS[@]}"; do kill -KILL "$p" 2>/dev/null; done
-  wait 2>/dev/null
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
-
-PORT=$((20000 + RANDOM % 20000))
-omniNames -start "$PORT" -always -nohostname -datadir "$WORK" \
-  -ORBendPoint "giop:tcp:127.0.0.1:$PORT" >"$WORK/ns.log" 2>&1 &
-PIDS+=($!)
-export CALIPER_NAMESERVICE=corbaname::127.0.0.1:$PORT
-for _ in $(seq 1 50); do nameclt -ORBInitRef "NameService=$CALIPER_NAMESERVICE" list >/dev/null 2>&1 && break; sleep 0.1; done
-start_model() {
-  "$BIN/caliper-model" -o "log.spool_dir=$WORK/spool" -o log.level=warn >>"$WORK/models.out" 2>&1 &
-  PIDS+=($!)
-  MODEL_PID=$!
-}
-start_model; start_model
-for i in 0 1; do
-  for _ in $(seq 1 100); do "$BIN/caliper-ctl" state model$i >/dev/null 2>&1 && break; sleep 0.1; done
-done
+# shellcheck source=../../launch/local_models.sh
+source "$SRC/launch/local_models.sh"
+trap 'local_models_stop; rm -rf "$WORK"' EXIT
+local_models_start "$WORK" 2
 
 # the truth: forearm 1.3 kg (shipped 1), flexor tendon 4000 N/m (shipped 3000)
 cat >"$WORK/runs.json" <<JSON
