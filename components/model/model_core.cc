@@ -113,17 +113,22 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
   const std::string base = std::filesystem::path(file_name).filename().string();
   const std::string ending = base.size() > 4 ? base.substr(base.size() - 4) : "";
   if (ending != ".dae" && ending != ".zae")
-    throw std::runtime_error(file_name + ": a scene sent by content must be named *.dae or *.zae");
-  if (bytes.empty()) throw std::runtime_error(file_name + ": the scene sent is empty");
+    throw LoadError(file_name + ": a scene sent by content must be named *.dae or *.zae");
+  if (bytes.empty()) throw LoadError(file_name + ": the scene sent is empty");
   ScratchDirectory scratch;
   const std::string path = scratch.path() + "/" + base;
   {
     std::ofstream out(path, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out.flush()) throw std::runtime_error("cannot write the scene to " + path);
+    if (!out.flush()) throw LoadError("cannot write the scene to " + path);
   }
   std::vector<std::string> warnings;
-  sgal::Scene scene = collada::Import(path, &warnings);
+  sgal::Scene scene;
+  try {
+    scene = collada::Import(path, &warnings);
+  } catch (const collada::ImportError& e) {
+    throw LoadError(e.what());
+  }
   for (const auto& w : warnings) logging::Get("model").warn("%s", w.c_str());
   return scene;
 }

@@ -53,6 +53,12 @@ class RunFailed : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A scene sent by content that cannot be loaded; the message names the file and the problem.
+class LoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// What run_experiment returns: the recording and where the time went.
 struct RunResult {
   experiment::Recording recording;
@@ -108,7 +114,7 @@ class ModelCore {
   /// Loads `scene_bytes` afresh (any earlier state or command is forgotten, so that the same
   /// experiment gives the same bits on any host), applies the overrides, steps as fast as
   /// possible with the schedule, sampling `record` at t = 0 and every N steps. Other control
-  /// calls get NotAvailable meanwhile; status() shows it RUNNING. Throws std::runtime_error (load),
+  /// calls get NotAvailable meanwhile; status() shows it RUNNING. Throws LoadError,
   /// UnknownId, InvalidValue, or RunFailed when the physics faults. Ends PAUSED at the last step.
   RunResult RunExperiment(const experiment::Experiment& experiment, const std::string& file_name,
                           const std::string& scene_bytes);

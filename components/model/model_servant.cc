@@ -467,15 +467,20 @@ M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
   e.every_n_steps = in.every_n_steps;
   e.duration_s = in.duration;
   const std::string bytes(reinterpret_cast<const char*>(in.scene_data.get_buffer()), in.scene_data.length());
-  RunResult result;
-  try {
-    result = Guard([&] { return core_.RunExperiment(e, e.scene, bytes); });
-  } catch (const experiment::FormatError& error) {
-    throw D::InvalidParameter(error.what());
-  } catch (const RunFailed& error) {
-    logging::Get("model").error("%s", error.what());
-    throw M::RunFailed(error.what());
-  }
+  const RunResult result = Guard([&] {
+    // the run's own failures first: Guard passes the IDL's exceptions through
+    try {
+      return core_.RunExperiment(e, e.scene, bytes);
+    } catch (const experiment::FormatError& error) {
+      throw D::InvalidParameter(error.what());
+    } catch (const RunFailed& error) {
+      logging::Get("model").error("%s", error.what());
+      throw M::RunFailed(error.what());
+    } catch (const LoadError& error) {
+      logging::Get("model").error("%s", error.what());
+      throw M::LoadFailed(error.what());
+    }
+  });
   const experiment::Recording& rec = result.recording;
   auto* out = new M::Recording;
   out->channels.length(static_cast<CORBA::ULong>(rec.channels.size()));

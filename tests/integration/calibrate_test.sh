@@ -88,5 +88,22 @@ if [ $rc -eq 0 ] && grep -q "Model lost" "$WORK/lost.err" && grep -q '^cost ' "$
   pass "a Model killed mid-search: $(grep -m1 'Model lost' "$WORK/lost.err")"
 else cat "$WORK/lost.err"; fail "the search with a killed Model (rc $rc)"; fi
 
+# candidates whose physics faults: a large finite cost each, the search goes on
+cat >"$WORK/faulty.json" <<JSON
+{"scene": "$SRC/models/ecce_arm.dae", "duration_s": 1, "every_n_steps": 10,
+ "record": ["ecce_arm.elbow.position"], "commands": [[0, "biceps", 1]]}
+JSON
+cat >"$WORK/faults.json" <<JSON
+{"experiments": "faulty.json", "measured": {"faulty": "truth/runs/truth.csv"},
+ "parameters": [{"id": "ecce_arm.biceps.max_isometric_force", "lower": 100, "upper": 1e16, "scale": "log"}],
+ "optimiser": {"generations": 2, "population": 6, "sigma0": 0.5}, "seed": 5}
+JSON
+"$BIN/caliper-calibrate" "$WORK/faults.json" --out "$WORK/faults" >"$WORK/faults.out" 2>"$WORK/faults.err"
+rc=$?
+faulted=$(sed -n 's/.*(\([0-9]*\) faulted).*/\1/p' "$WORK/faults.out")
+if [ $rc -eq 0 ] && [ "${faulted:-0}" -ge 1 ] && ! grep -qi nan "$WORK/faults/cost.csv"; then
+  pass "$faulted faulting candidates got a finite cost and the search finished"
+else cat "$WORK/faults.out" "$WORK/faults.err"; fail "faulting candidates (rc $rc, faulted '${faulted}')"; fi
+
 if [ $FAILS -eq 0 ]; then echo "calibrate_test: all checks passed"; exit 0; fi
 echo "calibrate_test: $FAILS checks failed"; exit 1
