@@ -2,7 +2,8 @@
 # caliper-calibrate against two real Models on a private loopback naming service: a short search
 # lowers the cost and moves the parameters toward the truth, the tuned scene re-imports with the
 # fitted values, a SIGKILLed calibration resumes from its checkpoint, a Model killed mid-search
-# loses nothing, and --dry-run reports the initial cost with its plots.
+# loses nothing, faulting candidates cost a finite amount, and --dry-run reports the initial cost
+# with its plots. Also batch runs' handling of a physics fault (failed once, not retried).
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
@@ -104,6 +105,18 @@ faulted=$(sed -n 's/.*(\([0-9]*\) faulted).*/\1/p' "$WORK/faults.out")
 if [ $rc -eq 0 ] && [ "${faulted:-0}" -ge 1 ] && ! grep -qi nan "$WORK/faults/cost.csv"; then
   pass "$faulted faulting candidates got a finite cost and the search finished"
 else cat "$WORK/faults.out" "$WORK/faults.err"; fail "faulting candidates (rc $rc, faulted '${faulted}')"; fi
+
+# batch runs: a run whose physics faults fails once with the Model's report, never retried
+cat >"$WORK/explode.json" <<JSON
+{"scene": "$SRC/models/ecce_arm.dae", "duration_s": 0.5, "record": ["ecce_arm.elbow.position"],
+ "set": {"ecce_arm.biceps.max_isometric_force": 1e15}, "commands": [[0, "biceps", 1]]}
+JSON
+"$BIN/caliper-ctl" batch "$WORK/explode.json" --out "$WORK/explode" >"$WORK/explode.out" 2>&1
+rc=$?
+row=$(tail -n +2 "$WORK/explode/summary.csv")
+if [ $rc -eq 1 ] && [[ "$row" == explode,failed,*,1,* ]] && [[ "$row" == *"faulted at t ="* ]]; then
+  pass "batch: the exploding run failed once with the report: ${row##*,}"
+else cat "$WORK/explode.out"; fail "batch with a faulting run (rc $rc): $row"; fi
 
 if [ $FAILS -eq 0 ]; then echo "calibrate_test: all checks passed"; exit 0; fi
 echo "calibrate_test: $FAILS checks failed"; exit 1
