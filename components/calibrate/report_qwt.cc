@@ -9,7 +9,11 @@
 #include <QApplication>
 #include <QImage>
 #include <QPainter>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdlib>
+#include <string>
 #include <memory>
 
 #include "report.h"
@@ -20,8 +24,13 @@ namespace {
 
 void EnsureApplication() {
   if (QApplication::instance() != nullptr) return;
-  // pictures only: no display needed
+  // pictures only: no display needed (and no session: a private runtime directory if none)
   setenv("QT_QPA_PLATFORM", "offscreen", 1);
+  if (std::getenv("XDG_RUNTIME_DIR") == nullptr) {
+    const std::string runtime = "/tmp/caliper-runtime-" + std::to_string(getuid());
+    mkdir(runtime.c_str(), 0700);
+    setenv("XDG_RUNTIME_DIR", runtime.c_str(), 1);
+  }
   static int argc = 1;
   static char name[] = "caliper-calibrate";
   static char* argv[] = {name, nullptr};
