@@ -30,5 +30,5 @@ local_models_add() {  # WORKDIR: one more Model; LOCAL_MODEL_PID is its pid
 local_models_stop() {
   local p
   for p in "${LOCAL_MODELS_PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
+  for p in "${LOCAL_MODELS_PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
 }

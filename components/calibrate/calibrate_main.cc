@@ -111,7 +111,7 @@ Options Parse(int argc, char** argv) {
   return o;
 }
 
-/// The parameters' values in the scene as it is (asked of a Model).
+// The parameters' values in the scene as it is (asked of a Model).
 std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
   const std::string bytes = ctl::ReadScene(spec.experiments.front().scene);
   std::vector<double> values;
@@ -133,6 +133,8 @@ std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
       }
     } catch (const M::LoadFailed& e) {
       throw SetupError(e.reason.in());
+    } catch (const M::NotAvailable& e) {
+      throw Busy(e.reason.in());  // another Model, or this one once it is idle
     } catch (const ::Caliper::Daq::UnknownId& e) {
       throw SetupError(std::string(e.reason.in()) + " (a parameter to fit)");
     } catch (const ::Caliper::Daq::NotAvailable& e) {
@@ -142,8 +144,8 @@ std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
   return values;
 }
 
-/// channels-EXPERIMENT.csv: the measured, initial and fitted values of every compared column at
-/// the simulated sample times; and its plots.
+// channels-EXPERIMENT.csv: the measured, initial and fitted values of every compared column at
+// the simulated sample times; and its plots.
 std::vector<Plot> WriteChannels(const Options& o, const Spec& spec, const Evaluation& before,
                                 const Evaluation* after) {
   std::vector<Plot> plots;
@@ -284,6 +286,7 @@ int Run(const Options& o) {
   while (search->progress().generation < spec.optimiser.generations) {
     interrupted = !search->Generation(ctl::InterruptPending);
     search->Save(checkpoint);
+    pool.Refresh();  // Models that appeared or came back join the next generation
     const Progress& p = search->progress();
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
@@ -305,16 +308,6 @@ int Run(const Options& o) {
   const Progress& p = search->progress();
   const std::vector<double> fitted = evaluator.ValuesOf(p.best_unit);
   const Evaluation after = evaluator.Evaluate(fitted, true);
-  const std::string tuned = o.out + "/tuned.dae";
-  pool.WithModel([&](M::Model_ptr model) {
-    const auto e = WithParameters(spec.experiments.front(), spec.parameters, fitted);
-    M::Recording_var ignored = model->run_experiment(
-        ctl::ToIdl(e, ctl::ReadScene(e.scene)));  // leaves the tuned scene loaded
-    M::Octets_var data = model->export_scene();
-    core::WriteFileReplacing(tuned, [&](std::ostream& out) {
-      out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
-    });
-  });
   core::WriteFileReplacing(o.out + "/parameters.csv", [&](std::ostream& out) {
     out << "id,initial,fitted,lower,upper,scale,change [%]\n" << std::setprecision(10);
     for (size_t i = 0; i < fitted.size(); ++i)
@@ -339,6 +332,24 @@ int Run(const Options& o) {
   for (auto& plot : WriteChannels(o, spec, before, &after)) plots.push_back(plot);
   const std::string png = o.out + "/report.png";
   const std::string why = WritePng(png, plots);
+  // the tuned scene last: whatever fails there, the results above are written
+  const std::string tuned = o.out + "/tuned.dae";
+  std::string export_error;
+  try {
+    pool.WithModel([&](M::Model_ptr model) {
+      const auto e = WithParameters(spec.experiments.front(), spec.parameters, fitted);
+      M::Recording_var ignored = model->run_experiment(
+          ctl::ToIdl(e, ctl::ReadScene(e.scene)));  // leaves the tuned scene loaded
+      M::Octets_var data = model->export_scene();
+      core::WriteFileReplacing(tuned, [&](std::ostream& out) {
+        out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
+      });
+    });
+  } catch (const std::exception& e) {
+    export_error = e.what();
+  } catch (const CORBA::Exception& e) {
+    export_error = rtc::Describe(e);
+  }
 
   std::cout << "cost " << Format(before.cost, 6) << " -> " << Format(after.cost, 6) << " ("
             << Format(before.cost / std::max(after.cost, 1e-300), 3) << "x lower) after "
@@ -348,9 +359,12 @@ int Run(const Options& o) {
     std::cout << "  " << std::left << std::setw(44) << spec.parameters[i].id << std::right
               << std::setw(12) << Format(initial[i], 6) << " -> " << std::setw(12)
               << Format(fitted[i], 6) << "\n";
-  std::cout << "results: " << o.out << "/parameters.csv, tuned scene: " << tuned << ", "
-            << (why.empty() ? "report: " + png : "no plots: " + why) << "\n";
-  return interrupted ? 130 : 0;
+  std::cout << "results: " << o.out << "/parameters.csv, "
+            << (export_error.empty() ? "tuned scene: " + tuned
+                                     : "no tuned scene (" + export_error + ")")
+            << ", " << (why.empty() ? "report: " + png : "no plots: " + why) << "\n";
+  if (interrupted) return 130;
+  return export_error.empty() ? 0 : 1;
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ std::string Resolve(const std::string& path, const std::string& relative_to) {
   return (fs::absolute(relative_to).parent_path() / path).lexically_normal().string();
 }
 
-/// `name [unit]` -> name, unit.
+// `name [unit]` -> name, unit.
 std::pair<std::string, std::string> SplitHeader(const std::string& field) {
   const auto open = field.rfind(" [");
   if (open == std::string::npos || field.back() != ']') return {field, ""};
@@ -234,9 +234,8 @@ std::vector<ChannelCost> CompareRecording(const experiment::Recording& sim, cons
       sum += d * d;
       ++cost.samples;
     }
-    // a simulated value that is not finite counts as an error of a whole range
+    // not finite: the caller treats the candidate as faulted (see Cost)
     cost.rms = cost.samples ? std::sqrt(sum / static_cast<double>(cost.samples)) : 0;
-    if (!std::isfinite(cost.rms)) cost.rms = cost.range;
     out.push_back(cost);
   }
   return out;

@@ -1,5 +1,6 @@
 #include "evaluator.h"
 
+#include <cmath>
 #include <thread>
 
 #include "caliper/logging/log.h"
@@ -58,6 +59,7 @@ size_t ModelPool::Refresh() {
     try {
       omniORB::setClientThreadCallTimeout(1000);
       M::SimulationStatus_var s = model->status();
+      if (s->state == M::RUNNING) continue;  // still busy with a run given up on
       std::lock_guard<std::mutex> lock(mutex_);
       members_[index].down = false;
     } catch (const CORBA::Exception&) {
@@ -129,6 +131,9 @@ void ModelPool::WithModel(const std::function<void(M::Model_ptr)>& fn) {
     } catch (const CORBA::SystemException& e) {
       last = rtc::Describe(e);
       Release(index, true, last);
+    } catch (const Busy& e) {
+      last = e.what();
+      Release(index, true, last);
     } catch (...) {
       Release(index, false, "");
       throw;
@@ -155,7 +160,8 @@ experiment::Recording ModelPool::Run(const experiment::Experiment& e, const std:
       // a value the engine refuses (e.g. out of its range): like a fault, a bad candidate
       throw RunFault(f.reason.in());
     } catch (const M::NotAvailable& f) {
-      throw SetupError(f.reason.in());
+      // busy with a run given up on earlier (or shutting down): another Model takes this one
+      throw Busy(f.reason.in());
     }
   });
   return out;
@@ -193,6 +199,13 @@ Evaluation Evaluator::Evaluate(const std::vector<double>& values, bool keep_reco
     }
   }
   out.cost = Cost(out.channels);
+  if (!std::isfinite(out.cost)) {
+    // a simulation that ran but gave NaN or infinity is as bad as one that faulted
+    ++faults_;
+    out.faulted = true;
+    out.fault = "the simulated channels are not finite";
+    out.cost = kFaultCost;
+  }
   return out;
 }
 

@@ -66,6 +66,12 @@ class ModelPool {
   std::chrono::steady_clock::time_point last_refresh_;
 };
 
+/// A Model that cannot take a run now (still busy with one given up on, shutting down).
+class Busy : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// A run whose physics faulted; the message is the Model's report.
 class RunFault : public std::runtime_error {
  public:

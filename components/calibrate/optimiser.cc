@@ -15,6 +15,8 @@
 #include <pagmo/population.hpp>
 #include <pagmo/problem.hpp>
 #include <pagmo/s11n.hpp>
+// thread_island{false}: a thread per island, not pagmo's pool, which runs at most as many
+// islands at once as this machine has cores (the Models may be on other machines)
 #include <random>
 #include <thread>
 
@@ -25,7 +27,7 @@ namespace caliper::calibrate {
 
 namespace {
 
-/// The calibration as a pagmo problem in the unit box; fitness is the cost.
+// The calibration as a pagmo problem in the unit box; fitness is the cost.
 struct Fit {
   Evaluator* evaluator = nullptr;
   size_t dimension = 1;
@@ -81,7 +83,7 @@ Search::Search(const Spec& spec, Evaluator& evaluator, unsigned islands,
       return pop;
     }));
   for (unsigned i = 0; i < islands; ++i)
-    impl_->archipelago.push_back(pagmo::thread_island{},
+    impl_->archipelago.push_back(pagmo::thread_island{false},
                                  MakeAlgorithm(spec.optimiser, static_cast<unsigned>(spec.seed + i)),
                                  made[i].get());
   progress_.evaluations = impl_->evaluations_before + evaluator.evaluations();
@@ -112,7 +114,7 @@ Search::Search(const Spec& spec, Evaluator& evaluator, const std::string& checkp
       archive >> algorithm >> xs >> fs;
       pagmo::population pop(impl_->problem, 0u, static_cast<unsigned>(spec.seed + i));
       for (size_t k = 0; k < xs.size(); ++k) pop.push_back(xs[k], fs[k]);
-      impl_->archipelago.push_back(pagmo::thread_island{}, algorithm, pop);
+      impl_->archipelago.push_back(pagmo::thread_island{false}, algorithm, pop);
     }
     progress_.evaluations = evaluations;
     impl_->evaluations_before = evaluations - evaluator.evaluations();

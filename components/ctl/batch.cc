@@ -48,7 +48,7 @@ struct BatchOptions {
   unsigned long spawn = 0;        // Models to ask the managers for (0: use those bound)
 };
 
-/// One Model the batch uses, and its worker thread.
+// One Model the batch uses, and its worker thread.
 struct Slot {
   std::string name;  // model1@hostb
   std::string path;
@@ -58,7 +58,7 @@ struct Slot {
   Clock::time_point since, last_answer;
   double sim_time = 0;  // of the run in flight, from the last status poll [s]
   std::atomic<bool> down{false};
-  std::atomic<bool> in_call{false};
+  bool in_call = false;  // guarded by mutex
   std::thread thread;
 };
 
@@ -81,6 +81,7 @@ class BatchRun {
       : client_(client), options_(std::move(options)), runs_(std::move(runs)),
         plan_(runs_.size(), options_.max_attempts), written_(runs_.size(), false) {}
 
+  // Dispatch, then Finish also when Dispatch throws (its message printed); the exit code.
   int Run();
 
  private:
@@ -90,6 +91,10 @@ class BatchRun {
   void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
   void Watch();
   void Progress(bool last);
+  int Dispatch();
+  // Stops the workers (a worker stuck in a call to a lost Model is left: the process then
+  // ends with _exit) and the Models asked of the managers.
+  int Finish(int rc);
   void WriteRun(size_t run, const M::Recording& recording);
   void WriteSummary(double wall_s);
 
@@ -174,10 +179,11 @@ void BatchRun::Work(Slot* slot) {
       try {
         omniORB::setClientThreadCallTimeout(2000);
         M::SimulationStatus_var s = model->status();
-        slot->down = false;
+        // back when it answers and no longer runs what it was given up on
+        if (s->state != M::RUNNING) slot->down = false;
       } catch (const CORBA::Exception&) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(500));
       }
+      if (slot->down) std::this_thread::sleep_for(std::chrono::milliseconds(500));
       omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
       continue;
     }
@@ -190,6 +196,11 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   M::Model_var model;
   {
     std::lock_guard<std::mutex> lock(slot->mutex);
+    if (stop_) {
+      plan_.Retry(ticket, slot->name + ": the batch was stopped");
+      return;
+    }
+    slot->in_call = true;  // with the ticket: the end of Run sees both or neither
     slot->ticket = ticket;
     slot->since = slot->last_answer = Clock::now();
     slot->sim_time = 0;
@@ -197,10 +208,8 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   }
   const M::Experiment idl = ToIdl(runs_[ticket.run], scenes_.at(runs_[ticket.run].scene));
   const auto begin = Clock::now();
-  slot->in_call = true;
   try {
     M::Recording_var r = model->run_experiment(idl);
-    slot->in_call = false;
     Outcome o;
     o.model = slot->name;
     o.wall_s = Since(begin);
@@ -218,16 +227,17 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   } catch (const D::InvalidParameter& e) {
     plan_.Fail(ticket, e.reason.in());
   } catch (const M::NotAvailable& e) {
+    // busy with a run given up on earlier, or shutting down: set aside until it is idle
     plan_.Retry(ticket, slot->name + ": " + e.reason.in());
-    std::this_thread::sleep_for(std::chrono::seconds(1));
+    slot->down = true;
   } catch (const CORBA::SystemException& e) {
     plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
     slot->down = true;
   } catch (const CORBA::Exception& e) {
     plan_.Fail(ticket, slot->name + ": " + rtc::Describe(e));
   }
-  slot->in_call = false;
   std::lock_guard<std::mutex> lock(slot->mutex);
+  slot->in_call = false;
   slot->ticket.reset();
 }
 
@@ -297,9 +307,6 @@ void BatchRun::Progress(bool last) {
   if (!last && !tty && Since(last_progress_) < 5) return;
   last_progress_ = Clock::now();
   const size_t total = plan_.size(), done = plan_.done(), failed = plan_.failed();
-  double sim = 0;
-  for (const auto& o : plan_.outcomes())
-    if (o.state == Outcome::State::kDone) sim += static_cast<double>(o.steps);
   // simulated seconds: steps of finished runs times their step, plus runs in flight
   double sim_done = 0, sim_left = 0;
   const auto outcomes = plan_.outcomes();
@@ -332,7 +339,6 @@ void BatchRun::Progress(bool last) {
   if (rate > 0 && sim_left > 0) line << ", ETA " << Fixed(std::max(0.0, sim_left) / rate, 0) << " s";
   else if (last) line << ", " << Fixed(wall, 1) << " s";
   std::cerr << (tty ? "\r\033[K" : "") << line.str() << (tty && !last ? "" : "\n") << std::flush;
-  (void)sim;
 }
 
 void BatchRun::WriteSummary(double wall_s) {
@@ -378,6 +384,46 @@ void BatchRun::WriteSummary(double wall_s) {
 
 int BatchRun::Run() {
   OmniThread omni;
+  int rc = 1;
+  try {
+    rc = Dispatch();
+  } catch (const std::exception& e) {
+    // the workers and the spawned Models must end before the error goes up
+    std::cerr << "caliper-ctl batch: " << e.what() << "\n";
+  }
+  return Finish(rc);
+}
+
+int BatchRun::Finish(int rc) {
+  stop_ = true;
+  StopModels(client_, spawned_, std::cerr);
+  bool stuck = false;
+  {
+    std::lock_guard<std::mutex> lock(slots_mutex_);
+    for (auto& s : slots_) {
+      bool in_call;
+      {
+        std::lock_guard<std::mutex> slot_lock(s->mutex);
+        in_call = s->in_call;
+      }
+      if (in_call) {
+        stuck = true;  // a call to a Model that no longer answers: not worth waiting for
+        std::cerr << "note: " << s->name << " still has a call open; not waiting for it\n";
+        s->thread.detach();
+      } else {
+        s->thread.join();
+      }
+    }
+  }
+  if (stuck) {
+    std::cout.flush();
+    std::cerr.flush();
+    _exit(rc);
+  }
+  return rc;
+}
+
+int BatchRun::Dispatch() {
   LoadScenes();
   fs::create_directories(options_.out + "/runs");
   client_.Root();  // fails early with the address when the naming service is not there
@@ -441,26 +487,7 @@ int BatchRun::Run() {
   Progress(true);
   WriteSummary(wall);
   for (const auto& e : write_errors_) std::cerr << "error: " << e << "\n";
-  const int rc = interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
-  StopModels(client_, spawned_, std::cerr);
-  bool stuck = false;
-  {
-    std::lock_guard<std::mutex> lock(slots_mutex_);
-    for (auto& s : slots_) {
-      if (s->in_call) {
-        stuck = true;  // a call to a Model that no longer answers: not worth waiting for
-        std::cerr << "note: " << s->name << " still has a call open; not waiting for it\n";
-        s->thread.detach();
-      } else {
-        s->thread.join();
-      }
-    }
-  }
-  if (stuck) {
-    std::cout.flush();
-    _exit(rc);
-  }
-  return rc;
+  return interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
 }
 
 int Batch(Client& client, std::vector<std::string>& args) {
@@ -480,6 +507,8 @@ int Batch(Client& client, std::vector<std::string>& args) {
   number("--stall-timeout", &options.stall_s, 0.5);
   number("--run-timeout", &options.run_timeout_s, 1);
   number("--max-attempts", &attempts, 1);
+  if (options.run_timeout_s > 4e6) throw UsageError("--run-timeout: at most 4000000 s");
+  if (attempts > 1000) throw UsageError("--max-attempts: at most 1000");
   number("--wait-models", &options.wait_models_s, 0);
   double spawn = 0;
   number("--spawn", &spawn, 1);

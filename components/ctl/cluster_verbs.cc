@@ -19,15 +19,15 @@ namespace RTC = ::Caliper::RTC;
 // create waits until the new Model is bound, destroy until it ended (KILL after 5 s) [ms]
 constexpr CORBA::ULong kLongCallMs = 300 * 1000;
 
-/// A manager as found in the naming service; `manager` is nil when it does not answer.
+// A manager as found in the naming service; `manager` is nil when it does not answer.
 struct ManagerRef {
   rtc::ComponentEntry entry;
   C::Manager_var manager;
   std::string error;  // why it does not answer
 };
 
-/// Every manager bound: its profile says type manager, or (when it does not answer) its
-/// instance name starts with `manager`.
+// Every manager bound: its profile says type manager, or (when it does not answer) its
+// instance name starts with `manager`.
 std::vector<ManagerRef> Managers(Client& client) {
   CosNaming::NamingContext_var root = client.Root();
   std::vector<ManagerRef> out;
@@ -49,7 +49,7 @@ std::vector<ManagerRef> Managers(Client& client) {
   return out;
 }
 
-/// The managers a verb works on: --manager NAME, else all of them.
+// The managers a verb works on: --manager NAME, else all of them.
 std::vector<ManagerRef> Targets(Client& client, std::vector<std::string>& args) {
   std::string name;
   if (!TakeOption(args, "--manager", &name)) return Managers(client);
@@ -64,7 +64,7 @@ std::vector<ManagerRef> Targets(Client& client, std::vector<std::string>& args) 
   return {m};
 }
 
-/// Runs calls on a manager: the IDL's reasons and unreachable managers become Failures.
+// Runs calls on a manager: the IDL's reasons and unreachable managers become Failures.
 template <class F>
 auto Call(const ManagerRef& m, F&& f) -> decltype(f()) {
   try {
@@ -119,16 +119,16 @@ int ListManagers(Client& client, std::vector<std::string>& args) {
   return 0;
 }
 
-/// A manager create may use: its free slots, or the reason it is full.
+// A manager create may use: its free slots, or the reason it is full.
 struct Slot {
   const ManagerRef* ref;
   long free;
   std::string full;
 };
 
-/// Starts up to `count` Models through `managers`, the freest first, printing each on `report`;
-/// returns those that started and puts why the others did not into `*why`. Failure when no
-/// manager answers.
+// Starts up to `count` Models through `managers`, the freest first, printing each on `report`;
+// returns those that started and puts why the others did not into `*why`. Failure when no
+// manager answers.
 std::vector<SpawnedModel> SpawnOn(Client& client, const std::vector<ManagerRef>& managers,
                                   unsigned long count, const RTC::NameValueList& config,
                                   std::ostream& report, std::string* why) {
@@ -158,14 +158,21 @@ std::vector<SpawnedModel> SpawnOn(Client& client, const std::vector<ManagerRef>&
         });
     if (!next->full.empty()) break;
     const ManagerRef& m = *next->ref;
-    C::Child* created_child = Call(m, [&]() -> C::Child* {
-      try {
-        return m.manager->create("model", config);
-      } catch (const C::CapacityReached& e) {
-        next->full = m.entry.instance + ": " + e.reason.in();
-        return nullptr;
-      }
-    });
+    C::Child* created_child = nullptr;
+    try {
+      created_child = Call(m, [&]() -> C::Child* {
+        try {
+          return m.manager->create("model", config);
+        } catch (const C::CapacityReached& e) {
+          next->full = m.entry.instance + ": " + e.reason.in();
+          return nullptr;
+        }
+      });
+    } catch (const Failure& e) {
+      // a start that failed, or a manager gone: that manager is out, the Models made stay
+      report << e.what() << "\n";
+      next->full = e.what();
+    }
     if (created_child == nullptr) continue;
     C::Child_var child = created_child;
     report << "created " << child->instance.in() << " (pid " << child->pid << ") as "

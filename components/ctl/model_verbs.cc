@@ -48,7 +48,7 @@ std::string Num(double v, int precision = 7) {
   return s.str();
 }
 
-/// A number given on the command line (nan and inf pass: the Model judges values).
+// A number given on the command line (nan and inf pass: the Model judges values).
 double ParseNumber(const std::string& text, const std::string& what) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
@@ -57,7 +57,7 @@ double ParseNumber(const std::string& text, const std::string& what) {
   return v;
 }
 
-/// A count from 1 to 2^32 - 1.
+// A count from 1 to 2^32 - 1.
 CORBA::ULong ParseCount(const std::string& text, const std::string& what) {
   const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
     return std::isdigit(static_cast<unsigned char>(c));
@@ -68,7 +68,7 @@ CORBA::ULong ParseCount(const std::string& text, const std::string& what) {
   return static_cast<CORBA::ULong>(v);
 }
 
-/// The Model's process has another working directory: send it absolute paths.
+// The Model's process has another working directory: send it absolute paths.
 std::string Absolute(const std::string& path) {
   if (path.empty() || path[0] == '/') return path;
   char cwd[PATH_MAX];
@@ -83,7 +83,7 @@ S::StringSeq ToSeq(const std::vector<std::string>& ids) {
   return out;
 }
 
-/// The Model a verb works on.
+// The Model a verb works on.
 struct ModelRef {
   std::string name;
   std::string path;
@@ -91,7 +91,7 @@ struct ModelRef {
   M::Model_var model;
 };
 
-/// Files go by content to a Model on another host (or with --send): it shares no disk with us.
+// Files go by content to a Model on another host (or with --send): it shares no disk with us.
 bool ByContent(const ModelRef& m, bool send_flag) {
   return send_flag || m.host != core::HostName();
 }
@@ -122,8 +122,8 @@ ModelRef Connect(Client& client, const std::string& name) {
   return ref;
 }
 
-/// Runs calls on the Model and turns what they raise into messages: a user exception's reason
-/// (exit 1), or that the Model cannot be reached.
+// Runs calls on the Model and turns what they raise into messages: a user exception's reason
+// (exit 1), or that the Model cannot be reached.
 template <class F>
 auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
   try {
@@ -152,7 +152,7 @@ M::SimulationStatus* StatusOf(const ModelRef& m) {
   return Call(m, [&] { return m.model->status(); });
 }
 
-/// Channel metadata by id (one list call).
+// Channel metadata by id (one list call).
 std::map<std::string, D::ChannelInfo> Channels(const ModelRef& m, const std::string& pattern) {
   D::ChannelInfoSeq_var list = Call(m, [&] { return m.model->list(pattern.c_str()); });
   std::map<std::string, D::ChannelInfo> out;
@@ -165,7 +165,7 @@ std::string UnitOf(const std::map<std::string, D::ChannelInfo>& channels, const 
   return it == channels.end() ? "" : it->second.unit.in();
 }
 
-/// `id = v unit`, `id = [a, b, c] unit`, or a matrix row by row under `id (RxC, unit) =`.
+// `id = v unit`, `id = [a, b, c] unit`, or a matrix row by row under `id (RxC, unit) =`.
 void PrintValue(const std::string& id, const std::string& unit, const D::Value& v) {
   const CORBA::ULong n = v.data.length();
   const std::string u = unit.empty() ? "" : " " + unit;
@@ -238,7 +238,7 @@ int Load(Client& client, std::vector<std::string>& args) {
   return 0;
 }
 
-/// start, pause, stop and reset: the call, then the state and time it left.
+// start, pause, stop and reset: the call, then the state and time it left.
 int Control(Client& client, std::vector<std::string>& args, const std::string& verb) {
   const std::string name = TakeModel(args);
   NoArguments(args);
@@ -447,7 +447,7 @@ int Motor(Client& client, std::vector<std::string>& args) {
 
 // ------------------------------------------------------------------------ record
 
-/// Receives the subscription's batches (on ORB threads) and hands them to the recording.
+// Receives the subscription's batches (on ORB threads) and hands them to the recording.
 class CsvConsumer : public virtual POA_Caliper::Daq::DataConsumer {
  public:
   explicit CsvConsumer(CsvRecording* recording) : recording_(recording) {}
@@ -464,7 +464,7 @@ class CsvConsumer : public virtual POA_Caliper::Daq::DataConsumer {
     recording_->Add(batch.batch, batch.times.get_buffer(), count, batch.data.get_buffer(), width);
   }
 
-  /// No batch reaches the recording after this.
+  // No batch reaches the recording after this.
   void Close() {
     std::lock_guard<std::mutex> lock(mutex);
     closed_ = true;
@@ -479,7 +479,7 @@ class CsvConsumer : public virtual POA_Caliper::Daq::DataConsumer {
   bool closed_ = false;
 };
 
-/// `recording:  45% (t = 0.450 of 1 s), 45 samples`; a complete recording shows 100 %.
+// `recording:  45% (t = 0.450 of 1 s), 45 samples`; a complete recording shows 100 %.
 std::string Progress(const CsvRecording& r, double start, double duration) {
   const double t = std::isnan(r.last_time()) ? start : r.last_time();
   std::ostringstream s;

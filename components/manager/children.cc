@@ -27,12 +27,13 @@ double Seconds(std::chrono::steady_clock::duration d) {
 }
 
 std::string EndState(int wait_status) {
+  if (wait_status == -1) return "ended (reaped elsewhere, status unknown)";
   if (WIFEXITED(wait_status)) return "exited with code " + std::to_string(WEXITSTATUS(wait_status));
   if (WIFSIGNALED(wait_status)) return "killed by signal " + std::to_string(WTERMSIG(wait_status));
   return "ended";
 }
 
-/// To the child's group (it leads one), or to the child alone when it left the group.
+// To the child's group (it leads one), or to the child alone when it left the group.
 void SignalChild(pid_t pid, int sig) {
   if (kill(-pid, sig) != 0) kill(pid, sig);
 }
@@ -51,7 +52,7 @@ struct ChildError {
   _exit(127);
 }
 
-/// Appends `value` in decimal to the NUL-terminated `buffer` (async-signal-safe).
+// Appends `value` in decimal to the NUL-terminated `buffer` (async-signal-safe).
 void AppendNumber(char* buffer, long value) {
   char digits[24];
   int n = 0;
@@ -106,7 +107,7 @@ void Supervisor::Run() {
                                 std::to_string(options_.max_running) + " children run (" +
                                 options_.capacity_key + " allows more)");
         const pid_t pid = Spawn(request.type, request.argv);
-        Child& child = children_[pid];
+        Child& child = children_[pid] = Child{};  // a reused pid starts afresh
         child.status.type = request.type;
         child.status.pid = pid;
         child.status.output_file =

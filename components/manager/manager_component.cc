@@ -22,7 +22,7 @@ namespace RTC = ::Caliper::RTC;
 const char* const kStartable = "model";  // the types create() starts
 constexpr auto kPollPeriod = std::chrono::milliseconds(50);
 
-/// The directory of this program (for its sibling programs).
+// The directory of this program (for its sibling programs).
 std::string OwnDirectory() {
   char path[PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
@@ -31,7 +31,7 @@ std::string OwnDirectory() {
   return exe.substr(0, exe.rfind('/'));
 }
 
-/// `giop:tcp:ADDR:` for `giop:tcp:ADDR:PORT`: children cannot share the manager's fixed port.
+// `giop:tcp:ADDR:` for `giop:tcp:ADDR:PORT`: children cannot share the manager's fixed port.
 std::string WithoutPort(const std::string& endpoint) {
   const size_t colon = endpoint.rfind(':');
   if (colon == std::string::npos || colon + 1 == endpoint.size()) return endpoint;

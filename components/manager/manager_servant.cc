@@ -19,8 +19,8 @@ void ToIdl(const ChildStatus& s, C::Child* out) {
   out->uptime = s.uptime;
 }
 
-/// Runs a component call and turns its C++ exceptions into the IDL's; anything else becomes
-/// `Fallback` with the reason (CORBA::INTERNAL for operations that raise nothing).
+// Runs a component call and turns its C++ exceptions into the IDL's; anything else becomes
+// `Fallback` with the reason (CORBA::INTERNAL for operations that raise nothing).
 template <class Fallback = void, class F>
 auto Guard(F&& f) -> decltype(f()) {
   std::string reason;

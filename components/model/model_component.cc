@@ -36,7 +36,16 @@ rtc::ReturnCode ModelComponent::OnActivated() {
 }
 
 rtc::ReturnCode ModelComponent::OnDeactivated() {
-  if (core_->status().state == RunState::kRunning) core_->Pause();
+  try {
+    if (core_->status().state == RunState::kRunning) core_->Pause();
+  } catch (const NotAvailable&) {
+    // an experiment owns the simulation: it is no periodic run to pause
+  }
+  return rtc::ReturnCode::kOk;
+}
+
+rtc::ReturnCode ModelComponent::OnFinalize() {
+  core_->CancelExperiment();  // the ORB's shutdown waits for calls in progress
   return rtc::ReturnCode::kOk;
 }
 

@@ -23,6 +23,7 @@ class ModelComponent : public rtc::Component {
   rtc::ReturnCode OnInitialize() override;
   rtc::ReturnCode OnActivated() override;
   rtc::ReturnCode OnDeactivated() override;
+  rtc::ReturnCode OnFinalize() override;
   rtc::ReturnCode OnExecute() override;
 
   ModelCore& core() { return *core_; }

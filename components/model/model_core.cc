@@ -44,7 +44,7 @@ std::string IdSafe(const std::string& name) {
   return out.empty() ? "model" : out;
 }
 
-/// Everything that belongs to one loaded scene.
+// Everything that belongs to one loaded scene.
 struct ModelCore::Loaded {
   std::shared_ptr<const sgal::Scene> description;  // as loaded (rewind rebuilds from it)
   std::string source;
@@ -66,6 +66,15 @@ void ModelCore::Require(bool scene_needed) const {
   if (scene_needed && !loaded_) throw NotAvailable("no scene is loaded (load one first)");
 }
 
+std::unique_lock<std::mutex> ModelCore::ReadLock() const {
+  ++readers_;
+  std::unique_lock<std::mutex> lock(mutex_);
+  --readers_;
+  return lock;
+}
+
+void ModelCore::CancelExperiment() { cancel_ = true; }
+
 void ModelCore::RequireIdle() const {
   if (!experiment_.empty())
     throw NotAvailable("experiment '" + experiment_ + "' is running; wait for it to end");
@@ -84,7 +93,7 @@ void ModelCore::Load(const std::string& path) {
 
 namespace {
 
-/// A private directory, removed with everything in it when the object goes.
+// A private directory, removed with everything in it when the object goes.
 class ScratchDirectory {
  public:
   ScratchDirectory() {
@@ -167,6 +176,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   {
     std::lock_guard<std::mutex> lock(mutex_);
     RequireIdle();
+    if (cancel_) throw NotAvailable("the Model is shutting down");
     experiment_ = e.name;
   }
   struct EndRun {
@@ -222,6 +232,15 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   const double dt = physics.description().settings.time_step;
   const uint64_t steps = experiment::StepCount(e.duration_s, dt);
   const uint64_t samples = steps / e.every_n_steps + 1;
+  // the recording travels in one message: refuse what cannot arrive before spending the run
+  const double bytes = static_cast<double>(samples) * (rec.values_per_sample + 1) * 8;
+  if (bytes > kMaxRecordingBytes)
+    throw InvalidValue("experiment '" + e.name + "': " + std::to_string(samples) +
+                       " samples of " + std::to_string(rec.values_per_sample) + " values are " +
+                       std::to_string(static_cast<long>(bytes / (1 << 20))) +
+                       " MiB, more than one reply carries (" +
+                       std::to_string(kMaxRecordingBytes >> 20) +
+                       " MiB): sample less often (every_n_steps) or record fewer ids");
   rec.times.reserve(samples);
   rec.data.reserve(samples * rec.values_per_sample);
   auto sample = [&] {
@@ -251,8 +270,12 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
       // let status() and readers in between; the experiment flag keeps control calls out
       MeasureRateLocked(0.5);
       lock.unlock();
-      std::this_thread::yield();
+      // hand the lock to waiting reads (bounded: each takes it once)
+      for (int spin = 0; readers_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
       lock.lock();
+      if (cancel_)
+        throw NotAvailable("experiment '" + e.name + "' cancelled at t = " +
+                           std::to_string(physics.time()) + " s: the Model is shutting down");
     }
   }
   result.step_wall_s = std::chrono::duration<double>(Clock::now() - step_begin).count();
@@ -270,6 +293,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   loaded->name = IdSafe(scene.name.empty() ? "model" : scene.name);
   loaded->physics = physics_bullet::MakeScene(scene, options_);
   std::lock_guard<std::mutex> lock(mutex_);
+  RequireIdle();  // again: an experiment may have begun while this scene was built
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
   last_error_.clear();
@@ -391,7 +415,7 @@ void ModelCore::SetRealTimeFactor(double factor) {
 }
 
 Status ModelCore::status() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = ReadLock();
   Status s;
   const bool running = state_ == RunState::kRunning || !experiment_.empty();
   s.state = experiment_.empty() ? state_ : RunState::kRunning;
@@ -565,7 +589,7 @@ std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) co
 }
 
 std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = ReadLock();
   Require(true);
   try {
     return registry_.Sample(ids);

@@ -3,6 +3,7 @@
 // and parameter writes queued for the next step boundary, run control with a real-time factor,
 // and snapshots for observers. Every public method is thread-safe; a step never overlaps a call.
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -58,6 +59,9 @@ class LoadError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// The largest recording a run may make [bytes]: it returns in one GIOP message (256 MiB).
+constexpr size_t kMaxRecordingBytes = size_t{240} << 20;
 
 /// What run_experiment returns: the recording and where the time went.
 struct RunResult {
@@ -128,6 +132,9 @@ class ModelCore {
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
   Status status() const;
+  /// The Model is shutting down: a running experiment ends at its next slice, later ones are
+  /// refused, both with NotAvailable.
+  void CancelExperiment();
 
   /// Advances a RUNNING simulation by what is due at the real-time factor, or by at most
   /// `budget` of wall time when running as fast as possible. Called by the execution context.
@@ -184,6 +191,9 @@ class ModelCore {
   void Require(bool scene_needed) const;
   /// NotAvailable while an experiment runs (the run owns the simulation).
   void RequireIdle() const;
+  /// Takes the lock for a read, after the running experiment has let go of it (a plain mutex
+  /// does not hand over: an experiment re-locking at once would starve status()).
+  std::unique_lock<std::mutex> ReadLock() const;
   sgal::Scene ImportBytes(const std::string& file_name, const std::string& bytes) const;
   /// ImportBytes, remembering the last result (only RunExperiment's thread calls it).
   std::shared_ptr<const sgal::Scene> ImportCached(const std::string& file_name,
@@ -197,6 +207,8 @@ class ModelCore {
   uint64_t generation_ = 0;
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
+  std::atomic<bool> cancel_{false};     // ends the running experiment (shutting down)
+  mutable std::atomic<int> readers_{0};  // reads waiting for the lock during an experiment
   // the last scene imported from bytes: batches send the same file run after run
   std::string imported_name_, imported_bytes_;
   std::shared_ptr<const sgal::Scene> imported_;

@@ -434,9 +434,13 @@ void ModelServant::load_scene_data(const char* file_name, const M::Octets& data)
   try {
     core_.LoadData(file_name, std::string(reinterpret_cast<const char*>(data.get_buffer()),
                                           data.length()));
+  } catch (const NotAvailable& e) {
+    throw M::NotAvailable(e.what());  // busy with an experiment: not the file's fault
   } catch (const std::exception& e) {
     logging::Get("model").error("load %s (sent by content) failed: %s", file_name, e.what());
     throw M::LoadFailed(e.what());
+  } catch (...) {
+    throw M::LoadFailed("internal error: an exception of unknown type");
   }
 }
 
@@ -481,27 +485,29 @@ M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
       throw M::LoadFailed(error.what());
     }
   });
-  const experiment::Recording& rec = result.recording;
-  auto* out = new M::Recording;
-  out->channels.length(static_cast<CORBA::ULong>(rec.channels.size()));
-  for (CORBA::ULong i = 0; i < rec.channels.size(); ++i) {
-    D::ChannelInfo& c = out->channels[i];
-    c.id = rec.channels[i].id.c_str();
-    c.unit = rec.channels[i].unit.c_str();
-    c.rows = rec.channels[i].rows;
-    c.cols = rec.channels[i].cols;
-    c.writable = false;
-    c.is_static = false;
-  }
-  out->times.length(static_cast<CORBA::ULong>(rec.times.size()));
-  std::copy(rec.times.begin(), rec.times.end(), out->times.get_buffer());
-  out->data.length(static_cast<CORBA::ULong>(rec.data.size()));
-  std::copy(rec.data.begin(), rec.data.end(), out->data.get_buffer());
-  out->values_per_sample = static_cast<CORBA::ULong>(rec.values_per_sample);
-  out->steps = result.steps;
-  out->load_wall_time = result.load_wall_s;
-  out->step_wall_time = result.step_wall_s;
-  return out;
+  return Guard([&] {
+    const experiment::Recording& rec = result.recording;
+    M::Recording_var out = new M::Recording;
+    out->channels.length(static_cast<CORBA::ULong>(rec.channels.size()));
+    for (CORBA::ULong i = 0; i < rec.channels.size(); ++i) {
+      D::ChannelInfo& c = out->channels[i];
+      c.id = rec.channels[i].id.c_str();
+      c.unit = rec.channels[i].unit.c_str();
+      c.rows = rec.channels[i].rows;
+      c.cols = rec.channels[i].cols;
+      c.writable = false;
+      c.is_static = false;
+    }
+    out->times.length(static_cast<CORBA::ULong>(rec.times.size()));
+    std::copy(rec.times.begin(), rec.times.end(), out->times.get_buffer());
+    out->data.length(static_cast<CORBA::ULong>(rec.data.size()));
+    std::copy(rec.data.begin(), rec.data.end(), out->data.get_buffer());
+    out->values_per_sample = static_cast<CORBA::ULong>(rec.values_per_sample);
+    out->steps = result.steps;
+    out->load_wall_time = result.load_wall_s;
+    out->step_wall_time = result.step_wall_s;
+    return out._retn();
+  });
 }
 
 void ModelServant::save_scene(const char* path) {

@@ -58,7 +58,8 @@ done
 start_naming() {  # DATADIR
   mkdir -p "$1"
   in_ns a omniNames -start 2809 -always -nohostname -datadir "$1" \
-    -ORBendPoint giop:tcp:198.51.100.1:2809 >>"$WORK/omninames.log" 2>&1 &
+    -ORBendPoint giop:tcp:198.51.100.1:2809 >>"$WORK/naming-service.out" 2>&1 &
+  NAMING_PID=$!
   for _ in $(seq 1 50); do
     in_ns a nameclt -ORBInitRef "NameService=$NS" list >/dev/null 2>&1 && return 0
     sleep 0.1
@@ -181,7 +182,7 @@ if grep -q "killed by signal 9" "$WORK/managers.out"; then pass "hostb's manager
 else cat "$WORK/managers.out"; fail "the manager does not report the killed Model"; fi
 
 # ---------------------------------------------------------------- the naming service restarts
-pkill -TERM -f "omniNames -start 2809" 2>/dev/null
+kill -TERM "$NAMING_PID" 2>/dev/null
 sleep 0.5
 start_naming "$WORK/names2"  # a fresh data directory: every binding is gone
 for _ in $(seq 1 100); do

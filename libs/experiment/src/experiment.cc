@@ -17,7 +17,7 @@ using boost::property_tree::ptree;
 
 namespace {
 
-/// Where an error is: `file: experiment 'name': key`.
+// Where an error is: `file: experiment 'name': key`.
 struct Where {
   std::string file;
   std::string experiment;
@@ -44,7 +44,7 @@ bool IsList(const ptree& node) {
                                       [](const auto& child) { return child.first.empty(); });
 }
 
-/// A number, or a list of numbers.
+// A number, or a list of numbers.
 std::vector<double> Numbers(const ptree& node, const Where& where, const std::string& key) {
   if (node.empty()) return {Number(node.data(), where, key)};
   if (!IsList(node)) where.Fail(key, "expected a number or a list of numbers");
@@ -73,7 +73,7 @@ std::string Resolve(const std::string& path, const std::string& relative_to) {
   return (fs::absolute(relative_to).parent_path() / path).lexically_normal().string();
 }
 
-/// What one JSON object says; absent keys leave `out` as it is.
+// What one JSON object says; absent keys leave `out` as it is.
 void Apply(const ptree& node, const Where& where, Experiment* out,
            std::vector<std::pair<std::string, std::vector<std::vector<double>>>>* sweep) {
   static const std::set<std::string> kKeys = {"name",        "scene",    "duration_s",
@@ -149,7 +149,7 @@ void Apply(const ptree& node, const Where& where, Experiment* out,
   }
 }
 
-/// One experiment per combination of the sweep's values, named NAME-K.
+// One experiment per combination of the sweep's values, named NAME-K.
 void Expand(const Experiment& base,
             const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& sweep,
             std::vector<Experiment>* out) {
