@@ -10,10 +10,10 @@ WORK=$(mktemp -d)
 source "$ROOT/launch/local_models.sh"
 trap 'local_models_stop; rm -rf "$WORK"' EXIT
 local_models_start "$WORK" 2
-# the example's experiments and measurements, 8 generations
+# the example's experiments and measurements, 16 generations
 CALIPER_CTL="$BIN/caliper-ctl" "$ROOT/examples/calibration/make_measurements.sh" >/dev/null 2>&1
 rate() {  # MODELS_GLOB
-  "$BIN/caliper-calibrate" "$ROOT/examples/calibration/calibration.json" --generations 8 \
+  "$BIN/caliper-calibrate" "$ROOT/examples/calibration/calibration.json" --generations 16 \
     --models "$1" --out "$WORK/out" 2>&1 >/dev/null | sed -n 's/.* \([0-9.]*\) evals\/s .*/\1/p' | tail -1
 }
 one=$(rate model0)
