@@ -5,7 +5,11 @@ LOCAL_MODELS_PIDS=()
 
 local_models_start() {  # WORKDIR COUNT
   local dir=$1 count=$2 port i
-  port=$((20000 + RANDOM % 20000))
+  # a port nobody listens on
+  for _ in $(seq 1 100); do
+    port=$((20000 + RANDOM % 20000))
+    (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null || break
+  done
   mkdir -p "$dir"
   omniNames -start "$port" -always -nohostname -datadir "$dir" \
     -ORBendPoint "giop:tcp:127.0.0.1:$port" >"$dir/naming-service.out" 2>&1 &  # (omninames.log is its data file)

@@ -29,7 +29,10 @@ void EnsureApplication() {
   if (std::getenv("XDG_RUNTIME_DIR") == nullptr) {
     const std::string runtime = "/tmp/caliper-runtime-" + std::to_string(getuid());
     mkdir(runtime.c_str(), 0700);
-    setenv("XDG_RUNTIME_DIR", runtime.c_str(), 1);
+    struct stat info {};
+    // only a directory of our own (another user may have made the name first)
+    if (lstat(runtime.c_str(), &info) == 0 && S_ISDIR(info.st_mode) && info.st_uid == getuid())
+      setenv("XDG_RUNTIME_DIR", runtime.c_str(), 1);
   }
   static int argc = 1;
   static char name[] = "caliper-calibrate";

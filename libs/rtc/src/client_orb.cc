@@ -1,5 +1,6 @@
 #include "caliper/rtc/client_orb.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 #include <vector>
@@ -12,6 +13,10 @@ std::string ListenEndpoint(const std::string& address) {
     if (c == '/' || c == ' ' || c == ',')
       throw std::invalid_argument("listening address '" + address +
                                   "': expected a host name or an IP address");
+  // one colon: a host with a port, which the ORB chooses itself
+  if (std::count(address.begin(), address.end(), ':') == 1)
+    throw std::invalid_argument("listening address '" + address +
+                                "': give the address alone, without a port");
   const bool ipv6 = address.find(':') != std::string::npos && address.front() != '[';
   return "giop:tcp:" + (ipv6 ? "[" + address + "]" : address) + ":";
 }
