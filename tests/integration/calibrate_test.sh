@@ -111,7 +111,7 @@ cat >"$WORK/explode.json" <<JSON
 {"scene": "$SRC/models/ecce_arm.dae", "duration_s": 0.5, "record": ["ecce_arm.elbow.position"],
  "set": {"ecce_arm.biceps.max_isometric_force": 1e15}, "commands": [[0, "biceps", 1]]}
 JSON
-"$BIN/caliper-ctl" batch "$WORK/explode.json" --out "$WORK/explode" >"$WORK/explode.out" 2>&1
+"$BIN/caliper-ctl" batch "$WORK/explode.json" --models model0 --out "$WORK/explode" >"$WORK/explode.out" 2>&1
 rc=$?
 row=$(tail -n +2 "$WORK/explode/summary.csv")
 if [ $rc -eq 1 ] && [[ "$row" == explode,failed,*,1,* ]] && [[ "$row" == *"faulted at t ="* ]]; then
