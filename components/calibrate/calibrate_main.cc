@@ -11,6 +11,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "arguments.h"
 #include "calibration.h"
 #include "caliper/core/system.h"
 #include "caliper/logging/log.h"
@@ -64,49 +65,34 @@ struct Options {
   double run_timeout_s = 300;
 };
 
+unsigned Whole(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || v < 1 || v > 1000000)
+    throw ctl::UsageError(flag + " takes a whole number from 1 to 1000000");
+  return static_cast<unsigned>(v);
+}
+
 Options Parse(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-      return argv[++i];
-    };
-    auto whole = [&](const std::string& text) {
-      char* end = nullptr;
-      const long v = std::strtol(text.c_str(), &end, 10);
-      if (text.empty() || *end != '\0' || v < 1 || v > 1000000)
-        throw std::invalid_argument(a + " takes a whole number >= 1");
-      return static_cast<unsigned>(v);
-    };
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (a == "--out") {
-      o.out = next();
-    } else if (a == "--dry-run") {
-      o.dry_run = true;
-    } else if (a == "--resume") {
-      o.resume = true;
-    } else if (a == "--generations") {
-      o.generations = whole(next());
-    } else if (a == "--islands") {
-      o.islands = whole(next());
-    } else if (a == "--models") {
-      o.models = next();
-    } else if (a == "--nameservice") {
-      o.nameservice = next();
-    } else if (a == "--run-timeout") {
-      o.run_timeout_s = whole(next());
-    } else if (!a.empty() && a[0] == '-') {
-      throw std::invalid_argument("unknown option " + a);
-    } else if (o.file.empty()) {
-      o.file = a;
-    } else {
-      throw std::invalid_argument("one calibration FILE only");
-    }
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (ctl::TakeFlag(args, "-h") || ctl::TakeFlag(args, "--help")) {
+    std::cout << kUsage;
+    std::exit(0);
   }
-  if (o.file.empty()) throw std::invalid_argument("expected a calibration FILE");
+  Options o;
+  std::string value;
+  ctl::TakeOption(args, "--out", &o.out);
+  ctl::TakeOption(args, "--models", &o.models);
+  ctl::TakeOption(args, "--nameservice", &o.nameservice);
+  o.dry_run = ctl::TakeFlag(args, "--dry-run");
+  o.resume = ctl::TakeFlag(args, "--resume");
+  if (ctl::TakeOption(args, "--generations", &value)) o.generations = Whole("--generations", value);
+  if (ctl::TakeOption(args, "--islands", &value)) o.islands = Whole("--islands", value);
+  if (ctl::TakeOption(args, "--run-timeout", &value))
+    o.run_timeout_s = Whole("--run-timeout", value);
+  ctl::RejectOptions(args);
+  if (args.size() != 1) throw ctl::UsageError("expected one calibration FILE");
+  o.file = args[0];
   if (o.out.empty()) o.out = fs::path(o.file).stem().string() + "-calibration";
   return o;
 }
@@ -116,11 +102,9 @@ std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
   const std::string bytes = ctl::ReadScene(spec.experiments.front().scene);
   std::vector<double> values;
   pool.WithModel([&](M::Model_ptr model) {
-    M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
-    data.length(static_cast<CORBA::ULong>(bytes.size()));
-    std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
     try {
-      model->load_scene_data(fs::path(spec.experiments.front().scene).filename().c_str(), data);
+      model->load_scene_data(fs::path(spec.experiments.front().scene).filename().c_str(),
+                             ctl::ToOctets(bytes));
       ::Caliper::Scene::StringSeq ids;
       ids.length(static_cast<CORBA::ULong>(spec.parameters.size()));
       for (CORBA::ULong i = 0; i < ids.length(); ++i) ids[i] = spec.parameters[i].id.c_str();
@@ -373,7 +357,7 @@ int main(int argc, char** argv) {
   Options options;
   try {
     options = Parse(argc, argv);
-  } catch (const std::invalid_argument& e) {
+  } catch (const ctl::UsageError& e) {
     std::cerr << "caliper-calibrate: " << e.what() << "\n" << kUsage;
     return 2;
   }

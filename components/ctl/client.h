@@ -7,15 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "arguments.h"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::ctl {
-
-/// A usage error: the message, then the verb's help; exit code 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// A failure the user should read: exit code 1.
 struct Failure : std::runtime_error {
@@ -72,13 +68,5 @@ struct Verb {
   std::string details;
   bool takes_interrupt = false;
 };
-
-/// Takes `--flag VALUE` out of args; returns true when it was there. UsageError without a value.
-bool TakeOption(std::vector<std::string>& args, const std::string& flag, std::string* value);
-/// Takes `--flag` out of args; returns true when it was there.
-bool TakeFlag(std::vector<std::string>& args, const std::string& flag);
-/// UsageError for the first remaining argument that looks like an option (`--x`), so that a
-/// misspelt option is not taken for a positional argument. Negative numbers pass.
-void RejectOptions(const std::vector<std::string>& args);
 
 }  // namespace caliper::ctl

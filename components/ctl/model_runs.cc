@@ -14,14 +14,6 @@ namespace caliper::ctl {
 
 namespace M = ::Caliper::Simulation;
 
-OmniThread::OmniThread() : dummy_(omni_thread::self() == nullptr) {
-  if (dummy_) omni_thread::create_dummy();
-}
-
-OmniThread::~OmniThread() {
-  if (dummy_) omni_thread::release_dummy();
-}
-
 bool InterruptPending() {
   sigset_t set;
   sigemptyset(&set);
@@ -55,12 +47,18 @@ std::string ReadScene(const std::string& path) {
   return bytes;
 }
 
+M::Octets ToOctets(const std::string& bytes) {
+  M::Octets out(static_cast<CORBA::ULong>(bytes.size()));
+  out.length(static_cast<CORBA::ULong>(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out.get_buffer()));
+  return out;
+}
+
 M::Experiment ToIdl(const experiment::Experiment& e, const std::string& bytes) {
   M::Experiment out;
   out.name = e.name.c_str();
   out.scene_file_name = std::filesystem::path(e.scene).filename().c_str();
-  out.scene_data.length(static_cast<CORBA::ULong>(bytes.size()));
-  std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out.scene_data.get_buffer()));
+  out.scene_data = ToOctets(bytes);
   out.overrides.length(static_cast<CORBA::ULong>(e.overrides.size()));
   for (CORBA::ULong i = 0; i < e.overrides.size(); ++i) {
     out.overrides[i].id = e.overrides[i].id.c_str();

@@ -10,21 +10,12 @@
 
 #include "caliper/experiment/experiment.h"
 #include "caliper/model.hh"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::ctl {
 
-/// Makes the calling thread known to omniORB, which per-thread call timeouts need.
-class OmniThread {
- public:
-  OmniThread();
-  ~OmniThread();
-  OmniThread(const OmniThread&) = delete;
-  OmniThread& operator=(const OmniThread&) = delete;
-
- private:
-  bool dummy_;
-};
+using rtc::OmniThread;
 
 /// True when SIGINT or SIGTERM is pending (for programs that block both in every thread and
 /// look between steps of their work); takes the signal.
@@ -43,6 +34,9 @@ std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std:
 /// A scene file's bytes; std::runtime_error when it cannot be read or exceeds what one message
 /// carries (rtc::kMaxMessageBytes less 1 MiB), naming the file and the sizes.
 std::string ReadScene(const std::string& path);
+
+/// A file's bytes as an IDL octet sequence.
+::Caliper::Simulation::Octets ToOctets(const std::string& bytes);
 
 /// The experiment as the Model's run_experiment takes it, with the scene's bytes.
 ::Caliper::Simulation::Experiment ToIdl(const experiment::Experiment& e,

@@ -16,7 +16,6 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -25,9 +24,9 @@
 
 #include "caliper/model.hh"
 #include "caliper/core/system.h"
-#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "csv_recording.h"
+#include "model_runs.h"
 
 namespace caliper::ctl {
 namespace {
@@ -208,18 +207,14 @@ int Load(Client& client, std::vector<std::string>& args) {
   Call(m, [&] {
     try {
       if (send) {
-        std::ifstream in(path, std::ios::binary);
-        if (!in) throw Failure(path + ": cannot be read");
-        const std::string bytes((std::istreambuf_iterator<char>(in)),
-                                std::istreambuf_iterator<char>());
-        if (bytes.size() + (1u << 20) > static_cast<size_t>(rtc::kMaxMessageBytes))
-          throw Failure(path + " is " + std::to_string(bytes.size() >> 20) +
-                        " MiB: a scene travels in one CORBA message of at most " +
-                        std::to_string((rtc::kMaxMessageBytes >> 20) - 1) + " MiB");
-        M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
-        data.length(static_cast<CORBA::ULong>(bytes.size()));
-        std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
-        m.model->load_scene_data(std::filesystem::path(path).filename().c_str(), data);
+        std::string bytes;
+        try {
+          bytes = ReadScene(path);
+        } catch (const std::runtime_error& e) {
+          throw Failure(e.what());
+        }
+        m.model->load_scene_data(std::filesystem::path(path).filename().c_str(),
+                                 ToOctets(bytes));
       } else {
         m.model->load_scene(path.c_str());
       }

@@ -361,8 +361,7 @@ void LogLink::Impl::FillGap() {
 }
 
 void LogLink::Impl::Run() {
-  // per-thread call timeouts need an omni_thread
-  omni_thread* self = omni_thread::create_dummy();
+  const rtc::OmniThread omni;  // per-thread call timeouts need an omni_thread
   Limit(short_ms);
   auto next = Clock::now();
   for (;;) {
@@ -390,7 +389,6 @@ void LogLink::Impl::Run() {
     finished = true;
   }
   wake.notify_all();
-  if (self != nullptr) omni_thread::release_dummy();
 }
 
 }  // namespace caliper::log_viewer

@@ -163,8 +163,7 @@ void ModelLink::Watch(std::vector<std::string> ids) {
 }
 
 void ModelLink::Run() {
-  // per-thread call timeouts need an omni_thread
-  omni_thread* self = omni_thread::create_dummy();
+  const rtc::OmniThread omni;  // per-thread call timeouts need an omni_thread
   Impl& i = *impl_;
   const auto short_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
   omniORB::setClientConnectTimeout(short_ms);
@@ -323,7 +322,6 @@ void ModelLink::Run() {
   }
   i.model = M::Model::_nil();
   i.root = CosNaming::NamingContext::_nil();
-  if (self != nullptr) omni_thread::release_dummy();
 }
 
 }  // namespace caliper::main_window

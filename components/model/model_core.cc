@@ -58,7 +58,7 @@ ModelCore::ModelCore(physics_bullet::Options options) : options_(options) {}
 
 ModelCore::~ModelCore() {
   // the channels refer to the scene: remove them first
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   registry_.Clear();
 }
 
@@ -66,10 +66,10 @@ void ModelCore::Require(bool scene_needed) const {
   if (scene_needed && !loaded_) throw NotAvailable("no scene is loaded (load one first)");
 }
 
-std::unique_lock<std::mutex> ModelCore::ReadLock() const {
-  ++readers_;
+std::unique_lock<std::mutex> ModelCore::Lock() const {
+  ++waiting_;
   std::unique_lock<std::mutex> lock(mutex_);
-  --readers_;
+  --waiting_;
   return lock;
 }
 
@@ -82,7 +82,7 @@ void ModelCore::RequireIdle() const {
 
 void ModelCore::Load(const std::string& path) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    const auto lock = Lock();
     RequireIdle();
   }
   std::vector<std::string> warnings;
@@ -156,7 +156,7 @@ std::shared_ptr<const sgal::Scene> ModelCore::ImportCached(const std::string& fi
 
 void ModelCore::LoadData(const std::string& file_name, const std::string& bytes) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    const auto lock = Lock();
     RequireIdle();
   }
   LoadScene(ImportBytes(file_name, bytes), file_name + " (sent by content)");
@@ -174,7 +174,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
                                    const std::string& scene_bytes) {
   experiment::Validate(e);
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    const auto lock = Lock();
     RequireIdle();
     if (cancel_) throw NotAvailable("the Model is shutting down");
     experiment_ = e.name;
@@ -215,11 +215,14 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   }
   loaded_->sampler->Refresh();
   experiment::Recording& rec = result.recording;
+  // resolved once: sampling reads through handles (no hashing, no allocation per sample)
+  std::vector<std::pair<daq::Handle, size_t>> columns;  // handle, first value in a sample
   for (const auto& id : e.record) {
     if (!registry_.Contains(id))
       throw UnknownId("experiment '" + e.name + "': unknown id '" + id + "' in record", id);
     const daq::ChannelInfo& info = registry_.Info(id);
     rec.channels.push_back({id, info.unit, info.shape.rows, info.shape.cols});
+    columns.emplace_back(registry_.Resolve(id), rec.values_per_sample);
     rec.values_per_sample += info.shape.size();
   }
   const auto& actuators = loaded_->description->actuators;
@@ -245,8 +248,9 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   rec.data.reserve(samples * rec.values_per_sample);
   auto sample = [&] {
     rec.times.push_back(physics.time());
-    for (const auto& reading : registry_.Sample(e.record))
-      rec.data.insert(rec.data.end(), reading.values.begin(), reading.values.end());
+    const size_t at = rec.data.size();
+    rec.data.resize(at + rec.values_per_sample);
+    for (const auto& [handle, offset] : columns) registry_.Read(handle, &rec.data[at + offset]);
   };
   const auto step_begin = Clock::now();
   rate_wall_ = step_begin;
@@ -270,8 +274,8 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
       // let status() and readers in between; the experiment flag keeps control calls out
       MeasureRateLocked(0.5);
       lock.unlock();
-      // hand the lock to waiting reads (bounded: each takes it once)
-      for (int spin = 0; readers_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
+      // hand the lock to waiting calls (bounded: each takes it once)
+      for (int spin = 0; waiting_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
       lock.lock();
       if (cancel_)
         throw NotAvailable("experiment '" + e.name + "' cancelled at t = " +
@@ -292,7 +296,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   loaded->source = source;
   loaded->name = IdSafe(scene.name.empty() ? "model" : scene.name);
   loaded->physics = physics_bullet::MakeScene(scene, options_);
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   RequireIdle();  // again: an experiment may have begun while this scene was built
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
@@ -339,7 +343,7 @@ void ModelCore::RewindLocked() {
 }
 
 void ModelCore::Start() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   if (state_ == RunState::kFaulted)
@@ -354,14 +358,14 @@ void ModelCore::Start() {
 }
 
 void ModelCore::Pause() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
 }
 
 void ModelCore::Stop() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   RewindLocked();
@@ -369,7 +373,7 @@ void ModelCore::Stop() {
 }
 
 void ModelCore::Reset() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
@@ -383,7 +387,7 @@ void ModelCore::Reset() {
 }
 
 void ModelCore::StepNow(uint64_t n) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
@@ -396,7 +400,7 @@ void ModelCore::StepNow(uint64_t n) {
 void ModelCore::SetTimeStep(double seconds) {
   if (!(seconds > 0 && seconds <= 0.1) || !std::isfinite(seconds))
     throw InvalidValue("time step " + std::to_string(seconds) + " s: must be in (0, 0.1] s");
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   loaded_->physics->SetParameter("simulation.time_step", seconds);
@@ -406,7 +410,7 @@ void ModelCore::SetRealTimeFactor(double factor) {
   if (!(factor >= 0) || !std::isfinite(factor))
     throw InvalidValue("real-time factor " + std::to_string(factor) +
                        ": must be >= 0 (1 real time, 0 as fast as possible)");
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   real_time_factor_ = factor;
   if (loaded_) {
     run_wall_start_ = Clock::now();
@@ -415,7 +419,7 @@ void ModelCore::SetRealTimeFactor(double factor) {
 }
 
 Status ModelCore::status() const {
-  const auto lock = ReadLock();
+  const auto lock = Lock();
   Status s;
   const bool running = state_ == RunState::kRunning || !experiment_.empty();
   s.state = experiment_.empty() ? state_ : RunState::kRunning;
@@ -476,7 +480,7 @@ void ModelCore::PublishLocked() {
 }
 
 void ModelCore::Advance(Clock::duration budget) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   if (!loaded_ || state_ != RunState::kRunning) return;
   sgal::PhysicsScene& physics = *loaded_->physics;
   const auto begin = Clock::now();
@@ -511,19 +515,19 @@ void ModelCore::MeasureRateLocked(double min_span_s) {
 }
 
 void ModelCore::Tick() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   if (loaded_ && state_ == RunState::kRunning) StepLocked();
 }
 
 std::shared_ptr<const sgal::Scene> ModelCore::description() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   return loaded_ ? loaded_->description : nullptr;
 }
 
 void ModelCore::Save(const std::string& path) {
   sgal::Scene current;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    const auto lock = Lock();
     Require(true);
     // the engine's copy holds the parameters tuned while running
     current = loaded_->physics->description();
@@ -533,7 +537,7 @@ void ModelCore::Save(const std::string& path) {
 }
 
 std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   std::vector<ActuatorInfo> out;
   const auto parameters = loaded_->physics->Parameters();
@@ -547,7 +551,7 @@ std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
 }
 
 void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& commands) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   for (const auto& [name, value] : commands) {
@@ -569,7 +573,7 @@ void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& c
 }
 
 std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   std::vector<ActuatorState> out;
   for (const auto& a : loaded_->description->actuators) {
@@ -584,12 +588,12 @@ std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
 }
 
 std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   return registry_.List(pattern.empty() ? "*" : pattern);
 }
 
 std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
-  const auto lock = ReadLock();
+  const auto lock = Lock();
   Require(true);
   try {
     return registry_.Sample(ids);
@@ -599,7 +603,7 @@ std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids)
 }
 
 void ModelCore::SetChannel(const std::string& id, const std::vector<double>& values) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   RequireIdle();
   if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
@@ -627,7 +631,7 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
 
 uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
                               size_t batch_steps) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   Require(true);
   if (every_n_steps == 0) throw InvalidValue("every_n_steps must be at least 1");
   if (ids.empty()) throw InvalidValue("subscribe to at least one id");
@@ -645,7 +649,7 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
 }
 
 void ModelCore::Unsubscribe(uint64_t subscription) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   try {
     recorder_.Unsubscribe(subscription);
   } catch (const daq::UnknownId&) {
@@ -670,7 +674,7 @@ bool ModelCore::WaitForBatches(uint64_t subscription, std::chrono::milliseconds 
 }
 
 void ModelCore::AddListener(CoreListener* listener) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   listeners_.push_back(listener);
   if (loaded_) {
     listener->OnScene(loaded_->description, generation_);
@@ -679,12 +683,12 @@ void ModelCore::AddListener(CoreListener* listener) {
 }
 
 void ModelCore::RemoveListener(CoreListener* listener) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   listeners_.erase(std::remove(listeners_.begin(), listeners_.end(), listener), listeners_.end());
 }
 
 std::string ModelCore::model_name() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  const auto lock = Lock();
   return loaded_ ? loaded_->name : "";
 }
 

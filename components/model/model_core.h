@@ -191,9 +191,9 @@ class ModelCore {
   void Require(bool scene_needed) const;
   /// NotAvailable while an experiment runs (the run owns the simulation).
   void RequireIdle() const;
-  /// Takes the lock for a read, after the running experiment has let go of it (a plain mutex
-  /// does not hand over: an experiment re-locking at once would starve status()).
-  std::unique_lock<std::mutex> ReadLock() const;
+  /// Takes the lock; every call does it this way, so that a running experiment, which lets go
+  /// between slices, hands it over (a plain mutex does not: re-locking at once starves callers).
+  std::unique_lock<std::mutex> Lock() const;
   sgal::Scene ImportBytes(const std::string& file_name, const std::string& bytes) const;
   /// ImportBytes, remembering the last result (only RunExperiment's thread calls it).
   std::shared_ptr<const sgal::Scene> ImportCached(const std::string& file_name,
@@ -208,7 +208,7 @@ class ModelCore {
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
   std::atomic<bool> cancel_{false};     // ends the running experiment (shutting down)
-  mutable std::atomic<int> readers_{0};  // reads waiting for the lock during an experiment
+  mutable std::atomic<int> waiting_{0};  // calls waiting for the lock (see Lock)
   // the last scene imported from bytes: batches send the same file run after run
   std::string imported_name_, imported_bytes_;
   std::shared_ptr<const sgal::Scene> imported_;

@@ -21,6 +21,14 @@ std::string ListenEndpoint(const std::string& address) {
   return "giop:tcp:" + (ipv6 ? "[" + address + "]" : address) + ":";
 }
 
+OmniThread::OmniThread() : dummy_(omni_thread::self() == nullptr) {
+  if (dummy_) omni_thread::create_dummy();
+}
+
+OmniThread::~OmniThread() {
+  if (dummy_) omni_thread::release_dummy();
+}
+
 CORBA::ORB_ptr ClientOrb(const char* program, double call_timeout_s) {
   // omniORB returns the existing ORB when there is one (its arguments are then ignored);
   // per-thread call timeouts (omniORB::setClientThreadCallTimeout) need supportPerThreadTimeOut

@@ -17,6 +17,19 @@ constexpr long kMaxMessageBytes = 256L * 1024 * 1024;
 /// std::invalid_argument for an empty or malformed one.
 std::string ListenEndpoint(const std::string& address);
 
+/// Makes the calling thread known to omniORB for its lifetime, which per-thread call timeouts
+/// need (a std::thread is not an omni_thread); does nothing in a thread omniORB already knows.
+class OmniThread {
+ public:
+  OmniThread();
+  ~OmniThread();
+  OmniThread(const OmniThread&) = delete;
+  OmniThread& operator=(const OmniThread&) = delete;
+
+ private:
+  bool dummy_;
+};
+
 /// The process's ORB: initialised on the first call (endpoint giop:tcp:127.0.0.1, or
 /// giop:tcp:$CALIPER_LISTEN: in network mode; per-thread call timeouts enabled; messages up to
 /// kMaxMessageBytes; `program` names it; outgoing calls and connections time out after
