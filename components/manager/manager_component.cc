@@ -93,6 +93,12 @@ ChildStatus ManagerComponent::Create(
   if (type != kStartable)
     throw UnknownComponent("'" + type + "' is not a type this manager starts (it starts: " +
                            kStartable + ")");
+  // where a child listens and registers is the manager's choice, not a client's
+  if (config.size() > 256) throw StartFailed("more than 256 configuration keys");
+  for (const auto& [key, value] : config)
+    if (key == "corba.endpoint" || key == "naming.service" || key.empty())
+      throw StartFailed("the key '" + key + "' is set by the manager (" +
+                        "its Models listen and register where it does)");
   const core::Config& own = runtime_.config();
   std::vector<std::string> argv = {
       bin_dir_ + "/caliper-" + type, "--nameservice", runtime_.naming_address(),

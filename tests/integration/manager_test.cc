@@ -149,6 +149,11 @@ TEST_F(ManagerTest, AFailedStartShowsTheEndOfTheModelsOutput) {
       << r.err;
   EXPECT_TRUE(Contains(r.err, "/nonexistent/scene.dae")) << r.err;
   EXPECT_TRUE(Contains(Ctl({"managers"}).out, "0/2 running"));
+  // where a child listens is the manager's choice: a client cannot open it to every interface
+  const auto open = Ctl({"create", "-o", "corba.endpoint=giop:tcp::"});
+  EXPECT_EQ(open.exit_code, 1);
+  EXPECT_TRUE(Contains(open.err, "'corba.endpoint' is set by the manager")) << open.err;
+  EXPECT_TRUE(Contains(Ctl({"managers"}).out, "0/2 running"));
 }
 
 TEST_F(ManagerTest, AChildThatNeverRegistersIsStoppedAfterTheStartTimeout) {
