@@ -75,6 +75,12 @@ std::unique_lock<std::mutex> ModelCore::Lock() const {
 
 void ModelCore::CancelExperiment() { cancel_ = true; }
 
+bool ModelCore::EndExperimentLocked(const std::string& request) {
+  if (experiment_.empty()) return false;
+  end_request_ = "a " + request + " request ended it early";
+  return true;
+}
+
 void ModelCore::RequireIdle() const {
   if (!experiment_.empty())
     throw NotAvailable("experiment '" + experiment_ + "' is running; wait for it to end");
@@ -178,6 +184,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
     RequireIdle();
     if (cancel_) throw NotAvailable("the Model is shutting down");
     experiment_ = e.name;
+    end_request_.clear();
   }
   struct EndRun {
     ModelCore* core;
@@ -277,9 +284,10 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
       // hand the lock to waiting calls (bounded: each takes it once)
       for (int spin = 0; waiting_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
       lock.lock();
-      if (cancel_)
-        throw NotAvailable("experiment '" + e.name + "' cancelled at t = " +
-                           std::to_string(physics.time()) + " s: the Model is shutting down");
+      if (cancel_ || !end_request_.empty())
+        throw NotAvailable("experiment '" + e.name + "' ended at t = " +
+                           std::to_string(physics.time()) + " s: " +
+                           (cancel_ ? "the Model is shutting down" : end_request_));
     }
   }
   result.step_wall_s = std::chrono::duration<double>(Clock::now() - step_begin).count();
@@ -360,14 +368,14 @@ void ModelCore::Start() {
 void ModelCore::Pause() {
   const auto lock = Lock();
   Require(true);
-  RequireIdle();
+  if (EndExperimentLocked("pause")) return;
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
 }
 
 void ModelCore::Stop() {
   const auto lock = Lock();
   Require(true);
-  RequireIdle();
+  if (EndExperimentLocked("stop")) return;
   RewindLocked();
   state_ = RunState::kStopped;
 }

@@ -118,7 +118,8 @@ class ModelCore {
   /// Loads `scene_bytes` afresh (any earlier state or command is forgotten, so that the same
   /// experiment gives the same bits on any host), applies the overrides, steps as fast as
   /// possible with the schedule, sampling `record` at t = 0 and every N steps. Other control
-  /// calls get NotAvailable meanwhile; status() shows it RUNNING. Throws LoadError,
+  /// calls get NotAvailable meanwhile, except stop and pause, which end the run early (it then
+  /// throws NotAvailable saying so); status() shows it RUNNING. Throws LoadError,
   /// UnknownId, InvalidValue, or RunFailed when the physics faults. Ends PAUSED at the last step.
   RunResult RunExperiment(const experiment::Experiment& experiment, const std::string& file_name,
                           const std::string& scene_bytes);
@@ -191,6 +192,8 @@ class ModelCore {
   void Require(bool scene_needed) const;
   /// NotAvailable while an experiment runs (the run owns the simulation).
   void RequireIdle() const;
+  /// Asks a running experiment to end at its next slice (stop, pause); false when none runs.
+  bool EndExperimentLocked(const std::string& request);
   /// Takes the lock; every call does it this way, so that a running experiment, which lets go
   /// between slices, hands it over (a plain mutex does not: re-locking at once starves callers).
   std::unique_lock<std::mutex> Lock() const;
@@ -208,6 +211,7 @@ class ModelCore {
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
   std::atomic<bool> cancel_{false};     // ends the running experiment (shutting down)
+  std::string end_request_;             // why the running experiment is to end ("" runs on)
   mutable std::atomic<int> waiting_{0};  // calls waiting for the lock (see Lock)
   // the last scene imported from bytes: batches send the same file run after run
   std::string imported_name_, imported_bytes_;

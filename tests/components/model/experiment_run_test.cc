@@ -5,7 +5,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <future>
 #include <iterator>
+#include <thread>
 
 #include "corpus.h"
 #include "model_core.h"
@@ -165,6 +167,36 @@ TEST(ExperimentRun, ExportedBytesLoadAgain) {
   // Bullet keeps masses in float
   EXPECT_NEAR(other.Sample({"ecce_arm.forearm.mass"})[0].values[0], 0.77, 1e-6);
   EXPECT_NE(other.status().scene.find("tuned.dae"), std::string::npos);
+}
+
+TEST(ExperimentRun, AnswersStatusMeanwhileAndStopEndsIt) {
+  ModelCore core;
+  const std::string arm = ArmBytes();
+  experiment::Experiment e = Bend(1000.0);  // far longer than the test waits
+  auto run = std::async(std::launch::async, [&] { return core.RunExperiment(e, "a.dae", arm); });
+  // status answers while the run steps: it shows the run's progress, not its end
+  Status s;
+  for (int i = 0; i < 2000; ++i) {
+    s = core.status();
+    if (s.steps > 100) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(s.state, RunState::kRunning);
+  EXPECT_GT(s.steps, 100u);
+  EXPECT_LT(s.sim_time, 1000.0);
+  // other control calls are refused; stop ends the run early and says so
+  EXPECT_THROW(core.Start(), NotAvailable);
+  EXPECT_THROW(core.SetChannel("ecce_arm.forearm.mass", {2.0}), NotAvailable);
+  core.Stop();
+  try {
+    run.get();
+    FAIL() << "the run went on after stop";
+  } catch (const NotAvailable& error) {
+    EXPECT_NE(std::string(error.what()).find("a stop request ended it early"), std::string::npos)
+        << error.what();
+  }
+  // the Model takes the next one
+  EXPECT_NO_THROW(core.RunExperiment(Bend(0.05), "ecce_arm.dae", arm));
 }
 
 TEST(ExperimentRun, ZaeArchiveLoadsByContent) {
