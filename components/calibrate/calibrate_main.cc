@@ -137,16 +137,16 @@ std::vector<Plot> WriteChannels(const Options& o, const Spec& spec, const Evalua
     const auto& rec = before.recordings[i];
     const Measured& m = spec.measured[i];
     const auto columns = ColumnNames(rec.channels);
-    std::vector<size_t> shown;
-    for (size_t c = 0; c < columns.size(); ++c)
-      if (std::find(m.columns.begin(), m.columns.end(), columns[c]) != m.columns.end())
-        shown.push_back(c);
+    // (recorded column, measured column) of every channel that has measurements
+    std::vector<std::pair<size_t, size_t>> shown;
+    for (size_t c = 0; c < columns.size(); ++c) {
+      const auto k = std::find(m.columns.begin(), m.columns.end(), columns[c]);
+      if (k != m.columns.end()) shown.emplace_back(c, static_cast<size_t>(k - m.columns.begin()));
+    }
     core::WriteFileReplacing(o.out + "/channels-" + spec.experiments[i].name + ".csv",
                              [&](std::ostream& out) {
       out << "time [s]";
-      for (size_t c : shown) {
-        const size_t k = static_cast<size_t>(
-            std::find(m.columns.begin(), m.columns.end(), columns[c]) - m.columns.begin());
+      for (const auto& [c, k] : shown) {
         const std::string unit = " [" + (m.units[k].empty() ? "-" : m.units[k]) + "]";
         out << "," << columns[c] << " measured" << unit << "," << columns[c] << " initial" << unit;
         if (after) out << "," << columns[c] << " fitted" << unit;
@@ -156,9 +156,7 @@ std::vector<Plot> WriteChannels(const Options& o, const Spec& spec, const Evalua
         const double t = rec.times[s];
         if (t < m.times.front() || t > m.times.back()) continue;
         out << t;
-        for (size_t c : shown) {
-          const size_t k = static_cast<size_t>(
-              std::find(m.columns.begin(), m.columns.end(), columns[c]) - m.columns.begin());
+        for (const auto& [c, k] : shown) {
           out << "," << m.At(k, t) << "," << rec.data[s * rec.values_per_sample + c];
           if (after)
             out << "," << after->recordings[i].data[s * rec.values_per_sample + c];
@@ -166,9 +164,7 @@ std::vector<Plot> WriteChannels(const Options& o, const Spec& spec, const Evalua
         out << "\n";
       }
     });
-    for (size_t c : shown) {
-      const size_t k = static_cast<size_t>(
-          std::find(m.columns.begin(), m.columns.end(), columns[c]) - m.columns.begin());
+    for (const auto& [c, k] : shown) {
       Plot p;
       p.title = spec.experiments[i].name + ": " + columns[c];
       p.x_title = "time [s]";

@@ -93,7 +93,6 @@ Measured LoadMeasured(const std::string& path) {
         m.units.push_back(unit);
       }
       m.values.resize(m.columns.size());
-      m.units.shrink_to_fit();
       continue;
     }
     if (fields.size() != m.columns.size() + 1)
