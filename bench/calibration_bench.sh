@@ -5,11 +5,9 @@
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
-WORK=$(mktemp -d)
 # shellcheck source=../launch/local_models.sh
 source "$ROOT/launch/local_models.sh"
-trap 'local_models_stop; rm -rf "$WORK"' EXIT
-local_models_start "$WORK" 2
+local_models_session 2
 # the example's experiments and measurements, 16 generations
 CALIPER_CTL="$BIN/caliper-ctl" "$ROOT/examples/calibration/make_measurements.sh" >/dev/null 2>&1
 rate() {  # MODELS_GLOB

@@ -5,11 +5,9 @@
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
-WORK=$(mktemp -d)
 # shellcheck source=../launch/local_models.sh
 source "$ROOT/launch/local_models.sh"
-trap 'local_models_stop; rm -rf "$WORK"' EXIT
-local_models_start "$WORK" 2
+local_models_session 2
 NS=$CALIPER_NAMESERVICE
 
 # the shipped arm bending its elbow, 8 runs of 3 s (a sweep over the forearm mass)

@@ -28,3 +28,10 @@ local_models_stop() {
   for p in "${LOCAL_MODELS_PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   for p in "${LOCAL_MODELS_PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
 }
+
+# The usual use: a temporary directory (WORK) and COUNT Models, all gone when the script exits.
+local_models_session() {  # COUNT
+  WORK=$(mktemp -d)
+  trap 'local_models_stop; rm -rf "$WORK"' EXIT
+  local_models_start "$WORK" "$1"
+}

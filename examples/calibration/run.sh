@@ -20,13 +20,11 @@ while [ $# -gt 0 ]; do
 done
 [ "${CALIPER_NO_BUILD:-}" = 1 ] || "$ROOT/launch/caliper" build >/dev/null
 BIN=${CALIPER_BIN_DIR:-$ROOT/build/bin}
-WORK=$(mktemp -d)
 # shellcheck source=../../launch/local_models.sh
 source "$ROOT/launch/local_models.sh"
-trap 'local_models_stop; rm -rf "$WORK"' EXIT
 trap 'exit 130' INT TERM
 MODELS=$(nproc)
-local_models_start "$WORK" "$MODELS"
+local_models_session "$MODELS"
 echo "$MODELS Models on $CALIPER_NAMESERVICE"
 CALIPER_CTL="$BIN/caliper-ctl" "$HERE/make_measurements.sh" "$NOISE"
 begin=$(date +%s)

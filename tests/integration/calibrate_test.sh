@@ -7,14 +7,12 @@
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
-WORK=$(mktemp -d)
 FAILS=0
 fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
 pass() { echo "ok: $*"; }
 # shellcheck source=../../launch/local_models.sh
 source "$SRC/launch/local_models.sh"
-trap 'local_models_stop; rm -rf "$WORK"' EXIT
-local_models_start "$WORK" 2
+local_models_session 2
 
 # the truth: forearm 1.3 kg (shipped 1), flexor tendon 4000 N/m (shipped 3000)
 cat >"$WORK/runs.json" <<JSON
