@@ -394,15 +394,17 @@ void ModelCore::Reset() {
   rate_sim_ = run_sim_start_;
 }
 
-void ModelCore::StepNow(uint64_t n) {
+uint64_t ModelCore::StepNow(uint64_t n) {
   const auto lock = Lock();
   Require(true);
   RequireIdle();
   if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
   if (state_ == RunState::kFaulted)
     throw NotAvailable("the simulation stopped on a fault (" + last_error_ + "); reset it first");
-  for (uint64_t i = 0; i < n && state_ != RunState::kFaulted; ++i) StepLocked();
+  uint64_t ran = 0;
+  for (; ran < n && state_ != RunState::kFaulted; ++ran) StepLocked();
   if (state_ != RunState::kFaulted) state_ = RunState::kPaused;
+  return ran;
 }
 
 void ModelCore::SetTimeStep(double seconds) {

@@ -128,8 +128,8 @@ class ModelCore {
   void Pause();
   void Stop();   // pause and rewind
   void Reset();  // rewind, keep the run state
-  /// Runs n steps now; NotAvailable while running.
-  void StepNow(uint64_t n);
+  /// Runs n steps now and returns how many ran; NotAvailable while running.
+  uint64_t StepNow(uint64_t n);
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
   Status status() const;

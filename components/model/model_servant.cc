@@ -398,7 +398,9 @@ void ModelServant::start() { Guard([&] { core_.Start(); }); }
 void ModelServant::pause() { Guard([&] { core_.Pause(); }); }
 void ModelServant::stop() { Guard([&] { core_.Stop(); }); }
 void ModelServant::reset() { Guard([&] { core_.Reset(); }); }
-void ModelServant::step(CORBA::ULong n) { Guard([&] { core_.StepNow(n); }); }
+CORBA::ULong ModelServant::step(CORBA::ULong n) {
+  return Guard([&] { return static_cast<CORBA::ULong>(core_.StepNow(n)); });
+}
 void ModelServant::set_time_step(CORBA::Double s) {
   Guard([&] { core_.SetTimeStep(s); });
 }

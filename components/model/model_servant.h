@@ -75,7 +75,7 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   void pause() override;
   void stop() override;
   void reset() override;
-  void step(CORBA::ULong n) override;
+  CORBA::ULong step(CORBA::ULong n) override;
   void set_time_step(CORBA::Double seconds) override;
   void set_real_time_factor(CORBA::Double factor) override;
   Caliper::Simulation::SimulationStatus* status() override;
