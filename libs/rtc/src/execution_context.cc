@@ -12,6 +12,7 @@ ExecutionContext::~ExecutionContext() {
 }
 
 ReturnCode ExecutionContext::Start() {
+  std::lock_guard<std::mutex> control(control_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (running_) return ReturnCode::kPreconditionNotMet;
@@ -19,11 +20,13 @@ ReturnCode ExecutionContext::Start() {
     stats_ = ContextStatistics();
   }
   lifecycle_->Startup();
+  // the previous thread was joined by the Stop that ended it, under the same control lock
   if (kind_ == ContextKind::kPeriodic) thread_ = std::thread([this] { Loop(); });
   return ReturnCode::kOk;
 }
 
 ReturnCode ExecutionContext::Stop() {
+  std::lock_guard<std::mutex> control(control_);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!running_) return ReturnCode::kPreconditionNotMet;

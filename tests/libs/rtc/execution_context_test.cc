@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <limits>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "test_component.h"
 
@@ -280,6 +283,84 @@ TEST_F(ExecutionContextTest, ExternalTicksRunOnErrorInError) {
   EXPECT_EQ(component_.count(testing::kOnError), 2);
   EXPECT_EQ(component_.count(testing::kExecute), 1);
   EXPECT_EQ(component_.count(testing::kStateUpdate), 0);
+}
+
+// --- concurrent control (clients calling start/stop and activate/deactivate at once)
+
+TEST_F(ExecutionContextTest, ConcurrentStartsAndStopsFromSixThreadsKeepStartupAndShutdownPaired) {
+  ExecutionContext context(&lifecycle_, ContextKind::kPeriodic, 1000);
+  constexpr int kThreads = 6;
+  constexpr int kPairs = 300;
+  std::atomic<int> started{0}, stopped{0}, refused{0}, other{0};
+  std::vector<std::thread> clients;
+  for (int t = 0; t < kThreads; ++t)
+    clients.emplace_back([&] {
+      for (int i = 0; i < kPairs; ++i) {
+        for (const bool start : {true, false}) {
+          const ReturnCode rc = start ? context.Start() : context.Stop();
+          if (rc == ReturnCode::kOk)
+            ++(start ? started : stopped);
+          else if (rc == ReturnCode::kPreconditionNotMet)
+            ++refused;
+          else
+            ++other;
+        }
+      }
+    });
+  for (auto& c : clients) c.join();
+
+  EXPECT_EQ(other.load(), 0);
+  EXPECT_EQ(started + stopped + refused, 2 * kThreads * kPairs);
+  EXPECT_GT(started.load(), 0);
+  // every accepted start ran on_startup once, every accepted stop on_shutdown once, alternately
+  EXPECT_EQ(component_.count(testing::kStartup), started.load());
+  EXPECT_EQ(component_.count(testing::kShutdown), stopped.load());
+  EXPECT_EQ(started - stopped, context.is_running() ? 1 : 0);
+  std::string previous;
+  for (const std::string& call : component_.calls()) {
+    if (call != "on_startup" && call != "on_shutdown") continue;
+    EXPECT_NE(call, previous) << "two " << call << " in a row";
+    previous = call;
+  }
+  // the context still works: started once more it ticks, stopped it does not
+  if (!context.is_running()) {
+    ASSERT_EQ(context.Start(), ReturnCode::kOk);
+  }
+  const int executes = component_.count(testing::kExecute);
+  EXPECT_TRUE(component_.WaitForExecutes(executes + 5, milliseconds(5000)));
+  ASSERT_EQ(context.Stop(), ReturnCode::kOk);
+  const int after_stop = component_.count(testing::kExecute);
+  std::this_thread::sleep_for(milliseconds(50));
+  EXPECT_EQ(component_.count(testing::kExecute), after_stop);
+}
+
+TEST_F(ExecutionContextTest, ConcurrentActivateDeactivateWhileStartingAndStoppingStayConsistent) {
+  ExecutionContext context(&lifecycle_, ContextKind::kPeriodic, 1000);
+  std::atomic<int> activated{0}, deactivated{0};
+  std::vector<std::thread> clients;
+  for (int t = 0; t < 3; ++t)
+    clients.emplace_back([&] {
+      for (int i = 0; i < 300; ++i) {
+        context.Start();
+        context.Stop();
+      }
+    });
+  for (int t = 0; t < 3; ++t)
+    clients.emplace_back([&] {
+      for (int i = 0; i < 300; ++i) {
+        if (lifecycle_.Deactivate() == ReturnCode::kOk) ++deactivated;
+        if (lifecycle_.Activate() == ReturnCode::kOk) ++activated;
+      }
+    });
+  for (auto& c : clients) c.join();
+  // the component was ACTIVE before: each deactivation was followed by one activation or none
+  const int open = deactivated - activated;
+  EXPECT_TRUE(open == 0 || open == 1) << deactivated << " deactivated, " << activated
+                                      << " activated";
+  EXPECT_EQ(lifecycle_.state(), open == 0 ? State::kActive : State::kInactive);
+  EXPECT_EQ(component_.count(testing::kActivated), activated.load() + 1) << "one in SetUp";
+  EXPECT_EQ(component_.count(testing::kDeactivated), deactivated.load());
+  EXPECT_EQ(component_.count(testing::kAborting), 0);
 }
 
 }  // namespace

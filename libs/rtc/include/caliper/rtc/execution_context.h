@@ -1,6 +1,9 @@
 #pragma once
 // Execution contexts: what makes a component's on_execute run. PERIODIC owns a thread that ticks
 // at a rate and counts overruns; EXTERNAL is ticked from outside (lock-step simulation).
+// Start and Stop may be called from any number of threads at once (several clients over CORBA):
+// they take turns, each one whole (hook, thread start or join), so on_startup and on_shutdown
+// alternate and the ticking thread is never replaced while it runs.
 
 #include <chrono>
 #include <condition_variable>
@@ -28,8 +31,10 @@ class ExecutionContext {
   ~ExecutionContext();
 
   /// Runs on_startup and, for PERIODIC, starts the thread; PRECONDITION_NOT_MET when running.
+  /// Not from a hook of this context's own component (it would wait for itself).
   ReturnCode Start();
-  /// Stops the thread and runs on_shutdown; PRECONDITION_NOT_MET when not running.
+  /// Stops the thread (waiting for a tick in progress) and runs on_shutdown;
+  /// PRECONDITION_NOT_MET when not running. Not from a hook of this context's own component.
   ReturnCode Stop();
   bool is_running() const;
   double rate() const;
@@ -47,7 +52,8 @@ class ExecutionContext {
 
   Lifecycle* lifecycle_;
   const ContextKind kind_;
-  mutable std::mutex mutex_;
+  std::mutex control_;  // held through a whole Start or Stop: one at a time
+  mutable std::mutex mutex_;  // guards the fields below; never held while a hook runs
   std::condition_variable wake_;
   double rate_hz_;
   bool running_ = false;
