@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "caliper/model.hh"
+#include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/rtc/idl_names.h"
 #include "csv_recording.h"
@@ -49,10 +50,9 @@ std::string Num(double v, int precision = 7) {
 
 // A number given on the command line (nan and inf pass: the Model judges values).
 double ParseNumber(const std::string& text, const std::string& what) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size())
-    throw UsageError(what + ": '" + text + "' is not a number");
+  double v = 0;
+  std::string why;
+  if (!core::ParseDouble(text, &v, &why)) throw UsageError(what + ": " + why);
   return v;
 }
 
@@ -261,12 +261,16 @@ int Step(Client& client, std::vector<std::string>& args) {
   ModelRef m = Connect(client, name);
   M::SimulationStatus_var before = StatusOf(m);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
-  Call(m, [&] { m.model->step(n); });
+  CORBA::ULong ran = 0;
+  Call(m, [&] { ran = m.model->step(n); });
   M::SimulationStatus_var after = StatusOf(m);
-  const unsigned long long done = after->steps - before->steps;
+  const unsigned long long done = ran;
   if (after->state == M::FAULTED)
     throw Failure(name + ": the simulation faulted after " + std::to_string(done) + " of " +
                   std::to_string(n) + " steps: " + after->last_error.in());
+  if (ran < n)
+    std::cout << name << ": ended early by a stop or pause from another client after " << ran
+              << " of " << n << " steps\n";
   std::cout << name << ": " << done << " steps, t = " << Num(after->sim_time, 10) << " s (+"
             << Num(after->sim_time - before->sim_time, 10) << " s), " << rtc::Name(after->state)
             << "\n";

@@ -54,7 +54,12 @@ struct ModelCore::Loaded {
   std::map<std::string, double> commands;           // last command per actuator
 };
 
-ModelCore::ModelCore(physics_bullet::Options options) : options_(options) {}
+ModelCore::ModelCore(physics_bullet::Options options, Limits limits, PhysicsFactory factory)
+    : options_(options), limits_(limits), factory_(std::move(factory)) {}
+
+std::unique_ptr<sgal::PhysicsScene> ModelCore::MakePhysics(const sgal::Scene& scene) const {
+  return factory_ ? factory_(scene) : physics_bullet::MakeScene(scene, options_);
+}
 
 ModelCore::~ModelCore() {
   // the channels refer to the scene: remove them first
@@ -76,14 +81,47 @@ std::unique_lock<std::mutex> ModelCore::Lock() const {
 void ModelCore::CancelExperiment() { cancel_ = true; }
 
 bool ModelCore::EndExperimentLocked(const std::string& request) {
-  if (experiment_.empty()) return false;
+  if (experiment_.empty() && step_request_ == 0) return false;
   end_request_ = "a " + request + " request ended it early";
-  return true;
+  return !experiment_.empty();
+}
+
+void ModelCore::RequireNoExperiment() const {
+  if (!experiment_.empty())
+    throw NotAvailable("experiment '" + experiment_ + "' is running; wait for it to end");
 }
 
 void ModelCore::RequireIdle() const {
-  if (!experiment_.empty())
-    throw NotAvailable("experiment '" + experiment_ + "' is running; wait for it to end");
+  RequireNoExperiment();
+  if (step_request_ != 0)
+    throw NotAvailable("a step request of " + std::to_string(step_request_) + " steps is running (" +
+                       std::to_string(step_done_) + " done); wait for it, or stop or pause it");
+}
+
+void ModelCore::HandOverLocked(std::unique_lock<std::mutex>& lock) {
+  lock.unlock();
+  // a plain mutex re-taken at once starves the callers waiting for it: let each in once
+  for (int spin = 0; waiting_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
+  lock.lock();
+}
+
+void ModelCore::RequireQueueRoomLocked(size_t adding) const {
+  const size_t queued = pending_commands_.size() + pending_sets_.size();
+  if (queued + adding > limits_.pending_writes)
+    throw NotAvailable(std::to_string(queued) + " commands and parameter writes are waiting for " +
+                       "the next step; at most " + std::to_string(limits_.pending_writes) +
+                       " may wait (is the simulation stepping?)");
+}
+
+void ModelCore::FaultLocked(const std::string& reason) {
+  state_ = RunState::kFaulted;
+  last_error_ = reason;
+  pending_commands_.clear();
+  pending_sets_.clear();
+  logging::Get("model").error("simulation stopped at t = %.6f s (step %llu): %s",
+                              loaded_ ? loaded_->physics->time() : 0.0,
+                              static_cast<unsigned long long>(loaded_ ? loaded_->physics->steps() : 0),
+                              reason.c_str());
 }
 
 void ModelCore::Load(const std::string& path) {
@@ -202,7 +240,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   loaded->description = scene;
   loaded->source = file_name + " (experiment " + e.name + ")";
   loaded->name = IdSafe(scene->name.empty() ? "model" : scene->name);
-  loaded->physics = physics_bullet::MakeScene(*scene, options_);
+  loaded->physics = MakePhysics(*scene);
   std::unique_lock<std::mutex> lock(mutex_);
   if (loaded_) loaded_->commands.clear();
   BuildLocked(std::move(loaded));
@@ -280,10 +318,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
     if (k % 256 == 0) {
       // let status() and readers in between; the experiment flag keeps control calls out
       MeasureRateLocked(0.5);
-      lock.unlock();
-      // hand the lock to waiting calls (bounded: each takes it once)
-      for (int spin = 0; waiting_ > 0 && spin < 1000; ++spin) std::this_thread::yield();
-      lock.lock();
+      HandOverLocked(lock);
       if (cancel_ || !end_request_.empty())
         throw NotAvailable("experiment '" + e.name + "' ended at t = " +
                            std::to_string(physics.time()) + " s: " +
@@ -303,7 +338,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   loaded->description = std::make_shared<const sgal::Scene>(scene);
   loaded->source = source;
   loaded->name = IdSafe(scene.name.empty() ? "model" : scene.name);
-  loaded->physics = physics_bullet::MakeScene(scene, options_);
+  loaded->physics = MakePhysics(scene);
   const auto lock = Lock();
   RequireIdle();  // again: an experiment may have begun while this scene was built
   BuildLocked(std::move(loaded));
@@ -345,7 +380,7 @@ void ModelCore::RewindLocked() {
   fresh->description = loaded_->description;
   fresh->source = loaded_->source;
   fresh->name = loaded_->name;
-  fresh->physics = physics_bullet::MakeScene(*fresh->description, options_);
+  fresh->physics = MakePhysics(*fresh->description);
   BuildLocked(std::move(fresh));
   last_error_.clear();
 }
@@ -369,13 +404,14 @@ void ModelCore::Pause() {
   const auto lock = Lock();
   Require(true);
   if (EndExperimentLocked("pause")) return;
-  if (state_ == RunState::kRunning) state_ = RunState::kPaused;
+  if (state_ == RunState::kRunning) state_ = RunState::kPaused;  // a step request ends paused
 }
 
 void ModelCore::Stop() {
   const auto lock = Lock();
   Require(true);
   if (EndExperimentLocked("stop")) return;
+  // a step request running sees the new scene generation and ends without another step
   RewindLocked();
   state_ = RunState::kStopped;
 }
@@ -395,15 +431,54 @@ void ModelCore::Reset() {
 }
 
 uint64_t ModelCore::StepNow(uint64_t n) {
-  const auto lock = Lock();
+  auto lock = Lock();
   Require(true);
   RequireIdle();
   if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
   if (state_ == RunState::kFaulted)
     throw NotAvailable("the simulation stopped on a fault (" + last_error_ + "); reset it first");
-  uint64_t ran = 0;
-  for (; ran < n && state_ != RunState::kFaulted; ++ran) StepLocked();
-  if (state_ != RunState::kFaulted) state_ = RunState::kPaused;
+  if (n == 0) return 0;
+  step_request_ = n;
+  step_done_ = 0;
+  end_request_.clear();
+  struct EndRequest {
+    ModelCore* core;
+    ~EndRequest() { core->step_request_ = 0; }  // the lock is held again when it ends
+  } end_request{this};
+  const uint64_t generation = generation_;
+  rate_wall_ = Clock::now();
+  rate_sim_ = loaded_->physics->time();
+  auto slice_end = rate_wall_ + kSlice;
+  std::string ended;
+  while (step_done_ < n) {
+    StepLocked();
+    if (state_ == RunState::kFaulted) break;
+    ++step_done_;
+    if ((step_done_ & 15) == 0 && step_done_ < n && Clock::now() > slice_end) {
+      MeasureRateLocked(0.5);
+      HandOverLocked(lock);
+      // a stop rewound (a new generation), a pause asked to end, or the Model is going
+      if (generation_ != generation || !end_request_.empty() || cancel_) {
+        ended = cancel_ ? "the Model is shutting down" : end_request_;
+        break;
+      }
+      slice_end = Clock::now() + kSlice;
+    }
+  }
+  const uint64_t ran = step_done_;
+  if (generation_ == generation && state_ != RunState::kFaulted) {
+    state_ = RunState::kPaused;
+    // writes that came during the request and found no step after them take effect now, as
+    // they do when nothing steps
+    if (!pending_commands_.empty() || !pending_sets_.empty()) {
+      ApplyPendingLocked();
+      loaded_->sampler->Refresh();
+    }
+  }
+  if (!ended.empty())
+    logging::Get("model").notice("step request of %llu steps ended after %llu: %s",
+                                 static_cast<unsigned long long>(n),
+                                 static_cast<unsigned long long>(ran), ended.c_str());
   return ran;
 }
 
@@ -431,8 +506,9 @@ void ModelCore::SetRealTimeFactor(double factor) {
 Status ModelCore::status() const {
   const auto lock = Lock();
   Status s;
-  const bool running = state_ == RunState::kRunning || !experiment_.empty();
-  s.state = experiment_.empty() ? state_ : RunState::kRunning;
+  const bool running =
+      state_ == RunState::kRunning || !experiment_.empty() || step_request_ != 0;
+  s.state = running ? RunState::kRunning : state_;
   s.real_time_factor = experiment_.empty() ? real_time_factor_ : 0;
   s.achieved_real_time_factor = running ? achieved_rtf_ : 0;
   s.last_error = last_error_;
@@ -464,18 +540,30 @@ void ModelCore::ApplyPendingLocked() {
 void ModelCore::StepLocked() {
   sgal::PhysicsScene& physics = *loaded_->physics;
   // commands and parameter writes take effect at this step boundary, in the order they came
-  ApplyPendingLocked();
+  // Any exception ends here, as a NaN does: the engine stays at the start of the failing step
+  // (PhysicsScene::Step promises it) and the Model says FAULTED with the reason; nothing escapes
+  // to the execution context or the caller.
   try {
+    ApplyPendingLocked();
     physics.Step();
   } catch (const sgal::SimulationFault& fault) {
-    state_ = RunState::kFaulted;
-    last_error_ = fault.what();
-    logging::Get("model").error("%s", fault.what());
+    FaultLocked(fault.what());
+    return;
+  } catch (const std::exception& e) {
+    FaultLocked(std::string("the physics step failed: ") + e.what());
+    return;
+  } catch (...) {
+    FaultLocked("the physics step failed with an exception of unknown type");
     return;
   }
-  loaded_->sampler->Refresh();
-  recorder_.OnStep(physics.steps(), physics.time());
-  PublishLocked();
+  try {
+    loaded_->sampler->Refresh();
+    recorder_.OnStep(physics.steps(), physics.time());
+    PublishLocked();
+  } catch (const std::exception& e) {
+    FaultLocked(std::string("after step ") + std::to_string(physics.steps()) +
+                ", sampling or publishing failed: " + e.what());
+  }
 }
 
 void ModelCore::PublishLocked() {
@@ -563,7 +651,7 @@ std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
 void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& commands) {
   const auto lock = Lock();
   Require(true);
-  RequireIdle();
+  RequireNoExperiment();
   for (const auto& [name, value] : commands) {
     const auto& actuators = loaded_->description->actuators;
     if (std::none_of(actuators.begin(), actuators.end(),
@@ -572,10 +660,12 @@ void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& c
     if (!std::isfinite(value))
       throw InvalidValue("command for '" + name + "' is not finite");
   }
+  const bool stepping = state_ == RunState::kRunning || step_request_ != 0;
+  if (stepping) RequireQueueRoomLocked(commands.size());
   pending_commands_.insert(pending_commands_.end(), commands.begin(), commands.end());
-  // while not running, the next step may be far away: apply now, between steps (after anything
+  // while not stepping, the next step may be far away: apply now, between steps (after anything
   // still queued), so that the engine and its channels show the command at once
-  if (state_ != RunState::kRunning) {
+  if (!stepping) {
     ApplyPendingLocked();
     loaded_->sampler->Refresh();
   }
@@ -598,11 +688,25 @@ std::vector<ModelCore::ActuatorState> ModelCore::ActuatorStates() const {
 }
 
 std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) const {
+  if (pattern.size() > limits_.pattern_length)
+    throw LimitExceeded("the pattern has " + std::to_string(pattern.size()) +
+                        " characters; at most " + std::to_string(limits_.pattern_length),
+                        limits_.pattern_length);
   const auto lock = Lock();
-  return registry_.List(pattern.empty() ? "*" : pattern);
+  std::vector<daq::ChannelInfo> channels = registry_.List(pattern.empty() ? "*" : pattern);
+  if (channels.size() > limits_.channels_per_list)
+    throw LimitExceeded(std::to_string(channels.size()) + " channels match '" + pattern +
+                        "'; one reply holds at most " + std::to_string(limits_.channels_per_list) +
+                        ": narrow the pattern (e.g. MODEL.BODY.*)",
+                        limits_.channels_per_list);
+  return channels;
 }
 
 std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
+  if (ids.size() > limits_.ids_per_call)
+    throw LimitExceeded(std::to_string(ids.size()) + " ids in one call; at most " +
+                        std::to_string(limits_.ids_per_call) + " (split the request)",
+                        limits_.ids_per_call);
   const auto lock = Lock();
   Require(true);
   try {
@@ -615,7 +719,7 @@ std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids)
 void ModelCore::SetChannel(const std::string& id, const std::vector<double>& values) {
   const auto lock = Lock();
   Require(true);
-  RequireIdle();
+  RequireNoExperiment();
   if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
   const daq::ChannelInfo& info = registry_.Info(id);
   if (!info.writable) throw InvalidValue(id + ": read-only (a state of the simulation)");
@@ -624,7 +728,8 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
                        info.shape.ToString() + "), got " + std::to_string(values.size()));
   for (double v : values)
     if (!std::isfinite(v)) throw InvalidValue(id + ": value is not finite");
-  if (state_ == RunState::kRunning) {
+  if (state_ == RunState::kRunning || step_request_ != 0) {
+    RequireQueueRoomLocked(1);
     pending_sets_.emplace_back(id, values);
     return;
   }
@@ -645,6 +750,9 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
   Require(true);
   if (every_n_steps == 0) throw InvalidValue("every_n_steps must be at least 1");
   if (ids.empty()) throw InvalidValue("subscribe to at least one id");
+  if (ids.size() > limits_.ids_per_call)
+    throw LimitExceeded(std::to_string(ids.size()) + " ids in one subscription; at most " +
+                        std::to_string(limits_.ids_per_call), limits_.ids_per_call);
   daq::SubscriptionOptions options;
   options.ids = ids;
   options.every_n_steps = every_n_steps;

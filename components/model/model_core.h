@@ -48,6 +48,32 @@ class UnknownId : public std::out_of_range {
   std::string id_;
 };
 
+/// A request above what one call may ask for or one queue may hold; `limit()` is the bound.
+class LimitExceeded : public std::length_error {
+ public:
+  LimitExceeded(const std::string& what, uint64_t limit) : std::length_error(what), limit_(limit) {}
+  uint64_t limit() const { return limit_; }
+
+ private:
+  uint64_t limit_;
+};
+
+/// Bounds of what one client call may ask the Model to do (each refused above with
+/// LimitExceeded naming the bound).
+struct Limits {
+  size_t ids_per_call = 100000;          // ids in one get/sample or subscribe
+  size_t channels_per_list = 200000;     // channels one list/channels reply may hold
+  size_t pattern_length = 1024;          // characters of a list/channels glob
+  size_t pending_writes = 100000;        // commands and parameter writes queued for the next step
+};
+
+/// Wall time a step request or an experiment holds the lock before letting other calls in.
+constexpr std::chrono::milliseconds kSlice{10};
+
+/// Builds the engine of a scene (tests substitute one that fails on demand).
+using PhysicsFactory =
+    std::function<std::unique_ptr<sgal::PhysicsScene>(const sgal::Scene& scene)>;
+
 /// A run that could not finish: its physics faulted (NaN, explosion); the message is the report.
 class RunFailed : public std::runtime_error {
  public:
@@ -103,7 +129,8 @@ class CoreListener {
 
 class ModelCore {
  public:
-  explicit ModelCore(physics_bullet::Options options = {});
+  explicit ModelCore(physics_bullet::Options options = {}, Limits limits = {},
+                     PhysicsFactory factory = nullptr);
   ~ModelCore();
 
   /// Imports and builds a scene outside the lock, then swaps it in. On failure throws
@@ -128,7 +155,11 @@ class ModelCore {
   void Pause();
   void Stop();   // pause and rewind
   void Reset();  // rewind, keep the run state
-  /// Runs n steps now and returns how many ran; NotAvailable while running.
+  /// Runs n steps now and returns how many ran: n, or fewer when a stop or pause ended it early
+  /// or the physics faulted. It lets other calls in between slices of kSlice: reads are answered,
+  /// commands and parameter writes queue for the next step, stop and pause end it; another step,
+  /// start, load, reset or a time-step change meanwhile gets NotAvailable saying what runs.
+  /// NotAvailable while running or faulted.
   uint64_t StepNow(uint64_t n);
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
@@ -192,6 +223,16 @@ class ModelCore {
   void Require(bool scene_needed) const;
   /// NotAvailable while an experiment runs (the run owns the simulation).
   void RequireIdle() const;
+  /// NotAvailable while an experiment runs; a step request does not count (writes queue).
+  void RequireNoExperiment() const;
+  /// Lets waiting calls take the lock, then takes it back (between slices of long work).
+  void HandOverLocked(std::unique_lock<std::mutex>& lock);
+  /// The simulation stops at the start of the failing step: FAULTED with `reason`, one error
+  /// record, queued writes dropped (they were for steps that will not come).
+  void FaultLocked(const std::string& reason);
+  std::unique_ptr<sgal::PhysicsScene> MakePhysics(const sgal::Scene& scene) const;
+  /// NotAvailable when `adding` more writes would queue more than limits_.pending_writes.
+  void RequireQueueRoomLocked(size_t adding) const;
   /// Asks a running experiment to end at its next slice (stop, pause); false when none runs.
   bool EndExperimentLocked(const std::string& request);
   /// Takes the lock; every call does it this way, so that a running experiment, which lets go
@@ -203,6 +244,8 @@ class ModelCore {
                                                   const std::string& bytes);
 
   physics_bullet::Options options_;
+  Limits limits_;
+  PhysicsFactory factory_;
   mutable std::mutex mutex_;
   daq::Registry registry_;
   daq::Recorder recorder_{registry_};
@@ -211,7 +254,9 @@ class ModelCore {
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
   std::atomic<bool> cancel_{false};     // ends the running experiment (shutting down)
-  std::string end_request_;             // why the running experiment is to end ("" runs on)
+  std::string end_request_;             // why the running experiment or step is to end ("" runs on)
+  uint64_t step_request_ = 0;           // steps asked of the step request running now (0: none)
+  uint64_t step_done_ = 0;              // of those, done so far
   mutable std::atomic<int> waiting_{0};  // calls waiting for the lock (see Lock)
   // the last scene imported from bytes: batches send the same file run after run
   std::string imported_name_, imported_bytes_;

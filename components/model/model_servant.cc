@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
+#include <variant>
 
 #include "caliper/logging/log.h"
+#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 
 namespace caliper::model {
@@ -137,6 +140,8 @@ auto Guard(F&& f) -> decltype(f()) {
     throw D::InvalidParameter(e.what());
   } catch (const NotAvailable& e) {
     throw Unavailable(e.what());
+  } catch (const LimitExceeded& e) {
+    throw D::LimitExceeded(e.what(), e.limit());
   } catch (const CORBA::UserException&) {
     throw;
   } catch (const std::exception& e) {
@@ -428,6 +433,27 @@ S::Description* ModelServant::scene_description() {
   return Guard([&] {
     auto scene = core_.description();
     if (!scene) throw NotAvailable("no scene is loaded");
+    // meshes make nearly all of it: refuse, saying so, what would fail as a bare MARSHAL
+    double bytes = 0;
+    std::set<const sgal::Mesh*> meshes;
+    auto count = [&](const sgal::Geometry& g) {
+      const sgal::Mesh* mesh = nullptr;
+      if (const auto* hull = std::get_if<sgal::ConvexHull>(&g)) mesh = hull->mesh.get();
+      if (const auto* tri = std::get_if<sgal::TriangleMesh>(&g)) mesh = tri->mesh.get();
+      if (mesh != nullptr && meshes.insert(mesh).second)
+        bytes += 24.0 * (mesh->vertices.size() + mesh->normals.size()) +
+                 12.0 * mesh->triangles.size();
+    };
+    for (const auto& b : scene->bodies) {
+      for (const auto& v : b.visuals) count(v.geometry);
+      for (const auto& shape : b.shapes) count(shape.geometry);
+    }
+    if (bytes > 0.9 * rtc::kMaxMessageBytes)
+      throw NotAvailable("the scene description is about " +
+                         std::to_string(static_cast<long>(bytes / (1 << 20))) + " MiB of meshes (" +
+                         std::to_string(meshes.size()) + " meshes), more than one GIOP message " +
+                         "carries (" + std::to_string(rtc::kMaxMessageBytes >> 20) +
+                         " MiB, corba.max_message_size): simplify the meshes");
     return ToIdl(*scene);
   });
 }

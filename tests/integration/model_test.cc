@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <regex>
@@ -88,7 +89,7 @@ class OrbEnvironment : public ::testing::Environment {
     static CORBA::ORB_var orb = [] {
       std::vector<std::string> args = {"model_test", "-ORBendPoint",
                                        "giop:tcp:127.0.0.1:", "-ORBclientCallTimeOutPeriod",
-                                       "10000"};
+                                       "10000", "-ORBgiopMaxMsgSize", "268435456"};
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(a.data());
       int argc = static_cast<int>(argv.size());
@@ -757,6 +758,71 @@ TEST(ModelVerbs, EveryVerbHasHelpAndBadUsageExits2WithoutASession) {
                               << r.err;
     EXPECT_TRUE(Contains(r.err, "Usage: caliper-ctl " + args[0])) << r.err;
   }
+}
+
+// ------------------------------------------------------------------------ hostile clients
+
+// step(4000000000) from one connection: status, get and a second step from another are
+// answered at once, and stop ends the request, which replies with the steps that ran.
+TEST_F(ModelTest, AHugeStepLeavesTheModelAnsweringAndStopEndsIt) {
+  Load(kPendulum);
+  M::Model_var stepper = M::Model::_duplicate(Model());
+  omniORB::setClientCallTimeout(stepper, 60000);
+  std::promise<CORBA::ULong> ran;
+  std::thread request([&] {
+    try {
+      ran.set_value(stepper->step(4000000000u));
+    } catch (...) {
+      ran.set_exception(std::current_exception());
+    }
+  });
+  auto result = ran.get_future();
+  // a second client: its own ORB connection through caliper-ctl
+  ASSERT_TRUE(WaitFor([&] { return Field(Status(), "state") == "RUNNING"; }, seconds(10)))
+      << Status();
+  const double during = SimTime();
+  EXPECT_GT(Get(kPosition + std::string()), -1e9);  // answered (not NaN from a failed call)
+  const auto second = Ctl({"step", "10"});
+  EXPECT_EQ(second.exit_code, 1);
+  EXPECT_TRUE(Contains(second.err, "4000000000")) << second.err;
+  EXPECT_TRUE(WaitFor([&] { return SimTime() > during; }, seconds(10)));
+  const auto stop = Ctl({"stop"});
+  EXPECT_EQ(stop.exit_code, 0) << stop.err;
+  ASSERT_EQ(result.wait_for(seconds(20)), std::future_status::ready) << "stop did not end it";
+  request.join();
+  const CORBA::ULong steps = result.get();
+  EXPECT_GT(steps, 0u);
+  EXPECT_LT(steps, 4000000000u);
+  EXPECT_EQ(Field(Status(), "state"), "STOPPED");
+  // pause ends one too, and ctl says it ended early
+  std::thread again([&] { Ctl({"step", "4000000000"}); });
+  ASSERT_TRUE(WaitFor([&] { return SimTime() > 0.05; }, seconds(10)));
+  EXPECT_EQ(Ctl({"pause"}).exit_code, 0);
+  again.join();
+  EXPECT_EQ(Field(Status(), "state"), "PAUSED");
+}
+
+TEST_F(ModelTest, CallsAskingTooMuchRaiseLimitExceededWithTheBound) {
+  Load(kPendulum);
+  S::StringSeq ids;
+  ids.length(1000001);
+  for (CORBA::ULong i = 0; i < ids.length(); ++i) ids[i] = "x";
+  try {
+    D::ValueSeq_var values = Model()->get(ids);
+    ADD_FAILURE() << "a million ids were read in one call";
+  } catch (const D::LimitExceeded& e) {
+    EXPECT_GT(e.limit, 0u);
+    EXPECT_LT(e.limit, 1000001u);
+    EXPECT_TRUE(Contains(e.reason.in(), "1000001 ids")) << e.reason.in();
+  }
+  try {
+    D::ChannelInfoSeq_var list = Model()->list(std::string(5000, '*').c_str());
+    ADD_FAILURE() << "a 5000-character pattern was accepted";
+  } catch (const D::LimitExceeded& e) {
+    EXPECT_TRUE(Contains(e.reason.in(), "5000 characters")) << e.reason.in();
+  }
+  // the Model is fine afterwards
+  EXPECT_EQ(Field(Status(), "state"), "STOPPED");
 }
 
 }  // namespace

@@ -1,0 +1,288 @@
+// ModelCore on its own, without CORBA: run states and their transitions, step requests in slices
+// that leave the Model answering (and stop or pause ending them), every kind of exception in a
+// step ending as a fault at the start of the failing step, and the bounds of what one call or
+// one queue may take.
+#include "model_core.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <future>
+#include <new>
+#include <string>
+#include <thread>
+
+#include "caliper/physics_bullet/bullet_scene.h"
+
+namespace caliper::model {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string Model(const std::string& file) {
+  const char* src = std::getenv("CALIPER_SOURCE_DIR");
+  return std::string(src ? src : ".") + "/models/" + file;
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// Waits (at most 20 s) until `done` holds; false when it never did.
+template <class F>
+bool WaitFor(F done) {
+  for (int i = 0; i < 2000; ++i) {
+    if (done()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return done();
+}
+
+TEST(ModelCore, RunStatesAndTheirTransitions) {
+  ModelCore core;
+  EXPECT_EQ(core.status().state, RunState::kEmpty);
+  EXPECT_THROW(core.Start(), NotAvailable);
+  EXPECT_THROW(core.StepNow(1), NotAvailable);
+  core.Load(Model("pendulum_tendon.dae"));
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+  EXPECT_EQ(core.StepNow(5), 5u);
+  EXPECT_EQ(core.status().state, RunState::kPaused);
+  EXPECT_EQ(core.status().steps, 5u);
+  core.Start();
+  EXPECT_EQ(core.status().state, RunState::kRunning);
+  try {
+    core.StepNow(1);
+    ADD_FAILURE() << "a step while running was accepted";
+  } catch (const NotAvailable& e) {
+    EXPECT_TRUE(Contains(e.what(), "running")) << e.what();
+  }
+  core.Tick();
+  EXPECT_EQ(core.status().steps, 6u);
+  core.Pause();
+  EXPECT_EQ(core.status().state, RunState::kPaused);
+  core.Tick();  // not running: no step
+  EXPECT_EQ(core.status().steps, 6u);
+  core.Stop();
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+  EXPECT_EQ(core.status().steps, 0u);
+  EXPECT_EQ(core.status().sim_time, 0.0);
+  EXPECT_EQ(core.StepNow(0), 0u);
+}
+
+// A step request of four billion steps: status and reads answered meanwhile, a second request
+// refused with the reason, writes queued, and pause ends it with the count of steps run.
+TEST(ModelCore, HugeStepRequestLeavesTheModelAnsweringAndPauseEndsIt) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  auto request = std::async(std::launch::async, [&] { return core.StepNow(4000000000u); });
+  ASSERT_TRUE(WaitFor([&] { return core.status().steps > 100; })) << "the steps never began";
+  const Status during = core.status();
+  EXPECT_EQ(during.state, RunState::kRunning);
+  EXPECT_FALSE(core.Sample({"pendulum_tendon.pendulum.position"}).empty());
+  try {
+    core.StepNow(10);
+    ADD_FAILURE() << "a second step request was accepted";
+  } catch (const NotAvailable& e) {
+    EXPECT_TRUE(Contains(e.what(), "4000000000")) << e.what();
+  }
+  EXPECT_THROW(core.Start(), NotAvailable);
+  EXPECT_THROW(core.Load(Model("pendulum_tendon.dae")), NotAvailable);
+  EXPECT_NO_THROW(core.SetCommands({{core.Actuators().at(0).name, 1.0}}));
+  EXPECT_TRUE(WaitFor([&] { return core.status().steps > during.steps; }))
+      << "the request did not go on between reads";
+  core.Pause();
+  ASSERT_EQ(request.wait_for(20s), std::future_status::ready) << "pause did not end the request";
+  const uint64_t ran = request.get();
+  EXPECT_GT(ran, 100u);
+  EXPECT_LT(ran, 4000000000u);
+  EXPECT_EQ(core.status().steps, ran);
+  EXPECT_EQ(core.status().state, RunState::kPaused);
+  // the queued command took effect at a step boundary
+  EXPECT_EQ(core.ActuatorStates().at(0).command, 1.0);
+  EXPECT_EQ(core.StepNow(3), 3u);  // a new request runs again
+}
+
+TEST(ModelCore, StopEndsAStepRequestAndRewinds) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  auto request = std::async(std::launch::async, [&] { return core.StepNow(4000000000u); });
+  ASSERT_TRUE(WaitFor([&] { return core.status().steps > 10; }));
+  core.Stop();
+  ASSERT_EQ(request.wait_for(20s), std::future_status::ready) << "stop did not end the request";
+  EXPECT_LT(request.get(), 4000000000u);
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+  EXPECT_EQ(core.status().steps, 0u);
+}
+
+// A Bullet scene that throws what the test asks for at a chosen step, before stepping (so the
+// engine is at the start of the failing step, as PhysicsScene::Step promises).
+class FailingScene : public sgal::PhysicsScene {
+ public:
+  enum class Kind { kNone, kFault, kBadAlloc, kOutOfRange, kRuntime, kUnknownType };
+  FailingScene(std::unique_ptr<sgal::PhysicsScene> inner, Kind kind, uint64_t at_step)
+      : inner_(std::move(inner)), kind_(kind), at_step_(at_step) {}
+  void Step() override {
+    if (inner_->steps() + 1 == at_step_) {
+      switch (kind_) {
+        case Kind::kNone: break;
+        case Kind::kFault:
+          throw sgal::SimulationFault("actuator 'line_motor': tension is not finite", "line_motor",
+                                      inner_->time());
+        case Kind::kBadAlloc: throw std::bad_alloc();
+        case Kind::kOutOfRange: throw std::out_of_range("tendon 'line': via point 7 of 3");
+        case Kind::kRuntime: throw std::runtime_error("muscle solver did not converge");
+        case Kind::kUnknownType: throw 42;
+      }
+    }
+    inner_->Step();
+  }
+  double time() const override { return inner_->time(); }
+  uint64_t steps() const override { return inner_->steps(); }
+  const sgal::Scene& description() const override { return inner_->description(); }
+  std::vector<sgal::BodyState> BodyStates() const override { return inner_->BodyStates(); }
+  std::vector<sgal::TendonState> TendonStates() const override { return inner_->TendonStates(); }
+  void SetCommand(const std::string& a, double v) override { inner_->SetCommand(a, v); }
+  std::vector<sgal::ParameterInfo> Parameters() const override { return inner_->Parameters(); }
+  double GetParameter(const std::string& id) const override { return inner_->GetParameter(id); }
+  int ParameterIndex(const std::string& id) const override { return inner_->ParameterIndex(id); }
+  double GetParameter(int index) const override { return inner_->GetParameter(index); }
+  void SetParameter(const std::string& id, double v) override { inner_->SetParameter(id, v); }
+
+ private:
+  std::unique_ptr<sgal::PhysicsScene> inner_;
+  Kind kind_;
+  uint64_t at_step_;
+};
+
+struct FaultCase {
+  FailingScene::Kind kind;
+  const char* reason;  // a part of last_error
+};
+
+class StepFault : public ::testing::TestWithParam<FaultCase> {};
+
+// The first scene built fails at step 5; the rewound one (reset) never does.
+PhysicsFactory FailOnce(FailingScene::Kind kind, std::shared_ptr<std::atomic<int>> built) {
+  return [kind, built](const sgal::Scene& scene) -> std::unique_ptr<sgal::PhysicsScene> {
+    const bool first = (*built)++ == 0;
+    return std::make_unique<FailingScene>(physics_bullet::MakeScene(scene),
+                                          first ? kind : FailingScene::Kind::kNone, 5);
+  };
+}
+
+TEST_P(StepFault, EveryExceptionEndsAsAFaultAtTheStartOfTheFailingStep) {
+  auto built = std::make_shared<std::atomic<int>>(0);
+  ModelCore core({}, {}, FailOnce(GetParam().kind, built));
+  core.Load(Model("pendulum_tendon.dae"));
+  const double dt = core.status().time_step;
+  EXPECT_EQ(core.StepNow(10), 4u);  // steps 1 to 4 ran, the fifth failed
+  Status s = core.status();
+  EXPECT_EQ(s.state, RunState::kFaulted);
+  EXPECT_EQ(s.steps, 4u);
+  EXPECT_NEAR(s.sim_time, 4 * dt, 1e-12);
+  EXPECT_TRUE(Contains(s.last_error, GetParam().reason)) << s.last_error;
+  // a faulted Model refuses to run until reset, and answers reads
+  EXPECT_THROW(core.Start(), NotAvailable);
+  EXPECT_THROW(core.StepNow(1), NotAvailable);
+  EXPECT_NO_THROW(core.Sample({"pendulum_tendon.pendulum.position"}));
+  core.Reset();
+  s = core.status();
+  EXPECT_EQ(s.state, RunState::kStopped);
+  EXPECT_EQ(s.steps, 0u);
+  EXPECT_TRUE(s.last_error.empty());
+  EXPECT_EQ(core.StepNow(10), 10u);
+}
+
+TEST_P(StepFault, ARunningModelFaultsWithoutTheExceptionEscaping) {
+  auto built = std::make_shared<std::atomic<int>>(0);
+  ModelCore core({}, {}, FailOnce(GetParam().kind, built));
+  core.Load(Model("pendulum_tendon.dae"));
+  core.SetRealTimeFactor(0);
+  core.Start();
+  for (int i = 0; i < 10 && core.status().state == RunState::kRunning; ++i)
+    EXPECT_NO_THROW(core.Advance(5ms));
+  const Status s = core.status();
+  EXPECT_EQ(s.state, RunState::kFaulted);
+  EXPECT_EQ(s.steps, 4u);
+  // commands sent to a faulted Model do not pile up for steps that will not come
+  EXPECT_NO_THROW(core.SetCommands({{core.Actuators().at(0).name, 2.0}}));
+  EXPECT_EQ(core.ActuatorStates().at(0).command, 2.0);
+  // a new load brings it back too
+  core.Load(Model("pendulum_tendon.dae"));
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Kinds, StepFault,
+    ::testing::Values(FaultCase{FailingScene::Kind::kFault, "line_motor"},
+                      FaultCase{FailingScene::Kind::kBadAlloc, "bad_alloc"},
+                      FaultCase{FailingScene::Kind::kOutOfRange, "via point 7"},
+                      FaultCase{FailingScene::Kind::kRuntime, "did not converge"},
+                      FaultCase{FailingScene::Kind::kUnknownType, "unknown type"}));
+
+TEST(ModelCore, CallsAskingTooMuchAreRefusedWithTheLimit) {
+  Limits limits;
+  limits.ids_per_call = 3;
+  limits.channels_per_list = 5;
+  limits.pattern_length = 16;
+  ModelCore core({}, limits);
+  core.Load(Model("pendulum_tendon.dae"));
+  const std::string id = "pendulum_tendon.pendulum.position";
+  EXPECT_EQ(core.Sample({id, id, id}).size(), 3u);
+  try {
+    core.Sample({id, id, id, id});
+    ADD_FAILURE() << "4 ids accepted";
+  } catch (const LimitExceeded& e) {
+    EXPECT_EQ(e.limit(), 3u);
+    EXPECT_TRUE(Contains(e.what(), "4 ids")) << e.what();
+  }
+  try {
+    core.Channels("*");
+    ADD_FAILURE() << "an unbounded list was accepted";
+  } catch (const LimitExceeded& e) {
+    EXPECT_EQ(e.limit(), 5u);
+    EXPECT_TRUE(Contains(e.what(), "narrow the pattern")) << e.what();
+  }
+  EXPECT_EQ(core.Channels("*.pendulum.mass").size(), 1u);
+  EXPECT_THROW(core.Channels(std::string(17, '*')), LimitExceeded);
+  EXPECT_THROW(core.Subscribe({id, id, id, id}, 1, 1), LimitExceeded);
+}
+
+TEST(ModelCore, WritesQueuedForTheNextStepAreBounded) {
+  Limits limits;
+  limits.pending_writes = 10;
+  ModelCore core({}, limits);
+  core.Load(Model("pendulum_tendon.dae"));
+  const std::string motor = core.Actuators().at(0).name;
+  core.Start();  // running, but nothing steps it here: writes queue
+  for (int i = 0; i < 10; ++i) core.SetCommands({{motor, 0.1 * i}});
+  try {
+    core.SetCommands({{motor, 1.0}});
+    ADD_FAILURE() << "an 11th queued write was accepted";
+  } catch (const NotAvailable& e) {
+    EXPECT_TRUE(Contains(e.what(), "at most 10")) << e.what();
+  }
+  EXPECT_THROW(core.SetChannel("pendulum_tendon.pendulum.mass", {2.0}), NotAvailable);
+  core.Tick();  // a step takes them all
+  EXPECT_NO_THROW(core.SetCommands({{motor, 1.0}}));
+}
+
+TEST(ModelCore, AParameterCannotMakeOneStepRunForHours) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const std::string motor = core.Actuators().at(0).name;
+  const std::string id = "pendulum_tendon." + motor + ".max_substep";
+  ASSERT_FALSE(core.Channels(id).empty()) << id << " is not a channel";
+  try {
+    core.SetChannel(id, {1e-12});
+    ADD_FAILURE() << "max_substep 1e-12 s was accepted";
+  } catch (const InvalidValue& e) {
+    EXPECT_TRUE(Contains(e.what(), "max_substep")) << e.what();
+  }
+  EXPECT_NO_THROW(core.SetChannel(id, {1e-4}));
+}
+
+}  // namespace
+}  // namespace caliper::model
