@@ -1,5 +1,22 @@
 # One-line helpers so that each unit's CMakeLists.txt says only what it is made of.
 
+# Sanitizers for everything this build directory compiles and links (launch/caliper test --sanitize
+# configures build-asan-ubsan/ or build-tsan/ with it): "address,undefined" or "thread". UBSan
+# stops at the first report (-fno-sanitize-recover) so that a test fails instead of logging.
+set(CALIPER_SANITIZE "" CACHE STRING "Sanitizers: address,undefined or thread (empty: none)")
+if(CALIPER_SANITIZE)
+  if(CALIPER_SANITIZE MATCHES "thread" AND CALIPER_SANITIZE MATCHES "address")
+    message(FATAL_ERROR "CALIPER_SANITIZE: thread cannot be combined with address")
+  endif()
+  set(_caliper_sanitize_flags -fsanitize=${CALIPER_SANITIZE} -fno-omit-frame-pointer)
+  if(CALIPER_SANITIZE MATCHES "undefined")
+    list(APPEND _caliper_sanitize_flags -fno-sanitize-recover=undefined)
+  endif()
+  add_compile_options(${_caliper_sanitize_flags})
+  add_link_options(${_caliper_sanitize_flags})
+  message(STATUS "Caliper: sanitizers ${CALIPER_SANITIZE}")
+endif()
+
 # Warnings for Caliper's own code (never for generated code).
 function(caliper_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow=local -Wno-missing-field-initializers)
@@ -28,18 +45,21 @@ function(caliper_executable name)
   caliper_warnings(${name})
 endfunction()
 
-# caliper_test(NAME SOURCES ... DEPS ... [LABELS l] [TIMEOUT s]): a GoogleTest program run by ctest
+# caliper_test(NAME SOURCES ... DEPS ... [LABELS l] [TIMEOUT s]): a GoogleTest program run by ctest.
+# Its main (tests/support/gtest_main.cc) exits 77 when tests were skipped and none failed, and
+# ctest reports that as Skipped, not Passed (SKIP_RETURN_CODE). Unlabelled tests are the unit
+# tests (one process, no display); LABELS integration / gui mark the others.
 function(caliper_test name)
   cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} caliper_gtest_main GTest::gtest)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   caliper_warnings(${name})
   add_test(NAME ${name} COMMAND ${name})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 120)
   endif()
-  set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT}
+  set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT} SKIP_RETURN_CODE 77
     LABELS "${ARG_LABELS}"
     ENVIRONMENT "CALIPER_BIN_DIR=${CMAKE_BINARY_DIR}/bin;CALIPER_CONFIG_DIR=${CMAKE_SOURCE_DIR}/config;CALIPER_SOURCE_DIR=${CMAKE_SOURCE_DIR};CALIPER_CORPUS_DEFAULT=${CMAKE_SOURCE_DIR}/../shared/corpus")
 endfunction()
