@@ -652,6 +652,9 @@ void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& c
   const auto lock = Lock();
   Require(true);
   RequireNoExperiment();
+  if (commands.size() > limits_.ids_per_call)
+    throw InvalidValue(std::to_string(commands.size()) + " commands in one call; at most " +
+                       std::to_string(limits_.ids_per_call));
   for (const auto& [name, value] : commands) {
     const auto& actuators = loaded_->description->actuators;
     if (std::none_of(actuators.begin(), actuators.end(),
