@@ -4,13 +4,31 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <ctime>
-#include <regex>
+#include <optional>
+#include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "caliper/core/system.h"
+#include "caliper/logging/message_pattern.h"
 
 namespace caliper::logger {
+
+std::string TruncationMarker(size_t cut_bytes) {
+  return "\xE2\x80\xA6 [truncated " + std::to_string(cut_bytes) + " bytes]";  // "…"
+}
+
+std::string Truncate(const std::string& text, size_t max_bytes) {
+  if (text.size() <= max_bytes) return text;
+  // room for the longest marker this text can need (cutting all of it)
+  const size_t room = TruncationMarker(text.size()).size();
+  size_t keep = max_bytes > room ? max_bytes - room : 0;
+  // never half a UTF-8 character: back off over continuation bytes (10xxxxxx)
+  while (keep > 0 && (static_cast<unsigned char>(text[keep]) & 0xC0) == 0x80) --keep;
+  return text.substr(0, keep) + TruncationMarker(text.size() - keep);
+}
 
 std::string SessionFileName(const std::string& session, int64_t time_us) {
   const time_t seconds = static_cast<time_t>(time_us / 1000000);
@@ -38,6 +56,14 @@ std::string FindSessionFile(const std::string& directory, const std::string& ses
   }
   closedir(dir);
   return found;
+}
+
+/// The record with its texts within the store's bounds.
+logging::Record Bounded(logging::Record r) {
+  r.message = Truncate(r.message, kMaxMessageBytes);
+  for (std::string* field : {&r.category, &r.component, &r.host, &r.source})
+    *field = Truncate(*field, kMaxFieldBytes);
+  return r;
 }
 
 }  // namespace
@@ -75,9 +101,10 @@ void LogStore::Recover() {
     good_bytes = position;
     logging::Record r;
     if (!logging::ParseLine(line, &r)) continue;
-    uint64_t& last = last_seq_[r.source];
-    if (r.seq > last) last = r.seq;
-    recent_.push_back({++serial_, std::move(r)});
+    // a file written before the bounds may hold longer texts: memory keeps to them anyway
+    r = Bounded(std::move(r));
+    if (r.seq != 0) seen_.Insert(r.source, r.seq);
+    recent_.push_back(std::make_shared<const StoredRecord>(StoredRecord{++serial_, std::move(r)}));
     if (recent_.size() > memory_records_) recent_.pop_front();
   }
   in.close();
@@ -86,26 +113,24 @@ void LogStore::Recover() {
 }
 
 std::vector<StoredRecord> LogStore::Submit(const std::vector<logging::Record>& records) {
+  std::vector<logging::Record> bounded;
+  bounded.reserve(records.size());
+  for (const auto& r : records) bounded.push_back(Bounded(r));
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<StoredRecord> stored;
   std::string text;
   // the batch counts as stored only once it is in the file, so that a retry after a failed
   // write is not taken for a duplicate
-  std::map<std::string, uint64_t> last_seq;
+  std::set<std::pair<std::string, uint64_t>> in_batch;
   uint64_t serial = serial_;
-  for (const auto& r : records) {
+  for (auto& r : bounded) {
     if (r.seq != 0) {
-      auto last = last_seq.find(r.source);
-      if (last == last_seq.end()) {
-        auto known = last_seq_.find(r.source);
-        last = last_seq.emplace(r.source, known == last_seq_.end() ? 0 : known->second).first;
-      }
-      if (r.seq <= last->second) continue;  // delivered before: a retried batch
-      last->second = r.seq;
+      // delivered before (a retried batch), or twice in this one
+      if (seen_.Contains(r.source, r.seq) || !in_batch.emplace(r.source, r.seq).second) continue;
     }
     text += logging::FormatLine(r);
     text += '\n';
-    stored.push_back({++serial, r});
+    stored.push_back({++serial, std::move(r)});
   }
   if (!text.empty()) {
     struct stat before;
@@ -125,31 +150,43 @@ std::vector<StoredRecord> LogStore::Submit(const std::vector<logging::Record>& r
     }
   }
   serial_ = serial;
-  for (const auto& [source, seq] : last_seq) last_seq_[source] = seq;
   for (const auto& s : stored) {
-    recent_.push_back(s);
+    if (s.record.seq != 0) seen_.Insert(s.record.source, s.record.seq);
+    recent_.push_back(std::make_shared<const StoredRecord>(s));
     if (recent_.size() > memory_records_) recent_.pop_front();
   }
   return stored;
 }
 
 std::vector<StoredRecord> LogStore::Query(const QueryFilter& f) const {
-  std::regex re;
-  const bool use_regex = !f.regex.empty();
-  if (use_regex) re = std::regex(f.regex, std::regex::ECMAScript);
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<StoredRecord> out;
-  for (const auto& s : recent_) {
-    const auto& r = s.record;
-    if (s.serial <= f.after_serial || r.priority > f.max_priority) continue;
-    if (!f.category_prefix.empty() && r.category.rfind(f.category_prefix, 0) != 0) continue;
-    if (!f.component.empty() && r.component != f.component) continue;
-    if (f.from_time_us != 0 && r.time_us < f.from_time_us) continue;
-    if (f.to_time_us != 0 && r.time_us > f.to_time_us) continue;
-    if (use_regex && !std::regex_search(r.message, re)) continue;
-    out.push_back(s);
+  std::optional<logging::MessagePattern> pattern;
+  if (!f.regex.empty()) pattern.emplace(f.regex);
+  const size_t limit = f.limit == 0 ? kMaxQueryRecords : std::min(f.limit, kMaxQueryRecords);
+  // newest first; under the lock only the cheap tests, and pointers copied
+  std::vector<std::shared_ptr<const StoredRecord>> candidates;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = recent_.rbegin(); it != recent_.rend(); ++it) {
+      const StoredRecord& s = **it;
+      const auto& r = s.record;
+      if (s.serial <= f.after_serial) break;  // serials grow: every older one is too
+      if (r.priority > f.max_priority) continue;
+      if (!f.category_prefix.empty() && r.category.rfind(f.category_prefix, 0) != 0) continue;
+      if (!f.component.empty() && r.component != f.component) continue;
+      if (f.from_time_us != 0 && r.time_us < f.from_time_us) continue;
+      if (f.to_time_us != 0 && r.time_us > f.to_time_us) continue;
+      candidates.push_back(*it);
+      if (!pattern && candidates.size() == limit) break;
+    }
   }
-  if (f.limit != 0 && out.size() > f.limit) out.erase(out.begin(), out.end() - f.limit);
+  if (before_match_) before_match_();
+  std::vector<StoredRecord> out;
+  for (const auto& c : candidates) {
+    if (out.size() == limit) break;
+    if (pattern && !pattern->Search(c->record.message)) continue;
+    out.push_back(*c);
+  }
+  std::reverse(out.begin(), out.end());
   return out;
 }
 

@@ -1,8 +1,9 @@
 #include "logger_servant.h"
 
-#include <regex>
+#include <string>
 
 #include "caliper/logging/log.h"
+#include "caliper/logging/message_pattern.h"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
 
@@ -12,17 +13,27 @@ namespace idl = ::Caliper::Logging;
 
 namespace {
 
-idl::StoredRecordSeq* ToIdl(const std::vector<StoredRecord>& records) {
+const StoredRecord& Ref(const StoredRecord& s) { return s; }
+const StoredRecord& Ref(const std::shared_ptr<const StoredRecord>& s) { return *s; }
+
+/// Query answers (records) and pushes (shared records) alike.
+template <typename Records>
+idl::StoredRecordSeq* ToIdl(const Records& records) {
   auto* out = new idl::StoredRecordSeq;
   out->length(static_cast<CORBA::ULong>(records.size()));
   for (CORBA::ULong i = 0; i < records.size(); ++i) {
-    (*out)[i].serial = records[i].serial;
-    (*out)[i].rec = rtc::ToIdl(records[i].record);
+    (*out)[i].serial = Ref(records[i]).serial;
+    (*out)[i].rec = rtc::ToIdl(Ref(records[i]).record);
   }
   return out;
 }
 
-constexpr size_t kMaxListenerQueue = 100000;
+/// What a queued record costs a listener's queue [bytes].
+size_t Bytes(const StoredRecord& s) {
+  const auto& r = s.record;
+  return sizeof(StoredRecord) + r.message.size() + r.category.size() + r.component.size() +
+         r.host.size() + r.source.size();
+}
 
 }  // namespace
 
@@ -37,8 +48,31 @@ ListenerHub::~ListenerHub() {
   for (auto& [id, l] : listeners) l->thread.join();
 }
 
-uint64_t ListenerHub::Add(idl::LogListener_ptr ref) {
+std::vector<std::unique_ptr<ListenerHub::Listener>> ListenerHub::TakeDead() {
+  std::vector<std::unique_ptr<Listener>> dead;
   std::lock_guard<std::mutex> lock(mutex_);
+  for (auto it = listeners_.begin(); it != listeners_.end();) {
+    if (it->second->dead) {
+      dead.push_back(std::move(it->second));
+      it = listeners_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return dead;
+}
+
+uint64_t ListenerHub::Add(idl::LogListener_ptr ref) {
+  if (CORBA::is_nil(ref)) throw CORBA::BAD_PARAM(0, CORBA::COMPLETED_NO);
+  // the places of dropped listeners are free again; their threads have ended
+  for (auto& dead : TakeDead()) dead->thread.join();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (listeners_.size() >= kMaxListeners)
+    throw idl::LimitExceeded(("already " + std::to_string(listeners_.size()) +
+                              " log listeners, at most " + std::to_string(kMaxListeners) +
+                              "; remove_listener frees a place")
+                                 .c_str(),
+                             kMaxListeners);
   const uint64_t id = next_id_++;
   auto listener = std::make_unique<Listener>();
   listener->ref = idl::LogListener::_duplicate(ref);
@@ -62,41 +96,84 @@ void ListenerHub::Remove(uint64_t id) {
   listener->thread.join();
 }
 
+size_t ListenerHub::size() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  size_t live = 0;
+  for (const auto& [id, l] : listeners_) live += l->dead ? 0 : 1;
+  return live;
+}
+
 void ListenerHub::Publish(const std::vector<StoredRecord>& records) {
   std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<Shared> shared;
   for (auto& [id, l] : listeners_) {
     if (l->dead) continue;
-    l->queue.insert(l->queue.end(), records.begin(), records.end());
+    // one copy of each record, whatever the number of listeners
+    if (shared.empty())
+      for (const auto& s : records) shared.push_back(std::make_shared<const StoredRecord>(s));
+    for (const auto& s : shared) {
+      l->queue.push_back(s);
+      l->queued_bytes += Bytes(*s);
+    }
     // a listener that falls this far behind loses its oldest records, never the logger's memory
-    while (l->queue.size() > kMaxListenerQueue) l->queue.pop_front();
+    while (l->queue.size() > kMaxQueueRecords || l->queued_bytes > kMaxQueueBytes) {
+      l->queued_bytes -= Bytes(*l->queue.front());
+      l->queue.pop_front();
+    }
   }
   wake_.notify_all();
 }
 
 void ListenerHub::Run(Listener* l) {
+  auto& log = logging::Get("listeners");
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     wake_.wait(lock, [&] { return l->stop || !l->queue.empty(); });
     if (l->stop) return;
-    std::vector<StoredRecord> batch(l->queue.begin(), l->queue.end());
-    l->queue.clear();
+    std::vector<Shared> batch;
+    size_t bytes = 0;
+    while (!l->queue.empty() && (batch.empty() || bytes + Bytes(*l->queue.front()) <= kMaxPushBytes)) {
+      const size_t b = Bytes(*l->queue.front());
+      bytes += b;
+      l->queued_bytes -= b;
+      batch.push_back(std::move(l->queue.front()));
+      l->queue.pop_front();
+    }
     lock.unlock();
-    bool gone = false;
+    bool timed_out = false;
+    std::string failure;
     try {
       std::unique_ptr<idl::StoredRecordSeq> seq(ToIdl(batch));
       l->ref->on_records(*seq);
+    } catch (const CORBA::TIMEOUT& e) {
+      timed_out = true;
+      failure = rtc::Describe(e);
     } catch (const CORBA::Exception& e) {
-      gone = true;
-      logging::Get("listeners").info("dropping a log listener: %s", rtc::Describe(e).c_str());
+      failure = rtc::Describe(e);
     }
     lock.lock();
-    if (gone) {
-      // leave the thread parked until Remove or the destructor joins it
-      l->queue.clear();
-      l->dead = true;
-      wake_.wait(lock, [&] { return l->stop; });
-      return;
+    if (failure.empty()) {
+      l->timeouts = 0;
+      continue;
     }
+    if (timed_out && ++l->timeouts < kMaxTimeouts) {
+      // slow, not gone: what waited for it is dropped, the listener stays
+      const size_t dropped = l->queue.size();
+      l->queue.clear();
+      l->queued_bytes = 0;
+      lock.unlock();
+      log.warn("a log listener did not answer in time (%s): %zu waiting records dropped",
+               failure.c_str(), dropped + batch.size());
+      lock.lock();
+      continue;
+    }
+    // gone (or stopped for kMaxTimeouts pushes): its place is freed by the next Add or Remove
+    l->queue.clear();
+    l->queued_bytes = 0;
+    l->dead = true;
+    lock.unlock();
+    log.info("dropping a log listener: %s", failure.c_str());
+    return;
   }
 }
 
@@ -132,8 +209,11 @@ idl::StoredRecordSeq* LoggerServant::query(const idl::RecordFilter& q) {
   f.limit = q.limit;
   try {
     return ToIdl(component_.Query(f));
-  } catch (const std::regex_error& e) {
-    throw idl::InvalidQuery(("bad regular expression '" + f.regex + "': " + e.what()).c_str());
+  } catch (const logging::PatternError& e) {
+    throw idl::InvalidQuery(e.what());
+  } catch (const std::exception& e) {
+    logging::Get("query").error("query failed: %s", e.what());
+    throw CORBA::INTERNAL(0, CORBA::COMPLETED_NO);
   }
 }
 

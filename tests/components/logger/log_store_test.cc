@@ -6,8 +6,12 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <limits>
 #include <memory>
 #include <regex>
 #include <sstream>
@@ -16,6 +20,7 @@
 #include <vector>
 
 #include "caliper/core/system.h"
+#include "caliper/logging/message_pattern.h"
 
 namespace caliper::logger {
 namespace {
@@ -394,12 +399,37 @@ TEST_F(LogStoreQueryTest, FiltersByRegexOnMessage) {
   EXPECT_EQ(Query(f), (Serial{1, 2, 5}));
 }
 
-TEST_F(LogStoreQueryTest, ThrowsOnBadRegex) {
+/// The message of the PatternError that `store.Query(filter)` throws, or "" when it answers.
+std::string QueryError(const LogStore& store, const QueryFilter& filter) {
+  try {
+    store.Query(filter);
+  } catch (const logging::PatternError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(LogStoreQueryTest, RefusesBadRegexWithRe2sReason) {
   QueryFilter f;
   f.regex = "joint (";
-  EXPECT_THROW(store_->Query(f), std::regex_error);
+  EXPECT_EQ(QueryError(*store_, f), "bad regular expression 'joint (': missing ): joint (");
   f.regex = "[";
-  EXPECT_THROW(store_->Query(f), std::regex_error);
+  EXPECT_EQ(QueryError(*store_, f), "bad regular expression '[': missing ]: [");
+  // ECMAScript's lookahead is not RE2 syntax
+  f.regex = "joint(?= 2)";
+  EXPECT_EQ(QueryError(*store_, f),
+            "bad regular expression 'joint(?= 2)': invalid perl operator: (?=");
+}
+
+TEST_F(LogStoreQueryTest, RefusesTooLongRegex) {
+  QueryFilter f;
+  f.regex = std::string(logging::kMaxPatternBytes, 'j');
+  EXPECT_EQ(QueryError(*store_, f), "");
+  f.regex += "j";
+  EXPECT_EQ(QueryError(*store_, f), "regular expression too long: " +
+                                        std::to_string(logging::kMaxPatternBytes + 1) +
+                                        " bytes, at most " +
+                                        std::to_string(logging::kMaxPatternBytes));
 }
 
 TEST_F(LogStoreQueryTest, FiltersByInclusiveTimeRange) {
@@ -445,6 +475,261 @@ TEST_F(LogStoreQueryTest, CombinesFilters) {
   f.after_serial = 0;
   f.regex = "joint";
   EXPECT_EQ(Query(f), (Serial{1}));
+}
+
+// ------------------------------------------------------------------------ hostile clients
+
+/// `letters` characters alternating a and b.
+std::string Ab(size_t letters) {
+  std::string text;
+  for (size_t i = 0; i < letters; ++i) text += i % 2 == 0 ? 'a' : 'b';
+  return text;
+}
+
+TEST_F(LogStoreTest, AlternationOverTwentyKilobyteMessageAnswersNormally) {
+  // std::regex recursed once per character here and overflowed the stack: the logger died
+  LogStore store(dir_, "s1", 100);
+  store.Submit({MakeRecord("a", 1, Ab(kMaxMessageBytes)),  // kept whole, no `c` in it
+                MakeRecord("a", 2, Ab(20 * 1024))});       // kept cut: its marker has a `c`
+  QueryFilter f;
+  f.regex = "(a|b)*c";
+  EXPECT_EQ(Serials(store.Query(f)), (std::vector<uint64_t>{2}));
+  f.regex = "^(a|b)*$";
+  EXPECT_EQ(Serials(store.Query(f)), (std::vector<uint64_t>{1}));
+  // and the store goes on
+  EXPECT_EQ(store.Submit({MakeRecord("a", 3, "after")}).size(), 1u);
+  f.regex = "^after$";
+  EXPECT_EQ(Serials(store.Query(f)), (std::vector<uint64_t>{3}));
+}
+
+TEST_F(LogStoreTest, NestedQuantifiersReturnWithoutBacktracking) {
+  // exponential backtracking with std::regex: more than 30 s for 20 letters
+  LogStore store(dir_, "s1", 100);
+  store.Submit({MakeRecord("a", 1, std::string(20, 'a')), MakeRecord("a", 2, "aaab")});
+  QueryFilter f;
+  f.regex = "(a*)*b";
+  EXPECT_EQ(Serials(store.Query(f)), (std::vector<uint64_t>{2}));
+}
+
+TEST_F(LogStoreTest, SubmitCompletesWhileAQueryMatches) {
+  LogStore store(dir_, "s1", 100);
+  store.Submit({MakeRecord("a", 1, std::string(20, 'a'))});
+  std::future<size_t> submitted;
+  bool done_during_match = false;
+  // runs inside Query, after the candidates are picked and before the expression runs
+  store.set_before_match([&] {
+    submitted = std::async(std::launch::async,
+                           [&] { return store.Submit({MakeRecord("b", 1)}).size(); });
+    done_during_match = submitted.wait_for(std::chrono::seconds(20)) == std::future_status::ready;
+  });
+  QueryFilter f;
+  f.regex = "(a*)*b";
+  EXPECT_TRUE(store.Query(f).empty()) << "the record submitted meanwhile is not a candidate";
+  EXPECT_TRUE(done_during_match) << "the submit waited for the query's lock";
+  EXPECT_EQ(submitted.get(), 1u);
+  store.set_before_match(nullptr);
+  EXPECT_EQ(Messages(store.Query({})), (std::vector<std::string>{std::string(20, 'a'), "b #1"}));
+}
+
+TEST_F(LogStoreTest, QueriesAndSubmitsFromSeveralThreads) {
+  LogStore store(dir_, "s1", 5000);
+  std::vector<Record> batch;
+  for (uint64_t i = 1; i <= 1000; ++i) batch.push_back(MakeRecord("a", i, std::string(20, 'a')));
+  store.Submit(batch);
+  std::atomic<bool> submitting{true};
+  auto queries = std::async(std::launch::async, [&] {
+    QueryFilter f;
+    f.regex = "(a*)*q";
+    size_t runs = 0;
+    // bounded: at least one, then until the submits are done, at most 10,000
+    do {
+      EXPECT_TRUE(store.Query(f).empty());
+    } while (++runs < 10000 && submitting);
+    return runs;
+  });
+  auto submits = std::async(std::launch::async, [&] {
+    size_t stored = 0;
+    for (uint64_t i = 1; i <= 200; ++i) stored += store.Submit({MakeRecord("c", i, "later")}).size();
+    submitting = false;
+    return stored;
+  });
+  ASSERT_EQ(submits.wait_for(std::chrono::seconds(60)), std::future_status::ready);
+  ASSERT_EQ(queries.wait_for(std::chrono::seconds(60)), std::future_status::ready);
+  EXPECT_EQ(submits.get(), 200u);
+  EXPECT_GE(queries.get(), 1u);
+  EXPECT_EQ(store.size(), 1200u);
+}
+
+TEST_F(LogStoreTest, KeepsTooLongMessageTruncatedWithMarker) {
+  const std::string original = Ab(100 * 1024);
+  std::string path, kept;
+  {
+    LogStore store(dir_, "s1", 100);
+    const auto stored = store.Submit({MakeRecord("a", 1, original)});
+    ASSERT_EQ(stored.size(), 1u);
+    kept = stored[0].record.message;
+    EXPECT_LE(kept.size(), kMaxMessageBytes);
+    const size_t marker_at = kept.find("\xE2\x80\xA6 [truncated ");
+    ASSERT_NE(marker_at, std::string::npos) << kept.substr(kept.size() - 40);
+    EXPECT_EQ(kept.substr(0, marker_at), original.substr(0, marker_at));
+    EXPECT_EQ(kept.substr(marker_at), TruncationMarker(original.size() - marker_at));
+    EXPECT_GT(marker_at, kMaxMessageBytes - 64) << "not more cut than the marker needs";
+    path = store.path();
+    EXPECT_EQ(Messages(store.Query({})), std::vector<std::string>{kept});
+    const auto records = FileRecords(path);
+    ASSERT_EQ(records.size(), 1u);
+    EXPECT_EQ(records[0].message, kept);
+  }
+  // read back the same after a restart
+  LogStore store(dir_, "s1", 100);
+  EXPECT_EQ(Messages(store.Query({})), std::vector<std::string>{kept});
+}
+
+TEST_F(LogStoreTest, KeepsMessagesUpToTheBoundWhole) {
+  LogStore store(dir_, "s1", 100);
+  const std::string longest = Ab(kMaxMessageBytes);
+  EXPECT_EQ(Messages(store.Submit({MakeRecord("a", 1, longest)})),
+            std::vector<std::string>{longest});
+}
+
+TEST(TruncateTest, CutsBetweenUtf8CharactersAndSaysHowMuch) {
+  EXPECT_EQ(Truncate("short", 100), "short");
+  EXPECT_EQ(TruncationMarker(12345), "\xE2\x80\xA6 [truncated 12345 bytes]");
+  // 2-byte characters: a cut never leaves half of one
+  std::string text;
+  for (int i = 0; i < 100; ++i) text += "\xC3\xA9";  // é
+  for (size_t max = 40; max < 60; ++max) {
+    const std::string cut = Truncate(text, max);
+    EXPECT_LE(cut.size(), max);
+    const size_t kept = cut.find("\xE2\x80\xA6");
+    ASSERT_NE(kept, std::string::npos);
+    EXPECT_EQ(kept % 2, 0u) << "half a character kept at max " << max;
+    EXPECT_EQ(cut.substr(kept), TruncationMarker(text.size() - kept));
+  }
+}
+
+TEST_F(LogStoreTest, BoundsTheOtherTextFields) {
+  LogStore store(dir_, "s1", 100);
+  Record r = MakeRecord(std::string(100000, 's'), 1);
+  r.category = std::string(100000, 'c');
+  const auto stored = store.Submit({r});
+  ASSERT_EQ(stored.size(), 1u);
+  EXPECT_LE(stored[0].record.source.size(), kMaxFieldBytes);
+  EXPECT_LE(stored[0].record.category.size(), kMaxFieldBytes);
+  EXPECT_NE(stored[0].record.category.find("[truncated "), std::string::npos);
+  EXPECT_TRUE(store.Submit({r}).empty()) << "the same record again is still a duplicate";
+}
+
+TEST_F(LogStoreTest, ForgedFarAheadSeqDoesNotSilenceTheSource) {
+  std::string path;
+  {
+    LogStore store(dir_, "s1", 100);
+    store.Submit({MakeRecord("victim", 1), MakeRecord("victim", 2)});
+    // another client names the victim's source with huge seqs
+    const auto forged = store.Submit({MakeRecord("victim", uint64_t{1} << 62, "forged"),
+                                      MakeRecord("victim", ~uint64_t{0}, "forged max")});
+    EXPECT_EQ(forged.size(), 2u) << "the forged records are records too";
+    // the victim's later records are all stored, its retries still are not
+    for (uint64_t seq = 3; seq <= 50; ++seq)
+      EXPECT_EQ(store.Submit({MakeRecord("victim", seq)}).size(), 1u) << seq;
+    EXPECT_TRUE(store.Submit({MakeRecord("victim", 2), MakeRecord("victim", 50)}).empty());
+    EXPECT_TRUE(store.Submit({MakeRecord("victim", ~uint64_t{0})}).empty());
+    EXPECT_EQ(store.size(), 52u);
+    path = store.path();
+  }
+  // the same after a restart, which rebuilds what was seen from the file
+  LogStore store(dir_, "s1", 100);
+  EXPECT_EQ(store.Submit({MakeRecord("victim", 51)}).size(), 1u);
+  EXPECT_TRUE(store.Submit({MakeRecord("victim", 7)}).empty());
+}
+
+TEST_F(LogStoreTest, ManyForgedSeqsDoNotSilenceTheSourceEither) {
+  LogStore store(dir_, "s1", 100);
+  for (uint64_t seq = 1; seq <= 10; ++seq) store.Submit({MakeRecord("victim", seq)});
+  // scattered far-ahead seqs, more than the ranges remembered per source
+  std::vector<Record> forged;
+  for (uint64_t i = 1; i <= 3 * SeenSequences::kMaxRanges; ++i)
+    forged.push_back(MakeRecord("victim", 1000000 * i, "forged"));
+  store.Submit(forged);
+  EXPECT_EQ(store.Submit({MakeRecord("victim", 11)}).size(), 1u);
+  // the victim's own range is the large one: it is what stays remembered
+  EXPECT_TRUE(store.Submit({MakeRecord("victim", 1), MakeRecord("victim", 11)}).empty());
+}
+
+TEST_F(LogStoreTest, QueryReturnsAtMostTheResultLimit) {
+  LogStore store(dir_, "s1", kMaxQueryRecords + 100);
+  std::vector<Record> batch;
+  for (uint64_t i = 1; i <= kMaxQueryRecords + 5; ++i) batch.push_back(MakeRecord("a", i, "m"));
+  store.Submit(batch);
+  QueryFilter f;  // limit 0: as many as allowed
+  auto all = Serials(store.Query(f));
+  ASSERT_EQ(all.size(), kMaxQueryRecords);
+  EXPECT_EQ(all.front(), 6u) << "the newest";
+  EXPECT_EQ(all.back(), kMaxQueryRecords + 5u);
+  f.limit = std::numeric_limits<uint32_t>::max();
+  EXPECT_EQ(store.Query(f).size(), kMaxQueryRecords);
+  f.regex = "^m$";
+  EXPECT_EQ(store.Query(f).size(), kMaxQueryRecords);
+  f.limit = 3;
+  EXPECT_EQ(Serials(store.Query(f)),
+            (std::vector<uint64_t>{kMaxQueryRecords + 3u, kMaxQueryRecords + 4u,
+                                   kMaxQueryRecords + 5u}));
+}
+
+// ------------------------------------------------------------------------ seen sequences
+
+TEST(SeenSequencesTest, RemembersExactlyWhatWasInserted) {
+  SeenSequences seen;
+  for (uint64_t seq : {1, 2, 3, 5, 4, 10}) seen.Insert("a", seq);
+  for (uint64_t seq : {1, 2, 3, 4, 5, 10}) EXPECT_TRUE(seen.Contains("a", seq)) << seq;
+  for (uint64_t seq : {0, 6, 9, 11}) EXPECT_FALSE(seen.Contains("a", seq)) << seq;
+  EXPECT_FALSE(seen.Contains("b", 1));
+  EXPECT_EQ(seen.ranges("a"), 2u) << "1-5 and 10";
+  seen.Insert("a", ~uint64_t{0});
+  EXPECT_TRUE(seen.Contains("a", ~uint64_t{0}));
+  EXPECT_FALSE(seen.Contains("a", ~uint64_t{0} - 1));
+  seen.Insert("a", 0);
+  EXPECT_TRUE(seen.Contains("a", 0));
+}
+
+TEST(SeenSequencesTest, MergesRangesThatMeet) {
+  SeenSequences seen;
+  seen.Insert("a", 1);
+  seen.Insert("a", 3);
+  EXPECT_EQ(seen.ranges("a"), 2u);
+  seen.Insert("a", 2);
+  EXPECT_EQ(seen.ranges("a"), 1u);
+  for (uint64_t seq = 4; seq < 1000; ++seq) seen.Insert("a", seq);
+  EXPECT_EQ(seen.ranges("a"), 1u) << "a process counting up needs one range";
+}
+
+TEST(SeenSequencesTest, ForgetsTheSmallestOtherRangeBeyondTheBound) {
+  SeenSequences seen(10, 3);
+  for (uint64_t seq = 1; seq <= 100; ++seq) seen.Insert("a", seq);
+  seen.Insert("a", 1000);
+  seen.Insert("a", 2000);
+  seen.Insert("a", 3000);  // a fourth range: the smallest other one (1000) goes
+  EXPECT_EQ(seen.ranges("a"), 3u);
+  EXPECT_FALSE(seen.Contains("a", 1000));
+  EXPECT_TRUE(seen.Contains("a", 2000));
+  EXPECT_TRUE(seen.Contains("a", 3000)) << "the range just inserted stays";
+  EXPECT_TRUE(seen.Contains("a", 50)) << "the large range stays";
+}
+
+TEST(SeenSequencesTest, ForgetsTheLeastRecentlyInsertedSourceBeyondTheBound) {
+  SeenSequences seen(3, 8);
+  seen.Insert("a", 1);
+  seen.Insert("b", 1);
+  seen.Insert("c", 1);
+  seen.Insert("a", 2);  // a is the most recent now, b the least
+  seen.Insert("d", 1);
+  EXPECT_EQ(seen.sources(), 3u);
+  EXPECT_FALSE(seen.Contains("b", 1));
+  EXPECT_TRUE(seen.Contains("a", 1));
+  EXPECT_TRUE(seen.Contains("c", 1));
+  EXPECT_TRUE(seen.Contains("d", 1));
+  for (int i = 0; i < 10000; ++i) seen.Insert("s" + std::to_string(i), 1);
+  EXPECT_EQ(seen.sources(), 3u) << "bounded whatever the number of sources";
 }
 
 }  // namespace
