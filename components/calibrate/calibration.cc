@@ -4,11 +4,13 @@
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
 #include <boost/tokenizer.hpp>
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <locale>
 #include <set>
+
+#include "caliper/core/numbers.h"
 
 namespace caliper::calibrate {
 
@@ -23,9 +25,7 @@ namespace {
 
 double Number(const std::string& text, const std::string& where) {
   double v = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
-  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+  if (!core::ParseDouble(text, &v) || !std::isfinite(v))
     Fail(where, "'" + text + "' is not a finite number");
   return v;
 }
@@ -111,7 +111,7 @@ Measured LoadMeasured(const std::string& path) {
 Spec LoadSpec(const std::string& path) {
   ptree root;
   try {
-    boost::property_tree::read_json(path, root);
+    boost::property_tree::read_json(path, root, std::locale::classic());
   } catch (const boost::property_tree::json_parser_error& e) {
     throw SpecError(path + ":" + std::to_string(e.line()) + ": " + e.message());
   }

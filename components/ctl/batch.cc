@@ -18,6 +18,7 @@
 
 #include "batch_plan.h"
 #include "cluster_verbs.h"
+#include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/experiment/experiment.h"
 #include "caliper/model.hh"
@@ -497,9 +498,8 @@ int Batch(Client& client, std::vector<std::string>& args) {
   TakeOption(args, "--models", &options.models);
   auto number = [&](const std::string& flag, double* target, double low) {
     if (!TakeOption(args, flag, &value)) return;
-    char* end = nullptr;
-    const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0' || !(v >= low))
+    double v = 0;
+    if (!core::ParseDouble(value, &v) || !(v >= low))
       throw UsageError(flag + " takes a number >= " + Fixed(low, 1));
     *target = v;
   };

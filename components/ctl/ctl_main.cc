@@ -14,6 +14,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
+#include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/logging.hh"
 #include "caliper/logging/record.h"
@@ -328,8 +329,7 @@ int Main(int argc, char** argv) {
     if (args[i] == "--nameservice") {
       options.nameservice = args[++i];
     } else if (args[i] == "--timeout") {
-      options.timeout_s = std::atof(args[++i].c_str());
-      if (options.timeout_s <= 0) {
+      if (!core::ParseDouble(args[++i], &options.timeout_s) || !(options.timeout_s > 0)) {
         std::cerr << "caliper-ctl: --timeout wants seconds > 0\n";
         return 2;
       }

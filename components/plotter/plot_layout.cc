@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "number_format.h"
 
@@ -101,10 +102,8 @@ Layout ParseLayout(const std::string& text, const std::string& origin) {
     return LayoutError(origin + ":" + std::to_string(line_no) + ": " + why);
   };
   auto parse_double = [&](const std::string& key, const std::string& v) {
-    char* end = nullptr;
-    errno = 0;
-    const double d = std::strtod(v.c_str(), &end);
-    if (v.empty() || *end != '\0' || errno != 0 || !std::isfinite(d))
+    double d = 0;
+    if (!core::ParseDouble(v, &d) || !std::isfinite(d))
       throw fail(key + " wants a number, not '" + v + "'");
     return d;
   };

@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "caliper/core/numbers.h"
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/logging/log.h"
 #include "caliper/render_coin/offscreen_renderer.h"
@@ -66,9 +67,7 @@ bool ParseOptions(int argc, char** argv, Options* out) {
       } else if (arg == "--session") {
         out->session = QString::fromStdString(value);
       } else {
-        char* end = nullptr;
-        out->after = std::strtod(value.c_str(), &end);
-        if (end == value.c_str() || *end != '\0' || out->after < 0) {
+        if (!core::ParseDouble(value, &out->after) || !(out->after >= 0)) {
           std::cerr << "caliper-renderer: error: --after needs a number of seconds >= 0\n";
           return false;
         }

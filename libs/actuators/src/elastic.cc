@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "caliper/core/numbers.h"
+
 namespace caliper::actuators {
 
 namespace {
@@ -321,14 +323,8 @@ std::vector<std::pair<double, double>> TableSpring::Parse(const std::string& tex
   std::vector<double> numbers;
   std::string word;
   while (in >> word) {
-    std::size_t used = 0;
     double value = 0;
-    try {
-      value = std::stod(word, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != word.size())
+    if (!core::ParseDouble(word, &value))
       throw std::invalid_argument("table spring: '" + word + "' is not a number in '" + text + "'");
     numbers.push_back(value);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "caliper/core/numbers.h"
 #include "dom_io.h"
 
 namespace caliper::collada::internal {
@@ -314,10 +315,9 @@ bool ParseNumbers(std::string_view text, std::vector<double>* out, std::string* 
     if (i >= n) return true;
     size_t j = i;
     while (j < n && !IsSpace(text[j])) ++j;
-    const std::string token(text.substr(i, j - i));
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0') {
+    const std::string_view token = text.substr(i, j - i);
+    double v = 0;
+    if (!core::ParseDouble(token, &v)) {
       *bad = token;
       return false;
     }
@@ -515,6 +515,7 @@ Document ReadDocument(const std::string& path) {
     if (line > 0) throw ReadError("malformed XML: " + what, line);
   }
   std::lock_guard<std::mutex> lock(DomMutex());
+  const core::ClassicLocaleScope classic;  // the DOM reads numbers with sscanf and streams
   DomLoad load;
   for (int attempt : attempts) {
     load = attempt == 150 ? LoadWithDom150(path) : LoadWithDom141(path);
@@ -585,6 +586,7 @@ Document ReadDocument(const std::string& path) {
 
 void WriteDocument150(const Element& root, const std::string& path) {
   std::lock_guard<std::mutex> lock(DomMutex());
+  const core::ClassicLocaleScope classic;  // the DOM writes numbers with printf and streams
   WriteWithDom150(root, path);
 }
 

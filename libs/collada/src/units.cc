@@ -1,8 +1,11 @@
 #include "units.h"
 
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <vector>
+
+#include "caliper/core/numbers.h"
 
 namespace caliper::collada::internal {
 
@@ -181,7 +184,12 @@ class Parser {
         *bad = "^" + digits;
         return false;
       }
-      *out = Power(*out, std::stoi(digits));
+      long long exponent = 0;
+      if (!core::ParseInt(digits, &exponent) || exponent < INT_MIN || exponent > INT_MAX) {
+        *bad = "^" + digits;
+        return false;
+      }
+      *out = Power(*out, static_cast<int>(exponent));
     }
     return true;
   }

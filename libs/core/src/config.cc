@@ -1,11 +1,12 @@
 #include "caliper/core/config.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
+#include <locale>
 #include <sstream>
+
+#include "caliper/core/numbers.h"
 
 namespace caliper::core {
 
@@ -32,20 +33,8 @@ bool ParseBool(const std::string& v, bool* out) {
   return false;
 }
 
-bool ParseDouble(const std::string& v, double* out) {
-  if (v.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  *out = std::strtod(v.c_str(), &end);
-  return errno == 0 && *end == '\0' && std::isfinite(*out);
-}
-
-bool ParseInt(const std::string& v, long long* out) {
-  if (v.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  *out = std::strtoll(v.c_str(), &end, 10);
-  return errno == 0 && *end == '\0';
+bool ParseFinite(const std::string& v, double* out) {
+  return ParseDouble(v, out) && std::isfinite(*out);
 }
 
 const char* TypeName(ConfigKey::Type t) {
@@ -108,7 +97,7 @@ void Config::Check(const ConfigKey& key, const std::string& value, const std::st
     }
     case ConfigKey::Type::kDouble: {
       double d;
-      if (!ParseDouble(value, &d))
+      if (!ParseFinite(value, &d))
         why = "expected a finite number";
       else if (d < key.min || d > key.max)
         why = "out of range";
@@ -117,6 +106,7 @@ void Config::Check(const ConfigKey& key, const std::string& value, const std::st
   }
   if (why.empty()) return;
   std::ostringstream msg;
+  msg.imbue(std::locale::classic());  // bounds print as they are written, in any locale
   msg << origin << ": " << key.name << " = '" << value << "': " << why;
   if (key.type == ConfigKey::Type::kInt || key.type == ConfigKey::Type::kDouble) {
     msg << " (allowed " << key.min << " .. " << key.max << ")";
@@ -171,7 +161,7 @@ long long Config::GetInt(const std::string& key) const {
 
 double Config::GetDouble(const std::string& key) const {
   double v = 0;
-  if (!ParseDouble(GetString(key), &v)) throw ConfigError(key + " is not a number");
+  if (!ParseFinite(GetString(key), &v)) throw ConfigError(key + " is not a number");
   return v;
 }
 

@@ -8,7 +8,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <locale>
 #include <set>
+
+#include "caliper/core/numbers.h"
 
 namespace caliper::experiment {
 
@@ -32,9 +35,8 @@ struct Where {
 };
 
 double Number(const std::string& text, const Where& where, const std::string& key) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+  double v = 0;
+  if (!core::ParseDouble(text, &v) || !std::isfinite(v))
     where.Fail(key, "'" + text + "' is not a finite number");
   return v;
 }
@@ -237,7 +239,9 @@ std::vector<Command> LoadScheduleCsv(const std::string& path) {
 std::vector<Experiment> LoadFile(const std::string& path) {
   ptree root;
   try {
-    boost::property_tree::read_json(path, root);
+    // numbers stay text (Number reads them); the classic locale keeps the stream itself
+    // independent of the process's
+    boost::property_tree::read_json(path, root, std::locale::classic());
   } catch (const boost::property_tree::json_parser_error& e) {
     throw FormatError(path + ":" + std::to_string(e.line()) + ": " + e.message());
   }

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "caliper/collada/importer.h"
+#include "comma_locale.h"
 #include "corpus.h"
 #include "scene_compare.h"
 
@@ -111,6 +112,24 @@ TEST_F(ColladaExportTest, RoundTripsTheExtensionExampleAndEveryTestFileThatImpor
     ++round_tripped;
   }
   EXPECT_GE(round_tripped, 5u);  // caliper_arm, minimal, transforms, nonphysical_inertia, ...
+}
+
+TEST_F(ColladaExportTest, WritesDecimalPointsUnderACommaDecimalLocale) {
+  // a Qt process under LANG=de_DE.UTF-8 exports: the file must read back the same in any locale
+  const sgal::Scene scene = Import(Data("caliper_arm.dae"), nullptr);
+  const std::string out = Out("german.dae");
+  {
+    CALIPER_COMMA_DECIMAL_LOCALE(locale);
+    ASSERT_NO_THROW(Export(scene, out));
+  }
+  std::ifstream in(out);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str().find("1,2"), std::string::npos) << "a decimal comma in the file";
+  sgal::Scene again;
+  ASSERT_NO_THROW(again = Import(out, nullptr));
+  EXPECT_EQ(again.FindBody("forearm")->inertia.mass, 1.2);
+  EXPECT_EQ(testing::SceneComparison(1e-9).Compare(scene, again), 0);
 }
 
 TEST_F(ColladaExportTest, RoundTripsEveryShapeKindConstraintKindAndBodyType) {

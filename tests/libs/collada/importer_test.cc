@@ -14,7 +14,9 @@
 #include <set>
 #include <sstream>
 
+#include "comma_locale.h"
 #include "corpus.h"
+#include "scene_compare.h"
 
 namespace caliper::collada {
 namespace {
@@ -482,6 +484,20 @@ TEST(ColladaImportTest, WarnsAboutAnUnknownElementOfTheTechniqueWithItsLine) {
       << warnings[0];
   EXPECT_NE(warnings[0].find("<muscle_synergy>"), std::string::npos) << warnings[0];
   EXPECT_NE(warnings[0].find("line 107"), std::string::npos) << warnings[0];
+}
+
+TEST(ColladaImportTest, ReadsNumbersTheSameUnderACommaDecimalLocale) {
+  // the Main Window and the tools are Qt processes: under LANG=de_DE.UTF-8 their C locale reads
+  // "1.2" as 1 (strtod, and Collada-DOM's own sscanf for float_array)
+  const sgal::Scene plain = Load(Data("caliper_arm.dae"));
+  CALIPER_COMMA_DECIMAL_LOCALE(locale);
+  const sgal::Scene german = Load(Data("caliper_arm.dae"));
+  ASSERT_EQ(german.bodies.size(), 4u);
+  EXPECT_EQ(german.FindBody("forearm")->inertia.mass, 1.2);
+  EXPECT_EQ(german.FindBody("upper_arm")->inertia.com.z(), 0.01);
+  ASSERT_EQ(german.actuators.size(), 5u);
+  EXPECT_EQ(german.actuators[0].parameters.at("resistance"), 0.516);
+  EXPECT_EQ(testing::SceneComparison(0).Compare(plain, german), 0);
 }
 
 TEST(ColladaImportTest, ImportsTheExtensionExample) {

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "comma_locale.h"
+
 namespace caliper::core {
 namespace {
 
@@ -199,6 +201,22 @@ TEST(ConfigTest, RejectsNonFiniteOrMalformedNumber) {
         << bad;
   }
   EXPECT_DOUBLE_EQ(config.GetDouble("exec.rate"), 100.0);
+}
+
+TEST(ConfigTest, ReadsDecimalPointsUnderACommaDecimalLocale) {
+  // a Qt process under LANG=de_DE.UTF-8 reads configuration files too
+  CALIPER_COMMA_DECIMAL_LOCALE(locale);
+  const TempFile file("exec.rate = 0.25\nqueue.depth = +12\n");
+  Config config(Schema());
+  config.LoadFile(file.path());
+  EXPECT_EQ(config.GetDouble("exec.rate"), 0.25);
+  EXPECT_EQ(config.GetInt("queue.depth"), 12);
+  config.Set("exec.rate", "2.5e2", "-o");
+  EXPECT_EQ(config.GetDouble("exec.rate"), 250.0);
+  // the locale's own spelling is not ours, and bounds print with a point
+  EXPECT_EQ(ErrorOf([&] { config.Set("exec.rate", "2,5", "-o"); }),
+            "-o: exec.rate = '2,5': expected a finite number (allowed 0.1 .. 1000); exec.rate is "
+            "tick rate [Hz]");
 }
 
 TEST(ConfigTest, RejectsBadBool) {
