@@ -8,7 +8,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
-#include <regex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +17,7 @@
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/logging.hh"
+#include "caliper/logging/message_pattern.h"
 #include "caliper/logging/record.h"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/log_service_sink.h"
@@ -132,7 +133,9 @@ void Print(const LogIdl::StoredRecord& s) {
 class FollowListener : public virtual POA_Caliper::Logging::LogListener {
  public:
   FollowListener(const LogIdl::RecordFilter& filter, CORBA::ULongLong* printed_serial)
-      : filter_(filter), printed_(printed_serial) {}
+      : filter_(filter), printed_(printed_serial) {
+    if (std::strlen(filter_.regex) > 0) pattern_.emplace(filter_.regex.in());
+  }
   void on_records(const LogIdl::StoredRecordSeq& records) override {
     std::lock_guard<std::mutex> lock(mutex_);
     for (CORBA::ULong i = 0; i < records.length(); ++i) {
@@ -151,12 +154,11 @@ class FollowListener : public virtual POA_Caliper::Logging::LogListener {
     if (std::string(r.category).rfind(filter_.category_prefix.in(), 0) != 0) return false;
     if (std::strlen(filter_.instance) > 0 && std::string(r.instance) != filter_.instance.in())
       return false;
-    if (std::strlen(filter_.regex) > 0 &&
-        !std::regex_search(std::string(r.message), std::regex(filter_.regex.in())))
-      return false;
+    if (pattern_ && !pattern_->Search(r.message.in())) return false;
     return true;
   }
   LogIdl::RecordFilter filter_;
+  std::optional<logging::MessagePattern> pattern_;
   CORBA::ULongLong* printed_;
 };
 
@@ -181,9 +183,9 @@ int Log(Client& client, std::vector<std::string>& args) {
   if (TakeOption(args, "--component", &value)) q.instance = value.c_str();
   if (TakeOption(args, "--grep", &value)) {
     try {
-      std::regex check(value);
-    } catch (const std::regex_error& e) {
-      throw UsageError("--grep: bad regular expression '" + value + "': " + e.what());
+      logging::MessagePattern check(value);
+    } catch (const logging::PatternError& e) {
+      throw UsageError(std::string("--grep: ") + e.what());
     }
     q.regex = value.c_str();
   }
@@ -281,6 +283,12 @@ std::map<std::string, Verb> Verbs() {
                   "printing new ones until Ctrl-C",
                   Log};
   verbs["log"].takes_interrupt = true;
+  verbs["log"].details =
+      "  --grep REGEX  a regular expression in RE2 syntax (no backreferences or lookaround), at\n"
+      "                most " +
+      std::to_string(logging::kMaxPatternBytes) +
+      " bytes, searched anywhere in the message\n"
+      "  --limit N     the logger returns at most 10000 records per query\n";
   verbs["inspect"] = {"inspect FILE [--export OUT.dae]",
                       "report what a COLLADA file (.dae, .zae) holds, or why it does not import "
                       "(no session needed); --export writes the imported scene back out",
