@@ -331,7 +331,7 @@ int Params(Client& client, std::vector<std::string>& args) {
   RejectOptions(args);
   if (args.size() > 1) throw UsageError("expected at most one PATTERN");
   std::string pattern = args.empty() ? "*" : args[0];
-  if (pattern.find_first_of("*?") == std::string::npos) pattern = "*" + pattern + "*";
+  if (pattern.find_first_of("*?[") == std::string::npos) pattern = "*" + pattern + "*";
   ModelRef m = Connect(client, name);
   D::ChannelInfoSeq_var list = Call(m, [&] { return m.model->list(pattern.c_str()); });
   if (list->length() == 0) {
@@ -670,7 +670,8 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       Status, "");
   add("params", "params [PATTERN] [--model NAME]",
       "list a Model's parameters and states: id, unit, shape, rw/ro, static/dynamic, value", Params,
-      "  PATTERN is a glob (* and ?); without one it matches the ids that contain it.\n"
+      "  PATTERN is a glob (*, ?, [set]: fnmatch(3)); without one it matches the ids that\n"
+      "  contain it.\n"
       "  VALUE is the current value of scalars.\n");
   add("get", "get ID... [--model NAME]", "print values with their units", Get,
       "  Vectors print on one line, matrices row by row.\n");

@@ -1,5 +1,7 @@
 #include "caliper/daq/registry.h"
 
+#include <fnmatch.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -14,25 +16,8 @@ InvalidValue::InvalidValue(const std::string& id, const std::string& reason)
 std::string Shape::ToString() const { return std::to_string(rows) + "x" + std::to_string(cols); }
 
 bool GlobMatch(const std::string& pattern, const std::string& text) {
-  // iterative matcher with a single backtrack point (the last '*'): linear in practice
-  size_t p = 0, t = 0;
-  size_t star = std::string::npos, resume = 0;
-  while (t < text.size()) {
-    if (p < pattern.size() && (pattern[p] == '?' || pattern[p] == text[t])) {
-      ++p;
-      ++t;
-    } else if (p < pattern.size() && pattern[p] == '*') {
-      star = p++;
-      resume = t;
-    } else if (star != std::string::npos) {
-      p = star + 1;
-      t = ++resume;
-    } else {
-      return false;
-    }
-  }
-  while (p < pattern.size() && pattern[p] == '*') ++p;
-  return p == pattern.size();
+  // no flags: neither '/' nor a leading '.' is special, so '*' and '?' cross the dots of ids
+  return fnmatch(pattern.c_str(), text.c_str(), 0) == 0;
 }
 
 Handle Registry::Add(ChannelInfo info, Getter getter, Setter setter) {

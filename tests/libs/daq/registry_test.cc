@@ -77,6 +77,22 @@ TEST(GlobMatch, MatchesStarsAndQuestionMarks) {
   EXPECT_TRUE(GlobMatch("a*b*c", "aXXbYYbZc"));
   EXPECT_FALSE(GlobMatch("arm", "arm.x"));
   EXPECT_TRUE(GlobMatch("arm.x", "arm.x"));
+  // no special leading dot or slash (fnmatch without FNM_PERIOD, FNM_PATHNAME)
+  EXPECT_TRUE(GlobMatch("*", ".hidden"));
+  EXPECT_TRUE(GlobMatch("?arm", ".arm"));
+  EXPECT_TRUE(GlobMatch("arm*", "arm/x.y"));
+  EXPECT_TRUE(GlobMatch("arm.?", "arm./"));
+  EXPECT_FALSE(GlobMatch("?", ""));
+}
+
+TEST(GlobMatch, MatchesSetsAndEscapesAsFnmatchDoes) {
+  EXPECT_TRUE(GlobMatch("arm.[ew]*.current", "arm.elbow.current"));
+  EXPECT_TRUE(GlobMatch("arm.[ew]*.current", "arm.wrist.current"));
+  EXPECT_FALSE(GlobMatch("arm.[ew]*.current", "arm.shoulder.current"));
+  EXPECT_TRUE(GlobMatch("arm.[!ew]*", "arm.shoulder.current"));
+  EXPECT_TRUE(GlobMatch("q[0-9]", "q7"));
+  EXPECT_TRUE(GlobMatch("a\\*b", "a*b"));
+  EXPECT_FALSE(GlobMatch("a\\*b", "aXb"));
 }
 
 TEST_F(Fixture, ListsChannelsMatchingAPatternSortedById) {

@@ -119,8 +119,7 @@ class Registry {
   /// Counts every Add, Remove and Clear: a user holding handles re-resolves when it changed.
   uint64_t version() const { return version_; }
 
-  /// The channels whose ids match the glob `pattern` (`*` any run of characters, dots included;
-  /// `?` one character), sorted by id.
+  /// The channels whose ids match the glob `pattern` (GlobMatch), sorted by id.
   std::vector<ChannelInfo> List(const std::string& pattern = "*") const;
   /// Throws UnknownId.
   const ChannelInfo& Info(const std::string& id) const;
@@ -172,7 +171,9 @@ class Registry {
   uint64_t version_ = 0;
 };
 
-/// Whether `text` matches the glob `pattern` (`*` any run of characters, `?` one character).
+/// Whether `text` matches the glob `pattern`, as fnmatch(3) without flags: `*` any run of
+/// characters, dots included; `?` one character; `[abc]`, `[a-z]`, `[!a]` one of a set; `\x`
+/// the character x itself.
 bool GlobMatch(const std::string& pattern, const std::string& text);
 
 }  // namespace caliper::daq
