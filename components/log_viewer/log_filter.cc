@@ -31,47 +31,6 @@ bool UnderCategory(const std::string& category, const std::string& prefix) {
   return category.size() == prefix.size() || category[prefix.size()] == '.';
 }
 
-std::string RequiredLiteral(const std::string& pattern) {
-  std::string best, run;
-  auto end_run = [&] {
-    if (run.size() > best.size()) best = run;
-    run.clear();
-  };
-  int depth = 0;  // inside a group nothing is certain: it may be optional or an alternative
-  for (size_t i = 0; i < pattern.size(); ++i) {
-    const char c = pattern[i];
-    if (c == '\\') {  // an escape: a class, an assertion, a back reference or a literal
-      end_run();
-      ++i;
-    } else if (c == '[') {  // a class: skip to its end
-      end_run();
-      for (++i; i < pattern.size() && pattern[i] != ']'; ++i)
-        if (pattern[i] == '\\') ++i;
-    } else if (c == '(') {
-      end_run();
-      ++depth;
-    } else if (c == ')') {
-      end_run();
-      --depth;
-    } else if (c == '|') {
-      if (depth == 0) return "";  // alternatives at the top: no part is required
-    } else if (depth > 0) {
-      continue;
-    } else if (c == '*' || c == '?' || c == '{') {  // the atom before may occur zero times
-      if (!run.empty()) run.pop_back();
-      end_run();
-      if (c == '{')
-        while (i < pattern.size() && pattern[i] != '}') ++i;
-    } else if (c == '+' || c == '.' || c == '^' || c == '$' || c == ']' || c == '}') {
-      end_run();
-    } else {
-      run += c;
-    }
-  }
-  end_run();
-  return best;
-}
-
 const char* ModeName(FilterMode mode) {
   return mode == FilterMode::kHighlight ? "highlight" : "hide";
 }
@@ -94,23 +53,15 @@ void LogView::Compile() {
   if (s.max_priority < logging::kDebug) active_mask_ |= Bit(kPriority);
   if (!s.excluded_categories.empty()) active_mask_ |= Bit(kCategory);
   if (!s.excluded_components.empty()) active_mask_ |= Bit(kComponent);
+  regex_.reset();
+  needle_.clear();
   if (!s.text.empty()) {
     if (s.regex) {
       try {
-        auto flags = std::regex::ECMAScript | std::regex::nosubs | std::regex::optimize;
-#if defined(__GLIBCXX__)
-        // libstdc++'s default matcher recurses once per character and overflows an 8 MB stack
-        // after 8 to 26 KB of message with a pattern like (a|b)*; its polynomial matcher keeps a
-        // set of states instead (back-references, which nosubs excludes anyway, need the other)
-        flags |= std::regex_constants::__polynomial;
-#endif
-        if (!s.case_sensitive) flags |= std::regex::icase;
-        regex_ = std::regex(s.text, flags);
-        needle_ = RequiredLiteral(s.text);
-        if (!s.case_sensitive) needle_ = Lower(needle_);
+        regex_ = std::make_shared<const logging::MessagePattern>(s.text, s.case_sensitive);
         active_mask_ |= Bit(kText);
-      } catch (const std::regex_error& e) {
-        error_ = "bad regular expression '" + s.text + "': " + e.what();
+      } catch (const logging::PatternError& e) {
+        error_ = e.what();
       }
     } else {
       needle_ = s.case_sensitive ? s.text : Lower(s.text);
@@ -151,14 +102,7 @@ bool LogView::ContainsNeedle(const std::string& message) const {
 }
 
 bool LogView::TextMatches(const std::string& message) const {
-  // a regular expression runs only where its required literal is (std::regex is slow)
-  if (!ContainsNeedle(message)) return false;
-  if (!settings_.regex) return true;
-  if (message.size() <= kRegexSearchBytes) return std::regex_search(message, regex_);
-  // only the start of a very long message; `$` does not match where it is cut
-  return std::regex_search(message.begin(),
-                           message.begin() + static_cast<std::ptrdiff_t>(kRegexSearchBytes), regex_,
-                           std::regex_constants::match_not_eol);
+  return regex_ ? regex_->Search(message) : ContainsNeedle(message);
 }
 
 void LogView::Classify(const RecordStore& store, size_t begin, size_t end, uint8_t kinds) {

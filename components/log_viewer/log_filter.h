@@ -8,11 +8,12 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <regex>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "caliper/logging/message_pattern.h"
 #include "caliper/logging/record.h"
 #include "record_store.h"
 
@@ -40,8 +41,8 @@ struct FilterSettings {
   std::set<std::string> excluded_components;
   /// Searched in the message; empty: off.
   std::string text;
-  /// `text` is an ECMAScript regular expression, matched against the first kRegexSearchBytes of
-  /// each message (plain text is searched in the whole message).
+  /// `text` is a regular expression in RE2 syntax (no backreferences or lookaround, at most
+  /// logging::kMaxPatternBytes), searched in the whole message like plain text.
   bool regex = false;
   bool case_sensitive = false;
   int64_t from_time_us = 0;  ///< earliest matching time [us since 1970 UTC]; 0: unbounded
@@ -53,18 +54,9 @@ struct FilterSettings {
   bool operator!=(const FilterSettings& o) const { return !(*this == o); }
 };
 
-/// How much of a message a regular expression looks at [bytes]: std::regex's cost grows with the
-/// length searched (quadratically for a search that fails), so a message of megabytes is cut.
-constexpr size_t kRegexSearchBytes = 64 * 1024;
-
 /// True when `category` is `prefix` or lies below it in the dotted hierarchy
 /// (`caliper.model.rtc` is under `caliper.model`, `caliper.modeller` is not).
 bool UnderCategory(const std::string& category, const std::string& prefix);
-
-/// The longest run of plain characters that every match of the ECMAScript regular expression
-/// `pattern` contains, or "" when none is certain (a top-level `|`, only groups, classes and
-/// quantified atoms). The text filter looks for it before running the regular expression.
-std::string RequiredLiteral(const std::string& pattern);
 
 /// `FilterMode` as `hide` or `highlight`, and back (false for anything else).
 const char* ModeName(FilterMode mode);
@@ -75,8 +67,8 @@ bool ParseMode(const std::string& text, FilterMode* mode);
 class LogView {
  public:
   /// Takes new settings and recomputes, over every record already classified, only the filters
-  /// whose parameters changed; then rebuilds rows(). A bad regular expression turns the text
-  /// filter off and sets error().
+  /// whose parameters changed; then rebuilds rows(). A bad or too long regular expression turns
+  /// the text filter off and sets error() (logging::MessagePattern's reason).
   void Apply(const FilterSettings& settings, const RecordStore& store);
 
   /// Classifies the records appended to `store` since the last call and appends those shown to
@@ -115,9 +107,9 @@ class LogView {
   uint8_t active_mask_ = 0;
   uint8_t hide_mask_ = 0;       ///< active filters that hide
   uint8_t highlight_mask_ = 0;  ///< active filters that highlight
-  std::regex regex_;
-  /// The substring searched (lower-cased for a case-insensitive search): the text itself, or
-  /// what every match of the regular expression contains ("": run the expression on everything).
+  /// The compiled text when it is a regular expression (RE2: linear in the message's length).
+  std::shared_ptr<const logging::MessagePattern> regex_;
+  /// The plain text searched (lower-cased for a case-insensitive search).
   std::string needle_;
 
   std::vector<uint8_t> bits_;         ///< per classified record: bit k set when filter k matches it

@@ -229,9 +229,9 @@ QWidget* LogViewerWindow::BuildFilterPanel() {
   regex_->setObjectName("regex");
   const QString regex_help =
       QString(
-          "An ECMAScript regular expression, matched against the first %1 KiB of each message "
-          "(plain text is searched in the whole message)")
-          .arg(kRegexSearchBytes / 1024);
+          "A regular expression in RE2 syntax (no backreferences or lookaround, at most %1 "
+          "bytes), searched in the whole message")
+          .arg(logging::kMaxPatternBytes);
   regex_->setToolTip(regex_help);
   text_->setToolTip("Records whose message contains this text match.\n" + regex_help + ".");
   case_sensitive_ = new QCheckBox("Match case");
