@@ -1,7 +1,9 @@
 #include "caliper/actuators/dc_motor.h"
 
 #include <algorithm>
+#include <boost/math/tools/toms748_solve.hpp>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -63,65 +65,6 @@ void Check(const char* name, const char* unit, double value, Range range) {
   }
 }
 
-// Brent's method on a bracket [a, b] with f(a), f(b) of opposite signs.
-template <class Function>
-double Brent(const Function& f, double a, double b, double fa, double fb, double tolerance) {
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
-  double c = b;
-  double fc = fb;
-  double d = b - a;
-  double e = d;
-  for (int iteration = 0; iteration < 200; ++iteration) {
-    if ((fb > 0 && fc > 0) || (fb < 0 && fc < 0)) {
-      c = a;
-      fc = fa;
-      d = e = b - a;
-    }
-    if (std::abs(fc) < std::abs(fb)) {
-      a = b;
-      b = c;
-      c = a;
-      fa = fb;
-      fb = fc;
-      fc = fa;
-    }
-    const double tol = 2 * kEps * std::abs(b) + 0.5 * tolerance;
-    const double m = 0.5 * (c - b);
-    if (std::abs(m) <= tol || fb == 0) return b;
-    if (std::abs(e) >= tol && std::abs(fa) > std::abs(fb)) {
-      const double s = fb / fa;
-      double p;
-      double q;
-      if (a == c) {
-        p = 2 * m * s;
-        q = 1 - s;
-      } else {
-        const double qa = fa / fc;
-        const double r = fb / fc;
-        p = s * (2 * m * qa * (qa - r) - (b - a) * (r - 1));
-        q = (qa - 1) * (r - 1) * (s - 1);
-      }
-      if (p > 0) q = -q;
-      p = std::abs(p);
-      if (2 * p < std::min(3 * m * q - std::abs(tol * q), std::abs(e * q))) {
-        e = d;
-        d = p / q;
-      } else {
-        d = m;
-        e = m;
-      }
-    } else {
-      d = m;
-      e = m;
-    }
-    a = b;
-    fa = fb;
-    b += std::abs(d) > tol ? d : (m > 0 ? tol : -tol);
-    fb = f(b);
-  }
-  return b;
-}
-
 // A root of f near x0, for f dominated by x - x0 far from the root (slope about one).
 template <class Function>
 double FindRoot(const Function& f, double x0, double tolerance) {
@@ -140,7 +83,20 @@ double FindRoot(const Function& f, double x0, double tolerance) {
     f1 = f(x1);
   }
   if (f1 == 0) return x1;
-  return Brent(f, x0, x1, f0, f1, tolerance);
+  // TOMS 748 on the bracket, down to a width of `tolerance` (plus rounding): its middle is
+  // within tolerance / 2 of a root
+  if (x1 < x0) {
+    std::swap(x0, x1);
+    std::swap(f0, f1);
+  }
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  const auto narrow_enough = [tolerance](double a, double b) {
+    return b - a <= tolerance + 4 * kEps * std::max(std::abs(a), std::abs(b));
+  };
+  std::uintmax_t iterations = 200;
+  const auto [a, b] =
+      boost::math::tools::toms748_solve(f, x0, x1, f0, f1, narrow_enough, iterations);
+  return 0.5 * (a + b);
 }
 
 }  // namespace

@@ -108,7 +108,7 @@ class ConstantSpoolLoad : public SpoolLoad {
 /// evaluation) and the switch's derivatives, |d^n(1/rho)/dx^n| <= |d(1/rho)/dx|. Where a stage
 /// may have several solutions (a current against the load while the speed crosses zero) the
 /// solution must be the first from the stage's base speed, or the stage falls back to the
-/// bracketing search from there and Brent's method (as it does should Newton fail).
+/// bracketing search from there and TOMS 748 (Boost.Math; as it does should Newton fail).
 /// With a current limit the driver lowers the voltage so that |i| stays at the limit.
 class DcMotor {
  public:
@@ -183,7 +183,7 @@ class DcMotor {
   // sub-step, starting from the guess w0.
   double SolveStage(const DcMotorState& a, double voltage, double h_load, double w0,
                     const SpoolLoad& load) const;
-  // the original bracketing + Brent solution (fallback)
+  // the original bracketing + TOMS 748 solution (fallback)
   double SolveStageBracketing(const DcMotorState& a, double voltage, double h_load,
                               const SpoolLoad& load) const;
   void Substep(double voltage, SpoolLoad& load, bool last);
