@@ -68,8 +68,7 @@ logging::Record Bounded(logging::Record r) {
 
 }  // namespace
 
-LogStore::LogStore(const std::string& directory, const std::string& session,
-                   size_t memory_records)
+LogStore::LogStore(const std::string& directory, const std::string& session, size_t memory_records)
     : memory_records_(memory_records) {
   core::MakeDirectories(directory);
   path_ = FindSessionFile(directory, session);

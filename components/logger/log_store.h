@@ -45,11 +45,11 @@ struct QueryFilter {
   int max_priority = logging::kDebug;  ///< keep records at least this severe
   std::string category_prefix;
   std::string component;
-  std::string regex;                   ///< RE2 syntax, searched in the message; "" for all
-  int64_t from_time_us = 0;            ///< 0: no bound
-  int64_t to_time_us = 0;              ///< 0: no bound
+  std::string regex;         ///< RE2 syntax, searched in the message; "" for all
+  int64_t from_time_us = 0;  ///< 0: no bound
+  int64_t to_time_us = 0;    ///< 0: no bound
   uint64_t after_serial = 0;
-  uint32_t limit = 0;                  ///< newest `limit` matches; 0: kMaxQueryRecords
+  uint32_t limit = 0;  ///< newest `limit` matches; 0: kMaxQueryRecords
 };
 
 class LogStore {

@@ -68,11 +68,11 @@ uint64_t ListenerHub::Add(idl::LogListener_ptr ref) {
   for (auto& dead : TakeDead()) dead->thread.join();
   std::lock_guard<std::mutex> lock(mutex_);
   if (listeners_.size() >= kMaxListeners)
-    throw idl::LimitExceeded(("already " + std::to_string(listeners_.size()) +
-                              " log listeners, at most " + std::to_string(kMaxListeners) +
-                              "; remove_listener frees a place")
-                                 .c_str(),
-                             kMaxListeners);
+    throw idl::LimitExceeded(
+        ("already " + std::to_string(listeners_.size()) + " log listeners, at most " +
+         std::to_string(kMaxListeners) + "; remove_listener frees a place")
+            .c_str(),
+        kMaxListeners);
   const uint64_t id = next_id_++;
   auto listener = std::make_unique<Listener>();
   listener->ref = idl::LogListener::_duplicate(ref);
@@ -132,7 +132,8 @@ void ListenerHub::Run(Listener* l) {
     if (l->stop) return;
     std::vector<Shared> batch;
     size_t bytes = 0;
-    while (!l->queue.empty() && (batch.empty() || bytes + Bytes(*l->queue.front()) <= kMaxPushBytes)) {
+    while (!l->queue.empty() &&
+           (batch.empty() || bytes + Bytes(*l->queue.front()) <= kMaxPushBytes)) {
       const size_t b = Bytes(*l->queue.front());
       bytes += b;
       l->queued_bytes -= b;
@@ -179,9 +180,8 @@ void ListenerHub::Run(Listener* l) {
 
 LoggerServant::LoggerServant(rtc::Runtime& runtime, LoggerComponent& component)
     : rtc::RTObjectServant(runtime), component_(component) {
-  component_.SetListener([this](const std::vector<StoredRecord>& records) {
-    hub_.Publish(records);
-  });
+  component_.SetListener(
+      [this](const std::vector<StoredRecord>& records) { hub_.Publish(records); });
 }
 
 LoggerServant::~LoggerServant() { component_.SetListener(nullptr); }
@@ -217,9 +217,7 @@ idl::StoredRecordSeq* LoggerServant::query(const idl::RecordFilter& q) {
   }
 }
 
-char* LoggerServant::session_file() {
-  return CORBA::string_dup(component_.session_file().c_str());
-}
+char* LoggerServant::session_file() { return CORBA::string_dup(component_.session_file().c_str()); }
 
 CORBA::ULongLong LoggerServant::add_listener(idl::LogListener_ptr listener) {
   return hub_.Add(listener);

@@ -47,7 +47,7 @@ class ListenerHub {
     Caliper::Logging::LogListener_var ref;
     std::deque<Shared> queue;
     size_t queued_bytes = 0;
-    int timeouts = 0;   ///< pushes timed out in a row
+    int timeouts = 0;  ///< pushes timed out in a row
     bool stop = false;
     bool dead = false;  ///< dropped: its thread has ended, nothing more is queued for it
     std::thread thread;

@@ -426,10 +426,9 @@ TEST_F(LogStoreQueryTest, RefusesTooLongRegex) {
   f.regex = std::string(logging::kMaxPatternBytes, 'j');
   EXPECT_EQ(QueryError(*store_, f), "");
   f.regex += "j";
-  EXPECT_EQ(QueryError(*store_, f), "regular expression too long: " +
-                                        std::to_string(logging::kMaxPatternBytes + 1) +
-                                        " bytes, at most " +
-                                        std::to_string(logging::kMaxPatternBytes));
+  EXPECT_EQ(QueryError(*store_, f),
+            "regular expression too long: " + std::to_string(logging::kMaxPatternBytes + 1) +
+                " bytes, at most " + std::to_string(logging::kMaxPatternBytes));
 }
 
 TEST_F(LogStoreQueryTest, FiltersByInclusiveTimeRange) {
@@ -518,8 +517,8 @@ TEST_F(LogStoreTest, SubmitCompletesWhileAQueryMatches) {
   bool done_during_match = false;
   // runs inside Query, after the candidates are picked and before the expression runs
   store.set_before_match([&] {
-    submitted = std::async(std::launch::async,
-                           [&] { return store.Submit({MakeRecord("b", 1)}).size(); });
+    submitted =
+        std::async(std::launch::async, [&] { return store.Submit({MakeRecord("b", 1)}).size(); });
     done_during_match = submitted.wait_for(std::chrono::seconds(20)) == std::future_status::ready;
   });
   QueryFilter f;
@@ -549,7 +548,8 @@ TEST_F(LogStoreTest, QueriesAndSubmitsFromSeveralThreads) {
   });
   auto submits = std::async(std::launch::async, [&] {
     size_t stored = 0;
-    for (uint64_t i = 1; i <= 200; ++i) stored += store.Submit({MakeRecord("c", i, "later")}).size();
+    for (uint64_t i = 1; i <= 200; ++i)
+      stored += store.Submit({MakeRecord("c", i, "later")}).size();
     submitting = false;
     return stored;
   });
@@ -671,9 +671,9 @@ TEST_F(LogStoreTest, QueryReturnsAtMostTheResultLimit) {
   f.regex = "^m$";
   EXPECT_EQ(store.Query(f).size(), kMaxQueryRecords);
   f.limit = 3;
-  EXPECT_EQ(Serials(store.Query(f)),
-            (std::vector<uint64_t>{kMaxQueryRecords + 3u, kMaxQueryRecords + 4u,
-                                   kMaxQueryRecords + 5u}));
+  EXPECT_EQ(
+      Serials(store.Query(f)),
+      (std::vector<uint64_t>{kMaxQueryRecords + 3u, kMaxQueryRecords + 4u, kMaxQueryRecords + 5u}));
 }
 
 // ------------------------------------------------------------------------ seen sequences

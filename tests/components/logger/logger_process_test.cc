@@ -3,8 +3,6 @@
 // over a 20 KB message, bad and too long patterns, a forged (source, seq), more listeners than
 // allowed, a listener that blocks and one that is gone: each answered, and the logger still
 // answers afterwards.
-#include "caliper/logging.hh"
-
 #include <gtest/gtest.h>
 
 #include <condition_variable>
@@ -13,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "caliper/logging.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "support/process.h"
@@ -241,14 +240,13 @@ TEST_F(LoggerProcessTest, AForgedSeqDoesNotSilenceTheProcessItNames) {
   ASSERT_EQ(logger_ref_->submit(Batch({MakeRecord("victim:7", 1, "victim 1")})), 1u);
   // another client names the victim's source with a huge seq
   ASSERT_EQ(logger_ref_->submit(Batch({MakeRecord("victim:7", 1ULL << 62, "forged")})), 1u);
-  EXPECT_EQ(logger_ref_->submit(Batch({MakeRecord("victim:7", 2, "victim 2"),
-                                       MakeRecord("victim:7", 3, "victim 3")})),
+  EXPECT_EQ(logger_ref_->submit(Batch(
+                {MakeRecord("victim:7", 2, "victim 2"), MakeRecord("victim:7", 3, "victim 3")})),
             2u);
   // a retried batch is still stored once
   EXPECT_EQ(logger_ref_->submit(Batch({MakeRecord("victim:7", 2, "victim 2")})), 0u);
   L::StoredRecordSeq_var victim = logger_ref_->query(Ours("^victim"));
-  EXPECT_EQ(Messages(victim.in()),
-            (std::vector<std::string>{"victim 1", "victim 2", "victim 3"}));
+  EXPECT_EQ(Messages(victim.in()), (std::vector<std::string>{"victim 1", "victim 2", "victim 3"}));
 }
 
 TEST_F(LoggerProcessTest, ListenersAreBoundedAndNeitherABlockedNorAGoneOneHoldsSubmit) {

@@ -324,9 +324,9 @@ TEST_F(LogFilterTest, Re2SyntaxAndItsBounds) {
             "bad regular expression 'tendon(?= biceps)': invalid perl operator: (?=");
   s.text = std::string(logging::kMaxPatternBytes + 1, 't');
   EXPECT_EQ(Shown(s), static_cast<size_t>(k::kKnownRecords));
-  EXPECT_EQ(view_.error(), "regular expression too long: " +
-                               std::to_string(logging::kMaxPatternBytes + 1) + " bytes, at most " +
-                               std::to_string(logging::kMaxPatternBytes));
+  EXPECT_EQ(view_.error(),
+            "regular expression too long: " + std::to_string(logging::kMaxPatternBytes + 1) +
+                " bytes, at most " + std::to_string(logging::kMaxPatternBytes));
   EXPECT_FALSE(view_.active(kText));
 }
 

@@ -62,9 +62,9 @@ TEST(MessagePatternTest, RefusesPatternsLongerThanTheBound) {
   const std::string longest(kMaxPatternBytes, 'a');
   EXPECT_EQ(ErrorOf(longest), "");
   EXPECT_TRUE(MessagePattern(longest).Search(longest));
-  EXPECT_EQ(ErrorOf(longest + "a"), "regular expression too long: " +
-                                        std::to_string(kMaxPatternBytes + 1) + " bytes, at most " +
-                                        std::to_string(kMaxPatternBytes));
+  EXPECT_EQ(ErrorOf(longest + "a"),
+            "regular expression too long: " + std::to_string(kMaxPatternBytes + 1) +
+                " bytes, at most " + std::to_string(kMaxPatternBytes));
 }
 
 TEST(MessagePatternTest, BadPatternsCarryRe2sReasonAndThePattern) {
