@@ -1,13 +1,14 @@
 #include "document.h"
 
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+#include <libxml/xmlerror.h>
+
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <fstream>
-#include <limits>
-#include <sstream>
 #include <unordered_map>
 
 #include "caliper/core/numbers.h"
@@ -33,211 +34,104 @@ bool EndsWithNoCase(const std::string& s, const std::string& suffix) {
   return true;
 }
 
-// One start tag found by the scan of a document's text.
-struct Tag {
-  std::string_view name;  // local name
-  int line = 0;
-  size_t offset = 0;  // of the '<' in the text
-  size_t end = 0;     // index of the first tag after this element's subtree
-};
+const char* Chars(const xmlChar* s) { return reinterpret_cast<const char*>(s); }
 
-// Scans an XML text for its start tags (comments, CDATA, processing instructions and the
-// document type are skipped). Returns false with the problem's line and description when the
-// tags do not nest or there is content after the root element.
-bool ScanTags(const std::string& text, std::vector<Tag>* tags, int* bad_line, std::string* what) {
-  std::vector<size_t> open;  // indices into tags
-  int line = 1;
-  size_t i = 0;
-  bool root_closed = false;
-  auto advance_to = [&](size_t to) {
-    for (; i < to && i < text.size(); ++i)
-      if (text[i] == '\n') ++line;
-  };
-  while (i < text.size()) {
-    const size_t lt = text.find('<', i);
-    if (lt == std::string::npos) {
-      // only white space may follow the root element
-      for (size_t k = i; k < text.size(); ++k) {
-        if (!IsSpace(text[k]) && open.empty() && root_closed) {
-          advance_to(k);
-          *bad_line = line;
-          *what = "content after the root element";
-          return false;
-        }
-      }
-      break;
-    }
-    if (open.empty() && root_closed) {
-      for (size_t k = i; k < lt; ++k)
-        if (!IsSpace(text[k])) {
-          advance_to(k);
-          *bad_line = line;
-          *what = "content after the root element";
-          return false;
-        }
-    }
-    advance_to(lt);
-    if (text.compare(lt, 4, "<!--") == 0) {
-      const size_t end = text.find("-->", lt + 4);
-      advance_to(end == std::string::npos ? text.size() : end + 3);
-      continue;
-    }
-    if (text.compare(lt, 9, "<![CDATA[") == 0) {
-      const size_t end = text.find("]]>", lt + 9);
-      advance_to(end == std::string::npos ? text.size() : end + 3);
-      continue;
-    }
-    if (text.compare(lt, 2, "<?") == 0 || text.compare(lt, 2, "<!") == 0) {
-      const size_t end = text.find('>', lt + 2);
-      advance_to(end == std::string::npos ? text.size() : end + 1);
-      continue;
-    }
-    const bool closing = lt + 1 < text.size() && text[lt + 1] == '/';
-    size_t name_begin = lt + (closing ? 2 : 1);
-    size_t name_end = name_begin;
-    while (name_end < text.size() && !IsSpace(text[name_end]) && text[name_end] != '>' &&
-           text[name_end] != '/')
-      ++name_end;
-    // find the end of the tag, skipping quoted attribute values
-    size_t k = name_end;
-    char quote = 0;
-    for (; k < text.size(); ++k) {
-      const char c = text[k];
-      if (quote != 0) {
-        if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') {
-        quote = c;
-      } else if (c == '>') {
-        break;
-      }
-    }
-    if (k >= text.size()) {
-      *bad_line = line;
-      *what = "unterminated tag";
-      return false;
-    }
-    const std::string_view name =
-        LocalName(std::string_view(text).substr(name_begin, name_end - name_begin));
-    const bool self_closing = !closing && k > lt && text[k - 1] == '/';
-    if (closing) {
-      if (open.empty() || (*tags)[open.back()].name != name) {
-        *bad_line = line;
-        *what = open.empty() ? "closing tag </" + std::string(name) + "> without an opening tag"
-                             : "opening and ending tag mismatch: <" +
-                                   std::string((*tags)[open.back()].name) + "> line " +
-                                   std::to_string((*tags)[open.back()].line) + " and </" +
-                                   std::string(name) + ">";
-        return false;
-      }
-      (*tags)[open.back()].end = tags->size();
-      open.pop_back();
-      if (open.empty()) root_closed = true;
-    } else {
-      if (open.empty() && root_closed) {
-        *bad_line = line;
-        *what = "a second root element <" + std::string(name) + ">";
-        return false;
-      }
-      tags->push_back({name, line, lt, 0});
-      if (self_closing) {
-        tags->back().end = tags->size();
-        if (open.empty()) root_closed = true;
-      } else {
-        open.push_back(tags->size() - 1);
-      }
-    }
-    advance_to(k + 1);
-  }
-  if (!open.empty()) {
-    *bad_line = (*tags)[open.back()].line;
-    *what = "<" + std::string((*tags)[open.back()].name) + "> is never closed";
-    return false;
-  }
-  return true;
-}
-
-// Gives each element the index of its start tag; elements the scan does not find (dropped by
-// the DOM or made up) get none. Children are matched by name in order, not by position: the DOM
-// keeps typed children in schema order, which need not be the file's.
-void AssignTags(const Element& e, const std::vector<Tag>& tags, size_t at,
-                std::unordered_map<const Element*, size_t>* index) {
-  (*index)[&e] = at;
-  std::unordered_map<std::string_view, std::vector<size_t>> by_name;
-  for (size_t j = at + 1; j < tags[at].end; j = tags[j].end) by_name[tags[j].name].push_back(j);
-  std::unordered_map<std::string_view, size_t> used;
-  for (const auto& child : e.children) {
-    const std::string_view name = child->local_name();
-    const auto it = by_name.find(name);
-    if (it == by_name.end()) continue;
-    size_t& next = used[name];
-    if (next >= it->second.size()) continue;
-    AssignTags(*child, tags, it->second[next++], index);
-  }
-}
-
-// Replaces the five predefined entities and character references.
-std::string Unescape(std::string_view v) {
-  std::string out;
-  for (size_t i = 0; i < v.size(); ++i) {
-    if (v[i] != '&') {
-      out += v[i];
-      continue;
-    }
-    const size_t semi = v.find(';', i);
-    if (semi == std::string_view::npos) {
-      out += v.substr(i);
-      break;
-    }
-    const std::string_view entity = v.substr(i + 1, semi - i - 1);
-    if (entity == "amp")
-      out += '&';
-    else if (entity == "lt")
-      out += '<';
-    else if (entity == "gt")
-      out += '>';
-    else if (entity == "quot")
-      out += '"';
-    else if (entity == "apos")
-      out += '\'';
-    else if (!entity.empty() && entity[0] == '#') {
-      const long code = std::strtol(
-          std::string(entity.substr(1)).c_str() + (entity.size() > 1 && entity[1] == 'x'), nullptr,
-          entity.size() > 1 && entity[1] == 'x' ? 16 : 10);
-      if (code < 0x80)
-        out += static_cast<char>(code);
-      else
-        out += '?';
-    } else {
-      out += v.substr(i, semi - i + 1);
-    }
-    i = semi;
-  }
+// An attribute's name as written (with its prefix) and its value with the references replaced.
+std::pair<std::string, std::string> AttributeOf(const xmlAttr* a) {
+  std::string name = Chars(a->name);
+  if (a->ns != nullptr && a->ns->prefix != nullptr) name = Chars(a->ns->prefix) + (":" + name);
+  xmlChar* value = xmlNodeListGetString(a->doc, a->children, 1);
+  std::pair<std::string, std::string> out(std::move(name), value == nullptr ? "" : Chars(value));
+  xmlFree(value);
   return out;
 }
 
-// The attributes of the start tag at `offset`.
-std::vector<std::pair<std::string, std::string>> TagAttributes(const std::string& text,
-                                                               size_t offset) {
-  std::vector<std::pair<std::string, std::string>> out;
-  size_t i = offset + 1;
-  while (i < text.size() && !IsSpace(text[i]) && text[i] != '>' && text[i] != '/') ++i;
-  while (i < text.size()) {
-    while (i < text.size() && IsSpace(text[i])) ++i;
-    if (i >= text.size() || text[i] == '>' || text[i] == '/') break;
-    const size_t name_begin = i;
-    while (i < text.size() && !IsSpace(text[i]) && text[i] != '=' && text[i] != '>') ++i;
-    const std::string name = text.substr(name_begin, i - name_begin);
-    while (i < text.size() && IsSpace(text[i])) ++i;
-    if (i >= text.size() || text[i] != '=') break;
-    ++i;
-    while (i < text.size() && IsSpace(text[i])) ++i;
-    if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) break;
-    const char quote = text[i++];
-    const size_t close = text.find(quote, i);
-    if (close == std::string::npos) break;
-    out.emplace_back(name, Unescape(std::string_view(text).substr(i, close - i)));
-    i = close + 1;
+// Gives each element its node in libxml2's tree; elements libxml2 does not have (made up by the
+// DOM) get none. Children are matched by name in order, not by position: the DOM keeps typed
+// children in schema order, which need not be the file's.
+void AssignNodes(const Element& e, const xmlNode* node,
+                 std::unordered_map<const Element*, const xmlNode*>* index) {
+  (*index)[&e] = node;
+  std::unordered_map<std::string_view, std::vector<const xmlNode*>> by_name;
+  for (const xmlNode* c = node->children; c != nullptr; c = c->next)
+    if (c->type == XML_ELEMENT_NODE) by_name[LocalName(Chars(c->name))].push_back(c);
+  std::unordered_map<std::string_view, size_t> used;
+  for (const auto& child : e.children) {
+    const auto it = by_name.find(child->local_name());
+    if (it == by_name.end()) continue;
+    size_t& next = used[it->first];
+    if (next >= it->second.size()) continue;
+    AssignNodes(*child, it->second[next++], index);
   }
+}
+
+// What one parse by libxml2 gave: the tree, or the first fatal error and its line.
+struct XmlParse {
+  XmlDocument doc;
+  int line = 0;
+  std::string problem;
+  std::unordered_map<const xmlNode*, int> big_lines;  // elements from line 65535 on
+};
+
+// the parser's context as the callbacks below get it
+struct ParseState {
+  startElementNsSAX2Func start = nullptr;  // libxml2's own tree builder
+  XmlParse* out = nullptr;
+};
+
+ParseState* StateOf(void* context) {
+  return static_cast<ParseState*>(static_cast<xmlParserCtxtPtr>(context)->_private);
+}
+
+// libxml2 reports each problem here (and prints none); the first fatal one is the reason
+void KeepFirstFatalError(void* context, xmlErrorPtr error) {
+  XmlParse* out = StateOf(context)->out;
+  if (error == nullptr || error->level != XML_ERR_FATAL || !out->problem.empty()) return;
+  out->line = error->line;
+  out->problem = error->message == nullptr ? "not well-formed" : error->message;
+  while (!out->problem.empty() && IsSpace(out->problem.back())) out->problem.pop_back();
+}
+
+// xmlNode keeps lines in 16 bits: from 65535 on each element's line is kept here
+void StartElement(void* context, const xmlChar* name, const xmlChar* prefix, const xmlChar* uri,
+                  int namespaces, const xmlChar** ns, int attributes, int defaulted,
+                  const xmlChar** values) {
+  ParseState* state = StateOf(context);
+  state->start(context, name, prefix, uri, namespaces, ns, attributes, defaulted, values);
+  const auto* ctxt = static_cast<xmlParserCtxtPtr>(context);
+  if (ctxt->node != nullptr && ctxt->input != nullptr && ctxt->input->line >= 65535)
+    state->out->big_lines[ctxt->node] = ctxt->input->line;
+}
+
+// Parses a document with libxml2, from `path` or, when given, from `text` (`path` then names it
+// in messages). No network; libxml2's default limits (10 MB per text node, entity amplification),
+// which the DOM's reader has too.
+XmlParse ParseXml(const std::string& path, const std::string* text) {
+  XmlParse out;
+  xmlParserCtxtPtr ctxt = xmlNewParserCtxt();
+  if (ctxt == nullptr) {
+    out.problem = "libxml2 could not make a parser";
+    return out;
+  }
+  ParseState state{ctxt->sax->startElementNs, &out};
+  ctxt->_private = &state;
+  ctxt->sax->serror = KeepFirstFatalError;
+  ctxt->sax->startElementNs = StartElement;
+  const int options = XML_PARSE_NONET | XML_PARSE_NOWARNING;
+  xmlDocPtr doc =
+      text == nullptr
+          ? xmlCtxtReadFile(ctxt, path.c_str(), nullptr, options)
+          : xmlCtxtReadMemory(ctxt, text->data(), static_cast<int>(text->size()), path.c_str(),
+                              nullptr, options);
+  const bool well_formed = doc != nullptr && ctxt->wellFormed != 0;
+  xmlFreeParserCtxt(ctxt);
+  if (well_formed) {
+    out.doc.reset(doc);
+    return out;
+  }
+  if (doc != nullptr) xmlFreeDoc(doc);
+  if (out.problem.empty()) out.problem = "not well-formed";
+  out.big_lines.clear();
   return out;
 }
 
@@ -363,123 +257,65 @@ const Element* Document::FindId(std::string_view id) const {
   return it == ids_.end() ? nullptr : it->second;
 }
 
-void Document::IndexTags() const {
-  if (tags_indexed_) return;
-  tags_indexed_ = true;
-  std::vector<Tag> tags;
-  int bad_line = 0;
-  std::string what;
-  ScanTags(text_, &tags, &bad_line, &what);
-  // subtrees a failed scan left open end at the last tag found
-  for (auto& t : tags)
-    if (t.end == 0) t.end = tags.size();
-  std::unordered_map<const Element*, size_t> index;
-  if (root && !tags.empty() && tags[0].name == root->local_name())
-    AssignTags(*root, tags, 0, &index);
-  for (const auto& [e, i] : index) tags_[e] = {tags[i].line, tags[i].offset};
+void XmlDocFree::operator()(_xmlDoc* doc) const { xmlFreeDoc(doc); }
+
+void Document::SetXml(XmlDocument xml, std::unordered_map<const _xmlNode*, int> big_lines) {
+  xml_ = std::move(xml);
+  big_lines_ = std::move(big_lines);
+  nodes_indexed_ = false;
+  nodes_.clear();
+}
+
+void Document::IndexNodes() const {
+  if (nodes_indexed_) return;
+  nodes_indexed_ = true;
+  const xmlNode* top = xml_ ? xmlDocGetRootElement(xml_.get()) : nullptr;
+  if (root && top != nullptr && LocalName(Chars(top->name)) == root->local_name())
+    AssignNodes(*root, top, &nodes_);
 }
 
 int Document::LineOf(const Element& element) const {
-  IndexTags();
-  const auto it = tags_.find(&element);
-  return it == tags_.end() ? 0 : it->second.first;
+  IndexNodes();
+  const auto it = nodes_.find(&element);
+  if (it == nodes_.end()) return 0;
+  const auto big = big_lines_.find(it->second);
+  return big != big_lines_.end() ? big->second : it->second->line;
 }
 
 std::vector<std::string> Document::RestoreAttributes(Element* subtree) {
-  IndexTags();
+  IndexNodes();
   std::vector<std::string> restored;
   std::vector<Element*> stack{subtree};
   while (!stack.empty()) {
     Element* e = stack.back();
     stack.pop_back();
     for (auto& c : e->children) stack.push_back(c.get());
-    const auto it = tags_.find(e);
-    if (it == tags_.end()) continue;
-    for (auto& [name, value] : TagAttributes(text_, it->second.second)) {
+    const auto it = nodes_.find(e);
+    if (it == nodes_.end()) continue;
+    for (const xmlAttr* a = it->second->properties; a != nullptr; a = a->next) {
+      auto [name, value] = AttributeOf(a);
       if (e->HasAttribute(name)) continue;
       restored.push_back(name + " = " + value);
-      e->attributes.emplace_back(name, value);
+      e->attributes.emplace_back(std::move(name), std::move(value));
     }
   }
   return restored;
 }
 
 void Document::RestoreNames() {
-  // cheap test first: a name attribute with a blank in its value
-  bool blanks = false;
-  for (size_t at = text_.find(" name=\""); at != std::string::npos && !blanks;
-       at = text_.find(" name=\"", at + 7)) {
-    const size_t close = text_.find('"', at + 7);
-    blanks = close != std::string::npos && text_.find_first_of(" \t", at + 7) < close;
-  }
-  if (!blanks || !root) return;
-  IndexTags();
+  if (!root) return;
+  IndexNodes();
   std::vector<Element*> stack{root.get()};
   while (!stack.empty()) {
     Element* e = stack.back();
     stack.pop_back();
     for (auto& c : e->children) stack.push_back(c.get());
-    const auto it = tags_.find(e);
-    if (it == tags_.end() || !e->HasAttribute("name")) continue;
-    for (const auto& [name, value] : TagAttributes(text_, it->second.second))
-      if (name == "name") e->Set("name", value);
+    const auto it = nodes_.find(e);
+    if (it == nodes_.end() || !e->HasAttribute("name")) continue;
+    for (const xmlAttr* a = it->second->properties; a != nullptr; a = a->next)
+      if (a->ns == nullptr && std::string_view(Chars(a->name)) == "name")
+        e->Set("name", AttributeOf(a).second);
   }
-}
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "";
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  std::string raw = buffer.str();
-  const bool le = raw.size() >= 2 && static_cast<unsigned char>(raw[0]) == 0xff &&
-                  static_cast<unsigned char>(raw[1]) == 0xfe;
-  const bool be = raw.size() >= 2 && static_cast<unsigned char>(raw[0]) == 0xfe &&
-                  static_cast<unsigned char>(raw[1]) == 0xff;
-  if (!le && !be) return raw;
-  // UTF-16: keep the ASCII subset, which is all the markup and numbers (other characters
-  // become '?', one per code unit, so lines keep their count)
-  std::string text;
-  text.reserve(raw.size() / 2);
-  for (size_t i = 2; i + 1 < raw.size(); i += 2) {
-    const unsigned lo = static_cast<unsigned char>(raw[le ? i : i + 1]);
-    const unsigned hi = static_cast<unsigned char>(raw[le ? i + 1 : i]);
-    text += hi == 0 && lo < 0x80 ? static_cast<char>(lo) : '?';
-  }
-  return text;
-}
-
-std::string SniffVersion(const std::string& text) {
-  const size_t root = text.find("<COLLADA");
-  if (root == std::string::npos) return "";
-  const size_t end = text.find('>', root);
-  const std::string tag =
-      text.substr(root, end == std::string::npos ? std::string::npos : end - root);
-  size_t at = 0;
-  while ((at = tag.find("version", at)) != std::string::npos) {
-    // the attribute itself, not xmlns or another name ending in "version"
-    const bool starts = at > 0 && IsSpace(tag[at - 1]);
-    size_t k = at + 7;
-    while (k < tag.size() && IsSpace(tag[k])) ++k;
-    if (starts && k < tag.size() && tag[k] == '=') {
-      ++k;
-      while (k < tag.size() && IsSpace(tag[k])) ++k;
-      if (k < tag.size() && (tag[k] == '"' || tag[k] == '\'')) {
-        const size_t close = tag.find(tag[k], k + 1);
-        if (close != std::string::npos) return tag.substr(k + 1, close - k - 1);
-      }
-    }
-    at += 7;
-  }
-  return "";
-}
-
-std::pair<int, std::string> FindXmlProblem(const std::string& text) {
-  std::vector<Tag> tags;
-  int line = 0;
-  std::string what;
-  if (ScanTags(text, &tags, &line, &what)) return {0, ""};
-  return {line, what};
 }
 
 std::mutex& DomMutex() {
@@ -495,8 +331,19 @@ Document ReadDocument(const std::string& path) {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw ReadError("cannot open the file", 0);
   }
-  std::string text = doc.zipped ? "" : ReadText(path);
-  doc.declared_version = doc.zipped ? "" : SniffVersion(text);
+  std::lock_guard<std::mutex> lock(DomMutex());
+  // malformed XML never reaches the DOM (its reader can loop forever on some: a start tag left
+  // open inside character data, found by fuzzing): libxml2 reads the file first and says what
+  // is wrong where; its tree also gives the elements' lines, which the DOM does not keep
+  XmlParse xml;
+  if (!doc.zipped) {
+    xml = ParseXml(path, nullptr);
+    if (!xml.doc) throw ReadError("malformed XML: " + xml.problem, xml.line);
+    const xmlNode* top = xmlDocGetRootElement(xml.doc.get());
+    for (const xmlAttr* a = top->properties; a != nullptr; a = a->next)
+      if (a->ns == nullptr && std::string_view(Chars(a->name)) == "version")
+        doc.declared_version = AttributeOf(a).second;
+  }
   std::vector<int> attempts;
   const std::string& v = doc.declared_version;
   if (v.rfind("1.5", 0) == 0) {
@@ -508,13 +355,6 @@ Document ReadDocument(const std::string& path) {
   } else {
     attempts = {150, 141};
   }
-  // malformed XML never reaches the DOM: its reader can loop forever on some (a start tag left
-  // open inside character data, found by fuzzing)
-  if (!doc.zipped) {
-    const auto [line, what] = FindXmlProblem(text);
-    if (line > 0) throw ReadError("malformed XML: " + what, line);
-  }
-  std::lock_guard<std::mutex> lock(DomMutex());
   const core::ClassicLocaleScope classic;  // the DOM reads numbers with sscanf and streams
   DomLoad load;
   for (int attempt : attempts) {
@@ -524,6 +364,8 @@ Document ReadDocument(const std::string& path) {
       break;
     }
   }
+  // a .zae: the .dae the DOM extracted from it
+  if (doc.zipped && !load.text.empty()) xml = ParseXml(load.extracted_path, &load.text);
   std::vector<std::string> errors;
   for (const auto& e : load.errors) {
     // a .zae is first read as XML, which fails twice before the DOM unzips it
@@ -539,9 +381,8 @@ Document ReadDocument(const std::string& path) {
     for (const auto& e : errors) message += (message.empty() ? "" : "; ") + e;
     if (message.empty()) message = "Collada-DOM could not load the document";
     if (load.wrong_version) message = "not a COLLADA 1.4 or 1.5 document: " + message;
-    const auto [line, what] = FindXmlProblem(doc.zipped ? load.text : text);
-    if (line > 0) message = "malformed XML (" + what + "): " + message;
-    throw ReadError(message, line);
+    if (!xml.problem.empty()) message = "malformed XML (" + xml.problem + "): " + message;
+    throw ReadError(message, xml.line);
   }
   for (const auto& w : load.warnings) {
     // the schema location attributes of XML Schema instances are harmless
@@ -552,7 +393,7 @@ Document ReadDocument(const std::string& path) {
   }
   doc.root = std::move(load.root);
   if (doc.declared_version.empty()) doc.declared_version = doc.root->Attribute("version");
-  doc.SetText(doc.zipped ? std::move(load.text) : std::move(text));
+  doc.SetXml(std::move(xml.doc), std::move(xml.big_lines));
   doc.RestoreNames();
   // Collada-DOM types elements inside a technique by their name where COLLADA has a global
   // element of that name (param, translate, ...), and drops the attributes that type lacks:

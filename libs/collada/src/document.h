@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+struct _xmlDoc;
+struct _xmlNode;
+
 namespace caliper::collada::internal {
 
 /// One XML element with its attributes, character data and children, in document order.
@@ -59,7 +62,7 @@ std::string FormatNumber(double value);
 /// Numbers separated by single spaces.
 std::string FormatNumbers(const double* values, size_t count);
 
-/// A document that could not be read: the message as the DOM or our scan reported it, and the
+/// A document that could not be read: the message as libxml2 or the DOM reported it, and the
 /// line where known (0 otherwise).
 class ReadError : public std::runtime_error {
  public:
@@ -69,6 +72,12 @@ class ReadError : public std::runtime_error {
  private:
   int line_;
 };
+
+/// libxml2's tree of a document (xmlFreeDoc frees it).
+struct XmlDocFree {
+  void operator()(_xmlDoc* doc) const;
+};
+using XmlDocument = std::unique_ptr<_xmlDoc, XmlDocFree>;
 
 /// A COLLADA document loaded through Collada-DOM.
 class Document {
@@ -85,43 +94,34 @@ class Document {
   /// The element with this id, nullptr when absent.
   const Element* FindId(std::string_view id) const;
 
-  /// The line of an element in the file; 0 when unknown (the scan of the file's text did not
-  /// find it, e.g. for an element the DOM made up). Collada-DOM keeps no line numbers: the first
-  /// call scans the text once and indexes every start tag by its path from the root.
+  /// The line of an element's start tag in the file; 0 when unknown (libxml2's tree of the file
+  /// has no such element, e.g. one the DOM made up). Collada-DOM keeps no line numbers: the first
+  /// call matches the DOM's elements to libxml2's nodes by their path from the root.
   int LineOf(const Element& element) const;
-  /// The text the lines refer to (the .dae itself, or the .dae inside a .zae).
-  void SetText(std::string text) { text_ = std::move(text); }
-  /// Adds to the elements of a subtree the attributes their start tags in the text have and the
+  /// libxml2's tree of the file (of the .dae inside a .zae) and the lines of its elements from
+  /// line 65535 on (xmlNode keeps 16 bits).
+  void SetXml(XmlDocument xml, std::unordered_map<const _xmlNode*, int> big_lines);
+  /// Adds to the elements of a subtree the attributes their start tags in the file have and the
   /// DOM dropped; returns them as "name = value".
   std::vector<std::string> RestoreAttributes(Element* subtree);
   /// Collada-DOM cuts name attributes at the first blank: puts back the whole names from the
-  /// text, where it has any with blanks.
+  /// file.
   void RestoreNames();
 
  private:
-  // finds each element's start tag in the text: its line and offset
-  void IndexTags() const;
+  // matches each element to its node in libxml2's tree
+  void IndexNodes() const;
 
   std::unordered_map<std::string_view, const Element*> ids_;
-  std::string text_;
-  mutable bool tags_indexed_ = false;
-  mutable std::unordered_map<const Element*, std::pair<int, size_t>> tags_;
+  XmlDocument xml_;
+  std::unordered_map<const _xmlNode*, int> big_lines_;
+  mutable bool nodes_indexed_ = false;
+  mutable std::unordered_map<const Element*, const _xmlNode*> nodes_;
 };
 
-/// The version attribute of the <COLLADA> element in a document's text; "" when it cannot be
-/// found (a file that is not XML).
-std::string SniffVersion(const std::string& text);
-
-/// Reads a file's text as UTF-8 ("" when it cannot be read); UTF-16 with a byte order mark is
-/// converted.
-std::string ReadText(const std::string& path);
-
-/// The first structural problem of an XML text (tags that do not match, content after the root
-/// element, an unclosed element): its line and description; {0, ""} when none is found.
-std::pair<int, std::string> FindXmlProblem(const std::string& text);
-
-/// Loads `path` with the Collada-DOM of the document's schema version (sniffed, or tried in turn
-/// for .zae archives). Throws ReadError when the DOM cannot load it.
+/// Loads `path` with the Collada-DOM of the document's schema version (its version attribute, or
+/// each in turn for .zae archives) once libxml2 found it well-formed. Throws ReadError when
+/// libxml2 or the DOM cannot read it.
 Document ReadDocument(const std::string& path);
 
 /// Writes a <COLLADA> tree through the 1.5.0 DOM. Throws std::runtime_error on failure.
