@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <boost/math/tools/toms748_solve.hpp>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -36,6 +37,25 @@ inline double SwitchBlend(double current_times_speed) {
   if (x > kSwitchSaturation) return 0;
   if (x < -kSwitchSaturation) return 1;
   return 1 / (1 + std::exp(x));
+}
+
+// v in the shortest form (up to 17 digits, locale-free) that is >= v (up) or <= v (down), so
+// that a bound read from a message and typed back is accepted
+std::string BoundText(double v, bool up) {
+  char text[32];
+  for (int digits = 6; digits <= 17; ++digits) {
+    const auto end = std::to_chars(text, text + sizeof text, v, std::chars_format::general, digits);
+    double back = 0;
+    std::from_chars(text, end.ptr, back);
+    if (digits == 17 || (up ? back >= v : back <= v)) return std::string(text, end.ptr);
+  }
+  return std::to_string(v);
+}
+
+std::string Text(double v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, end.ptr);
 }
 
 enum class Range { kPositive, kNonNegative, kFraction };
@@ -156,6 +176,21 @@ void DcMotor::Reset() {
   last_acceleration_ = 0;
 }
 
+double DcMotor::Substeps(double dt, double max_substep) {
+  return std::max(1.0, std::ceil(dt / max_substep - 1e-9));
+}
+
+void DcMotor::CheckSubsteps(double dt, double max_substep) {
+  const double n = Substeps(dt, max_substep);
+  if (n <= kMaxSubstepsPerStep) return;
+  throw std::invalid_argument(
+      "a time step of " + Text(dt) + " s with max_substep = " + Text(max_substep) + " s needs " +
+      Text(n) + " sub-steps, more than the " + std::to_string(kMaxSubstepsPerStep) +
+      " one step may take: max_substep must be at least " +
+      BoundText(dt / kMaxSubstepsPerStep, true) + " s (or the time step at most " +
+      BoundText(max_substep * kMaxSubstepsPerStep, false) + " s)");
+}
+
 void DcMotor::set_locked(bool locked) {
   locked_ = locked;
   if (locked_) state_.spool_speed = 0;
@@ -168,7 +203,7 @@ void DcMotor::UpdateConstants(double dt) {
   const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
   const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
   k.dt = dt;
-  k.substeps = std::max(1, static_cast<int>(std::ceil(dt / p.max_substep - 1e-9)));
+  k.substeps = static_cast<int>(Substeps(dt, p.max_substep));  // checked by Step()
   k.h = dt / k.substeps;
   k.c = kGamma * k.h;
   k.inverse_c = 1 / k.c;
@@ -466,7 +501,14 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
     throw std::invalid_argument("dc motor: voltage must be finite, got " + std::to_string(voltage));
   if (!(dt > 0) || !std::isfinite(dt))
     throw std::invalid_argument("dc motor: time step must be > 0 [s], got " + std::to_string(dt));
-  if (dt != constants_.dt) UpdateConstants(dt);
+  if (dt != constants_.dt) {
+    try {
+      CheckSubsteps(dt, parameters_.max_substep);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("dc motor: ") + e.what());
+    }
+    UpdateConstants(dt);
+  }
   load_sign_ = load.TorqueSign();
   const int n = constants_.substeps;
   for (int i = 0; i < n; ++i) Substep(voltage, load, i + 1 == n);

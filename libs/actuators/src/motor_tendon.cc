@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -144,6 +145,7 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + e.what());
     }
     elastic_ = MakeElasticElement(a);
+    elastic_state_ = elastic_->StateSize();
     if (typeid(*elastic_) == typeid(LinearSpringDamper))
       linear_ = static_cast<const LinearSpringDamper*>(elastic_.get());
     Reset(elastic_->RelaxedLength(pretension_));
@@ -184,6 +186,42 @@ class DcMotorTendon : public TendonActuator {
   }
 
   double tension() const override { return tension_; }
+
+  // the motor's, the elastic element's, and what the step reports
+  std::size_t StateSize() const override { return kOwnState + elastic_state_; }
+
+  void SaveState(double* out) const override {
+    motor_.SaveState(out);
+    out += DcMotor::kStateSize;
+    out[0] = path_length_;
+    out[1] = path_speed_;
+    out[2] = line_length_;
+    out[3] = elastic_length_;
+    out[4] = tension_;
+    if (elastic_state_ > 0) elastic_->SaveState(out + 5);
+  }
+
+  void RestoreState(const double* in) override {
+    motor_.RestoreState(in);
+    in += DcMotor::kStateSize;
+    path_length_ = in[0];
+    path_speed_ = in[1];
+    line_length_ = in[2];
+    elastic_length_ = in[3];
+    tension_ = in[4];
+    if (elastic_state_ > 0) elastic_->RestoreState(in + 5);
+  }
+
+  void SetTimeStep(double dt) override {
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
+    try {
+      DcMotor::CheckSubsteps(dt, motor_.parameters().max_substep);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
+    }
+    time_step_ = dt;
+  }
 
   void SetCommand(double value) override {
     RequireFinite(prefix_, "command", value);
@@ -228,6 +266,16 @@ class DcMotorTendon : public TendonActuator {
         if (name != field.name) continue;
         DcMotorParameters p = motor_.parameters();
         p.*field.member = value;
+        p.Validate();
+        // the engine's time step must not need more sub-steps than one step may take
+        if (time_step_ > 0) {
+          try {
+            DcMotor::CheckSubsteps(time_step_, p.max_substep);
+          } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument("parameter '" + name + "' = " + Number(value) + " [" +
+                                        field.unit + "] refused: " + e.what());
+          }
+        }
         motor_.set_parameters(p);
         return;
       }
@@ -279,10 +327,13 @@ class DcMotorTendon : public TendonActuator {
   DcMotor motor_;
   std::unique_ptr<ElasticElement> elastic_;
   const LinearSpringDamper* linear_ = nullptr;  // elastic_ when it is linear (no virtual calls)
+  std::size_t elastic_state_ = 0;               // elastic_->StateSize()
+  static constexpr std::size_t kOwnState = DcMotor::kStateSize + 5;
   bool duty_input_ = false;
   double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
   double pretension_ = 0;                          // at Reset [N]
   double command_ = 0;                             // [V] or duty [-]
+  double time_step_ = 0;                           // the engine's, once told [s]
   double path_length_ = 0;                         // [m]
   double path_speed_ = 0;                          // [m/s]
   double line_length_ = 0;                         // free kite line [m]
@@ -330,6 +381,19 @@ class Ligament : public TendonActuator {
   }
 
   double tension() const override { return tension_; }
+
+  // the spring is stateless: the step changes only what it reports
+  std::size_t StateSize() const override { return 3; }
+  void SaveState(double* out) const override {
+    out[0] = tension_;
+    out[1] = length_;
+    out[2] = speed_;
+  }
+  void RestoreState(const double* in) override {
+    tension_ = in[0];
+    length_ = in[1];
+    speed_ = in[2];
+  }
 
   void SetCommand(double) override {
     throw std::invalid_argument(prefix_ + "a ligament is passive and takes no command");

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -516,7 +519,7 @@ class HillMuscle : public TendonActuator {
       return out_.tension;
     }
     // fibre sub-steps of at most 1 ms (activation takes finer ones inside)
-    const int n = elastic_ ? std::max(1, static_cast<int>(std::ceil(dt / kMaxSubstep - 1e-9))) : 1;
+    const int n = elastic_ ? FiberSubsteps(dt) : 1;
     const double h = dt / n;
     for (int i = 0; i < n; ++i) {
       const double a0 = activation_;
@@ -531,6 +534,26 @@ class HillMuscle : public TendonActuator {
   }
 
   double tension() const override { return out_.tension; }
+
+  // the activation, the fibre length and the outputs Get() reports (the solvers start afresh
+  // from these in every step)
+  std::size_t StateSize() const override { return 2 + kOutputValues; }
+  void SaveState(double* out) const override {
+    out[0] = activation_;
+    out[1] = fiber_length_;
+    std::memcpy(out + 2, &out_, sizeof out_);
+  }
+  void RestoreState(const double* in) override {
+    activation_ = in[0];
+    fiber_length_ = in[1];
+    std::memcpy(static_cast<void*>(&out_), in + 2, sizeof out_);
+  }
+
+  void SetTimeStep(double dt) override {
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
+    if (elastic_) FiberSubsteps(dt);  // throws when there would be too many
+  }
 
   void SetCommand(double value) override {
     CheckFinite("excitation", value);
@@ -682,6 +705,19 @@ class HillMuscle : public TendonActuator {
     const double tau_act = thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act;
     const double tau_deact = thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact;
     return Clamp(ExactActivation(u, a, h, tau_act, tau_deact), minimum, 1);
+  }
+
+  // the fibre sub-steps of a step of dt [s] (elastic tendon); throws std::invalid_argument when
+  // there would be more than one step may take
+  int FiberSubsteps(double dt) const {
+    const double n = std::max(1.0, std::ceil(dt / kMaxSubstep - 1e-9));
+    if (n > kMaxSubstepsPerStep)
+      throw std::invalid_argument(Prefix() + "a time step of " + Num(dt) + " s needs " + Num(n) +
+                                  " fibre sub-steps of " + Num(kMaxSubstep) +
+                                  " s, more than the " + std::to_string(kMaxSubstepsPerStep) +
+                                  " one step may take: the time step must be at most " +
+                                  Num(kMaxSubstep * kMaxSubstepsPerStep) + " s");
+    return static_cast<int>(n);
   }
 
   // --- Thelen with an elastic tendon: fibre length state
@@ -869,6 +905,11 @@ class HillMuscle : public TendonActuator {
     o->passive_force = f0 * o->passive_force_length;
     o->tension = std::max(0.0, (o->active_fiber_force + o->passive_force) * cos);
   }
+
+  static constexpr std::size_t kOutputValues = sizeof(Outputs) / sizeof(double);
+  static_assert(sizeof(Outputs) == kOutputValues * sizeof(double) &&
+                    std::is_trivially_copyable_v<Outputs>,
+                "Outputs is saved as plain doubles");
 
   std::string name_;
   Curves curves_;

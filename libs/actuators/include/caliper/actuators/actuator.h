@@ -3,6 +3,7 @@
 // calls Step() with its length and lengthening speed, and applies the returned tension along the
 // path. New kinds register a factory; the engine code never changes for them. SI units.
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -12,6 +13,11 @@
 #include "caliper/sgal/scene.h"
 
 namespace caliper::actuators {
+
+/// The most internal sub-steps (or solver stages of the same cost) one Step() may take: a
+/// parameter or a time step that would need more is refused, so that no value can make a single
+/// physics step run for hours.
+inline constexpr int kMaxSubstepsPerStep = 10000;
 
 /// A named scalar an actuator exposes: a parameter (static, usually writable) or a state.
 struct Quantity {
@@ -43,6 +49,24 @@ class TendonActuator {
 
   /// The tension of the last Step [N].
   virtual double tension() const = 0;
+
+  /// How many values SaveState() writes; fixed for the actuator's lifetime. The default, 0, is
+  /// for kinds whose Step() changes nothing.
+  virtual std::size_t StateSize() const { return 0; }
+  /// Writes StateSize() values: everything Step() changes (states, outputs, solver start values
+  /// and caches whose contents change results), so that RestoreState() puts the actuator back
+  /// where a repeated Step() gives the same result bit for bit. Parameters and the command are
+  /// not part of it. Called before every physics step: a few stores, no allocation.
+  virtual void SaveState(double* out) const { (void)out; }
+  /// Reads back the StateSize() values SaveState() wrote.
+  virtual void RestoreState(const double* in) { (void)in; }
+
+  /// The time step the engine will call Step() with [s]. Kinds whose work per step depends on
+  /// a parameter (internal sub-steps) refuse with std::invalid_argument a time step that would
+  /// need more than kMaxSubstepsPerStep of them, naming the smallest parameter value that would
+  /// do, and then refuse such parameter values in Set() while this time step holds. Unchanged
+  /// when it throws. The default accepts any time step.
+  virtual void SetTimeStep(double dt) { (void)dt; }
 
   /// The input: voltage [V], PWM duty [-] or excitation [-] depending on the kind.
   virtual void SetCommand(double value) = 0;

@@ -5,7 +5,10 @@
 // (a load torque on the spool) or with a load that depends on the spool angle and speed (a
 // tendon with a series-elastic element). SI units.
 
+#include <cstddef>
 #include <string>
+
+#include "caliper/actuators/actuator.h"
 
 namespace caliper::actuators {
 
@@ -23,7 +26,8 @@ struct DcMotorParameters {
   double bridge_resistance = 0;        // R_bridge: H-bridge resistance in series [ohm]
   double current_limit = 0;            // |i| the driver allows [A]; 0: no limit
   double spool_radius = 0.0045;        // r_s [m]
-  double max_substep = 3.4e-4;         // longest internal integration step [s] (see DcMotor)
+  double max_substep = 3.4e-4;         // longest internal integration step [s] (see DcMotor);
+                                       // a step takes at most kMaxSubstepsPerStep of them
 
   /// Throws std::invalid_argument naming the first parameter out of range (non-finite values,
   /// non-positive R, L, k_t, k_e, rotor inertia, N, r_s, max_substep, an efficiency outside
@@ -132,10 +136,45 @@ class DcMotor {
   bool locked() const { return locked_; }
 
   /// Advances by dt [s] > 0 with the terminal voltage [V] held and the spool loaded by `load`.
-  /// Throws std::invalid_argument for a non-finite voltage or a dt that is not positive.
+  /// Throws std::invalid_argument (the state unchanged) for a non-finite voltage, a dt that is
+  /// not positive, or one that would take more than kMaxSubstepsPerStep sub-steps.
   void Step(double voltage, double dt, SpoolLoad& load);
   /// Advances by dt [s] with a constant load torque [N m] (positive against positive speed).
   void Step(double voltage, double dt, double load_torque);
+
+  /// The sub-steps a step of dt [s] takes with this max_substep [s] (as a double: it may be
+  /// beyond any int).
+  static double Substeps(double dt, double max_substep);
+  /// Throws std::invalid_argument when a step of dt [s] would take more than
+  /// kMaxSubstepsPerStep sub-steps of at most max_substep [s]; the message gives the smallest
+  /// max_substep and the longest time step allowed.
+  static void CheckSubsteps(double dt, double max_substep);
+
+  /// Writes everything Step() changes (kStateSize values: the state, the applied voltage and
+  /// load torque, the Newton start value's memory and the exp() cache) for RestoreState(), after
+  /// which a repeated Step() gives the same result bit for bit.
+  void SaveState(double* out) const {
+    out[0] = state_.current;
+    out[1] = state_.spool_speed;
+    out[2] = state_.spool_angle;
+    out[3] = applied_voltage_;
+    out[4] = load_torque_;
+    out[5] = last_acceleration_;
+    out[6] = exp_argument_;
+    out[7] = exp_value_;
+  }
+  /// Reads back the kStateSize values SaveState() wrote.
+  void RestoreState(const double* in) {
+    state_.current = in[0];
+    state_.spool_speed = in[1];
+    state_.spool_angle = in[2];
+    applied_voltage_ = in[3];
+    load_torque_ = in[4];
+    last_acceleration_ = in[5];
+    exp_argument_ = in[6];
+    exp_value_ = in[7];
+  }
+  static constexpr std::size_t kStateSize = 8;
 
   /// The voltage the driver applied at the end of the last step [V] (lower than the command
   /// while the current is limited).

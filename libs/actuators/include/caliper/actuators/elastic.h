@@ -3,6 +3,7 @@
 // (shock cord, a spring) or makes up a ligament. All are tension-only: slack below their rest
 // length, never pushing. SI units.
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <utility>
@@ -45,6 +46,13 @@ class ElasticElement {
 
   /// As Peek(), and accepts the step: the element's state moves on.
   virtual double Force(double length, double rate, double dt) = 0;
+
+  /// How many values SaveState() writes (0 for the stateless elements).
+  virtual std::size_t StateSize() const { return 0; }
+  /// Writes StateSize() values: what Force() changes.
+  virtual void SaveState(double* out) const { (void)out; }
+  /// Reads back the StateSize() values SaveState() wrote.
+  virtual void RestoreState(const double* in) { (void)in; }
 
   /// The length [m] at which the relaxed element carries this tension [N] (>= 0). Throws
   /// std::invalid_argument when the element never reaches it.
@@ -182,6 +190,19 @@ class ZenerElement : public ElasticElement {
                    double* slope, double* low, double* high) const override;
   double Force(double length, double rate, double dt) override;
   double RelaxedLength(double force) const override;
+  /// The strain, the Maxwell arm's stress and the stress (the factor cache holds exact values
+  /// of its step lengths: not part of the state).
+  std::size_t StateSize() const override { return 3; }
+  void SaveState(double* out) const override {
+    out[0] = strain_;
+    out[1] = maxwell_stress_;
+    out[2] = stress_;
+  }
+  void RestoreState(const double* in) override {
+    strain_ = in[0];
+    maxwell_stress_ = in[1];
+    stress_ = in[2];
+  }
 
   /// The strain [-] and stress [Pa] of the last accepted step.
   double strain() const { return strain_; }
