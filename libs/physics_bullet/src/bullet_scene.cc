@@ -4,11 +4,20 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
+#include <exception>
 #include <functional>
 #include <sstream>
-#include <unordered_map>
 #include <stdexcept>
+#include <typeinfo>
+#include <unordered_map>
+#include <utility>
+
+#if defined(__GNUG__)
+#include <cxxabi.h>
+#endif
 
 #include "caliper/actuators/actuator.h"
 #include "caliper/actuators/tendon_contact.h"
@@ -20,6 +29,9 @@ namespace {
 
 using Eigen::Isometry3d;
 using Eigen::Vector3d;
+
+// the most constraint solver iterations a scene may ask for per step
+constexpr int kMaxSolverIterations = actuators::kMaxSubstepsPerStep;
 
 btVector3 ToBt(const Vector3d& v, double s = 1.0) {
   return btVector3(static_cast<btScalar>(v.x() * s), static_cast<btScalar>(v.y() * s),
@@ -76,18 +88,77 @@ struct TendonData {
   double tension = 0;
   int contacts = 0;
   std::vector<int> actuators;
+  bool has_wraps = false;  // the path keeps a side per wrap from step to step
+  // the state at the start of the step, put back when the step fails
+  actuators::TendonPath saved_path;       // only when has_wraps
+  actuators::PathGeometry saved_geometry;  // swapped, not copied
+  double saved_previous_length = -1;
+  double saved_tension = 0;
+  int saved_contacts = 0;
 };
 
 struct ActuatorData {
   const sgal::Actuator* desc = nullptr;
   std::unique_ptr<actuators::TendonActuator> model;
   int tendon = -1;
+  size_t state_offset = 0;  // of its SaveState() in the scene's buffer
 };
 
 struct Snapshot {
   btTransform transform;
   btVector3 linear, angular;
 };
+
+/// A step's own fault (a non-finite tension, an exploding body): passed on as it is.
+class StepFault : public sgal::SimulationFault {
+ public:
+  using sgal::SimulationFault::SimulationFault;
+};
+
+/// The part of a step that runs, for the message of a fault: an actuator, a tendon or the world.
+struct StepStage {
+  enum Kind { kWorld, kTendon, kActuator } kind = kWorld;
+  int index = -1;
+};
+
+/// A number as text, shortest round-trip form, independent of the locale.
+std::string Text(double v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, end.ptr);
+}
+
+/// The readable name of a type.
+std::string TypeName(const std::type_info& type) {
+#if defined(__GNUG__)
+  int status = 0;
+  char* name = abi::__cxa_demangle(type.name(), nullptr, nullptr, &status);
+  if (status == 0 && name != nullptr) {
+    std::string readable(name);
+    std::free(name);
+    return readable;
+  }
+#endif
+  return type.name();
+}
+
+/// What the exception being handled says: its type, and its message when it has one that is not
+/// just the type's name.
+std::string CurrentException() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    const std::string type = TypeName(typeid(e));
+    const std::string what = e.what();
+    return what.empty() || what == type ? type : type + ": " + what;
+  } catch (...) {
+#if defined(__GNUG__)
+    if (const std::type_info* type = abi::__cxa_current_exception_type())
+      return "an exception of type " + TypeName(*type);
+#endif
+    return "an exception of unknown type";
+  }
+}
 
 class BulletScene : public sgal::PhysicsScene {
  public:
@@ -119,6 +190,11 @@ class BulletScene : public sgal::PhysicsScene {
   void ApplyJointSprings();
   void CheckState();
   void BuildParameters();
+  // the state at the start of a step (bodies, tendons, actuators), and putting it back
+  void SaveStepState();
+  void RestoreStepState();
+  [[noreturn]] void FailStep();
+  std::string Describe(const StepStage& stage) const;
 
   /// One parameter with its accessors, built once.
   struct ParameterEntry {
@@ -149,7 +225,10 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<Vector3d> coms_;           // centres of mass this step [m]
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
-  std::vector<Snapshot> snapshot_;
+  std::vector<Snapshot> snapshot_;          // bodies at the start of the step
+  std::vector<double> actuator_states_;     // actuators' SaveState() at the start of the step,
+                                            // sized once
+  StepStage stage_;                         // what the step is doing (for a fault's message)
   double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
   std::vector<ParameterEntry> parameters_;
   std::unordered_map<std::string, int> parameter_index_;
@@ -210,6 +289,14 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
   world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                      solver_.get(), configuration_.get());
   world_->setGravity(ToBt(scene_.gravity, scale_));
+  // each solver iteration sweeps every constraint and contact: bounded like actuator sub-steps
+  if (scene_.settings.solver_iterations < 1 ||
+      scene_.settings.solver_iterations > kMaxSolverIterations)
+    throw std::invalid_argument((scene_.source.empty() ? scene_.name : scene_.source) +
+                                ": solver_iterations = " +
+                                std::to_string(scene_.settings.solver_iterations) +
+                                " is out of range: it sets the work of every step and must be "
+                                "in [1, " + std::to_string(kMaxSolverIterations) + "]");
   world_->getSolverInfo().m_numIterations = scene_.settings.solver_iterations;
   fixed_body_ = std::make_unique<btRigidBody>(0, nullptr, nullptr);
   fixed_body_->setMassProps(0, btVector3(0, 0, 0));
@@ -399,6 +486,7 @@ void BulletScene::BuildTendons() {
         ref.body = ref.obstacle->body.empty() ? -1 : scene_.BodyIndex(ref.obstacle->body);
       }
       t.elements.push_back(ref);
+      t.has_wraps |= e.kind != sgal::PathElement::Kind::kPoint;
     }
   }
   actuators_.resize(scene_.actuators.size());
@@ -406,9 +494,12 @@ void BulletScene::BuildTendons() {
     ActuatorData& a = actuators_[i];
     a.desc = &scene_.actuators[i];
     a.model = actuators::Make(*a.desc);
+    a.model->SetTimeStep(dt_);  // refuses a step that would take too many sub-steps
     for (size_t t = 0; t < scene_.tendons.size(); ++t)
       if (scene_.tendons[t].name == a.desc->tendon) a.tendon = static_cast<int>(t);
     tendons_[a.tendon].actuators.push_back(static_cast<int>(i));
+    a.state_offset = actuator_states_.size();
+    actuator_states_.resize(a.state_offset + a.model->StateSize());
   }
   double largest = 0;
   for (const auto& b : scene_.bodies)
@@ -458,7 +549,9 @@ void BulletScene::EvaluateTendons() {
     if (body < 0) return Vector3d::Zero();
     return velocities_[body] + spins_[body].cross(p - coms_[body]);
   };
-  for (auto& t : tendons_) {
+  for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+    TendonData& t = tendons_[ti];
+    stage_ = {StepStage::kTendon, static_cast<int>(ti)};
     t.world.resize(t.elements.size());
     for (size_t k = 0; k < t.elements.size(); ++k) {
       const ElementRef& ref = t.elements[k];
@@ -504,8 +597,10 @@ void BulletScene::EvaluateTendons() {
 }
 
 void BulletScene::ApplyTendonForces() {
-  for (auto& t : tendons_) {
+  for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+    const TendonData& t = tendons_[ti];
     if (t.tension <= 0) continue;
+    stage_ = {StepStage::kTendon, static_cast<int>(ti)};
     for (const auto& f : actuators::PathForces(t.geometry, t.tension)) {
       if (f.body < 0 || scene_.bodies[f.body].type != sgal::BodyType::kDynamic) continue;
       bodies_[f.body].rigid->applyForce(ToBt(f.force, scale_), ToBt(f.position - coms_[f.body], scale_));
@@ -577,62 +672,132 @@ void BulletScene::CheckState() {
     }
     if (!problem.empty()) {
       const std::string name = scene_.bodies[i].name;
-      throw sgal::SimulationFault("body '" + name + "': " + problem + " at t = " +
-                                      std::to_string(time_ + dt_) + " s; simulation stopped",
-                                  name, time_ + dt_);
+      throw StepFault("body '" + name + "': " + problem + " at t = " +
+                          std::to_string(time_ + dt_) + " s; simulation stopped at t = " +
+                          std::to_string(time_) + " s (step " + std::to_string(steps_) + ")",
+                      name, time_ + dt_);
     }
   }
 }
 
-void BulletScene::Step() {
-  // keep the last good state: a failing step leaves the scene as it was
-  std::vector<Snapshot>& snapshot = snapshot_;
-  snapshot.resize(bodies_.size());
+void BulletScene::SaveStepState() {
+  snapshot_.resize(bodies_.size());
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
-    snapshot[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
+    snapshot_[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
   }
-  auto restore = [&] {
-    for (size_t i = 0; i < bodies_.size(); ++i) {
-      btRigidBody& rb = *bodies_[i].rigid;
-      rb.setCenterOfMassTransform(snapshot[i].transform);
-      rb.setLinearVelocity(snapshot[i].linear);
-      rb.setAngularVelocity(snapshot[i].angular);
-      rb.clearForces();
-    }
-  };
-
-  // poses were cached at the end of the last step (or at construction)
-  RefreshWorldShapes();
-  EvaluateTendons();
-  UpdateJoints();
   for (auto& t : tendons_) {
-    t.tension = 0;
-    for (int index : t.actuators) {
-      ActuatorData& a = actuators_[index];
-      const double f = a.model->Step(t.geometry.length, t.geometry.speed, dt_);
-      if (!std::isfinite(f)) {
-        restore();
-        throw sgal::SimulationFault("actuator '" + a.desc->name + "': tension is not finite at t = " +
-                                        std::to_string(time_ + dt_) + " s; simulation stopped",
-                                    a.desc->name, time_ + dt_);
-      }
-      t.tension += f;
-    }
-    t.previous_length = t.geometry.length;
+    // the geometry is evaluated afresh each step: keep the last one by a swap, no copy
+    std::swap(t.geometry, t.saved_geometry);
+    if (t.has_wraps) t.saved_path = t.path;  // a few ints, no allocation after the first step
+    t.saved_previous_length = t.previous_length;
+    t.saved_tension = t.tension;
+    t.saved_contacts = t.contacts;
   }
-  ApplyTendonForces();
-  ApplyJointSprings();
-  world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
-  try {
-    CheckState();
-  } catch (...) {
-    restore();
-    CacheBodyPoses();
-    throw;
+  for (const auto& a : actuators_) a.model->SaveState(actuator_states_.data() + a.state_offset);
+}
+
+void BulletScene::RestoreStepState() {
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    btRigidBody& rb = *bodies_[i].rigid;
+    // velocities first: setting the transform copies them into the interpolation state, as a
+    // step does
+    rb.setLinearVelocity(snapshot_[i].linear);
+    rb.setAngularVelocity(snapshot_[i].angular);
+    rb.setCenterOfMassTransform(snapshot_[i].transform);
+    rb.clearForces();
   }
+  for (auto& t : tendons_) {
+    std::swap(t.geometry, t.saved_geometry);
+    if (t.has_wraps) t.path = t.saved_path;
+    t.previous_length = t.saved_previous_length;
+    t.tension = t.saved_tension;
+    t.contacts = t.saved_contacts;
+  }
+  for (auto& a : actuators_) a.model->RestoreState(actuator_states_.data() + a.state_offset);
   CacheBodyPoses();
   UpdateJoints();
+}
+
+std::string BulletScene::Describe(const StepStage& stage) const {
+  switch (stage.kind) {
+    case StepStage::kActuator: {
+      const sgal::Actuator& a = *actuators_[stage.index].desc;
+      return "actuator '" + a.name + "' (" + a.kind + ")";
+    }
+    case StepStage::kTendon:
+      return "tendon '" + tendons_[stage.index].desc->name + "'";
+    case StepStage::kWorld:
+      break;
+  }
+  return "the Bullet world";
+}
+
+void BulletScene::FailStep() {
+  // called while an exception is handled: back to the start of the step, then say why
+  std::string what;
+  try {
+    throw;
+  } catch (const StepFault&) {
+    RestoreStepState();
+    throw;
+  } catch (...) {
+    what = CurrentException();
+  }
+  RestoreStepState();
+  const std::string element = stage_.kind == StepStage::kActuator
+                                  ? actuators_[stage_.index].desc->name
+                                  : stage_.kind == StepStage::kTendon
+                                        ? tendons_[stage_.index].desc->name
+                                        : std::string("world");
+  throw sgal::SimulationFault(Describe(stage_) + " failed at t = " + std::to_string(time_ + dt_) +
+                                  " s: " + what + "; simulation stopped at t = " +
+                                  std::to_string(time_) + " s (step " + std::to_string(steps_) +
+                                  ")",
+                              element, time_ + dt_);
+}
+
+void BulletScene::Step() {
+  // A failing step leaves the scene as it was at its start: bodies, tendons, every actuator's
+  // state, time and step count. Bullet's contact cache (warm-start impulses) is not rolled back:
+  // after a fault inside stepSimulation or an exploding body, a scene with contacts that steps on
+  // may differ in the last bits from one that never faulted. Faults before it (tendon paths,
+  // actuators) touch nothing in Bullet.
+  SaveStepState();
+  try {
+    // poses were cached at the end of the last step (or at construction)
+    stage_ = {StepStage::kWorld, -1};
+    RefreshWorldShapes();
+    EvaluateTendons();
+    stage_ = {StepStage::kWorld, -1};
+    UpdateJoints();
+    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+      TendonData& t = tendons_[ti];
+      t.tension = 0;
+      for (int index : t.actuators) {
+        stage_ = {StepStage::kActuator, index};
+        ActuatorData& a = actuators_[index];
+        const double f = a.model->Step(t.geometry.length, t.geometry.speed, dt_);
+        if (!std::isfinite(f))
+          throw StepFault(Describe(stage_) + ": tension is not finite (" + std::to_string(f) +
+                              ") at t = " + std::to_string(time_ + dt_) +
+                              " s; simulation stopped at t = " + std::to_string(time_) +
+                              " s (step " + std::to_string(steps_) + ")",
+                          a.desc->name, time_ + dt_);
+        t.tension += f;
+      }
+      t.previous_length = t.geometry.length;
+    }
+    ApplyTendonForces();
+    stage_ = {StepStage::kWorld, -1};
+    ApplyJointSprings();
+    world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
+    CheckState();
+    CacheBodyPoses();
+    UpdateJoints();
+  } catch (...) {
+    FailStep();
+  }
   time_ += dt_;
   ++steps_;
 }
@@ -681,6 +846,18 @@ void BulletScene::BuildParameters() {
   };
   add({"simulation.time_step", "s", true, true}, [this] { return dt_; }, [this](double v) {
     if (!(v > 0 && v <= 0.1)) throw std::invalid_argument("simulation.time_step: must be in (0, 0.1] s");
+    // A time step that an actuator cannot take within its bound of sub-steps per step is refused
+    // (rather than clamping its sub-steps, which would change its accuracy silently): every
+    // actuator is told first, and all keep the old one if one refuses.
+    for (size_t k = 0; k < actuators_.size(); ++k) {
+      try {
+        actuators_[k].model->SetTimeStep(v);
+      } catch (const std::invalid_argument& e) {
+        for (size_t j = 0; j < k; ++j) actuators_[j].model->SetTimeStep(dt_);
+        throw std::invalid_argument("simulation.time_step = " + Text(v) + " s refused: " +
+                                    e.what());
+      }
+    }
     dt_ = v;
     scene_.settings.time_step = v;
   });

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
 
 #include "test_kinds.h"
 
@@ -195,8 +198,10 @@ TEST(BulletScene, NonFiniteTensionStopsTheStepNamingTheActuator) {
   } catch (const sgal::SimulationFault& fault) {
     EXPECT_EQ(fault.element(), "faulty");
     EXPECT_NEAR(fault.time(), 0.011, 1e-9);
-    EXPECT_NE(std::string(fault.what()).find("actuator 'faulty': tension is not finite"),
-              std::string::npos);
+    EXPECT_NE(std::string(fault.what())
+                  .find("actuator 'faulty' (test_constant_tension): tension is not finite"),
+              std::string::npos)
+        << fault.what();
   }
   EXPECT_EQ(scene->steps(), 10u);
   EXPECT_EQ(scene->BodyStates()[0].pose.position, before.pose.position) << "state kept";
@@ -216,6 +221,252 @@ TEST(BulletScene, ExplodingBodyStopsTheStepNamingTheBody) {
     EXPECT_NE(std::string(fault.what()).find("speed"), std::string::npos) << fault.what();
   }
   EXPECT_EQ(scene->time(), 0.0);
+}
+
+/// A tendon from a point fixed in the world to the centre of a body.
+sgal::Tendon TendonTo(const std::string& name, const Vector3d& anchor, const std::string& body) {
+  sgal::Tendon t;
+  t.name = name;
+  sgal::PathElement from;
+  from.position = anchor;
+  sgal::PathElement to;
+  to.body = body;
+  t.path = {from, to};
+  return t;
+}
+
+/// The pendulum pulled by a DC motor with a Zener element, a muscle with an elastic tendon, a
+/// ligament and the test kind that fails on purpose ("faulty", a DC motor too): on a tendon of
+/// its own after all the others, or sharing the first motor's tendon after it.
+sgal::Scene PulledPendulum(bool share_tendon) {
+  sgal::Scene s = Pendulum(0.4, 0.0);
+  const std::string bob = s.bodies[0].name;
+  s.tendons.push_back(TendonTo("t_motor", Vector3d(0.35, 0, -0.3), bob));
+  s.tendons.push_back(TendonTo("t_muscle", Vector3d(-0.35, 0, -0.3), bob));
+  s.tendons.push_back(TendonTo("t_ligament", Vector3d(0, 0, -0.8), bob));
+  if (!share_tendon) s.tendons.push_back(TendonTo("t_faulty", Vector3d(0.35, 0, -0.5), bob));
+  s.actuators.push_back(
+      {"motor", "dc_motor_tendon", "t_motor", {{"pretension", 2}}, {{"elastic", "zener"}}});
+  s.actuators.push_back({"muscle",
+                         "hill_muscle",
+                         "t_muscle",
+                         {{"optimal_fiber_length", 0.1},
+                          {"tendon_slack_length", 0.25},
+                          {"max_isometric_force", 30}},
+                         {{"tendon", "elastic"}}});
+  s.actuators.push_back(
+      {"ligament", "ligament", "t_ligament", {{"stiffness", 300}, {"rest_length", 0.39}}, {}});
+  s.actuators.push_back({"faulty",
+                         "test_faulty_motor",
+                         share_tendon ? "t_motor" : "t_faulty",
+                         {{"pretension", 1}, {"stiffness", 2000}},
+                         {}});
+  return s;
+}
+
+std::unique_ptr<sgal::PhysicsScene> MakePulledPendulum(bool share_tendon) {
+  auto scene = MakeScene(PulledPendulum(share_tendon));
+  scene->SetCommand("motor", 0.05);  // [V]
+  scene->SetCommand("muscle", 0.4);
+  scene->SetCommand("faulty", -0.03);
+  return scene;
+}
+
+/// Everything a scene reports, by name: time, step count, body states, tendon states and every
+/// parameter and state (but the test kind's switch `fail`).
+std::vector<std::pair<std::string, double>> Everything(const sgal::PhysicsScene& scene) {
+  std::vector<std::pair<std::string, double>> all = {
+      {"time", scene.time()}, {"steps", static_cast<double>(scene.steps())}};
+  const auto bodies = scene.BodyStates();
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const std::string n = scene.description().bodies[i].name + ".";
+    const sgal::BodyState& b = bodies[i];
+    for (int k = 0; k < 3; ++k) {
+      all.push_back({n + "position", b.pose.position[k]});
+      all.push_back({n + "linear_velocity", b.linear_velocity[k]});
+      all.push_back({n + "angular_velocity", b.angular_velocity[k]});
+    }
+    for (int k = 0; k < 4; ++k) all.push_back({n + "orientation", b.pose.orientation.coeffs()[k]});
+  }
+  const auto tendons = scene.TendonStates();
+  for (size_t i = 0; i < tendons.size(); ++i) {
+    const std::string n = scene.description().tendons[i].name + ".state.";
+    all.push_back({n + "length", tendons[i].length});
+    all.push_back({n + "speed", tendons[i].speed});
+    all.push_back({n + "tension", tendons[i].tension});
+    all.push_back({n + "contacts", static_cast<double>(tendons[i].contacts)});
+    for (const auto& p : tendons[i].points)
+      for (int k = 0; k < 3; ++k) all.push_back({n + "points", p[k]});
+  }
+  const auto parameters = scene.Parameters();
+  for (size_t i = 0; i < parameters.size(); ++i)
+    if (parameters[i].id != "faulty.fail")
+      all.push_back({parameters[i].id, scene.GetParameter(static_cast<int>(i))});
+  return all;
+}
+
+void ExpectSameBits(const std::vector<std::pair<std::string, double>>& expected,
+                    const std::vector<std::pair<std::string, double>>& actual) {
+  ASSERT_EQ(expected.size(), actual.size());
+  int differences = 0;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    ASSERT_EQ(expected[i].first, actual[i].first);
+    if (std::memcmp(&expected[i].second, &actual[i].second, sizeof(double)) != 0 &&
+        ++differences <= 10)
+      ADD_FAILURE() << expected[i].first << ": " << expected[i].second << " != "
+                    << actual[i].second;
+  }
+  EXPECT_EQ(differences, 0);
+}
+
+TEST(BulletScene, AnyFaultInAStepEndsAtTheStartOfThatStep) {
+  testing::RegisterTestKinds();
+  const std::pair<int, std::string> faults[] = {
+      {1, "failed at t = 0.026000 s: std::runtime_error: injected fault; simulation stopped at "
+          "t = 0.025000 s (step 25)"},
+      {2, "failed at t = 0.026000 s: std::bad_alloc;"},
+      {3, ": tension is not finite (nan) at t = 0.026000 s"},
+      {4, "failed at t = 0.026000 s: an exception of type int;"}};
+  for (const bool share_tendon : {false, true}) {
+    for (const auto& [mode, detail] : faults) {
+      SCOPED_TRACE("fail = " + std::to_string(mode) + (share_tendon ? ", shared tendon" : ""));
+      auto faulting = MakePulledPendulum(share_tendon);
+      auto reference = MakePulledPendulum(share_tendon);
+      for (int i = 0; i < 25; ++i) {
+        faulting->Step();
+        reference->Step();
+      }
+      const auto before = Everything(*faulting);
+      faulting->SetParameter("faulty.fail", mode);
+      for (int attempt = 0; attempt < 2; ++attempt) {  // and again: the same fault, same state
+        try {
+          faulting->Step();
+          ADD_FAILURE() << "the step must fail";
+        } catch (const sgal::SimulationFault& fault) {
+          const std::string what = fault.what();
+          EXPECT_EQ(fault.element(), "faulty");
+          EXPECT_NEAR(fault.time(), 0.026, 1e-12);
+          EXPECT_EQ(what.rfind("actuator 'faulty' (test_faulty_motor)", 0), 0u) << what;
+          EXPECT_NE(what.find(detail), std::string::npos) << what;
+        }
+        EXPECT_EQ(faulting->steps(), 25u);
+        ExpectSameBits(before, Everything(*faulting));
+      }
+      // disarmed, it steps on exactly as a scene that never faulted: every actuator was restored
+      faulting->SetParameter("faulty.fail", 0);
+      for (int i = 0; i < 25; ++i) {
+        faulting->Step();
+        reference->Step();
+      }
+      ExpectSameBits(Everything(*reference), Everything(*faulting));
+      EXPECT_GT(std::abs(faulting->GetParameter("motor.current")), 1e-3) << "the motors ran";
+      EXPECT_GT(faulting->GetParameter("muscle.tension"), 0);
+      EXPECT_GT(faulting->GetParameter("ligament.tension"), 0);
+    }
+  }
+}
+
+TEST(BulletScene, AnExplodingBodyPutsTheActuatorsBackToo) {
+  sgal::Scene s;
+  s.gravity = Vector3d(5000, 0, 0);  // 5 m/s more each step: over the 1000 m/s limit at step 5
+  sgal::Body b = Ball("rocket", Vector3d::Zero(), 1.0, 0.1);
+  b.linear_velocity = Vector3d(980, 0, 0);
+  s.bodies.push_back(b);
+  // a soft line the rocket pays out, its motor running meanwhile
+  s.tendons.push_back(TendonTo("line", Vector3d(-1, 0, 0), "rocket"));
+  s.actuators.push_back(
+      {"winch", "dc_motor_tendon", "line", {{"pretension", 1}, {"stiffness", 10}}, {}});
+  auto scene = MakeScene(s);
+  scene->SetCommand("winch", 1);
+  std::vector<std::pair<std::string, double>> before;
+  try {
+    for (int i = 0; i < 1000; ++i) {
+      before = Everything(*scene);
+      scene->Step();
+    }
+    FAIL() << "the rocket must exceed the speed limit";
+  } catch (const sgal::SimulationFault& fault) {
+    EXPECT_EQ(fault.element(), "rocket");
+    EXPECT_NE(std::string(fault.what()).find("speed"), std::string::npos) << fault.what();
+  }
+  EXPECT_GT(scene->steps(), 2u);
+  EXPECT_NE(scene->GetParameter("winch.current"), 0);
+  ExpectSameBits(before, Everything(*scene));
+}
+
+TEST(BulletScene, RefusesAMaxSubstepOrTimeStepThatWouldMakeAStepTooLong) {
+  sgal::Scene s = Pendulum(0.4, 0.0);
+  s.tendons.push_back(TendonTo("t1", Vector3d(0.35, 0, -0.3), "bob"));
+  s.tendons.push_back(TendonTo("t2", Vector3d(-0.35, 0, -0.3), "bob"));
+  s.actuators.push_back({"m1", "dc_motor_tendon", "t1", {}, {}});
+  s.actuators.push_back({"m2", "dc_motor_tendon", "t2", {}, {}});
+  auto scene = MakeScene(s);
+  try {
+    scene->SetParameter("m2.max_substep", 1e-12);
+    FAIL() << "10^9 sub-steps per step accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("actuator 'm2' (dc_motor_tendon): parameter 'max_substep' = 1e-12"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("max_substep must be at least 1e-07 s"), std::string::npos) << m;
+  }
+  EXPECT_EQ(scene->GetParameter("m2.max_substep"), 3.4e-4);
+  EXPECT_EQ(scene->description().actuators[1].parameters.count("max_substep"), 0u);
+  scene->SetParameter("m2.max_substep", 1e-6);
+
+  // m1 takes a 50 ms step, m2 cannot (5*10^4 sub-steps): refused, and m1 keeps 1 ms too
+  try {
+    scene->SetParameter("simulation.time_step", 0.05);
+    FAIL() << "5*10^4 sub-steps per step accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("simulation.time_step = 0.05 s refused: actuator 'm2'"), std::string::npos)
+        << m;
+    EXPECT_NE(m.find("or the time step at most 0.01 s"), std::string::npos) << m;
+  }
+  EXPECT_EQ(scene->GetParameter("simulation.time_step"), 1e-3);
+  scene->SetParameter("m1.max_substep", 1e-7);  // allowed at 1 ms, not at 50 ms
+  scene->Step();
+  EXPECT_NEAR(scene->time(), 1e-3, 1e-15);
+  // the longest step both can take
+  scene->SetParameter("m1.max_substep", 1e-6);
+  scene->SetParameter("simulation.time_step", 0.01);
+  EXPECT_THROW(scene->SetParameter("m1.max_substep", 1e-7), std::invalid_argument);
+  scene->Step();
+  EXPECT_NEAR(scene->time(), 0.011, 1e-12);
+}
+
+TEST(BulletScene, RefusesASceneWhoseStepsCannotBeBounded) {
+  sgal::Scene s = Pendulum(0.4, 0.0);
+  s.settings.solver_iterations = 1000000;
+  try {
+    MakeScene(s);
+    FAIL() << "10^6 solver iterations per step accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("solver_iterations = 1000000 is out of range"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("[1, 10000]"), std::string::npos) << e.what();
+  }
+  s.settings.solver_iterations = 0;
+  EXPECT_THROW(MakeScene(s), std::invalid_argument);
+  s.settings.solver_iterations = 10000;
+  EXPECT_NO_THROW(MakeScene(s));
+
+  // a scene's own time step that an actuator cannot take in 10^4 sub-steps
+  s.settings.solver_iterations = 10;
+  s.settings.time_step = 10;
+  s.tendons.push_back(TendonTo("t1", Vector3d(0.35, 0, -0.3), "bob"));
+  s.actuators.push_back({"m1", "dc_motor_tendon", "t1", {}, {}});
+  try {
+    MakeScene(s);
+    FAIL() << "a 10 s step of 3e4 motor sub-steps accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("actuator 'm1' (dc_motor_tendon): a time step of 10 s"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(BulletScene, RejectsAnInvalidSceneWithEveryProblem) {

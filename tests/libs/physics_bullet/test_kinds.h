@@ -4,6 +4,11 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "caliper/actuators/actuator.h"
 
@@ -42,11 +47,71 @@ class ConstantTension : public actuators::TendonActuator {
   double last_length_ = 0;
 };
 
+/// A dc_motor_tendon (all its parameters and options) that fails on purpose after its own step
+/// while its parameter `fail` is set: 1 throws std::runtime_error("injected fault"), 2
+/// std::bad_alloc, 3 returns a NaN tension, 4 throws an int. Its state is the motor's.
+class FaultyMotor : public actuators::TendonActuator {
+ public:
+  explicit FaultyMotor(const sgal::Actuator& a) : fail_(actuators::ParameterOr(a, "fail", 0)) {
+    sgal::Actuator motor = a;
+    motor.kind = "dc_motor_tendon";
+    motor.parameters.erase("fail");
+    motor_ = actuators::Make(motor);
+  }
+  void Reset(double length) override { motor_->Reset(length); }
+  double Step(double length, double speed, double dt) override {
+    const double tension = motor_->Step(length, speed, dt);  // the motor has moved on
+    switch (static_cast<int>(fail_)) {
+      case 1:
+        throw std::runtime_error("injected fault");
+      case 2:
+        throw std::bad_alloc();
+      case 3:
+        return std::numeric_limits<double>::quiet_NaN();
+      case 4:
+        throw 42;
+      default:
+        return tension;
+    }
+  }
+  double tension() const override { return motor_->tension(); }
+  size_t StateSize() const override { return motor_->StateSize(); }
+  void SaveState(double* out) const override { motor_->SaveState(out); }
+  void RestoreState(const double* in) override { motor_->RestoreState(in); }
+  void SetTimeStep(double dt) override { motor_->SetTimeStep(dt); }
+  void SetCommand(double v) override { motor_->SetCommand(v); }
+  double command() const override { return motor_->command(); }
+  std::string command_unit() const override { return motor_->command_unit(); }
+  std::vector<actuators::Quantity> Quantities() const override {
+    auto q = motor_->Quantities();
+    q.push_back({"fail", "", true, true});
+    return q;
+  }
+  double Get(const std::string& name) const override {
+    return name == "fail" ? fail_ : motor_->Get(name);
+  }
+  void Set(const std::string& name, double value) override {
+    if (name == "fail")
+      fail_ = value;
+    else
+      motor_->Set(name, value);
+  }
+
+ private:
+  std::unique_ptr<actuators::TendonActuator> motor_;
+  double fail_;
+};
+
 inline void RegisterTestKinds() {
   actuators::RegisterKind(
       "test_constant_tension",
       {{"tension", "N", 0, false, "constant tension"}, {"nan_after", "", 0, false, "steps"}},
       [](const sgal::Actuator& a) { return std::make_unique<ConstantTension>(a); });
+  auto faulty = actuators::KindParameters("dc_motor_tendon");
+  faulty.push_back({"fail", "", 0, false, "0 none, 1 runtime_error, 2 bad_alloc, 3 NaN, 4 int"});
+  actuators::RegisterKind("test_faulty_motor", faulty, [](const sgal::Actuator& a) {
+    return std::make_unique<FaultyMotor>(a);
+  });
 }
 
 }  // namespace caliper::testing

@@ -18,7 +18,13 @@ struct Options {
 };
 
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
-/// an actuator that cannot be made (unknown kind, missing parameter).
+/// an actuator that cannot be made (unknown kind, missing parameter), or a step whose work has no
+/// bound (solver_iterations outside [1, 10^4], a time step an actuator cannot take in 10^4
+/// sub-steps). A failing Step() puts back the bodies, tendons and actuators (see
+/// sgal::PhysicsScene::Step); Bullet's contact cache (warm-start impulses) is not rolled back, so
+/// after a fault inside Bullet's own step or an exploding body a scene with contacts that steps
+/// on may differ in the last bits from one that never faulted (faults in tendon paths and
+/// actuators come before Bullet's step and leave it untouched).
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
 
 }  // namespace caliper::physics_bullet

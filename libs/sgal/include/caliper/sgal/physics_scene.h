@@ -51,8 +51,14 @@ class PhysicsScene {
  public:
   virtual ~PhysicsScene() = default;
 
-  /// Advances by one fixed time step. Throws SimulationFault (and stays at the last good state)
-  /// when the state becomes non-finite or explodes.
+  /// Advances by one fixed time step. Whatever fails inside the step (a non-finite tension, an
+  /// exploding body, or any exception of any type from an actuator, a tendon path or the
+  /// engine) ends at the last consistent state, the start of the failing step: the bodies, the
+  /// tendons, every actuator's internal state, time() and steps() as they were. Then it throws
+  /// SimulationFault whose message names the element (an actuator and its kind, a tendon, a
+  /// body or the engine's world) and what happened (the original exception's type and
+  /// message), with element() that name ("world" for the engine) and time() the time the step
+  /// would have reached [s]. Nothing else escapes.
   virtual void Step() = 0;
   virtual double time() const = 0;     // simulated time [s]
   virtual uint64_t steps() const = 0;
@@ -72,7 +78,10 @@ class PhysicsScene {
   virtual int ParameterIndex(const std::string& id) const = 0;
   /// The value of Parameters()[index]; throws std::out_of_range for a bad index.
   virtual double GetParameter(int index) const = 0;
-  /// Throws std::out_of_range (unknown), std::invalid_argument (read-only or bad value).
+  /// Throws std::out_of_range (unknown), std::invalid_argument (read-only or bad value, or one
+  /// that would make a single step take more than a bounded amount of work, such as an
+  /// actuator's max_substep below time_step / 10^4 or a time step that needs more sub-steps:
+  /// the message gives the reason and the bound).
   virtual void SetParameter(const std::string& id, double value) = 0;
 };
 
