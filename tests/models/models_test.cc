@@ -252,28 +252,33 @@ TEST_P(ShippedModel, MotorsMoveItStablyUnderACommandPattern) {
   std::cout << " deg\n";
 }
 
-TEST_P(ShippedModel, TendonsWrapTheirObstacles) {
-  const sgal::Scene description = Load();
-  std::unique_ptr<sgal::PhysicsScene> scene = physics_bullet::MakeScene(description);
-  scene->Step();
-  const auto at_rest = scene->TendonStates();
-  ASSERT_EQ(at_rest.size(), description.tendons.size());
+// Every wrapping tendon of every shipped model wraps at rest, and some model has one (a model
+// without one has nothing to check here: it is not a skip).
+TEST(ShippedModels, TendonsWrapTheirObstacles) {
   int wrapping = 0;
-  for (size_t i = 0; i < description.tendons.size(); ++i) {
-    const sgal::Tendon& t = description.tendons[i];
-    size_t points = 0;
-    bool wraps = false;
-    for (const auto& e : t.path) {
-      points += e.kind == sgal::PathElement::Kind::kPoint ? 1 : 0;
-      wraps = wraps || e.kind == sgal::PathElement::Kind::kWrap;
+  for (const Case& c : Cases()) {
+    std::vector<std::string> warnings;
+    const sgal::Scene description = collada::Import(ModelsDir() + "/" + c.file, &warnings);
+    std::unique_ptr<sgal::PhysicsScene> scene = physics_bullet::MakeScene(description);
+    scene->Step();
+    const auto at_rest = scene->TendonStates();
+    ASSERT_EQ(at_rest.size(), description.tendons.size()) << c.file;
+    for (size_t i = 0; i < description.tendons.size(); ++i) {
+      const sgal::Tendon& t = description.tendons[i];
+      size_t points = 0;
+      bool wraps = false;
+      for (const auto& e : t.path) {
+        points += e.kind == sgal::PathElement::Kind::kPoint ? 1 : 0;
+        wraps = wraps || e.kind == sgal::PathElement::Kind::kWrap;
+      }
+      if (!wraps) continue;
+      ++wrapping;
+      EXPECT_GT(at_rest[i].points.size(), points)
+          << c.file << ": tendon '" << t.name << "' does not wrap at rest";
+      EXPECT_GT(at_rest[i].points.size(), 2u) << c.file << ": " << t.name;
     }
-    if (!wraps) continue;
-    ++wrapping;
-    EXPECT_GT(at_rest[i].points.size(), points)
-        << "tendon '" << t.name << "' does not wrap at rest";
-    EXPECT_GT(at_rest[i].points.size(), 2u) << t.name;
   }
-  if (wrapping == 0) GTEST_SKIP() << GetParam().file << " has no wrapping tendon";
+  EXPECT_GT(wrapping, 0) << "no shipped model has a wrapping tendon";
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, ShippedModel, ::testing::ValuesIn(Cases()),
