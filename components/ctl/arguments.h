@@ -1,6 +1,10 @@
 #pragma once
 // Command-line arguments of the Caliper command-line tools (caliper-ctl's verbs,
-// caliper-calibrate): options taken out of the list by name, the rest positional.
+// caliper-calibrate): options taken out of the list by name, the rest positional. These stay
+// beside core::ParseArguments, which parses whole command lines (caliper-ctl's global options
+// included): some sixty call sites in the verbs take their options one at a time, wherever they
+// stand among the positional words and some more than once (the cluster verbs' `-o`), before
+// RejectOptions refuses what is left that looks like an option.
 
 #include <stdexcept>
 #include <string>

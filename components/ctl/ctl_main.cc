@@ -14,6 +14,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
+#include "caliper/core/arguments.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/logging.hh"
@@ -323,35 +324,36 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
 int Main(int argc, char** argv) {
   const auto verbs = Verbs();
   Options options;
-  std::vector<std::string> args(argv + 1, argv + argc);
-  size_t i = 0;
-  for (; i < args.size() && args[i].rfind("--", 0) == 0; ++i) {
-    if (args[i] == "--help") {
-      PrintHelp(verbs);
-      return 0;
-    }
-    if (i + 1 >= args.size()) {
-      std::cerr << "caliper-ctl: " << args[i] << " needs a value\n";
-      return 2;
-    }
-    if (args[i] == "--nameservice") {
-      options.nameservice = args[++i];
-    } else if (args[i] == "--timeout") {
-      if (!core::ParseDouble(args[++i], &options.timeout_s) || !(options.timeout_s > 0)) {
-        std::cerr << "caliper-ctl: --timeout wants seconds > 0\n";
-        return 2;
-      }
-    } else {
-      std::cerr << "caliper-ctl: unknown option " << args[i] << " (see --help)\n";
-      return 2;
-    }
+  // the global options, up to the verb; the verb's own follow it
+  core::ArgumentSpec spec;
+  spec.valued = {"--nameservice", "--timeout"};
+  spec.stop_at_positional = true;
+  const core::Arguments global = core::ParseArguments({argv + 1, argv + argc}, spec);
+  if (global.help) {
+    PrintHelp(verbs);
+    return 0;
   }
-  if (i >= args.size()) {
+  if (!global.missing_value.empty()) {
+    std::cerr << "caliper-ctl: " << global.missing_value << " needs a value\n";
+    return 2;
+  }
+  if (!global.unknown.empty()) {
+    std::cerr << "caliper-ctl: unknown option " << global.unknown << " (see --help)\n";
+    return 2;
+  }
+  options.nameservice = global.Value("--nameservice", options.nameservice);
+  if (global.Has("--timeout") &&
+      (!core::ParseDouble(global.Value("--timeout"), &options.timeout_s) ||
+       !(options.timeout_s > 0))) {
+    std::cerr << "caliper-ctl: --timeout wants seconds > 0\n";
+    return 2;
+  }
+  if (global.positional.empty()) {
     PrintHelp(verbs);
     return 2;
   }
-  const std::string verb_name = args[i];
-  std::vector<std::string> rest(args.begin() + static_cast<long>(i) + 1, args.end());
+  const std::string verb_name = global.positional[0];
+  std::vector<std::string> rest(global.positional.begin() + 1, global.positional.end());
   const auto it = verbs.find(verb_name);
   if (it == verbs.end()) {
     std::cerr << "caliper-ctl: unknown verb '" << verb_name << "' (see --help)\n";

@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "caliper/core/arguments.h"
 #include "caliper/core/numbers.h"
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/logging/log.h"
@@ -47,35 +48,31 @@ struct Options {
 
 // takes our own options out of the command line; false (with a message) when they are malformed
 bool ParseOptions(int argc, char** argv, Options* out) {
-  out->rest.push_back(argv[0]);
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--screenshot" || arg == "--after" || arg == "--geometry" || arg == "--session") {
-      if (i + 1 >= argc) {
-        std::cerr << "caliper-renderer: error: option " << arg << " needs a value\n";
-        return false;
-      }
-      const std::string value = argv[++i];
-      if (arg == "--screenshot") {
-        out->screenshot = value;
-      } else if (arg == "--geometry") {
-        if (!gui_session::ParseGeometry(QString::fromStdString(value), &out->geometry)) {
-          std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y, not '"
-                    << value << "'\n";
-          return false;
-        }
-      } else if (arg == "--session") {
-        out->session = QString::fromStdString(value);
-      } else {
-        if (!core::ParseDouble(value, &out->after) || !(out->after >= 0)) {
-          std::cerr << "caliper-renderer: error: --after needs a number of seconds >= 0\n";
-          return false;
-        }
-      }
-    } else {
-      out->rest.push_back(argv[i]);
-    }
+  core::ArgumentSpec spec;
+  spec.valued = {"--screenshot", "--after", "--geometry", "--session"};
+  spec.help = {};  // RunComponent's, as every other word
+  spec.pass = [](const std::string&) { return 1; };
+  const core::Arguments args = core::ParseArguments({argv + 1, argv + argc}, spec);
+  if (!args.Error().empty()) {
+    std::cerr << "caliper-renderer: error: " << args.Error() << "\n";
+    return false;
   }
+  out->screenshot = args.Value("--screenshot");
+  out->session = QString::fromStdString(args.Value("--session"));
+  if (args.Has("--geometry") &&
+      !gui_session::ParseGeometry(QString::fromStdString(args.Value("--geometry")),
+                                  &out->geometry)) {
+    std::cerr << "caliper-renderer: error: --geometry needs WIDTHxHEIGHT+X+Y, not '"
+              << args.Value("--geometry") << "'\n";
+    return false;
+  }
+  if (args.Has("--after") &&
+      (!core::ParseDouble(args.Value("--after"), &out->after) || !(out->after >= 0))) {
+    std::cerr << "caliper-renderer: error: --after needs a number of seconds >= 0\n";
+    return false;
+  }
+  out->rest.push_back(argv[0]);
+  for (const size_t i : args.passed) out->rest.push_back(argv[i + 1]);
   out->rest.push_back(nullptr);
   return true;
 }

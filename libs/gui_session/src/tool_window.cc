@@ -15,6 +15,8 @@
 #include <QTimer>
 #include <QWidget>
 
+#include "caliper/core/arguments.h"
+
 namespace caliper::gui_session {
 
 bool ParseGeometry(const QString& text, QRect* rect) {
@@ -123,30 +125,28 @@ std::string ToolArguments::Value(const std::string& option, const std::string& f
 
 ToolArguments SplitToolArguments(int argc, char** argv, const std::set<std::string>& valued,
                                  const std::set<std::string>& flags) {
+  core::ArgumentSpec spec;
+  spec.valued = valued;
+  spec.flags = flags;
+  // Qt's own (-platform offscreen, -style fusion ...): what Qt does not take stays in
+  // QApplication::arguments() for the tool to refuse
+  spec.pass = [](const std::string& word) {
+    if (word.size() < 2 || word[0] != '-' || word[1] == '-') return 0;
+    return IsQtOptionWithValue(word) ? 2 : 1;
+  };
+  const core::Arguments parsed = core::ParseArguments({argv + 1, argv + argc}, spec);
   ToolArguments out;
-  out.qt_argv.push_back(argv[0]);
-  for (int i = 1; i < argc && out.error.empty(); ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      out.help = true;
-    } else if (valued.count(a) != 0) {
-      if (i + 1 < argc)
-        out.values[a].push_back(argv[++i]);
-      else
-        out.error = "option " + a + " needs a value";
-    } else if (flags.count(a) != 0) {
-      out.flags.insert(a);
-    } else if (a.rfind("--", 0) == 0) {
-      out.error = "unknown option '" + a + "'";
-    } else if (a.size() > 1 && a[0] == '-') {
-      // Qt's own (-platform offscreen, -style fusion ...): what Qt does not take stays in
-      // QApplication::arguments() for the tool to refuse
-      out.qt_argv.push_back(argv[i]);
-      if (IsQtOptionWithValue(a) && i + 1 < argc) out.qt_argv.push_back(argv[++i]);
-    } else {
-      out.positional.push_back(a);
-    }
+  for (const auto& [option, value] : parsed.options) {
+    if (flags.count(option) != 0)
+      out.flags.insert(option);
+    else
+      out.values[option].push_back(value);
   }
+  out.positional = parsed.positional;
+  out.help = parsed.help;
+  out.error = parsed.Error();
+  out.qt_argv.push_back(argv[0]);
+  for (const size_t i : parsed.passed) out.qt_argv.push_back(argv[i + 1]);
   out.qt_argv.push_back(nullptr);
   return out;
 }

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <thread>
 
+#include "caliper/core/arguments.h"
 #include "caliper/core/system.h"
 #include "caliper/logging/batching_appender.h"
 #include "caliper/rtc/client_orb.h"
@@ -248,32 +249,33 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     std::vector<std::string> overrides;
     if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
       overrides.push_back("corba.endpoint=" + ListenEndpoint(listen));
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw core::ConfigError("option " + arg + " needs a value");
-        return argv[++i];
-      };
-      if (arg == "-h" || arg == "--help") {
-        PrintUsage(type, config);
-        return 0;
-      } else if (arg == "-f") {
-        config.LoadFile(next());
-      } else if (arg == "-o") {
-        overrides.push_back(next());
-      } else if (arg == "--nameservice") {
-        overrides.push_back("naming.service=" + next());
-      } else if (arg == "--listen") {
-        overrides.push_back("corba.endpoint=" + ListenEndpoint(next()));
-      } else if (arg == "--instance") {
-        overrides.push_back("naming.instance=" + next());
-      } else if (arg.rfind("-ORB", 0) == 0) {
-        orb_args.push_back(arg);
-        orb_args.push_back(next());
-      } else {
-        throw core::ConfigError("unknown argument '" + arg + "' (see --help)");
-      }
+    core::ArgumentSpec spec;
+    spec.valued = {"-f", "-o", "--nameservice", "--listen", "--instance"};
+    spec.pass = [](const std::string& word) { return word.rfind("-ORB", 0) == 0 ? 2 : 0; };
+    const std::vector<std::string> words(argv + 1, argv + argc);
+    const core::Arguments args = core::ParseArguments(words, spec);
+    if (args.help) {
+      PrintUsage(type, config);
+      return 0;
     }
+    // a component takes no positional word: the first one comes before where the parser stopped
+    const std::string unknown = args.positional.empty() ? args.unknown : args.positional[0];
+    if (!unknown.empty())
+      throw core::ConfigError("unknown argument '" + unknown + "' (see --help)");
+    if (!args.missing_value.empty()) throw core::ConfigError(args.Error());
+    for (const auto& [option, value] : args.options) {
+      if (option == "-f")
+        config.LoadFile(value);
+      else if (option == "-o")
+        overrides.push_back(value);
+      else if (option == "--nameservice")
+        overrides.push_back("naming.service=" + value);
+      else if (option == "--listen")
+        overrides.push_back("corba.endpoint=" + ListenEndpoint(value));
+      else
+        overrides.push_back("naming.instance=" + value);
+    }
+    for (const size_t i : args.passed) orb_args.push_back(words[i]);
     for (const auto& o : overrides) config.SetAssignment(o, "-o");
   } catch (const core::ConfigError& e) {
     std::cerr << program << ": error: " << e.what() << "\n";

@@ -83,7 +83,8 @@ struct ToolArguments {
   std::string Value(const std::string& option, const std::string& fallback = "") const;
 };
 
-/// Splits argv: `valued` options take the next word, `flags` none; single-dash words go to Qt.
+/// Splits argv with core::ParseArguments: `valued` options take the next word, `flags` none;
+/// single-dash words go to Qt (with the next word for the options IsQtOptionWithValue names).
 ToolArguments SplitToolArguments(int argc, char** argv, const std::set<std::string>& valued,
                                  const std::set<std::string>& flags);
 
