@@ -5,6 +5,11 @@
 #include <set>
 #include <variant>
 
+#include <omniORB4/IIOP.h>
+#include <omniORB4/minorCode.h>
+#include <omniORB4/omniIOR.h>
+#include <omniORB4/omniObjRef.h>
+
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
@@ -92,9 +97,47 @@ S::TendonStateSeq ToIdl(const std::vector<sgal::TendonState>& tendons) {
   return out;
 }
 
+// the process behind a reference is gone: the object does not exist, or nothing listens at its
+// address; anything else (a timeout, a broken connection, a refused call) may pass
 bool PeerGone(const CORBA::Exception& e) {
-  return CORBA::TRANSIENT::_downcast(&e) || CORBA::COMM_FAILURE::_downcast(&e) ||
-         CORBA::OBJECT_NOT_EXIST::_downcast(&e) || CORBA::TIMEOUT::_downcast(&e);
+  if (CORBA::OBJECT_NOT_EXIST::_downcast(&e)) return true;
+  const auto* transient = CORBA::TRANSIENT::_downcast(&e);
+  return transient != nullptr && transient->minor() == omni::TRANSIENT_ConnectFailed;
+}
+
+// the client a reference belongs to: host:port of its first IIOP profile (see PushLimits)
+std::string ClientOf(CORBA::Object_ptr ref) {
+  std::string client;
+  omniIOR* ior = ref->_PR_getobj()->_getIOR();
+  const IOP::TaggedProfileList& profiles = ior->iopProfiles();
+  for (CORBA::ULong i = 0; i < profiles.length() && client.empty(); ++i) {
+    if (profiles[i].tag != IOP::TAG_INTERNET_IOP) continue;
+    try {
+      IIOP::ProfileBody body;
+      IIOP::unmarshalProfile(profiles[i], body);
+      client = std::string(body.address.host.in()) + ":" + std::to_string(body.address.port);
+    } catch (const CORBA::SystemException&) {
+      // a malformed profile: try the next one
+    }
+  }
+  ior->release();
+  return client.empty() ? "(no IIOP address)" : client;
+}
+
+// raises `Refused` unless `ref` answers within the push deadline and is a `repository_id`
+template <class Refused>
+void RequireReachable(CORBA::Object_ptr ref, const char* what, const char* repository_id,
+                      std::chrono::milliseconds timeout) {
+  omniORB::setClientCallTimeout(ref, static_cast<CORBA::ULong>(timeout.count()));
+  try {
+    if (ref->_non_existent())
+      throw Refused((std::string("the ") + what + " does not exist").c_str());
+    // asked of the object itself: omniORB answers _is_a locally from the reference's static type
+    if (!ref->_PR_getobj()->_remote_is_a(repository_id))
+      throw Refused((std::string("the object is not a ") + what + " (" + repository_id + ")").c_str());
+  } catch (const CORBA::SystemException& e) {
+    throw Refused((std::string("the ") + what + " does not answer: " + rtc::Describe(e)).c_str());
+  }
 }
 
 D::Value ToIdl(const daq::Reading& v) {
@@ -232,163 +275,363 @@ S::Description* ToIdl(const sgal::Scene& scene) {
   return d;
 }
 
-// ------------------------------------------------------------------------ observers
+// ------------------------------------------------------------------------ sender pool
 
-ObserverSender::ObserverSender(S::SceneObserver_ptr observer)
-    : observer_(S::SceneObserver::_duplicate(observer)) {
-  thread_ = std::thread([this] { Run(); });
+using Clock = std::chrono::steady_clock;
+
+// how often a subscription without batches is looked at again
+constexpr std::chrono::milliseconds kPollInterval{20};
+
+PushPool::PushPool(const PushLimits& limits) : limits_(limits) {
+  for (size_t i = 0; i < std::max<size_t>(1, limits_.threads); ++i)
+    threads_.emplace_back([this] { Work(); });
 }
 
-ObserverSender::~ObserverSender() {
+PushPool::~PushPool() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
   }
   wake_.notify_all();
-  thread_.join();
+  for (auto& t : threads_) t.join();
+  for (auto& [key, entry] : entries_) entry->target->Detach();
 }
 
-void ObserverSender::OnScene(std::shared_ptr<const sgal::Scene> scene, uint64_t generation) {
+uint64_t PushPool::Find(Kind kind, CORBA::Object_ptr ref) {
   std::lock_guard<std::mutex> lock(mutex_);
-  scene_ = std::move(scene);
-  scene_generation_ = generation;
-  snapshot_.reset();
-  wake_.notify_all();
+  return FindLocked(kind, ref);
 }
 
-void ObserverSender::OnSnapshot(std::shared_ptr<const Snapshot> snapshot) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (snapshot_) ++coalesced_;
-  snapshot_ = std::move(snapshot);
-  wake_.notify_all();
-}
-
-void ObserverSender::OnCleared() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  cleared_ = true;
-  wake_.notify_all();
-}
-
-void ObserverSender::Run() {
-  sgal::ChangeFilter filter;
-  uint64_t generation = 0;
-  uint64_t update = 0;
-  std::unique_lock<std::mutex> lock(mutex_);
-  while (true) {
-    wake_.wait(lock, [&] { return stop_ || cleared_ || scene_ || snapshot_; });
-    if (stop_) return;
-    const bool cleared = cleared_;
-    cleared_ = false;
-    auto scene = std::move(scene_);
-    scene_.reset();
-    const uint64_t scene_generation = scene_generation_;
-    auto snapshot = std::move(snapshot_);
-    snapshot_.reset();
-    lock.unlock();
-    try {
-      if (cleared) observer_->on_scene_cleared();
-      if (scene) {
-        std::unique_ptr<S::Description> description(ToIdl(*scene));
-        observer_->on_scene(*description);
-        generation = scene_generation;
-        filter = sgal::ChangeFilter();
-      }
-      if (snapshot && snapshot->generation == generation) {
-        const std::vector<int> changed = filter.Changed(snapshot->bodies);
-        S::BodyTransformSeq transforms;
-        transforms.length(static_cast<CORBA::ULong>(changed.size()));
-        for (CORBA::ULong i = 0; i < changed.size(); ++i) {
-          transforms[i].body_index = static_cast<CORBA::ULong>(changed[i]);
-          transforms[i].pose = ToFrame(snapshot->bodies[changed[i]].pose);
-        }
-        observer_->on_transforms(++update, snapshot->time, transforms, ToIdl(snapshot->tendons));
-        ++sent_;
-      }
-    } catch (const CORBA::Exception& e) {
-      if (PeerGone(e)) {
-        logging::Get("observers").info("dropping an observer: %s", rtc::Describe(e).c_str());
-        dead_ = true;
-        lock.lock();
-        wake_.wait(lock, [&] { return stop_; });
-        return;
-      }
-      logging::Get("observers").warn("observer call failed: %s", rtc::Describe(e).c_str());
+uint64_t PushPool::FindLocked(Kind kind, CORBA::Object_ptr ref) {
+  for (auto& [key, entry] : entries_)
+    if (key.first == kind && entry->ref->_is_equivalent(ref)) {
+      entry->retry_at = Clock::time_point{};
+      wake_.notify_one();
+      return key.second;
     }
-    lock.lock();
+  return 0;
+}
+
+size_t PushPool::CountLocked(Kind kind, const std::string* client) const {
+  size_t n = 0;
+  for (const auto& [key, entry] : entries_)
+    if (key.first == kind && (client == nullptr || entry->client == *client)) ++n;
+  return n;
+}
+
+void PushPool::CheckRoom(Kind kind, const std::string& client) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  CheckRoomLocked(kind, client);
+}
+
+void PushPool::CheckRoomLocked(Kind kind, const std::string& client) const {
+  const bool observers = kind == Kind::kObserver;
+  const char* what = observers ? "observers" : "subscriptions";
+  const size_t per_client =
+      observers ? limits_.observers_per_client : limits_.subscriptions_per_client;
+  const size_t total = observers ? limits_.observers : limits_.subscriptions;
+  if (CountLocked(kind, &client) >= per_client)
+    throw D::LimitExceeded((std::string("client ") + client + " has " +
+                            std::to_string(per_client) + " " + what +
+                            ", the most one client may have")
+                               .c_str(),
+                           per_client);
+  if (CountLocked(kind, nullptr) >= total)
+    throw D::LimitExceeded((std::string("the Model serves ") + std::to_string(total) + " " + what +
+                            ", the most it takes")
+                               .c_str(),
+                           total);
+}
+
+uint64_t PushPool::Add(Kind kind, uint64_t id, const std::string& client, CORBA::Object_ptr ref,
+                       std::shared_ptr<PushTarget> target) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (kind == Kind::kObserver) {
+    // registered meanwhile by a call of its own
+    const uint64_t existing = FindLocked(kind, ref);
+    if (existing != 0) return existing;
   }
+  CheckRoomLocked(kind, client);
+  auto entry = std::make_shared<Entry>();
+  entry->target = std::move(target);
+  entry->client = client;
+  entry->ref = CORBA::Object::_duplicate(ref);
+  entries_[{kind, id}] = std::move(entry);
+  wake_.notify_one();
+  return id;
 }
 
-ConsumerSender::ConsumerSender(ModelCore& core, uint64_t subscription, D::DataConsumer_ptr consumer)
-    : core_(core), subscription_(subscription), consumer_(D::DataConsumer::_duplicate(consumer)) {
-  thread_ = std::thread([this] { Run(); });
+bool PushPool::Remove(Kind kind, uint64_t id) {
+  std::shared_ptr<Entry> entry;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = entries_.find({kind, id});
+    if (it == entries_.end()) return false;
+    entry = it->second;
+    entry->removed = true;
+    entries_.erase(it);
+  }
+  entry->target->Detach();
+  return true;
 }
 
-ConsumerSender::~ConsumerSender() {
-  stop_ = true;
-  thread_.join();
+void PushPool::Wake() {
+  { std::lock_guard<std::mutex> lock(mutex_); }
+  wake_.notify_one();
 }
 
-void ConsumerSender::Run() {
-  while (!stop_) {
-    auto batches = core_.TakeBatches(subscription_);
-    if (batches.empty()) {
-      core_.WaitForBatches(subscription_, std::chrono::milliseconds(50));
+std::shared_ptr<PushPool::Entry> PushPool::PickLocked(Clock::time_point now,
+                                                      Clock::time_point* wake_at) {
+  *wake_at = now + std::chrono::hours(1);
+  if (entries_.empty()) return nullptr;
+  // in turn, starting after the one served last
+  auto it = entries_.upper_bound(cursor_);
+  for (size_t n = 0; n < entries_.size(); ++n, ++it) {
+    if (it == entries_.end()) it = entries_.begin();
+    Entry& e = *it->second;
+    if (e.busy || in_flight_.count(e.client) > 0) continue;
+    if (e.retry_at > now) {
+      *wake_at = std::min(*wake_at, e.retry_at);
       continue;
     }
-    for (const auto& b : batches) {
-      D::SampleBatch out;
-      out.subscription = subscription_;
-      out.batch = b.sequence;
-      out.first_step = b.first_step;
-      out.layout = b.layout;
-      out.times.length(static_cast<CORBA::ULong>(b.times.size()));
-      for (CORBA::ULong i = 0; i < b.times.size(); ++i) out.times[i] = b.times[i];
-      out.values_per_sample = static_cast<CORBA::ULong>(b.values_per_sample);
-      out.data.length(static_cast<CORBA::ULong>(b.data.size()));
-      for (CORBA::ULong i = 0; i < b.data.size(); ++i) out.data[i] = b.data[i];
-      const std::vector<std::string> stale = b.StaleIds();
-      out.stale_ids.length(static_cast<CORBA::ULong>(stale.size()));
-      for (CORBA::ULong i = 0; i < stale.size(); ++i) out.stale_ids[i] = stale[i].c_str();
-      try {
-        consumer_->on_samples(out);
-      } catch (const CORBA::Exception& e) {
-        if (PeerGone(e)) {
-          logging::Get("daq").info("dropping subscription %llu: %s",
-                                   static_cast<unsigned long long>(subscription_),
-                                   rtc::Describe(e).c_str());
-          core_.Unsubscribe(subscription_);
-          dead_ = true;
-          return;
-        }
-      }
+    if (!e.target->HasWork()) continue;
+    cursor_ = it->first;
+    return it->second;
+  }
+  return nullptr;
+}
+
+void PushPool::Work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    Clock::time_point wake_at;
+    const std::shared_ptr<Entry> entry = PickLocked(Clock::now(), &wake_at);
+    if (!entry) {
+      wake_.wait_until(lock, wake_at);
+      continue;
+    }
+    const Key key = cursor_;
+    entry->busy = true;
+    ++in_flight_[entry->client];
+    lock.unlock();
+    std::string why;
+    PushTarget::Outcome outcome;
+    try {
+      outcome = entry->target->Push(&why);
+    } catch (const std::exception& e) {
+      outcome = PushTarget::Outcome::kFailed;
+      why = e.what();
+    } catch (...) {
+      outcome = PushTarget::Outcome::kFailed;
+      why = "an exception of unknown type";
+    }
+    lock.lock();
+    entry->busy = false;
+    if (--in_flight_[entry->client] == 0) in_flight_.erase(entry->client);
+    const std::shared_ptr<PushTarget> dropped = AccountLocked(key, *entry, outcome, why);
+    if (dropped) {
+      lock.unlock();
+      dropped->Detach();
+      lock.lock();
     }
   }
+}
+
+std::shared_ptr<PushTarget> PushPool::AccountLocked(const Key& key, Entry& entry,
+                                                    PushTarget::Outcome outcome,
+                                                    const std::string& why) {
+  using Outcome = PushTarget::Outcome;
+  const bool observer = key.first == Kind::kObserver;
+  auto& log = logging::Get(observer ? "observers" : "daq");
+  const auto id = static_cast<unsigned long long>(key.second);
+  const auto now = Clock::now();
+  if (outcome == Outcome::kNothing) {
+    // subscriptions are polled (their batches come from the recorder, which tells no one)
+    if (!observer) entry.retry_at = now + kPollInterval;
+    return nullptr;
+  }
+  if (outcome == Outcome::kSent) {
+    if (entry.failures > 0)
+      log.info("%s %llu (client %s) answers again after %llu failed pushes",
+               observer ? "observer" : "subscription", id, entry.client.c_str(),
+               static_cast<unsigned long long>(entry.failures));
+    entry.failures = 0;
+    entry.failing_since.reset();
+    return nullptr;
+  }
+  const bool gone = outcome == Outcome::kGone;
+  if (!gone) {
+    if (!entry.failing_since) entry.failing_since = now;
+    if (entry.failures++ == 0)
+      log.warn("%s %llu (client %s) is slow or unreachable: %s; retrying every %lld ms with the "
+               "latest state",
+               observer ? "observer" : "subscription", id, entry.client.c_str(), why.c_str(),
+               static_cast<long long>(limits_.retry_after.count()));
+    entry.retry_at = now + limits_.retry_after;
+    if (now - *entry.failing_since < limits_.drop_after) return nullptr;
+  }
+  if (entry.removed) return nullptr;  // removed by its client meanwhile
+  const std::string reason =
+      gone ? why
+           : "no push succeeded for " +
+                 std::to_string(std::chrono::duration_cast<std::chrono::seconds>(
+                                    now - *entry.failing_since)
+                                    .count()) +
+                 " s (last: " + why + ")";
+  if (observer)
+    log.info("dropping an observer (%llu, client %s): %s", id, entry.client.c_str(),
+             reason.c_str());
+  else
+    log.info("dropping subscription %llu (client %s): %s", id, entry.client.c_str(),
+             reason.c_str());
+  entry.removed = true;
+  std::shared_ptr<PushTarget> target = entry.target;
+  entries_.erase(key);
+  return target;
+}
+
+// ------------------------------------------------------------------------ observers
+
+ObserverTarget::ObserverTarget(ModelCore& core, PushPool& pool, S::SceneObserver_ptr observer)
+    : core_(core), pool_(pool), observer_(S::SceneObserver::_duplicate(observer)) {
+  omniORB::setClientCallTimeout(observer_.in(),
+                                static_cast<CORBA::ULong>(pool.limits().call_timeout.count()));
+}
+
+void ObserverTarget::MarkPending() {
+  if (!pending_.exchange(true)) pool_.Wake();
+}
+
+void ObserverTarget::OnScene(std::shared_ptr<const sgal::Scene> scene, uint64_t generation) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    scene_ = std::move(scene);
+    scene_generation_ = generation;
+    snapshot_.reset();
+  }
+  MarkPending();
+}
+
+void ObserverTarget::OnSnapshot(std::shared_ptr<const Snapshot> snapshot) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_ = std::move(snapshot);
+  }
+  MarkPending();
+}
+
+void ObserverTarget::OnCleared() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cleared_ = true;
+    scene_.reset();
+    snapshot_.reset();
+  }
+  MarkPending();
+}
+
+PushTarget::Outcome ObserverTarget::Push(std::string* why) {
+  pending_ = false;  // what arrives from now on marks it again
+  bool cleared;
+  std::shared_ptr<const sgal::Scene> scene;
+  uint64_t scene_generation;
+  std::shared_ptr<const Snapshot> snapshot;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cleared = cleared_;
+    cleared_ = false;
+    scene = std::move(scene_);
+    scene_.reset();
+    scene_generation = scene_generation_;
+    snapshot = std::move(snapshot_);
+    snapshot_.reset();
+  }
+  if (!cleared && !scene && !snapshot) return Outcome::kNothing;
+  enum { kClearing, kDescribing, kMoving } stage = kClearing;
+  try {
+    if (cleared) observer_->on_scene_cleared();
+    stage = kDescribing;
+    if (scene) {
+      std::unique_ptr<S::Description> description(ToIdl(*scene));
+      observer_->on_scene(*description);
+      generation_ = scene_generation;
+      filter_ = sgal::ChangeFilter();
+    }
+    stage = kMoving;
+    if (snapshot && snapshot->generation == generation_) {
+      const std::vector<int> changed = filter_.Changed(snapshot->bodies);
+      S::BodyTransformSeq transforms;
+      transforms.length(static_cast<CORBA::ULong>(changed.size()));
+      for (CORBA::ULong i = 0; i < changed.size(); ++i) {
+        transforms[i].body_index = static_cast<CORBA::ULong>(changed[i]);
+        transforms[i].pose = ToFrame(snapshot->bodies[changed[i]].pose);
+      }
+      observer_->on_transforms(++update_, snapshot->time, transforms, ToIdl(snapshot->tendons));
+    }
+    return Outcome::kSent;
+  } catch (const CORBA::Exception& e) {
+    *why = rtc::Describe(e);
+    if (PeerGone(e)) return Outcome::kGone;
+    // the backlog goes, the observer stays: what did not arrive is sent again unless something
+    // newer replaced it, and the next transforms carry every body
+    filter_ = sgal::ChangeFilter();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const bool newer = cleared_ || scene_;
+      if (stage == kClearing) cleared_ = true;
+      if (!newer && stage <= kDescribing && scene) {
+        scene_ = std::move(scene);
+        scene_generation_ = scene_generation;
+      }
+      if (!newer && !snapshot_) snapshot_ = std::move(snapshot);
+    }
+    pending_ = true;
+    return Outcome::kFailed;
+  }
+}
+
+// ------------------------------------------------------------------------ subscriptions
+
+SubscriptionTarget::SubscriptionTarget(ModelCore& core, uint64_t subscription,
+                                       D::DataConsumer_ptr consumer)
+    : core_(core), subscription_(subscription), consumer_(D::DataConsumer::_duplicate(consumer)) {}
+
+PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
+  const auto batches = core_.TakeBatches(subscription_);
+  if (batches.empty()) return Outcome::kNothing;
+  for (size_t k = 0; k < batches.size(); ++k) {
+    const daq::Batch& b = batches[k];
+    D::SampleBatch out;
+    out.subscription = subscription_;
+    out.batch = b.sequence;
+    out.first_step = b.first_step;
+    out.layout = b.layout;
+    out.times.length(static_cast<CORBA::ULong>(b.times.size()));
+    for (CORBA::ULong i = 0; i < b.times.size(); ++i) out.times[i] = b.times[i];
+    out.values_per_sample = static_cast<CORBA::ULong>(b.values_per_sample);
+    out.data.length(static_cast<CORBA::ULong>(b.data.size()));
+    for (CORBA::ULong i = 0; i < b.data.size(); ++i) out.data[i] = b.data[i];
+    const std::vector<std::string> stale = b.StaleIds();
+    out.stale_ids.length(static_cast<CORBA::ULong>(stale.size()));
+    for (CORBA::ULong i = 0; i < stale.size(); ++i) out.stale_ids[i] = stale[i].c_str();
+    try {
+      consumer_->on_samples(out);
+    } catch (const CORBA::Exception& e) {
+      // this batch and the rest of the backlog go; the consumer sees the gap in `batch`
+      dropped_ += batches.size() - k;
+      *why = rtc::Describe(e) + " (" + std::to_string(dropped_) + " batches dropped so far)";
+      return PeerGone(e) ? Outcome::kGone : Outcome::kFailed;
+    }
+  }
+  return Outcome::kSent;
 }
 
 // ------------------------------------------------------------------------ servant
 
-ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core)
-    : rtc::RTObjectServant(runtime), core_(core) {}
+ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core, const PushLimits& limits)
+    : rtc::RTObjectServant(runtime), core_(core), pool_(limits) {}
 
-ModelServant::~ModelServant() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  for (auto& [id, o] : observers_) core_.RemoveListener(o.get());
-  observers_.clear();
-  consumers_.clear();
-}
-
-void ModelServant::DropDead() {
-  for (auto it = observers_.begin(); it != observers_.end();) {
-    if (it->second->dead()) {
-      core_.RemoveListener(it->second.get());
-      it = observers_.erase(it);
-    } else {
-      ++it;
-    }
-  }
-  for (auto it = consumers_.begin(); it != consumers_.end();)
-    it = it->second->dead() ? consumers_.erase(it) : std::next(it);
-}
+ModelServant::~ModelServant() = default;
 
 void ModelServant::load_scene(const char* path) {
   try {
@@ -617,6 +860,10 @@ D::ValueSeq* ModelServant::sample(const S::StringSeq& ids) { return get(ids); }
 CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong every_n_steps,
                                          D::DataConsumer_ptr consumer) {
   if (CORBA::is_nil(consumer)) throw D::InvalidParameter("the consumer is nil");
+  const std::string client = ClientOf(consumer);
+  pool_.CheckRoom(PushPool::Kind::kSubscription, client);
+  RequireReachable<D::InvalidParameter>(consumer, "DataConsumer", D::DataConsumer::_PD_repoId,
+                                        pool_.limits().call_timeout);
   // batches about twenty times a second of simulated time
   const double dt = core_.status().time_step;
   const double per_sample = (dt > 0 ? dt : 1e-3) * std::max<CORBA::ULong>(every_n_steps, 1);
@@ -625,35 +872,46 @@ CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong e
       Guard<D::NotAvailable>([&] {
         return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps);
       });
-  std::lock_guard<std::mutex> lock(mutex_);
-  DropDead();
-  consumers_[id] = std::make_unique<ConsumerSender>(core_, id, consumer);
+  try {
+    pool_.Add(PushPool::Kind::kSubscription, id, client, consumer,
+              std::make_shared<SubscriptionTarget>(core_, id, consumer));
+  } catch (const D::LimitExceeded&) {
+    core_.Unsubscribe(id);  // another call of the same client took the last place meanwhile
+    throw;
+  }
   return id;
 }
 
 void ModelServant::unsubscribe(CORBA::ULongLong subscription) {
   core_.Unsubscribe(subscription);
-  std::lock_guard<std::mutex> lock(mutex_);
-  consumers_.erase(subscription);
+  pool_.Remove(PushPool::Kind::kSubscription, subscription);
 }
 
 CORBA::ULongLong ModelServant::add_observer(S::SceneObserver_ptr observer) {
   if (CORBA::is_nil(observer)) throw M::NotAvailable("the observer is nil");
-  std::lock_guard<std::mutex> lock(mutex_);
-  DropDead();
-  auto sender = std::make_unique<ObserverSender>(observer);
-  core_.AddListener(sender.get());
+  // registering again (a client checking that it is still registered) is cheap and keeps its id
+  const uint64_t existing = pool_.Find(PushPool::Kind::kObserver, observer);
+  if (existing != 0) return existing;
+  const std::string client = ClientOf(observer);
+  pool_.CheckRoom(PushPool::Kind::kObserver, client);
+  RequireReachable<M::NotAvailable>(observer, "SceneObserver", S::SceneObserver::_PD_repoId,
+                                    pool_.limits().call_timeout);
   const uint64_t id = next_observer_++;
-  observers_[id] = std::move(sender);
-  return id;
+  auto target = std::make_shared<ObserverTarget>(core_, pool_, observer);
+  core_.AddListener(target.get());  // the scene and the current state are its first push
+  uint64_t used = 0;
+  try {
+    used = pool_.Add(PushPool::Kind::kObserver, id, client, observer, target);
+  } catch (...) {
+    core_.RemoveListener(target.get());
+    throw;
+  }
+  if (used != id) core_.RemoveListener(target.get());
+  return used;
 }
 
 void ModelServant::remove_observer(CORBA::ULongLong id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = observers_.find(id);
-  if (it == observers_.end()) return;
-  core_.RemoveListener(it->second.get());
-  observers_.erase(it);
+  pool_.Remove(PushPool::Kind::kObserver, id);
 }
 
 }  // namespace caliper::model

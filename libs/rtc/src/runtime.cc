@@ -299,11 +299,13 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
   }
   logging::SetInstance(runtime.instance());
 
+  // no clientConnectTimeOutPeriod: omniORB stretches the deadline of a call that opens a
+  // connection to it, so a shorter per-object deadline (the Model's pushes to observers) would
+  // not hold; without it a connect is bounded by the call's own deadline
   const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
   orb_args.insert(orb_args.end(),
                   {"-ORBendPoint", config.GetString("corba.endpoint"),
                    "-ORBclientCallTimeOutPeriod", std::to_string(timeout_ms),
-                   "-ORBclientConnectTimeOutPeriod", std::to_string(timeout_ms),
                    "-ORBgiopMaxMsgSize",
                    std::to_string(static_cast<long>(config.GetDouble("corba.max_message_size") *
                                                     1024 * 1024))});
