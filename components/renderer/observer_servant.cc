@@ -110,6 +110,8 @@ void ObserverServant::on_scene(const S::Description& scene) {
     R::SceneDescription plain = FromIdl(scene);
     logging::Get("renderer").info("scene '%s': %zu bodies, %zu tendons", plain.name.c_str(),
                                   plain.bodies.size(), plain.tendons.size());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_update_ = 0;  // a new registration (or a new Model) counts from 1 again
     mailbox_.PutScene(std::move(plain));
   } catch (const std::exception& e) {
     logging::Get("renderer").error("cannot take the scene: %s", e.what());
@@ -133,6 +135,14 @@ void ObserverServant::on_transforms(CORBA::ULongLong update, CORBA::Double sim_t
       states[i].length = tendons[i].length;
       states[i].tension = tendons[i].tension;
     }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (update <= last_update_) {
+      logging::Get("renderer").debug("ignored transforms %llu (applied %llu already)",
+                                     static_cast<unsigned long long>(update),
+                                     static_cast<unsigned long long>(last_update_));
+      return;
+    }
+    last_update_ = update;
     mailbox_.PutTransforms(update, sim_time, indices, poses, std::move(states));
   } catch (const std::exception& e) {
     logging::Get("renderer").error("cannot take transforms: %s", e.what());

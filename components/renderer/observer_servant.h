@@ -1,6 +1,13 @@
 #pragma once
 // The renderer's SceneObserver: converts what the Model sends into plain descriptions and leaves
 // them in the mailbox for the GUI thread. Never throws a C++ exception to the ORB.
+//
+// Transforms older than the newest applied since the last scene are ignored: after the renderer
+// was stopped (SIGSTOP, a busy machine), calls the Model gave up on (its push deadline passed)
+// still arrive, on connections of their own, in any order, mixed with current ones.
+
+#include <cstdint>
+#include <mutex>
 
 #include "caliper/observer.hh"
 #include "scene_mailbox.h"
@@ -18,6 +25,8 @@ class ObserverServant : public virtual POA_Caliper::Scene::SceneObserver {
 
  private:
   SceneMailbox& mailbox_;
+  std::mutex mutex_;           // orders the check of `update` with the hand-over to the mailbox
+  uint64_t last_update_ = 0;  // the Model's update counter of the newest transforms applied
 };
 
 /// The plain mirror of an IDL frame.

@@ -72,21 +72,24 @@ void RendererComponent::CheckRegistration() {
     if (!reported_missing_) log.info("no Model '%s' yet: %s", name.c_str(), e.what());
     reported_missing_ = true;
   }
+  if (CORBA::is_nil(found)) return;  // not bound (yet), or the naming service is away
+  // registering again is cheap and keeps the id while the Model still has us; a Model that
+  // dropped us (unreachable too long) or a new Model process gives a new id
   try {
-    if (!CORBA::is_nil(model_)) {
-      const bool same = !CORBA::is_nil(found) && model_->_is_equivalent(found);
-      if (same && !model_->_non_existent()) return;  // still registered with the live Model
-      log.notice("the Model '%s' went away or was replaced", name.c_str());
-      model_ = M::Model::_nil();
-    }
-    if (CORBA::is_nil(found)) return;
-    observer_id_ = found->add_observer(observer_);
+    const bool same_model = !CORBA::is_nil(model_) && model_->_is_equivalent(found);
+    if (!CORBA::is_nil(model_) && !same_model)
+      log.notice("the Model '%s' was replaced", name.c_str());
+    const CORBA::ULongLong id = found->add_observer(observer_);
+    if (!same_model || id != observer_id_)
+      log.notice("observing the Model '%s' (observer %llu)", name.c_str(),
+                 static_cast<unsigned long long>(id));
+    observer_id_ = id;
     model_ = found._retn();
     reported_missing_ = false;
-    log.notice("observing the Model '%s' (observer %llu)", name.c_str(),
-               static_cast<unsigned long long>(observer_id_));
   } catch (const CORBA::Exception& e) {
-    log.info("Model '%s' unreachable: %s", name.c_str(), rtc::Describe(e).c_str());
+    if (!CORBA::is_nil(model_) || !reported_missing_)
+      log.info("Model '%s' unreachable: %s", name.c_str(), rtc::Describe(e).c_str());
+    reported_missing_ = true;
     model_ = M::Model::_nil();
   }
 }

@@ -1,6 +1,8 @@
 #pragma once
 // The Scene Renderer's lifecycle: while active it keeps itself registered as a SceneObserver of
-// the Model, checking periodically, so that a restarted Model finds it again. What the Model sends
+// the Model: every renderer.check_interval it looks the Model up in the naming service and adds
+// its observer again (the Model keeps the id of an observer it still has), so that a restarted
+// Model, or one that dropped the renderer after a long stop, finds it again. What the Model sends
 // lands in the SceneMailbox, which the GUI thread drains.
 //
 // Configuration (config/renderer.conf):
@@ -29,7 +31,7 @@ class RendererComponent : public rtc::Component {
   static std::vector<core::ConfigKey> ConfigKeys();
 
  private:
-  /// Registers with the Model found under renderer.model unless already registered with it.
+  /// Registers with the Model found under renderer.model (again: add_observer keeps the id).
   void CheckRegistration();
   void Unregister();
 
