@@ -14,6 +14,8 @@
 #include <tuple>
 #include <vector>
 
+#include "comma_locale.h"
+
 namespace caliper::experiment {
 namespace {
 
@@ -112,6 +114,24 @@ TEST_F(ExperimentFileTest, ReadsOneRunNamedAfterTheFileWithoutExperimentsList) {
   EXPECT_EQ(e.record, (std::vector<std::string>{"arm.elbow.position", "arm.hand.position"}));
   EXPECT_TRUE(e.overrides.empty());
   EXPECT_TRUE(e.schedule.empty());
+}
+
+TEST_F(ExperimentFileTest, ReadsDecimalPointsUnderACommaDecimalLocale) {
+  // caliper-calibrate shows a Qt report: its process runs under the user's locale
+  const std::string path = Write("german.json", R"({
+    "scene": "arm.dae", "duration_s": 0.25, "record": ["arm.elbow.position"],
+    "set": {"arm.elbow.stiffness": [1.5, 2.5e-1]},
+    "commands": [[0.125, "elbow_flexor", 6.5]]
+  })");
+  const std::string csv =
+      Write("schedule.csv", "time [s],actuator,value\n0.5,elbow_flexor,-1.25\n");
+  CALIPER_COMMA_DECIMAL_LOCALE(locale);
+  const auto runs = LoadFile(path);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].duration_s, 0.25);
+  EXPECT_EQ(ValuesOf(runs[0], "arm.elbow.stiffness"), (std::vector<double>{1.5, 0.25}));
+  EXPECT_EQ(Rows(runs[0].schedule), (std::vector<Row>{{0.125, "elbow_flexor", 6.5}}));
+  EXPECT_EQ(Rows(LoadScheduleCsv(csv)), (std::vector<Row>{{0.5, "elbow_flexor", -1.25}}));
 }
 
 TEST_F(ExperimentFileTest, SamplesEveryStepByDefault) {
