@@ -1,11 +1,13 @@
 #include "logger_servant.h"
 
+#include <algorithm>
 #include <string>
 
 #include "caliper/logging/log.h"
 #include "caliper/logging/message_pattern.h"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
+#include "caliper/rtc/peers.h"
 
 namespace caliper::logger {
 
@@ -66,6 +68,7 @@ uint64_t ListenerHub::Add(idl::LogListener_ptr ref) {
   if (CORBA::is_nil(ref)) throw CORBA::BAD_PARAM(0, CORBA::COMPLETED_NO);
   // the places of dropped listeners are free again; their threads have ended
   for (auto& dead : TakeDead()) dead->thread.join();
+  const std::string client = rtc::ClientOf(ref);
   std::lock_guard<std::mutex> lock(mutex_);
   if (listeners_.size() >= kMaxListeners)
     throw idl::LimitExceeded(
@@ -73,9 +76,18 @@ uint64_t ListenerHub::Add(idl::LogListener_ptr ref) {
          std::to_string(kMaxListeners) + "; remove_listener frees a place")
             .c_str(),
         kMaxListeners);
+  const auto of_client = std::count_if(listeners_.begin(), listeners_.end(),
+                                       [&](const auto& l) { return l.second->client == client; });
+  if (static_cast<size_t>(of_client) >= kMaxListenersPerClient)
+    throw idl::LimitExceeded(("the client at " + client + " has " + std::to_string(of_client) +
+                              " log listeners already, at most " +
+                              std::to_string(kMaxListenersPerClient) + " per client")
+                                 .c_str(),
+                             kMaxListenersPerClient);
   const uint64_t id = next_id_++;
   auto listener = std::make_unique<Listener>();
   listener->ref = idl::LogListener::_duplicate(ref);
+  listener->client = client;
   Listener* raw = listener.get();
   listener->thread = std::thread([this, raw] { Run(raw); });
   listeners_[id] = std::move(listener);

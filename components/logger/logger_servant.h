@@ -26,6 +26,8 @@ namespace caliper::logger {
 class ListenerHub {
  public:
   static constexpr size_t kMaxListeners = 64;
+  /// Listeners of one client process (rtc::ClientOf: the endpoint serving the reference).
+  static constexpr size_t kMaxListenersPerClient = 8;
   static constexpr size_t kMaxQueueRecords = 100000;
   static constexpr size_t kMaxQueueBytes = 64u << 20;
   /// One push carries at most about this much [bytes] (at least one record).
@@ -34,7 +36,8 @@ class ListenerHub {
 
   ~ListenerHub();
   /// Registers a listener; throws Caliper::Logging::LimitExceeded when kMaxListeners are
-  /// registered, CORBA::BAD_PARAM for a nil reference.
+  /// registered, or kMaxListenersPerClient of the same client, CORBA::BAD_PARAM for a nil
+  /// reference.
   uint64_t Add(Caliper::Logging::LogListener_ptr listener);
   void Remove(uint64_t id);
   void Publish(const std::vector<StoredRecord>& records);
@@ -45,6 +48,7 @@ class ListenerHub {
   using Shared = std::shared_ptr<const StoredRecord>;
   struct Listener {
     Caliper::Logging::LogListener_var ref;
+    std::string client;  ///< rtc::ClientOf(ref)
     std::deque<Shared> queue;
     size_t queued_bytes = 0;
     int timeouts = 0;  ///< pushes timed out in a row

@@ -5,14 +5,11 @@
 #include <set>
 #include <variant>
 
-#include <omniORB4/IIOP.h>
-#include <omniORB4/minorCode.h>
-#include <omniORB4/omniIOR.h>
-#include <omniORB4/omniObjRef.h>
 
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
+#include "caliper/rtc/peers.h"
 
 namespace caliper::model {
 
@@ -97,32 +94,8 @@ S::TendonStateSeq ToIdl(const std::vector<sgal::TendonState>& tendons) {
   return out;
 }
 
-// the process behind a reference is gone: the object does not exist, or nothing listens at its
-// address; anything else (a timeout, a broken connection, a refused call) may pass
-bool PeerGone(const CORBA::Exception& e) {
-  if (CORBA::OBJECT_NOT_EXIST::_downcast(&e)) return true;
-  const auto* transient = CORBA::TRANSIENT::_downcast(&e);
-  return transient != nullptr && transient->minor() == omni::TRANSIENT_ConnectFailed;
-}
-
-// the client a reference belongs to: host:port of its first IIOP profile (see PushLimits)
-std::string ClientOf(CORBA::Object_ptr ref) {
-  std::string client;
-  omniIOR* ior = ref->_PR_getobj()->_getIOR();
-  const IOP::TaggedProfileList& profiles = ior->iopProfiles();
-  for (CORBA::ULong i = 0; i < profiles.length() && client.empty(); ++i) {
-    if (profiles[i].tag != IOP::TAG_INTERNET_IOP) continue;
-    try {
-      IIOP::ProfileBody body;
-      IIOP::unmarshalProfile(profiles[i], body);
-      client = std::string(body.address.host.in()) + ":" + std::to_string(body.address.port);
-    } catch (const CORBA::SystemException&) {
-      // a malformed profile: try the next one
-    }
-  }
-  ior->release();
-  return client.empty() ? "(no IIOP address)" : client;
-}
+using rtc::ClientOf;
+using rtc::PeerGone;
 
 // raises `Refused` unless `ref` answers within the push deadline and is a `repository_id`
 template <class Refused>

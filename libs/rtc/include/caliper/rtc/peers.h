@@ -1,0 +1,22 @@
+#pragma once
+// What a server can tell about the client behind an object reference it was given (an observer,
+// a consumer, a listener): which process it is, and whether that process is gone.
+
+#include <omniORB4/CORBA.h>
+
+#include <string>
+
+namespace caliper::rtc {
+
+/// The client a reference belongs to: "host:port" of its first IIOP profile, i.e. the endpoint
+/// of the ORB that serves it (one per client process). The calling connection's peer does not
+/// serve: every local client is 127.0.0.1, and one client may call over several connections.
+/// A client can name other endpoints in references it makes, so per-client caps need a total cap
+/// beside them. "(no IIOP address)" when the reference has none.
+std::string ClientOf(CORBA::Object_ptr ref);
+
+/// The process behind a reference is gone: the object does not exist, or nothing listens at its
+/// address. Anything else (a timeout, a broken connection, a refused call) may pass.
+bool PeerGone(const CORBA::Exception& e);
+
+}  // namespace caliper::rtc
