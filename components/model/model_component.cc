@@ -1,6 +1,7 @@
 #include "model_component.h"
 
 #include "caliper/logging/log.h"
+#include "fault_injection.h"
 
 namespace caliper::model {
 
@@ -13,6 +14,9 @@ std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
       {"model.autostart", Type::kBool, "false", "start simulating once loaded and active"},
       {"model.tendon_contact", Type::kBool, "true",
        "bend tendons around bodies they would cut through"},
+      {"model.inject_fault", Type::kString, "",
+       "for tests of the fault path: KIND@STEP makes step STEP of the first scene built throw "
+       "(KIND: simulation_fault, bad_alloc, out_of_range, runtime_error, unknown); '' = never"},
   };
 }
 
@@ -20,7 +24,13 @@ ModelComponent::ModelComponent(rtc::Runtime& runtime)
     : runtime_(runtime), autostart_(runtime.config().GetBool("model.autostart")) {
   physics_bullet::Options options;
   options.tendon_body_contact = runtime.config().GetBool("model.tendon_contact");
-  core_ = std::make_unique<ModelCore>(options);
+  const InjectedFault fault = ParseInjectedFault(runtime.config().GetString("model.inject_fault"));
+  if (fault.kind != InjectedFault::Kind::kNone)
+    logging::Get("model").warn("model.inject_fault: step %llu of the first scene will throw",
+                               static_cast<unsigned long long>(fault.at_step));
+  core_ = std::make_unique<ModelCore>(
+      options, Limits{},
+      fault.kind == InjectedFault::Kind::kNone ? nullptr : FailFirstScene(fault, options));
   core_->SetRealTimeFactor(runtime.config().GetDouble("model.real_time_factor"));
 }
 

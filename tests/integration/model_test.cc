@@ -205,11 +205,11 @@ class ModelTest : public ::testing::Test {
  protected:
   void SetUp() override {
     naming_ = std::make_unique<NamingService>(dir_.path());
-    model_ = std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
-                                 "exec.auto_activate=true", "-o", "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model.out");
+    std::vector<std::string> argv{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
+                                  "exec.auto_activate=true", "-o", "log.service=none", "-o",
+                                  "log.spool_dir=" + dir_.path() + "/spool"};
+    argv.insert(argv.end(), extra_args_.begin(), extra_args_.end());
+    model_ = std::make_unique<Process>(argv, dir_.path() + "/model.out");
     ASSERT_TRUE(WaitFor([&] { return Ctl({"status"}).exit_code == 0; }, seconds(10)))
         << model_->Output();
   }
@@ -248,6 +248,7 @@ class ModelTest : public ::testing::Test {
     return model_ref_.in();
   }
 
+  std::vector<std::string> extra_args_;  // more arguments of caliper-model (set before SetUp)
   TempDir dir_;
   std::unique_ptr<NamingService> naming_;
   std::unique_ptr<Process> model_;
@@ -823,6 +824,53 @@ TEST_F(ModelTest, CallsAskingTooMuchRaiseLimitExceededWithTheBound) {
   }
   // the Model is fine afterwards
   EXPECT_EQ(Field(Status(), "state"), "STOPPED");
+}
+
+// A Model whose fifth step throws std::bad_alloc (model.inject_fault, a fail point): over the
+// IDL, the step request returns the four steps that ran, the state is FAULTED with the reason,
+// the component stays ACTIVE (its execution context goes on), and reset brings it back. The
+// same while running: the periodic execution context meets the exception.
+class FaultingModelTest : public ModelTest {
+ protected:
+  FaultingModelTest() { extra_args_ = {"-o", "model.inject_fault=bad_alloc@5"}; }
+};
+
+TEST_F(FaultingModelTest, AnExceptionInAStepIsAFaultedStateNotACrash) {
+  Load(kPendulum);
+  EXPECT_EQ(Model()->step(10), 4u);
+  M::SimulationStatus_var s = Model()->status();
+  EXPECT_EQ(s->state, M::FAULTED);
+  EXPECT_EQ(s->steps, 4u);
+  EXPECT_TRUE(Contains(s->last_error.in(), "bad_alloc")) << s->last_error.in();
+  EXPECT_THROW(Model()->step(1), M::NotAvailable);
+  EXPECT_THROW(Model()->start(), M::NotAvailable);
+  const auto state = Ctl({"state", "model0"});
+  EXPECT_TRUE(Contains(state.out, "ACTIVE")) << state.out << state.err;
+  EXPECT_FALSE(Contains(state.out, "ERROR")) << state.out;
+  Model()->reset();
+  EXPECT_EQ(Model()->status()->state, M::STOPPED);
+  EXPECT_EQ(Model()->step(10), 10u);
+  EXPECT_TRUE(model_->Running());
+}
+
+class FaultingRunningModelTest : public ModelTest {
+ protected:
+  FaultingRunningModelTest() { extra_args_ = {"-o", "model.inject_fault=runtime_error@200"}; }
+};
+
+TEST_F(FaultingRunningModelTest, TheExecutionContextMeetsTheExceptionAndTheModelSaysFaulted) {
+  Load(kPendulum);
+  ASSERT_EQ(Ctl({"start"}).exit_code, 0);
+  ASSERT_TRUE(WaitFor([&] { return Field(Status(), "state") == "FAULTED"; }, seconds(10)))
+      << Status();
+  EXPECT_TRUE(Contains(Field(Status(), "last error"), "solver did not converge")) << Status();
+  EXPECT_EQ(Field(Status(), "steps"), "199");
+  const auto state = Ctl({"state", "model0"});
+  EXPECT_TRUE(Contains(state.out, "ACTIVE")) << state.out << state.err;
+  ASSERT_EQ(Ctl({"stop"}).exit_code, 0);
+  ASSERT_EQ(Ctl({"start"}).exit_code, 0);
+  const double from = SimTime();
+  EXPECT_TRUE(WaitFor([&] { return SimTime() > from + 0.3; }, seconds(10))) << Status();
 }
 
 }  // namespace

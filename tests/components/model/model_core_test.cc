@@ -3,6 +3,7 @@
 // step ending as a fault at the start of the failing step, and the bounds of what one call or
 // one queue may take.
 #include "model_core.h"
+#include "fault_injection.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +15,6 @@
 #include <string>
 #include <thread>
 
-#include "caliper/physics_bullet/bullet_scene.h"
 
 namespace caliper::model {
 namespace {
@@ -116,65 +116,18 @@ TEST(ModelCore, StopEndsAStepRequestAndRewinds) {
   EXPECT_EQ(core.status().steps, 0u);
 }
 
-// A Bullet scene that throws what the test asks for at a chosen step, before stepping (so the
-// engine is at the start of the failing step, as PhysicsScene::Step promises).
-class FailingScene : public sgal::PhysicsScene {
- public:
-  enum class Kind { kNone, kFault, kBadAlloc, kOutOfRange, kRuntime, kUnknownType };
-  FailingScene(std::unique_ptr<sgal::PhysicsScene> inner, Kind kind, uint64_t at_step)
-      : inner_(std::move(inner)), kind_(kind), at_step_(at_step) {}
-  void Step() override {
-    if (inner_->steps() + 1 == at_step_) {
-      switch (kind_) {
-        case Kind::kNone: break;
-        case Kind::kFault:
-          throw sgal::SimulationFault("actuator 'line_motor': tension is not finite", "line_motor",
-                                      inner_->time());
-        case Kind::kBadAlloc: throw std::bad_alloc();
-        case Kind::kOutOfRange: throw std::out_of_range("tendon 'line': via point 7 of 3");
-        case Kind::kRuntime: throw std::runtime_error("muscle solver did not converge");
-        case Kind::kUnknownType: throw 42;
-      }
-    }
-    inner_->Step();
-  }
-  double time() const override { return inner_->time(); }
-  uint64_t steps() const override { return inner_->steps(); }
-  const sgal::Scene& description() const override { return inner_->description(); }
-  std::vector<sgal::BodyState> BodyStates() const override { return inner_->BodyStates(); }
-  std::vector<sgal::TendonState> TendonStates() const override { return inner_->TendonStates(); }
-  void SetCommand(const std::string& a, double v) override { inner_->SetCommand(a, v); }
-  std::vector<sgal::ParameterInfo> Parameters() const override { return inner_->Parameters(); }
-  double GetParameter(const std::string& id) const override { return inner_->GetParameter(id); }
-  int ParameterIndex(const std::string& id) const override { return inner_->ParameterIndex(id); }
-  double GetParameter(int index) const override { return inner_->GetParameter(index); }
-  void SetParameter(const std::string& id, double v) override { inner_->SetParameter(id, v); }
-
- private:
-  std::unique_ptr<sgal::PhysicsScene> inner_;
-  Kind kind_;
-  uint64_t at_step_;
-};
-
 struct FaultCase {
-  FailingScene::Kind kind;
+  InjectedFault::Kind kind;
   const char* reason;  // a part of last_error
 };
 
 class StepFault : public ::testing::TestWithParam<FaultCase> {};
 
 // The first scene built fails at step 5; the rewound one (reset) never does.
-PhysicsFactory FailOnce(FailingScene::Kind kind, std::shared_ptr<std::atomic<int>> built) {
-  return [kind, built](const sgal::Scene& scene) -> std::unique_ptr<sgal::PhysicsScene> {
-    const bool first = (*built)++ == 0;
-    return std::make_unique<FailingScene>(physics_bullet::MakeScene(scene),
-                                          first ? kind : FailingScene::Kind::kNone, 5);
-  };
-}
+PhysicsFactory FailOnce(InjectedFault::Kind kind) { return FailFirstScene({kind, 5}); }
 
 TEST_P(StepFault, EveryExceptionEndsAsAFaultAtTheStartOfTheFailingStep) {
-  auto built = std::make_shared<std::atomic<int>>(0);
-  ModelCore core({}, {}, FailOnce(GetParam().kind, built));
+  ModelCore core({}, {}, FailOnce(GetParam().kind));
   core.Load(Model("pendulum_tendon.dae"));
   const double dt = core.status().time_step;
   EXPECT_EQ(core.StepNow(10), 4u);  // steps 1 to 4 ran, the fifth failed
@@ -196,8 +149,7 @@ TEST_P(StepFault, EveryExceptionEndsAsAFaultAtTheStartOfTheFailingStep) {
 }
 
 TEST_P(StepFault, ARunningModelFaultsWithoutTheExceptionEscaping) {
-  auto built = std::make_shared<std::atomic<int>>(0);
-  ModelCore core({}, {}, FailOnce(GetParam().kind, built));
+  ModelCore core({}, {}, FailOnce(GetParam().kind));
   core.Load(Model("pendulum_tendon.dae"));
   core.SetRealTimeFactor(0);
   core.Start();
@@ -216,11 +168,22 @@ TEST_P(StepFault, ARunningModelFaultsWithoutTheExceptionEscaping) {
 
 INSTANTIATE_TEST_SUITE_P(
     Kinds, StepFault,
-    ::testing::Values(FaultCase{FailingScene::Kind::kFault, "line_motor"},
-                      FaultCase{FailingScene::Kind::kBadAlloc, "bad_alloc"},
-                      FaultCase{FailingScene::Kind::kOutOfRange, "via point 7"},
-                      FaultCase{FailingScene::Kind::kRuntime, "did not converge"},
-                      FaultCase{FailingScene::Kind::kUnknownType, "unknown type"}));
+    ::testing::Values(FaultCase{InjectedFault::Kind::kFault, "tension is not finite"},
+                      FaultCase{InjectedFault::Kind::kBadAlloc, "bad_alloc"},
+                      FaultCase{InjectedFault::Kind::kOutOfRange, "index 7 of 3"},
+                      FaultCase{InjectedFault::Kind::kRuntime, "did not converge"},
+                      FaultCase{InjectedFault::Kind::kUnknownType, "unknown type"}));
+
+TEST(InjectedFault, ParsesKindAtStepAndRefusesTheRest) {
+  EXPECT_EQ(ParseInjectedFault("").kind, InjectedFault::Kind::kNone);
+  const InjectedFault f = ParseInjectedFault("bad_alloc@12");
+  EXPECT_EQ(f.kind, InjectedFault::Kind::kBadAlloc);
+  EXPECT_EQ(f.at_step, 12u);
+  EXPECT_THROW(ParseInjectedFault("bad_alloc"), std::invalid_argument);
+  EXPECT_THROW(ParseInjectedFault("meteor@3"), std::invalid_argument);
+  EXPECT_THROW(ParseInjectedFault("bad_alloc@0"), std::invalid_argument);
+  EXPECT_THROW(ParseInjectedFault("bad_alloc@x"), std::invalid_argument);
+}
 
 TEST(ModelCore, CallsAskingTooMuchAreRefusedWithTheLimit) {
   Limits limits;
