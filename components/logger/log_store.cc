@@ -68,8 +68,9 @@ logging::Record Bounded(logging::Record r) {
 
 }  // namespace
 
-LogStore::LogStore(const std::string& directory, const std::string& session, size_t memory_records)
-    : memory_records_(memory_records) {
+LogStore::LogStore(const std::string& directory, const std::string& session, size_t memory_records,
+                   size_t memory_bytes)
+    : memory_records_(memory_records), memory_bytes_(memory_bytes) {
   core::MakeDirectories(directory);
   path_ = FindSessionFile(directory, session);
   const bool existing = !path_.empty();
@@ -103,8 +104,7 @@ void LogStore::Recover() {
     // a file written before the bounds may hold longer texts: memory keeps to them anyway
     r = Bounded(std::move(r));
     if (r.seq != 0) seen_.Insert(r.source, r.seq);
-    recent_.push_back(std::make_shared<const StoredRecord>(StoredRecord{++serial_, std::move(r)}));
-    if (recent_.size() > memory_records_) recent_.pop_front();
+    Remember(std::make_shared<const StoredRecord>(StoredRecord{++serial_, std::move(r)}));
   }
   in.close();
   if (good_bytes < position && truncate(path_.c_str(), static_cast<off_t>(good_bytes)) != 0)
@@ -151,10 +151,26 @@ std::vector<StoredRecord> LogStore::Submit(const std::vector<logging::Record>& r
   serial_ = serial;
   for (const auto& s : stored) {
     if (s.record.seq != 0) seen_.Insert(s.record.source, s.record.seq);
-    recent_.push_back(std::make_shared<const StoredRecord>(s));
-    if (recent_.size() > memory_records_) recent_.pop_front();
+    Remember(std::make_shared<const StoredRecord>(s));
   }
   return stored;
+}
+
+namespace {
+size_t BytesOf(const StoredRecord& s) {
+  const auto& r = s.record;
+  return sizeof(StoredRecord) + r.message.size() + r.category.size() + r.component.size() +
+         r.host.size() + r.source.size();
+}
+}  // namespace
+
+void LogStore::Remember(std::shared_ptr<const StoredRecord> record) {
+  recent_bytes_ += BytesOf(*record);
+  recent_.push_back(std::move(record));
+  while (!recent_.empty() && (recent_.size() > memory_records_ || recent_bytes_ > memory_bytes_)) {
+    recent_bytes_ -= BytesOf(*recent_.front());
+    recent_.pop_front();
+  }
 }
 
 std::vector<StoredRecord> LogStore::Query(const QueryFilter& f) const {

@@ -57,7 +57,11 @@ class LogStore {
   /// Opens `<directory>/caliper-YYYYmmdd-HHMMSS-<session>.log`, reusing an existing file of the
   /// same session (a restarted logger goes on with it: its records are read back so that
   /// duplicates are still recognised). Throws std::runtime_error when the file cannot be opened.
-  LogStore(const std::string& directory, const std::string& session, size_t memory_records);
+  /// Memory keeps the newest `memory_records` records, and at most about `memory_bytes` of them
+  /// (the file keeps all).
+  LogStore(const std::string& directory, const std::string& session, size_t memory_records,
+           size_t memory_bytes = kDefaultMemoryBytes);
+  static constexpr size_t kDefaultMemoryBytes = size_t{256} << 20;
 
   /// Appends the records not stored before, in the given order, their texts bounded (see
   /// Truncate); returns the newly stored ones.
@@ -78,9 +82,13 @@ class LogStore {
 
  private:
   void Recover();
+  /// Keeps `record` for queries, dropping the oldest beyond the bounds.
+  void Remember(std::shared_ptr<const StoredRecord> record);
 
   std::string path_;
   size_t memory_records_;
+  size_t memory_bytes_;
+  size_t recent_bytes_ = 0;  ///< BytesOf every record in recent_
   mutable std::mutex mutex_;
   std::ofstream file_;
   /// shared with the queries that copied them: a query holds the lock only to copy pointers

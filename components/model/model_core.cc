@@ -106,9 +106,9 @@ void ModelCore::HandOverLocked(std::unique_lock<std::mutex>& lock) {
 }
 
 void ModelCore::RequireQueueRoomLocked(size_t adding) const {
-  const size_t queued = pending_commands_.size() + pending_sets_.size();
+  const size_t queued = pending_commands_.size();
   if (queued + adding > limits_.pending_writes)
-    throw NotAvailable(std::to_string(queued) + " commands and parameter writes are waiting for " +
+    throw NotAvailable(std::to_string(queued) + " commands are waiting for " +
                        "the next step; at most " + std::to_string(limits_.pending_writes) +
                        " may wait (is the simulation stepping?)");
 }
@@ -117,7 +117,6 @@ void ModelCore::FaultLocked(const std::string& reason) {
   state_ = RunState::kFaulted;
   last_error_ = reason;
   pending_commands_.clear();
-  pending_sets_.clear();
   logging::Get("model").error("simulation stopped at t = %.6f s (step %llu): %s",
                               loaded_ ? loaded_->physics->time() : 0.0,
                               static_cast<unsigned long long>(loaded_ ? loaded_->physics->steps() : 0),
@@ -302,6 +301,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   rate_sim_ = physics.time();
   size_t next_command = 0;
   sample();
+  auto slice_end = Clock::now() + kSlice;
   for (uint64_t k = 1; k <= steps; ++k) {
     // commands due by the start of this step (a part per billion of a step counts as due)
     const double now = physics.time() + 1e-9 * dt;
@@ -315,10 +315,11 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
       throw RunFailed("experiment '" + e.name + "' faulted at t = " + std::to_string(physics.time()) +
                       " s (step " + std::to_string(k) + "): " + last_error_);
     if (k % e.every_n_steps == 0) sample();
-    if (k % 256 == 0) {
+    if (k % 16 == 0 && Clock::now() > slice_end) {
       // let status() and readers in between; the experiment flag keeps control calls out
       MeasureRateLocked(0.5);
       HandOverLocked(lock);
+      slice_end = Clock::now() + kSlice;
       if (cancel_ || !end_request_.empty())
         throw NotAvailable("experiment '" + e.name + "' ended at t = " +
                            std::to_string(physics.time()) + " s: " +
@@ -367,7 +368,6 @@ void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded) {
   loaded_ = std::move(loaded);
   ++generation_;
   pending_commands_.clear();
-  pending_sets_.clear();
   if (had_scene)
     for (auto* l : listeners_) l->OnCleared();
   for (auto* l : listeners_) l->OnScene(loaded_->description, generation_);
@@ -470,7 +470,7 @@ uint64_t ModelCore::StepNow(uint64_t n) {
     state_ = RunState::kPaused;
     // writes that came during the request and found no step after them take effect now, as
     // they do when nothing steps
-    if (!pending_commands_.empty() || !pending_sets_.empty()) {
+    if (!pending_commands_.empty()) {
       ApplyPendingLocked();
       loaded_->sampler->Refresh();
     }
@@ -527,14 +527,6 @@ void ModelCore::ApplyPendingLocked() {
     loaded_->commands[name] = value;
   }
   pending_commands_.clear();
-  for (const auto& [id, values] : pending_sets_) {
-    try {
-      registry_.Set(id, values);
-    } catch (const std::exception& e) {
-      logging::Get("model").warn("parameter %s not applied: %s", id.c_str(), e.what());
-    }
-  }
-  pending_sets_.clear();
 }
 
 void ModelCore::StepLocked() {
@@ -731,13 +723,9 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
                        info.shape.ToString() + "), got " + std::to_string(values.size()));
   for (double v : values)
     if (!std::isfinite(v)) throw InvalidValue(id + ": value is not finite");
-  if (state_ == RunState::kRunning || step_request_ != 0) {
-    RequireQueueRoomLocked(1);
-    pending_sets_.emplace_back(id, values);
-    return;
-  }
-  // nothing steps soon: apply now, between steps (after anything still queued, to keep the
-  // order), and let the engine's refusal reach the caller
+  // holding the lock, the simulation is between two steps even while running: apply now (after
+  // anything still queued, to keep the order), so that the engine's refusal (a bound, a
+  // negative mass) reaches the caller instead of a log line
   ApplyPendingLocked();
   try {
     registry_.Set(id, values);
@@ -756,12 +744,33 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
   if (ids.size() > limits_.ids_per_call)
     throw LimitExceeded(std::to_string(ids.size()) + " ids in one subscription; at most " +
                         std::to_string(limits_.ids_per_call), limits_.ids_per_call);
+  // every subscribed value is read at every sampled step with the lock held: bound them all
+  size_t values = 0;
+  for (const auto& id : ids) {
+    if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
+    values += registry_.Info(id).shape.size();
+  }
+  if (subscribed_values_ + values > limits_.subscribed_values)
+    throw LimitExceeded("subscribing " + std::to_string(values) + " values to the " +
+                        std::to_string(subscribed_values_) + " subscribed already: at most " +
+                        std::to_string(limits_.subscribed_values) +
+                        " values in all subscriptions together",
+                        limits_.subscribed_values);
   daq::SubscriptionOptions options;
   options.ids = ids;
   options.every_n_steps = every_n_steps;
   options.batch_steps = std::max<size_t>(1, batch_steps);
+  // the batches waiting for slow consumers stay within kQueuedBytes in all (each queue gets the
+  // share of a subscription holding every value allowed)
+  const double batch_bytes =
+      8.0 * static_cast<double>(limits_.subscribed_values) * options.batch_steps;
+  options.queue_capacity = static_cast<size_t>(
+      std::clamp(static_cast<double>(limits_.queued_bytes) / batch_bytes, 2.0, 64.0));
   try {
-    return recorder_.Subscribe(options);
+    const uint64_t id = recorder_.Subscribe(options);
+    subscribed_values_ += values;
+    subscription_values_[id] = values;
+    return id;
   } catch (const daq::UnknownId& e) {
     throw UnknownId(e.what(), e.id());
   } catch (const std::invalid_argument& e) {
@@ -775,6 +784,11 @@ void ModelCore::Unsubscribe(uint64_t subscription) {
     recorder_.Unsubscribe(subscription);
   } catch (const daq::UnknownId&) {
     // already gone
+  }
+  const auto it = subscription_values_.find(subscription);
+  if (it != subscription_values_.end()) {
+    subscribed_values_ -= it->second;
+    subscription_values_.erase(it);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -64,7 +65,9 @@ struct Limits {
   size_t ids_per_call = 100000;          // ids in one get/sample or subscribe
   size_t channels_per_list = 200000;     // channels one list/channels reply may hold
   size_t pattern_length = 1024;          // characters of a list/channels glob
-  size_t pending_writes = 100000;        // commands and parameter writes queued for the next step
+  size_t pending_writes = 100000;        // motor commands queued for the next step
+  size_t subscribed_values = 100000;     // values of all data subscriptions together
+  size_t queued_bytes = size_t{256} << 20;  // batches waiting for slow consumers, in all
 };
 
 /// Wall time a step request or an experiment holds the lock before letting other calls in.
@@ -192,8 +195,9 @@ class ModelCore {
   // channels (parameters and states) through the DAQ registry
   std::vector<daq::ChannelInfo> Channels(const std::string& pattern) const;
   std::vector<daq::Reading> Sample(const std::vector<std::string>& ids) const;
-  /// Shape and finiteness checked now; applied at the next step boundary while running, at once
-  /// otherwise (then the engine's own refusal, e.g. a negative mass, is raised too).
+  /// Applied at once, between two steps even while running (the lock makes it a step boundary),
+  /// after the commands still queued; a bad shape, a non-finite value and the engine's own
+  /// refusal (a negative mass, a bound) are raised to the caller.
   void SetChannel(const std::string& id, const std::vector<double>& values);
   /// Subscriptions outlive scene reloads: ids that vanish are reported stale.
   uint64_t Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
@@ -212,7 +216,7 @@ class ModelCore {
  private:
   struct Loaded;
   void BuildLocked(std::unique_ptr<Loaded> loaded);
-  /// Applies the queued commands and parameter writes, in the order they came.
+  /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();
   void PublishLocked();
@@ -228,10 +232,10 @@ class ModelCore {
   /// Lets waiting calls take the lock, then takes it back (between slices of long work).
   void HandOverLocked(std::unique_lock<std::mutex>& lock);
   /// The simulation stops at the start of the failing step: FAULTED with `reason`, one error
-  /// record, queued writes dropped (they were for steps that will not come).
+  /// record, queued commands dropped (they were for steps that will not come).
   void FaultLocked(const std::string& reason);
   std::unique_ptr<sgal::PhysicsScene> MakePhysics(const sgal::Scene& scene) const;
-  /// NotAvailable when `adding` more writes would queue more than limits_.pending_writes.
+  /// NotAvailable when `adding` more commands would queue more than limits_.pending_writes.
   void RequireQueueRoomLocked(size_t adding) const;
   /// Asks a running experiment to end at its next slice (stop, pause); false when none runs.
   bool EndExperimentLocked(const std::string& request);
@@ -264,8 +268,9 @@ class ModelCore {
   double real_time_factor_ = 1.0;
   std::string last_error_;
   std::vector<std::pair<std::string, double>> pending_commands_;
-  std::vector<std::pair<std::string, std::vector<double>>> pending_sets_;
   std::vector<CoreListener*> listeners_;
+  size_t subscribed_values_ = 0;                    // of all subscriptions
+  std::map<uint64_t, size_t> subscription_values_;  // per subscription
   // real-time pacing: wall clock and sim time when the current run began
   std::chrono::steady_clock::time_point run_wall_start_;
   double run_sim_start_ = 0;

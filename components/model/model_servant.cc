@@ -691,6 +691,11 @@ void ModelServant::load_scene_data(const char* file_name, const M::Octets& data)
 M::Octets* ModelServant::export_scene() {
   return Guard([&] {
     const std::string bytes = core_.ExportBytes();
+    if (bytes.size() > static_cast<size_t>(0.95 * rtc::kMaxMessageBytes))
+      throw NotAvailable("the exported scene is " + std::to_string(bytes.size() >> 20) +
+                         " MiB, more than one GIOP message carries (" +
+                         std::to_string(rtc::kMaxMessageBytes >> 20) +
+                         " MiB, corba.max_message_size): save it to a file on the Model's host");
     auto* out = new M::Octets(static_cast<CORBA::ULong>(bytes.size()));
     out->length(static_cast<CORBA::ULong>(bytes.size()));
     std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(out->get_buffer()));
@@ -722,7 +727,8 @@ M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
     } catch (const experiment::FormatError& error) {
       throw D::InvalidParameter(error.what());
     } catch (const RunFailed& error) {
-      logging::Get("model").error("%s", error.what());
+      // the fault itself was logged once, as an error, where it happened
+      logging::Get("model").info("%s", error.what());
       throw M::RunFailed(error.what());
     } catch (const LoadError& error) {
       logging::Get("model").error("%s", error.what());

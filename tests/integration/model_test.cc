@@ -796,10 +796,14 @@ TEST_F(ModelTest, AHugeStepLeavesTheModelAnsweringAndStopEndsIt) {
   EXPECT_LT(steps, 4000000000u);
   EXPECT_EQ(Field(Status(), "state"), "STOPPED");
   // pause ends one too, and ctl says it ended early
-  std::thread again([&] { Ctl({"step", "4000000000"}); });
+  CommandResult paused_step;
+  std::thread again([&] { paused_step = Ctl({"step", "4000000000"}); });
   ASSERT_TRUE(WaitFor([&] { return SimTime() > 0.05; }, seconds(10)));
   EXPECT_EQ(Ctl({"pause"}).exit_code, 0);
   again.join();
+  EXPECT_EQ(paused_step.exit_code, 0) << paused_step.err;
+  EXPECT_TRUE(Contains(paused_step.out, "ended early by a stop or pause")) << paused_step.out;
+  EXPECT_TRUE(Contains(paused_step.out, "of 4000000000 steps")) << paused_step.out;
   EXPECT_EQ(Field(Status(), "state"), "PAUSED");
 }
 

@@ -1,7 +1,6 @@
 #include "caliper/collada/importer.h"
 
 #include <cmath>
-#include <regex>
 
 #include "document.h"
 #include "extension.h"
@@ -80,21 +79,23 @@ const Element* VisualSceneOf(Context& ctx) {
 void CheckScene(const Context& ctx) {
   const auto problems = sgal::Validate(ctx.scene);
   if (problems.empty()) return;
-  static const std::regex kSubject("^(body|constraint|obstacle|tendon|actuator) '([^']*)'");
+  // a finding starts "KIND 'NAME'": split with plain string functions (std::regex recurses per
+  // character and a name of 100 KB from a file would overflow the stack)
+  const std::pair<const char*, const std::map<std::string, const Element*>*> kinds[] = {
+      {"body", &ctx.body_source},         {"constraint", &ctx.constraint_source},
+      {"obstacle", &ctx.obstacle_source}, {"tendon", &ctx.tendon_source},
+      {"actuator", &ctx.actuator_source}};
   std::string message;
   for (const auto& p : problems) {
     const Element* source = nullptr;
-    std::smatch m;
-    if (std::regex_search(p, m, kSubject)) {
-      const std::map<std::string, const Element*>* map = nullptr;
-      const std::string kind = m[1];
-      if (kind == "body") map = &ctx.body_source;
-      if (kind == "constraint") map = &ctx.constraint_source;
-      if (kind == "obstacle") map = &ctx.obstacle_source;
-      if (kind == "tendon") map = &ctx.tendon_source;
-      if (kind == "actuator") map = &ctx.actuator_source;
-      const auto it = map->find(m[2]);
+    for (const auto& [kind, map] : kinds) {
+      const std::string prefix = std::string(kind) + " '";
+      if (p.compare(0, prefix.size(), prefix) != 0) continue;
+      const size_t end = p.find('\'', prefix.size());
+      if (end == std::string::npos) break;
+      const auto it = map->find(p.substr(prefix.size(), end - prefix.size()));
       if (it != map->end()) source = it->second;
+      break;
     }
     message += (message.empty() ? "" : "\n") + ctx.Where(source) + ": " + p;
   }

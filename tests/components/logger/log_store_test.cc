@@ -178,6 +178,22 @@ TEST_F(LogStoreTest, SkipsDuplicatesWithinOneBatch) {
   EXPECT_EQ(Messages(stored), (std::vector<std::string>{"a #1", "a #2"}));
 }
 
+TEST_F(LogStoreTest, MemoryKeepsTheNewestWithinItsByteBound) {
+  // 1 MiB for queries: about 64 messages of 16 KiB, however many records are allowed; the file
+  // keeps them all
+  LogStore store(dir_, "s1", 100000, size_t{1} << 20);
+  for (uint64_t seq = 1; seq <= 1000; ++seq)
+    store.Submit({MakeRecord("big", seq, std::to_string(seq) + std::string(16000, 'x'))});
+  QueryFilter all;
+  all.limit = 10000;
+  const auto kept = store.Query(all);
+  EXPECT_LT(kept.size(), 70u);
+  EXPECT_GT(kept.size(), 50u);
+  ASSERT_FALSE(kept.empty());
+  EXPECT_EQ(kept.back().record.seq, 1000u);  // the newest stay
+  EXPECT_EQ(store.size(), 1000u);
+}
+
 TEST_F(LogStoreTest, StoresUnnumberedRecordsEveryTime) {
   LogStore store(dir_, "s1", 100);
   EXPECT_EQ(store.Submit({MakeRecord("a", 0)}).size(), 1u);

@@ -213,6 +213,25 @@ TEST(ModelCore, CallsAskingTooMuchAreRefusedWithTheLimit) {
   EXPECT_THROW(core.Subscribe({id, id, id, id}, 1, 1), LimitExceeded);
 }
 
+TEST(ModelCore, SubscribedValuesAreBoundedInAll) {
+  Limits limits;
+  limits.subscribed_values = 7;
+  ModelCore core({}, limits);
+  core.Load(Model("pendulum_tendon.dae"));
+  const std::string position = "pendulum_tendon.pendulum.position";  // 3 values
+  const uint64_t a = core.Subscribe({position, position}, 1, 10);
+  try {
+    core.Subscribe({position}, 1, 10);
+    ADD_FAILURE() << "9 subscribed values accepted with a bound of 7";
+  } catch (const LimitExceeded& e) {
+    EXPECT_EQ(e.limit(), 7u);
+    EXPECT_TRUE(Contains(e.what(), "6 subscribed already")) << e.what();
+  }
+  EXPECT_NO_THROW(core.Subscribe({"pendulum_tendon.pendulum.mass"}, 1, 10));
+  core.Unsubscribe(a);  // frees its values
+  EXPECT_NO_THROW(core.Subscribe({position, position}, 1, 10));
+}
+
 TEST(ModelCore, WritesQueuedForTheNextStepAreBounded) {
   Limits limits;
   limits.pending_writes = 10;
@@ -227,7 +246,9 @@ TEST(ModelCore, WritesQueuedForTheNextStepAreBounded) {
   } catch (const NotAvailable& e) {
     EXPECT_TRUE(Contains(e.what(), "at most 10")) << e.what();
   }
-  EXPECT_THROW(core.SetChannel("pendulum_tendon.pendulum.mass", {2.0}), NotAvailable);
+  // a parameter write does not queue: it applies between two steps at once
+  EXPECT_NO_THROW(core.SetChannel("pendulum_tendon.pendulum.mass", {2.0}));
+  EXPECT_EQ(core.Sample({"pendulum_tendon.pendulum.mass"}).at(0).values.at(0), 2.0);
   core.Tick();  // a step takes them all
   EXPECT_NO_THROW(core.SetCommands({{motor, 1.0}}));
 }
@@ -245,6 +266,10 @@ TEST(ModelCore, AParameterCannotMakeOneStepRunForHours) {
     EXPECT_TRUE(Contains(e.what(), "max_substep")) << e.what();
   }
   EXPECT_NO_THROW(core.SetChannel(id, {1e-4}));
+  // while running too: the refusal reaches the caller, not only the log
+  core.Start();
+  EXPECT_THROW(core.SetChannel(id, {1e-12}), InvalidValue);
+  EXPECT_THROW(core.SetChannel("pendulum_tendon.pendulum.mass", {-1.0}), InvalidValue);
 }
 
 }  // namespace

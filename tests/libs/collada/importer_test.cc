@@ -476,6 +476,25 @@ TEST(ColladaImportTest, NamesLinesBeyondSixteenBits) {
   std::remove(broken_file.c_str());
 }
 
+TEST(ColladaImportTest, AFindingAboutAHugeNameIsReportedNotACrash) {
+  // the finding "tendon 'NAME' ..." is matched to its element; with std::regex a name of 200 KB
+  // overflowed the stack (libstdc++ recurses per character)
+  std::ifstream in(Data("malformed_tendon_one_point.dae"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string file = text.str();
+  const std::string name(200000, 'n');
+  for (size_t at = file.find("\"line\""); at != std::string::npos;
+       at = file.find("\"line\"", at + name.size()))
+    file.replace(at, 6, "\"" + name + "\"");
+  const std::string path = std::filesystem::temp_directory_path().string() + "/huge_name.dae";
+  std::ofstream(path) << file;
+  const std::string message = ErrorOf(path);
+  EXPECT_NE(message.find("at least two points"), std::string::npos) << message.substr(0, 300);
+  EXPECT_NE(message.find("huge_name.dae:100:"), std::string::npos) << message.substr(0, 300);
+  std::remove(path.c_str());
+}
+
 TEST(ColladaImportTest, ImportsTheMinimalSceneTheMalformedFilesBreak) {
   std::vector<std::string> warnings;
   const sgal::Scene s = Load(Data("minimal.dae"), &warnings);
