@@ -101,16 +101,8 @@ using rtc::PeerGone;
 template <class Refused>
 void RequireReachable(CORBA::Object_ptr ref, const char* what, const char* repository_id,
                       std::chrono::milliseconds timeout) {
-  omniORB::setClientCallTimeout(ref, static_cast<CORBA::ULong>(timeout.count()));
-  try {
-    if (ref->_non_existent())
-      throw Refused((std::string("the ") + what + " does not exist").c_str());
-    // asked of the object itself: omniORB answers _is_a locally from the reference's static type
-    if (!ref->_PR_getobj()->_remote_is_a(repository_id))
-      throw Refused((std::string("the object is not a ") + what + " (" + repository_id + ")").c_str());
-  } catch (const CORBA::SystemException& e) {
-    throw Refused((std::string("the ") + what + " does not answer: " + rtc::Describe(e)).c_str());
-  }
+  const std::string why = rtc::Unreachable(ref, what, repository_id, timeout);
+  if (!why.empty()) throw Refused(why.c_str());
 }
 
 D::Value ToIdl(const daq::Reading& v) {

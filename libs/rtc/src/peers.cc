@@ -1,5 +1,7 @@
 #include "caliper/rtc/peers.h"
 
+#include "caliper/rtc/naming.h"
+
 #include <omniORB4/IIOP.h>
 #include <omniORB4/minorCode.h>
 #include <omniORB4/omniIOR.h>
@@ -30,6 +32,20 @@ bool PeerGone(const CORBA::Exception& e) {
   if (CORBA::OBJECT_NOT_EXIST::_downcast(&e)) return true;
   const auto* transient = CORBA::TRANSIENT::_downcast(&e);
   return transient != nullptr && transient->minor() == omni::TRANSIENT_ConnectFailed;
+}
+
+std::string Unreachable(CORBA::Object_ptr ref, const char* what, const char* repository_id,
+                        std::chrono::milliseconds timeout) {
+  if (CORBA::is_nil(ref)) return std::string("the ") + what + " is nil";
+  omniORB::setClientCallTimeout(ref, static_cast<CORBA::ULong>(timeout.count()));
+  try {
+    if (ref->_non_existent()) return std::string("the ") + what + " does not exist";
+    if (!ref->_PR_getobj()->_remote_is_a(repository_id))
+      return std::string("the object is not a ") + what + " (" + repository_id + ")";
+  } catch (const CORBA::SystemException& e) {
+    return std::string("the ") + what + " does not answer: " + Describe(e);
+  }
+  return "";
 }
 
 }  // namespace caliper::rtc

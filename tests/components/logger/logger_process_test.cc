@@ -265,6 +265,16 @@ TEST_F(LoggerProcessTest, ListenersAreBoundedAndNeitherABlockedNorAGoneOneHoldsS
         << e.reason.in();
   }
   EXPECT_THROW(logger_ref_->add_listener(L::LogListener::_nil()), CORBA::BAD_PARAM);
+  // a reference to nothing takes no place: refused with the reason
+  ActiveListener gone;
+  gone.Deactivate();
+  try {
+    logger_ref_->add_listener(gone.ref());
+    ADD_FAILURE() << "a listener that does not exist was taken";
+  } catch (const L::NotAvailable& e) {
+    EXPECT_NE(std::string(e.reason.in()).find("does not exist"), std::string::npos)
+        << e.reason.in();
+  }
 
   // a listener that blocks in on_records: submits still return (this test's calls time out
   // after 10 s, the listener blocks up to 30 s)

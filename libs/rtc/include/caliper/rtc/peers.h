@@ -4,6 +4,7 @@
 
 #include <omniORB4/CORBA.h>
 
+#include <chrono>
 #include <string>
 
 namespace caliper::rtc {
@@ -18,5 +19,12 @@ std::string ClientOf(CORBA::Object_ptr ref);
 /// The process behind a reference is gone: the object does not exist, or nothing listens at its
 /// address. Anything else (a timeout, a broken connection, a refused call) may pass.
 bool PeerGone(const CORBA::Exception& e);
+
+/// Why `ref` cannot be taken as a `what` (e.g. "SceneObserver") of `repository_id`: it does not
+/// exist, does not answer within `timeout`, or is another type (asked of the object itself:
+/// omniORB answers _is_a locally from the reference's static type); "" when it can. Sets the
+/// reference's call timeout to `timeout`.
+std::string Unreachable(CORBA::Object_ptr ref, const char* what, const char* repository_id,
+                        std::chrono::milliseconds timeout);
 
 }  // namespace caliper::rtc
