@@ -207,6 +207,7 @@ int Log(Client& client, std::vector<std::string>& args) {
       PortableServer::POA_var poa = client.RootPoa();
       listener = new FollowListener(q, &printed);
       PortableServer::ObjectId_var id = poa->activate_object(listener);
+      listener->_remove_ref();  // the POA owns it
       CORBA::Object_var ref = poa->id_to_reference(id);
       listener_id = logger->add_listener(LogIdl::LogListener::_narrow(ref));
       listener->mutex_.lock();

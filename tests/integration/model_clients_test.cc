@@ -235,7 +235,8 @@ class ModelClientsTest : public ::testing::Test {
 
 TEST_F(ModelClientsTest, TenThousandAddObserverCallsStopAtTheCapAndTheThreadsStayFew) {
   const int threads_before = Threads(model_->pid());
-  std::atomic<int> transforms{0};
+  // the counters are static: the Model pushes to the observers until TearDown stops it
+  static std::atomic<int> transforms{0};
   std::vector<CORBA::ULongLong> ids;
   std::vector<S::SceneObserver_var> refs;
   int limited = 0;
@@ -284,7 +285,7 @@ TEST_F(ModelClientsTest, TenThousandAddObserverCallsStopAtTheCapAndTheThreadsSta
 }
 
 TEST_F(ModelClientsTest, ObserversOfManyClientsStopAtTheModelsTotal) {
-  std::atomic<int> transforms{0};
+  static std::atomic<int> transforms{0};
   CORBA::ULongLong added = 0;
   int total_refusals = 0;
   for (int client = 0; client < kClients; ++client)
@@ -338,7 +339,7 @@ TEST_F(ModelClientsTest, ASlowObserverIsKeptAndGetsTheCurrentStateOnceItAnswers)
   gated->_add_ref();  // kept for the test, beyond the POA's reference
   PortableServer::ServantBase_var keep(gated);
   CORBA::Object_var gated_obj = Orb::Get().Activate(gated, "slow", 1);
-  std::atomic<int> others{0};
+  static std::atomic<int> others{0};
   S::SceneObserver_var other = NewObserver("other-client", 2, &others);
   model()->set_command("motor", 6);
   model()->add_observer(S::SceneObserver::_unchecked_narrow(gated_obj));
@@ -372,7 +373,7 @@ TEST_F(ModelClientsTest, TenThousandSubscribeCallsStopAtTheCapsAndTheThreadsStay
   S::StringSeq ids;
   ids.length(1);
   ids[0] = kTension;
-  std::atomic<int> batches{0};
+  static std::atomic<int> batches{0};
   int subscribed = 0, limited = 0;
   for (int i = 0; i < 10000; ++i) {
     D::DataConsumer_var consumer = NewConsumer("consumer" + std::to_string(i), 0, &batches);

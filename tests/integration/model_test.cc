@@ -852,7 +852,7 @@ TEST_F(FaultingModelTest, AnExceptionInAStepIsAFaultedStateNotACrash) {
   EXPECT_TRUE(Contains(state.out, "ACTIVE")) << state.out << state.err;
   EXPECT_FALSE(Contains(state.out, "ERROR")) << state.out;
   Model()->reset();
-  EXPECT_EQ(Model()->status()->state, M::STOPPED);
+  EXPECT_EQ(M::SimulationStatus_var(Model()->status())->state, M::STOPPED);
   EXPECT_EQ(Model()->step(10), 10u);
   EXPECT_TRUE(model_->Running());
 }
