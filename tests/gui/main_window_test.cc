@@ -237,7 +237,11 @@ TEST_F(MainWindowTest, StartAdvancesTheSimulatedTimeAndEditingAParameterReachesT
   EXPECT_TRUE(w->grab().save(QString::fromStdString(png))) << png;
 
   QTest::mouseClick(w->findChild<QPushButton*>("pause"), Qt::LeftButton);
-  EXPECT_TRUE(WaitInGui([&] { return M::SimulationStatus_var(model->status())->state == M::PAUSED; }, seconds(5)));
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return M::SimulationStatus_var(model->status())->state == M::PAUSED;
+      },
+      seconds(5)));
   w.reset();
   process->Signal(SIGTERM);
   EXPECT_EQ(process->Wait(seconds(10)), 0) << process->Output();

@@ -63,7 +63,9 @@ TEST(PdController, BendsTheElbowToItsTargetThroughTheTendonMotors) {
   controller_args.insert(controller_args.end(), common.begin(), common.end());
   Process controller(controller_args, dir.path() + "/controller.out");
   // lock-step: the controller steps the Model 10 ms per tick; 4 s of simulated time suffice
-  ASSERT_TRUE(WaitFor([&] { return M::SimulationStatus_var(arm->status())->sim_time > 4.0; }, seconds(60)))
+  ASSERT_TRUE(WaitFor(
+      [&] { return M::SimulationStatus_var(arm->status())->sim_time > 4.0; },
+      seconds(60)))
       << controller.Output();
   EXPECT_NEAR(elbow(), target, 0.1) << controller.Output();
   M::SimulationStatus_var status = arm->status();
