@@ -14,6 +14,12 @@ if(CALIPER_SANITIZE)
   endif()
   add_compile_options(${_caliper_sanitize_flags})
   add_link_options(${_caliper_sanitize_flags})
+  if(CALIPER_SANITIZE MATCHES "address")
+    # Eigen stops trusting malloc's alignment under ASan and frees with its own offset header,
+    # while the uninstrumented libpagmo allocates Eigen vectors with plain malloc: a vector made in
+    # one and freed in the other is a bad free. glibc's malloc aligns to 16 bytes, Eigen's default.
+    add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
+  endif()
   message(STATUS "Caliper: sanitizers ${CALIPER_SANITIZE}")
 endif()
 

@@ -17,9 +17,10 @@ bool IsDir(const std::string& p) {
 }  // namespace
 
 std::string CorpusDir() {
+  // a CALIPER_CORPUS that is set wins, also when it is not there (no fallback to the default)
   for (const char* var : {"CALIPER_CORPUS", "CALIPER_CORPUS_DEFAULT"}) {
     const char* dir = std::getenv(var);
-    if (dir != nullptr && *dir != '\0' && IsDir(dir)) return dir;
+    if (dir != nullptr && *dir != '\0') return IsDir(dir) ? dir : "";
   }
   return "";
 }

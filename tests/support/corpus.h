@@ -10,14 +10,15 @@
 
 namespace caliper::testing {
 
-/// The corpus directory, or "" when it is absent (a user's clone without shared/).
+/// The corpus directory: $CALIPER_CORPUS when set, else ../shared/corpus beside the source tree
+/// (CALIPER_CORPUS_DEFAULT, set by ctest); "" when that is absent (a user's clone without shared/).
 std::string CorpusDir();
 
 /// Skips the current test, saying why, when the corpus is absent.
 #define CALIPER_REQUIRE_CORPUS()                                                          \
   do {                                                                                    \
     if (::caliper::testing::CorpusDir().empty())                                          \
-      GTEST_SKIP() << "reference corpus not found (looked at $CALIPER_CORPUS and "        \
+      GTEST_SKIP() << "reference corpus not found ($CALIPER_CORPUS if set, else "         \
                       "../shared/corpus beside the source tree); set CALIPER_CORPUS to run"; \
   } while (0)
 
