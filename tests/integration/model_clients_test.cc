@@ -208,6 +208,7 @@ class ModelClientsTest : public ::testing::Test {
   }
 
   void TearDown() override {
+    if (!model_) return;  // SetUp failed before starting it (and said why)
     model_->Signal(SIGTERM);
     EXPECT_EQ(model_->Wait(seconds(10)), 0) << model_->Output();
   }
