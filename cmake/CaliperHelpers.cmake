@@ -22,6 +22,12 @@ if(CALIPER_SANITIZE)
   endif()
   message(STATUS "Caliper: sanitizers ${CALIPER_SANITIZE}")
 endif()
+# instrumented code runs 2-10 times slower: test timeouts are multiplied by this
+if(CALIPER_SANITIZE)
+  set(CALIPER_TIMEOUT_FACTOR 3)
+else()
+  set(CALIPER_TIMEOUT_FACTOR 1)
+endif()
 
 # Warnings for Caliper's own code (never for generated code).
 function(caliper_warnings target)
@@ -65,6 +71,7 @@ function(caliper_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 120)
   endif()
+  math(EXPR ARG_TIMEOUT "${ARG_TIMEOUT} * ${CALIPER_TIMEOUT_FACTOR}")
   set_tests_properties(${name} PROPERTIES TIMEOUT ${ARG_TIMEOUT} SKIP_RETURN_CODE 77
     LABELS "${ARG_LABELS}"
     ENVIRONMENT "CALIPER_BIN_DIR=${CMAKE_BINARY_DIR}/bin;CALIPER_CONFIG_DIR=${CMAKE_SOURCE_DIR}/config;CALIPER_SOURCE_DIR=${CMAKE_SOURCE_DIR};CALIPER_CORPUS_DEFAULT=${CMAKE_SOURCE_DIR}/../shared/corpus")
