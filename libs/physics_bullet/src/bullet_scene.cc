@@ -681,7 +681,11 @@ void BulletScene::CheckState() {
 }
 
 void BulletScene::SaveStepState() {
+  // what may allocate (and so throw) comes first, before anything of the scene is swapped: a
+  // failure here leaves the scene as it was
   snapshot_.resize(bodies_.size());
+  for (auto& t : tendons_)
+    if (t.has_wraps) t.saved_path = t.path;  // a few ints, no allocation after the first step
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
     snapshot_[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
@@ -689,7 +693,6 @@ void BulletScene::SaveStepState() {
   for (auto& t : tendons_) {
     // the geometry is evaluated afresh each step: keep the last one by a swap, no copy
     std::swap(t.geometry, t.saved_geometry);
-    if (t.has_wraps) t.saved_path = t.path;  // a few ints, no allocation after the first step
     t.saved_previous_length = t.previous_length;
     t.saved_tension = t.tension;
     t.saved_contacts = t.contacts;
