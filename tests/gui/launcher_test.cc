@@ -49,8 +49,8 @@ std::vector<std::string> Lines(const std::string& path) {
 }
 
 TEST(LauncherSession, OpensTheToolsInTheirPlacesAndCtrlCEndsEveryProcess) {
-  if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0')
-    GTEST_SKIP() << "no DISPLAY: the session's windows need X (launch/caliper test starts Xvfb)";
+  if (const std::string why = NoDisplay("the session's windows need X"); !why.empty())
+    GTEST_SKIP() << why;
   TempDir dir;
   const std::string run = dir.path() + "/run";
   const QString settings = QString::fromStdString(dir.path() + "/caliper-main.ini");

@@ -45,9 +45,8 @@ PixelCounts Count(const QImage& image) {
 class Renderer : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0')
-      GTEST_SKIP() << "no DISPLAY: the renderer needs X with GLX (launch/caliper test starts Xvfb; "
-                      "or run `Xvfb :57 -screen 0 1280x800x24 & export DISPLAY=:57`)";
+    if (const std::string why = NoDisplay("the renderer needs X with GLX"); !why.empty())
+      GTEST_SKIP() << why;
     naming_ = std::make_unique<NamingService>(dir_.path());
     common_ = {"--nameservice", naming_->address(), "-o", "log.service=none", "-o",
                "log.spool_dir=" + dir_.path() + "/spool"};

@@ -33,8 +33,8 @@ bool Alive(long long pid) { return pid > 0 && ::kill(static_cast<pid_t>(pid), 0)
 class ToolsSession : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0')
-      GTEST_SKIP() << "no DISPLAY: the tools are X clients (launch/caliper test starts Xvfb)";
+    if (const std::string why = NoDisplay("the tools are X clients"); !why.empty())
+      GTEST_SKIP() << why;
     App();
     Orb();
     naming_ = std::make_unique<NamingService>(dir_.path());

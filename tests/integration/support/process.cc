@@ -85,6 +85,13 @@ int Process::Wait(std::chrono::milliseconds timeout) {
 
 std::string Process::Output() const { return ReadFile(output_file_); }
 
+std::string NoDisplay(const std::string& what) {
+  const char* display = std::getenv("DISPLAY");
+  if (display != nullptr && *display != '\0') return "";
+  return "no DISPLAY: " + what + " (launch/caliper test starts Xvfb; or run "
+         "`Xvfb :57 -screen 0 1280x800x24 & export DISPLAY=:57`)";
+}
+
 int FreePort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in addr{};

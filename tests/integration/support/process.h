@@ -46,6 +46,10 @@ class Process {
   std::string output_file_;
 };
 
+/// Why a test that opens X windows cannot run here ("" when DISPLAY is set): `what` says what
+/// needs X, e.g. "the renderer needs X with GLX".
+std::string NoDisplay(const std::string& what);
+
 /// A free TCP port on 127.0.0.1 (bound once to port 0 by the kernel, then released).
 int FreePort();
 
