@@ -95,10 +95,20 @@ ChildStatus ManagerComponent::Create(
                            kStartable + ")");
   // where a child listens and registers is the manager's choice, not a client's
   if (config.size() > 256) throw StartFailed("more than 256 configuration keys");
-  for (const auto& [key, value] : config)
-    if (key == "corba.endpoint" || key == "naming.service" || key.empty())
+  // what a client may choose of a child: an allow-list, so that a key added later (a timeout, a
+  // message size, a test's fail point) is not a client's to set until it is listed here
+  for (const auto& [key, value] : config) {
+    if (key == "corba.endpoint" || key == "naming.service")
       throw StartFailed("the key '" + key + "' is set by the manager (" +
                         "its Models listen and register where it does)");
+    const bool allowed =
+        (key.rfind("model.", 0) == 0 && key != "model.inject_fault") ||
+        key == "exec.kind" || key == "exec.rate" || key == "log.level" ||
+        key == "naming.update.interval";
+    if (!allowed)
+      throw StartFailed("the key '" + key + "' is not one a client may set (model.*, exec.kind, " +
+                        "exec.rate, log.level, naming.update.interval)");
+  }
   const core::Config& own = runtime_.config();
   std::vector<std::string> argv = {
       bin_dir_ + "/caliper-" + type, "--nameservice", runtime_.naming_address(),

@@ -278,6 +278,11 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   sgal::PhysicsScene& physics = *loaded_->physics;
   const double dt = physics.description().settings.time_step;
   const uint64_t steps = experiment::StepCount(e.duration_s, dt);
+  if (steps > limits_.experiment_steps)
+    throw InvalidValue("experiment '" + e.name + "': " + std::to_string(steps) + " steps of " +
+                       std::to_string(dt) + " s; one run takes at most " +
+                       std::to_string(limits_.experiment_steps) +
+                       " (split it, or use a longer time step)");
   const uint64_t samples = steps / e.every_n_steps + 1;
   // the recording travels in one message: refuse what cannot arrive before spending the run
   const double bytes = static_cast<double>(samples) * (rec.values_per_sample + 1) * 8;
@@ -687,6 +692,13 @@ std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) co
     throw LimitExceeded("the pattern has " + std::to_string(pattern.size()) +
                         " characters; at most " + std::to_string(limits_.pattern_length),
                         limits_.pattern_length);
+  // fnmatch(3) retries every position for each '*': its work grows with their number to the
+  // power of the id's length, and it runs with the lock held
+  const auto stars = static_cast<size_t>(std::count(pattern.begin(), pattern.end(), '*'));
+  if (stars > limits_.pattern_stars)
+    throw LimitExceeded("the pattern has " + std::to_string(stars) + " '*'; at most " +
+                        std::to_string(limits_.pattern_stars),
+                        limits_.pattern_stars);
   const auto lock = Lock();
   std::vector<daq::ChannelInfo> channels = registry_.List(pattern.empty() ? "*" : pattern);
   if (channels.size() > limits_.channels_per_list)

@@ -65,6 +65,8 @@ struct Limits {
   size_t ids_per_call = 100000;          // ids in one get/sample or subscribe
   size_t channels_per_list = 200000;     // channels one list/channels reply may hold
   size_t pattern_length = 1024;          // characters of a list/channels glob
+  size_t pattern_stars = 8;              // '*' in a list/channels glob
+  uint64_t experiment_steps = 100000000;  // steps of one run_experiment (28 h at 1 ms)
   size_t pending_writes = 100000;        // motor commands queued for the next step
   size_t subscribed_values = 100000;     // values of all data subscriptions together
   size_t queued_bytes = size_t{256} << 20;  // batches waiting for slow consumers, in all

@@ -153,6 +153,12 @@ TEST_F(ManagerTest, AFailedStartShowsTheEndOfTheModelsOutput) {
   const auto open = Ctl({"create", "-o", "corba.endpoint=giop:tcp::"});
   EXPECT_EQ(open.exit_code, 1);
   EXPECT_TRUE(Contains(open.err, "'corba.endpoint' is set by the manager")) << open.err;
+  // nor anything not on the allow-list: timeouts, message sizes, the fail point of tests
+  for (const char* key : {"corba.call_timeout=0.01", "model.inject_fault=bad_alloc@1"}) {
+    const auto refused = Ctl({"create", "-o", key});
+    EXPECT_EQ(refused.exit_code, 1) << key;
+    EXPECT_TRUE(Contains(refused.err, "is not one a client may set")) << refused.err;
+  }
   EXPECT_TRUE(Contains(Ctl({"managers"}).out, "0/2 running"));
 }
 

@@ -10,7 +10,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
 #include <future>
+#include <iterator>
 #include <new>
 #include <string>
 #include <thread>
@@ -210,6 +212,7 @@ TEST(ModelCore, CallsAskingTooMuchAreRefusedWithTheLimit) {
   }
   EXPECT_EQ(core.Channels("*.pendulum.mass").size(), 1u);
   EXPECT_THROW(core.Channels(std::string(17, '*')), LimitExceeded);
+
   EXPECT_THROW(core.Subscribe({id, id, id, id}, 1, 1), LimitExceeded);
 }
 
@@ -230,6 +233,41 @@ TEST(ModelCore, SubscribedValuesAreBoundedInAll) {
   EXPECT_NO_THROW(core.Subscribe({"pendulum_tendon.pendulum.mass"}, 1, 10));
   core.Unsubscribe(a);  // frees its values
   EXPECT_NO_THROW(core.Subscribe({position, position}, 1, 10));
+}
+
+TEST(ModelCore, AnExperimentOfTooManyStepsIsRefusedBeforeItRuns) {
+  Limits limits;
+  limits.experiment_steps = 100;
+  ModelCore core({}, limits);
+  std::ifstream in(Model("pendulum_tendon.dae"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  experiment::Experiment e;
+  e.name = "long";
+  e.scene = "pendulum_tendon.dae";
+  e.record = {"pendulum_tendon.pendulum.position"};
+  e.duration_s = 0.5;  // 500 steps of 1 ms
+  try {
+    core.RunExperiment(e, "pendulum_tendon.dae", bytes);
+    ADD_FAILURE() << "500 steps ran with a bound of 100";
+  } catch (const InvalidValue& error) {
+    EXPECT_TRUE(Contains(error.what(), "at most 100")) << error.what();
+  }
+  EXPECT_EQ(core.status().steps, 0u);
+  e.duration_s = 0.05;
+  EXPECT_EQ(core.RunExperiment(e, "pendulum_tendon.dae", bytes).steps, 50u);
+}
+
+TEST(ModelCore, AGlobOfManyStarsIsRefused) {
+  // fnmatch's work grows as the number of '*' to the power of the id's length
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  try {
+    core.Channels("*a*a*a*a*a*a*a*a*b");  // 9 '*'
+    ADD_FAILURE() << "a pattern of 9 '*' was matched";
+  } catch (const LimitExceeded& e) {
+    EXPECT_EQ(e.limit(), 8u);
+  }
+  EXPECT_FALSE(core.Channels("*.pendulum.*").empty());
 }
 
 TEST(ModelCore, WritesQueuedForTheNextStepAreBounded) {
