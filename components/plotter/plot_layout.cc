@@ -80,7 +80,9 @@ std::string FormatLayout(const Layout& layout) {
   for (const auto& p : layout.plots) {
     out << "\n[plot]\n"
         << "autoscale = " << (p.autoscale ? "true" : "false") << "\n";
-    if (!p.autoscale)
+    // a range set under autoscale is kept for when autoscale is turned off (it was dropped on
+    // saving; found by fuzzing)
+    if (!p.autoscale || p.y_min != PlotSpec{}.y_min || p.y_max != PlotSpec{}.y_max)
       out << "y_range = " << FormatNumber(p.y_min) << " " << FormatNumber(p.y_max) << "\n";
     for (const auto& c : p.curves) {
       out << "curve = " << c.key << " " << Name(c.style);

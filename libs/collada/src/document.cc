@@ -318,6 +318,49 @@ void Document::RestoreNames() {
   }
 }
 
+void Document::CheckNumbers() {
+  if (!root) return;
+  IndexNodes();
+  std::vector<Element*> stack{root.get()};
+  while (!stack.empty()) {
+    Element* e = stack.back();
+    stack.pop_back();
+    for (auto& c : e->children) stack.push_back(c.get());
+    if (!e->numeric) continue;
+    const auto it = nodes_.find(e);
+    if (it == nodes_.end()) continue;  // an element the DOM made up has no text in the file
+    xmlChar* content = xmlNodeGetContent(it->second);
+    const std::string text = content == nullptr ? "" : Chars(content);
+    xmlFree(content);
+    const bool decimals = e->local_name() == "float_array";
+    std::vector<double> values;
+    values.reserve(e->numbers.size());
+    const std::string_view all(text);
+    for (size_t i = 0; i < all.size();) {
+      while (i < all.size() && IsSpace(all[i])) ++i;
+      size_t j = i;
+      while (j < all.size() && !IsSpace(all[j])) ++j;
+      if (j == i) break;
+      const std::string_view word = all.substr(i, j - i);
+      std::string why;
+      double value = 0;
+      long long integer = 0;
+      const bool ok = decimals ? core::ParseDouble(word, &value, &why)
+                               : core::ParseInt(word, &integer, &why);
+      if (!ok && word.size() > 64)  // a word of megabytes is not repeated whole
+        why = "'" + std::string(word.substr(0, 64)) + "...' (" + std::to_string(word.size()) +
+              " characters) is not " + (decimals ? "a number" : "an integer");
+      if (!ok)
+        throw ReadError(e->Describe() + ": " + why + " (value " +
+                            std::to_string(values.size() + 1) + " of the list)",
+                        LineOf(*e));
+      values.push_back(decimals ? value : static_cast<double>(integer));
+      i = j;
+    }
+    e->numbers = std::move(values);
+  }
+}
+
 std::mutex& DomMutex() {
   static std::mutex m;
   return m;
@@ -395,6 +438,7 @@ Document ReadDocument(const std::string& path) {
   if (doc.declared_version.empty()) doc.declared_version = doc.root->Attribute("version");
   doc.SetXml(std::move(xml.doc), std::move(xml.big_lines));
   doc.RestoreNames();
+  doc.CheckNumbers();
   // Collada-DOM types elements inside a technique by their name where COLLADA has a global
   // element of that name (param, translate, ...), and drops the attributes that type lacks:
   // inside Caliper's techniques they come back from the file's text

@@ -107,6 +107,11 @@ class Document {
   /// Collada-DOM cuts name attributes at the first blank: puts back the whole names from the
   /// file.
   void RestoreNames();
+  /// Collada-DOM reads a word of a numeric list that is not a number (`1 abc -1`) as a made-up
+  /// value and says nothing: reads each numeric list again from the file's text (decimal numbers
+  /// in float_array, integers in int_array, p, vcount and h) and keeps those values. Throws
+  /// ReadError naming the element and the word, with the element's line.
+  void CheckNumbers();
 
  private:
   // matches each element to its node in libxml2's tree

@@ -66,9 +66,10 @@ class ExtensionReader {
   // A unit from a unit attribute; fails naming it when unknown.
   Unit ParseUnitOf(const Element& e, const std::string& text) {
     Unit u;
-    std::string bad;
-    if (!ParseUnit(text, &u, &bad))
-      ctx_.Fail(&e, "unknown unit '" + text + "'" + (bad != text ? " (at '" + bad + "')" : ""));
+    std::string bad, why;
+    if (!ParseUnit(text, &u, &bad, &why))
+      ctx_.Fail(&e, (why.empty() ? "unknown unit '" + text + "'" : "unit '" + text + "': " + why) +
+                        (bad != text ? " (at '" + bad + "')" : ""));
     return u;
   }
 
@@ -365,8 +366,10 @@ void ExportExtension(const sgal::Scene& scene, Element* technique) {
     e->Set("kind", a.kind);
     e->Set("tendon", a.tendon);
     for (const auto& [name, value] : a.parameters) {
-      const auto spec =
-          std::find_if(specs.begin(), specs.end(), [&](const auto& s) { return s.name == name; });
+      // a lambda captures no structured binding before C++20 (clang refuses; build-fuzz/)
+      const std::string& parameter = name;
+      const auto spec = std::find_if(specs.begin(), specs.end(),
+                                     [&](const auto& s) { return s.name == parameter; });
       if (spec == specs.end())
         throw std::invalid_argument("actuator '" + a.name + "' (" + a.kind +
                                     "): unknown parameter '" + name + "'");

@@ -1,6 +1,5 @@
 #include "units.h"
 
-#include <climits>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -12,6 +11,11 @@ namespace caliper::collada::internal {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// bounds that no real unit comes near and that keep the arithmetic exact: a written power, each
+// exponent of a result, and the nesting of parentheses (the parser recurses per level)
+constexpr int kMaxPower = 12;
+constexpr int kMaxExponent = 24;
+constexpr int kMaxDepth = 16;
 
 struct Symbol {
   const char* name;
@@ -78,6 +82,17 @@ bool LookUp(const std::string& token, Unit* out) {
   return false;
 }
 
+// Why a result is out of bounds ("" when it is not): an exponent beyond kMaxExponent, or a scale
+// that is not a normal positive double (1e-6^9999 underflowed to 0 before: found by fuzzing).
+std::string OutOfRange(const Unit& u) {
+  for (int d : u.dimension)
+    if (d < -kMaxExponent || d > kMaxExponent)
+      return "an exponent beyond " + std::to_string(kMaxExponent) + " in magnitude";
+  if (!std::isnormal(u.scale) || u.scale < 0) return "a scale to SI that a double cannot hold";
+  return "";
+}
+
+// operands within kMaxExponent and powers within kMaxPower: no int overflows
 Unit Power(const Unit& u, int exponent) {
   Unit r;
   r.scale = std::pow(u.scale, exponent);
@@ -95,7 +110,7 @@ Unit Product(const Unit& a, const Unit& b, int sign) {
 
 class Parser {
  public:
-  explicit Parser(std::string_view text) : text_(text) {}
+  Parser(std::string_view text, std::string* why) : text_(text), why_(why) {}
 
   bool Parse(Unit* out, std::string* bad) {
     SkipSpace();
@@ -141,17 +156,26 @@ class Parser {
         *bad = std::string(text_.substr(pos_));
         return false;
       }
+      const size_t begin = pos_;
       Unit next;
       if (!Factor(&next, bad)) return false;
       *out = Product(*out, next, sign);
+      if (const std::string why = OutOfRange(*out); !why.empty())
+        return Refuse(begin, why, bad);
     }
   }
   // factor := ( '(' expression ')' | symbol ) [ '^' integer ]
   bool Factor(Unit* out, std::string* bad) {
     SkipSpace();
+    const size_t start = pos_;
     if (pos_ < text_.size() && text_[pos_] == '(') {
+      if (depth_ == kMaxDepth)
+        return Refuse(pos_, "more than " + std::to_string(kMaxDepth) + " nested parentheses", bad);
       ++pos_;
-      if (!Expression(out, bad)) return false;
+      ++depth_;
+      const bool ok = Expression(out, bad);
+      --depth_;
+      if (!ok) return false;
       SkipSpace();
       if (pos_ >= text_.size() || text_[pos_] != ')') {
         *bad = "(" + std::string(text_.substr(pos_));
@@ -185,23 +209,38 @@ class Parser {
         return false;
       }
       long long exponent = 0;
-      if (!core::ParseInt(digits, &exponent) || exponent < INT_MIN || exponent > INT_MAX) {
+      if (!core::ParseInt(digits, &exponent) || exponent < -kMaxPower || exponent > kMaxPower) {
         *bad = "^" + digits;
+        if (why_ != nullptr)
+          *why_ = "a power beyond " + std::to_string(kMaxPower) + " in magnitude";
         return false;
       }
       *out = Power(*out, static_cast<int>(exponent));
     }
+    if (const std::string why = OutOfRange(*out); !why.empty()) return Refuse(start, why, bad);
     return true;
   }
 
+  // the text from `at` on is the bad part, for the reason `why`
+  bool Refuse(size_t at, const std::string& why, std::string* bad) {
+    *bad = std::string(text_.substr(at));
+    if (why_ != nullptr) *why_ = why;
+    return false;
+  }
+
   std::string_view text_;
+  std::string* why_;
   size_t pos_ = 0;
+  int depth_ = 0;
 };
 
 }  // namespace
 
-bool ParseUnit(std::string_view text, Unit* out, std::string* bad) {
-  return Parser(text).Parse(out, bad);
+bool ParseUnit(std::string_view text, Unit* out, std::string* bad, std::string* why) {
+  std::string reason;
+  const bool ok = Parser(text, &reason).Parse(out, bad);
+  if (why != nullptr) *why = ok ? "" : reason;
+  return ok;
 }
 
 }  // namespace caliper::collada::internal

@@ -406,6 +406,16 @@ TEST(LayoutTest, SavesAndLoadsTheSameLayout) {
   EXPECT_EQ(empty.every_n_steps, 1u);
 }
 
+TEST(LayoutTest, KeepsARangeSetUnderAutoscale) {
+  // the range was dropped on saving when autoscale was on (found by fuzzing the layout parser)
+  const Layout l = ParseLayout("[plot]\nautoscale = true\ny_range = -5 5\ncurve = a.b line\n");
+  ASSERT_EQ(l.plots.size(), 1u);
+  EXPECT_EQ(l.plots[0].y_min, -5);
+  EXPECT_EQ(ParseLayout(FormatLayout(l)), l) << FormatLayout(l);
+  // the default range under autoscale is not written
+  EXPECT_EQ(FormatLayout(ParseLayout("[plot]\n")).find("y_range"), std::string::npos);
+}
+
 TEST(LayoutTest, RejectsMalformedLayoutsNamingTheLine) {
   struct Case {
     std::string text, message;

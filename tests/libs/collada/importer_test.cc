@@ -451,6 +451,24 @@ TEST(ColladaImportTest, RejectsMalformedFilesNamingFileLineElementAndProblem) {
   }
 }
 
+TEST(ColladaImportTest, RejectsAWordThatIsNotANumberInANumericList) {
+  // Collada-DOM read `0.1 abc 0` as three numbers, one of them made up, and said nothing
+  const std::string floats = ErrorOf(Data("malformed_float_array_word.dae"));
+  EXPECT_NE(floats.find("malformed_float_array_word.dae:14: float_array 'tri-positions-array': "
+                        "'abc' is not a number (value 5 of the list)"),
+            std::string::npos)
+      << floats;
+  const std::string indices = ErrorOf(Data("malformed_p_word.dae"));
+  EXPECT_NE(indices.find("malformed_p_word.dae:28: p: 'two' is not an integer (value 3 of the "
+                         "list)"),
+            std::string::npos)
+      << indices;
+  const std::string fraction = ErrorOf(Data("malformed_p_fraction.dae"));
+  EXPECT_NE(fraction.find("malformed_p_fraction.dae:28: p: '1.5' is not an integer"),
+            std::string::npos)
+      << fraction;
+}
+
 TEST(ColladaImportTest, NamesLinesBeyondSixteenBits) {
   // libxml2's nodes keep 16-bit lines: a long file (a large mesh before the physics) still
   // names the right one, for the elements and for malformed XML

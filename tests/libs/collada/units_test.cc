@@ -60,5 +60,26 @@ TEST(UnitsTest, RejectsUnknownSymbols) {
   EXPECT_FALSE(ParseUnit("m^", &u, &bad));
 }
 
+TEST(UnitsTest, RejectsUnitsBeyondItsBoundsSayingWhy) {
+  // found by fuzzing: 1e-6^9999 underflowed to a scale of 0, large powers overflowed the
+  // exponents (int), and every parenthesis recursed once
+  Unit u;
+  std::string bad, why;
+  EXPECT_FALSE(ParseUnit("kg m^3 um^9999", &u, &bad, &why));
+  EXPECT_EQ(bad, "^9999");
+  EXPECT_EQ(why, "a power beyond 12 in magnitude");
+  EXPECT_FALSE(ParseUnit("((m^12)^12)", &u, &bad, &why));
+  EXPECT_EQ(why, "an exponent beyond 24 in magnitude");
+  EXPECT_FALSE(ParseUnit("pm^12 pg^12", &u, &bad, &why));
+  EXPECT_EQ(bad, "pg^12");
+  EXPECT_EQ(why, "a scale to SI that a double cannot hold");
+  EXPECT_FALSE(ParseUnit(std::string(100000, '(') + "m", &u, &bad, &why));
+  EXPECT_EQ(why, "more than 16 nested parentheses");
+  EXPECT_TRUE(ParseUnit("kg m^2/(s^2 rad)", &u, &bad, &why));
+  EXPECT_EQ(why, "");
+  EXPECT_FALSE(ParseUnit("furlong", &u, &bad, &why));
+  EXPECT_EQ(why, "") << "an unknown symbol has no bound to name";
+}
+
 }  // namespace
 }  // namespace caliper::collada::internal
