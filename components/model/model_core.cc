@@ -78,7 +78,10 @@ std::unique_lock<std::mutex> ModelCore::Lock() const {
   return lock;
 }
 
-void ModelCore::CancelExperiment() { cancel_ = true; }
+void ModelCore::CancelExperiment() {
+  cancel_ = true;
+  NotifyRoom();  // a step waiting for a lossless consumer looks again
+}
 
 bool ModelCore::EndExperimentLocked(const std::string& request) {
   if (experiment_.empty() && step_request_ == 0) return false;
@@ -308,6 +311,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   sample();
   auto slice_end = Clock::now() + kSlice;
   for (uint64_t k = 1; k <= steps; ++k) {
+    AwaitConsumersLocked(lock);  // the experiment flag keeps control calls out meanwhile
     // commands due by the start of this step (a part per billion of a step counts as due)
     const double now = physics.time() + 1e-9 * dt;
     for (; next_command < e.schedule.size() && e.schedule[next_command].time_s <= now;
@@ -406,19 +410,26 @@ void ModelCore::Start() {
 }
 
 void ModelCore::Pause() {
-  const auto lock = Lock();
-  Require(true);
-  if (EndExperimentLocked("pause")) return;
-  if (state_ == RunState::kRunning) state_ = RunState::kPaused;  // a step request ends paused
+  {
+    const auto lock = Lock();
+    Require(true);
+    if (!EndExperimentLocked("pause") && state_ == RunState::kRunning)
+      state_ = RunState::kPaused;  // a step request ends paused
+  }
+  NotifyRoom();  // a step waiting for a lossless consumer ends
 }
 
 void ModelCore::Stop() {
-  const auto lock = Lock();
-  Require(true);
-  if (EndExperimentLocked("stop")) return;
-  // a step request running sees the new scene generation and ends without another step
-  RewindLocked();
-  state_ = RunState::kStopped;
+  {
+    const auto lock = Lock();
+    Require(true);
+    if (!EndExperimentLocked("stop")) {
+      // a step request running sees the new scene generation and ends without another step
+      RewindLocked();
+      state_ = RunState::kStopped;
+    }
+  }
+  NotifyRoom();  // a step waiting for a lossless consumer ends
 }
 
 void ModelCore::Reset() {
@@ -456,6 +467,12 @@ uint64_t ModelCore::StepNow(uint64_t n) {
   auto slice_end = rate_wall_ + kSlice;
   std::string ended;
   while (step_done_ < n) {
+    // a lossless consumer is let catch up; a stop, pause or shutdown meanwhile ends the request
+    if (AwaitConsumersLocked(lock) &&
+        (generation_ != generation || !end_request_.empty() || cancel_)) {
+      ended = cancel_ ? "the Model is shutting down" : end_request_;
+      break;
+    }
     StepLocked();
     if (state_ == RunState::kFaulted) break;
     ++step_done_;
@@ -575,7 +592,7 @@ void ModelCore::PublishLocked() {
 }
 
 void ModelCore::Advance(Clock::duration budget) {
-  const auto lock = Lock();
+  auto lock = Lock();
   if (!loaded_ || state_ != RunState::kRunning) return;
   sgal::PhysicsScene& physics = *loaded_->physics;
   const auto begin = Clock::now();
@@ -593,7 +610,10 @@ void ModelCore::Advance(Clock::duration budget) {
       }
     }
   } else {
+    // as fast as possible: as fast as the lossless consumers take the batches, too
     do {
+      AwaitConsumersLocked(lock);
+      if (!loaded_ || state_ != RunState::kRunning) return;
       StepLocked();
     } while (Clock::now() - begin < budget && state_ == RunState::kRunning);
   }
@@ -610,8 +630,11 @@ void ModelCore::MeasureRateLocked(double min_span_s) {
 }
 
 void ModelCore::Tick() {
-  const auto lock = Lock();
-  if (loaded_ && state_ == RunState::kRunning) StepLocked();
+  auto lock = Lock();
+  if (!loaded_ || state_ != RunState::kRunning) return;
+  // lock-step: a tick waits for the lossless consumers (bounded by their wait)
+  if (AwaitConsumersLocked(lock) && (!loaded_ || state_ != RunState::kRunning)) return;
+  StepLocked();
 }
 
 std::shared_ptr<const sgal::Scene> ModelCore::description() const {
@@ -748,7 +771,7 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
 }
 
 uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
-                              size_t batch_steps) {
+                              size_t batch_steps, std::chrono::milliseconds lossless_wait) {
   const auto lock = Lock();
   Require(true);
   if (every_n_steps == 0) throw InvalidValue("every_n_steps must be at least 1");
@@ -782,6 +805,12 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
     const uint64_t id = recorder_.Subscribe(options);
     subscribed_values_ += values;
     subscription_values_[id] = values;
+    Feed& feed = feeds_[id];
+    feed.capacity = options.queue_capacity;
+    if (lossless_wait.count() > 0) {
+      feed.lossless_wait = lossless_wait;
+      ++lossless_;
+    }
     return id;
   } catch (const daq::UnknownId& e) {
     throw UnknownId(e.what(), e.id());
@@ -790,12 +819,42 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
   }
 }
 
-void ModelCore::Unsubscribe(uint64_t subscription) {
-  const auto lock = Lock();
+void ModelCore::Unsubscribe(uint64_t subscription, const std::string& reason) {
+  {
+    const auto lock = Lock();
+    UnsubscribeLocked(subscription, reason);
+  }
+  NotifyRoom();
+}
+
+void ModelCore::UnsubscribeLocked(uint64_t subscription, const std::string& reason) {
+  const auto feed = feeds_.find(subscription);
+  if (feed == feeds_.end()) return;  // already gone
+  const std::string kind = feed->second.lossless_wait.count() > 0 ? "lossless " : "";
   try {
+    const daq::SubscriptionStats stats = recorder_.Stats(subscription);
     recorder_.Unsubscribe(subscription);
+    const uint64_t dropped = stats.dropped_samples + feed->second.undelivered_samples;
+    auto& log = logging::Get("daq");
+    if (!reason.empty())
+      log.warn("%ssubscription %llu ended by the Model after %llu samples (%llu dropped): %s",
+               kind.c_str(), static_cast<unsigned long long>(subscription),
+               static_cast<unsigned long long>(stats.samples),
+               static_cast<unsigned long long>(dropped), reason.c_str());
+    else if (dropped > 0)
+      log.notice("%ssubscription %llu ended: %llu samples taken, %llu of them dropped (the "
+                 "consumer was slower than the simulation ran)",
+                 kind.c_str(), static_cast<unsigned long long>(subscription),
+                 static_cast<unsigned long long>(stats.samples),
+                 static_cast<unsigned long long>(dropped));
   } catch (const daq::UnknownId&) {
     // already gone
+  }
+  if (feed->second.lossless_wait.count() > 0) --lossless_;
+  feeds_.erase(feed);
+  if (!reason.empty()) {
+    ended_[subscription] = reason;
+    if (ended_.size() > 64) ended_.erase(ended_.begin());
   }
   const auto it = subscription_values_.find(subscription);
   if (it != subscription_values_.end()) {
@@ -804,10 +863,118 @@ void ModelCore::Unsubscribe(uint64_t subscription) {
   }
 }
 
-std::vector<daq::Batch> ModelCore::TakeBatches(uint64_t subscription) {
+FeedStatus ModelCore::SubscriptionStatus(uint64_t subscription) const {
+  const auto lock = Lock();
+  const auto feed = feeds_.find(subscription);
+  if (feed == feeds_.end()) {
+    const auto ended = ended_.find(subscription);
+    const std::string id = std::to_string(subscription);
+    throw UnknownId(ended != ended_.end()
+                        ? "subscription " + id + " was ended by the Model: " + ended->second
+                        : "no subscription " + id,
+                    id);
+  }
+  const daq::SubscriptionStats stats = recorder_.Stats(subscription);
+  FeedStatus out;
+  out.lossless = feed->second.lossless_wait.count() > 0;
+  out.samples = stats.samples;
+  out.batches = stats.batches;
+  out.dropped_batches = stats.dropped + feed->second.undelivered_batches;
+  out.dropped_samples = stats.dropped_samples + feed->second.undelivered_samples;
+  out.queued = stats.queued;
+  out.waited_s = feed->second.waited_s;
+  return out;
+}
+
+void ModelCore::NoteUndelivered(uint64_t subscription, uint64_t batches, uint64_t samples) {
+  const auto lock = Lock();
+  const auto feed = feeds_.find(subscription);
+  if (feed == feeds_.end()) return;
+  feed->second.undelivered_batches += batches;
+  feed->second.undelivered_samples += samples;
+}
+
+void ModelCore::SetConsumerWake(std::function<void(uint64_t)> wake) {
+  const auto lock = Lock();
+  consumer_wake_ = std::move(wake);
+}
+
+void ModelCore::NotifyRoom() {
+  {
+    std::lock_guard<std::mutex> room(room_mutex_);
+    ++room_events_;
+  }
+  room_.notify_all();
+}
+
+bool ModelCore::AwaitConsumersLocked(std::unique_lock<std::mutex>& lock) {
+  if (lossless_ == 0) return false;
+  // what ends the wait besides room: a stop, pause, load or shutdown meanwhile
+  const RunState state = state_;
+  const uint64_t generation = generation_;
+  bool released = false;
+  uint64_t waiting_for = 0;  // the subscription waited for now (0: none yet)
+  Clock::time_point since;
+  for (;;) {
+    // read before looking at the queues: a take after the look changes it
+    uint64_t seen;
+    {
+      std::lock_guard<std::mutex> room(room_mutex_);
+      seen = room_events_;
+    }
+    uint64_t blocked = 0;
+    for (const auto& [id, feed] : feeds_) {
+      if (feed.lossless_wait.count() == 0) continue;
+      // one step queues at most two batches (one on a layout change, one full)
+      if (recorder_.Stats(id).queued + 2 > feed.capacity) {
+        blocked = id;
+        break;
+      }
+    }
+    if (blocked == 0) return released;
+    Feed& feed = feeds_[blocked];
+    const auto now = Clock::now();
+    if (blocked != waiting_for) {
+      waiting_for = blocked;
+      since = now;
+      if (consumer_wake_) consumer_wake_(blocked);
+    }
+    const auto deadline = since + feed.lossless_wait;
+    if (now >= deadline) {
+      UnsubscribeLocked(
+          blocked, "its consumer took no batch for " +
+                       std::to_string(feed.lossless_wait.count()) +
+                       " ms while the simulation waited for it (lossless); the Model goes on "
+                       "without it");
+      waiting_for = 0;
+      continue;
+    }
+    lock.unlock();
+    released = true;
+    {
+      std::unique_lock<std::mutex> room(room_mutex_);
+      room_.wait_until(room, deadline, [&] { return room_events_ != seen; });
+    }
+    lock.lock();
+    const auto it = feeds_.find(blocked);
+    if (it != feeds_.end())
+      it->second.waited_s += std::chrono::duration<double>(Clock::now() - now).count();
+    if (state_ != state || generation_ != generation || !end_request_.empty() || cancel_)
+      return true;
+  }
+}
+
+std::vector<daq::Batch> ModelCore::TakeBatches(uint64_t subscription, bool* gone,
+                                               uint64_t* dropped_samples) {
+  if (gone != nullptr) *gone = false;
   try {
-    return recorder_.TakeBatches(subscription);
+    std::vector<daq::Batch> batches = recorder_.TakeBatches(subscription);
+    if (!batches.empty()) NotifyRoom();
+    if (dropped_samples != nullptr)
+      *dropped_samples = recorder_.Stats(subscription).dropped_samples;
+    return batches;
   } catch (const daq::UnknownId&) {
+    if (gone != nullptr) *gone = true;
     return {};
   }
 }

@@ -122,6 +122,17 @@ struct Snapshot {
   std::vector<sgal::TendonState> tendons;
 };
 
+/// The counters of one data subscription.
+struct FeedStatus {
+  bool lossless = false;         // the stepping waits for its consumer (see Subscribe)
+  uint64_t samples = 0;          // taken so far
+  uint64_t batches = 0;          // completed so far
+  uint64_t dropped_batches = 0;  // never delivered: the queue was full or their push failed
+  uint64_t dropped_samples = 0;  // the samples those batches held
+  uint64_t queued = 0;           // batches waiting to be taken
+  double waited_s = 0;           // wall time the stepping waited for the consumer [s]
+};
+
 /// Told about scenes and steps; implemented by the servant's observer senders. Called with the
 /// core's lock held: must only post and return.
 class CoreListener {
@@ -202,11 +213,30 @@ class ModelCore {
   /// refusal (a negative mass, a bound) are raised to the caller.
   void SetChannel(const std::string& id, const std::vector<double>& values);
   /// Subscriptions outlive scene reloads: ids that vanish are reported stale.
+  ///
+  /// `lossless_wait` > 0 makes a lossless subscription: before each step of a lock-step or
+  /// as-fast-as-possible run (StepNow, Tick, Advance at a factor of 0, RunExperiment) the stepping
+  /// waits, with the lock released, until its queue has room for one more step's batches; a
+  /// consumer that takes none for `lossless_wait` is ended (Unsubscribe with the reason). Advance
+  /// at a real-time factor > 0 never waits: a full queue drops its oldest batch, counted.
   uint64_t Subscribe(const std::vector<std::string>& ids, uint32_t every_n_steps,
-                     size_t batch_steps);
-  void Unsubscribe(uint64_t subscription);
-  /// Thread-safe without the model's lock: for the subscribers' sender threads.
-  std::vector<daq::Batch> TakeBatches(uint64_t subscription);
+                     size_t batch_steps,
+                     std::chrono::milliseconds lossless_wait = std::chrono::milliseconds(0));
+  /// Ends a subscription (nothing when there is none); a non-empty `reason` says why the Model,
+  /// not its client, ended it: logged, and given by SubscriptionStatus afterwards.
+  void Unsubscribe(uint64_t subscription, const std::string& reason = "");
+  /// Throws UnknownId, saying why the Model ended it when it did.
+  FeedStatus SubscriptionStatus(uint64_t subscription) const;
+  /// Batches taken by a sender but not delivered (a failed push): counted as dropped.
+  void NoteUndelivered(uint64_t subscription, uint64_t batches, uint64_t samples);
+  /// Called, with the core's lock held, when the stepping begins to wait for the consumer of a
+  /// lossless subscription (its sender should push now): must only post and return.
+  void SetConsumerWake(std::function<void(uint64_t subscription)> wake);
+  /// Thread-safe without the model's lock: for the subscribers' sender threads. `gone` tells
+  /// whether the subscription no longer exists (the Model ended it, or its client did).
+  /// `dropped_samples` gets how many samples its full queue dropped so far.
+  std::vector<daq::Batch> TakeBatches(uint64_t subscription, bool* gone = nullptr,
+                                      uint64_t* dropped_samples = nullptr);
   bool WaitForBatches(uint64_t subscription, std::chrono::milliseconds timeout);
 
   void AddListener(CoreListener* listener);
@@ -233,6 +263,14 @@ class ModelCore {
   void RequireNoExperiment() const;
   /// Lets waiting calls take the lock, then takes it back (between slices of long work).
   void HandOverLocked(std::unique_lock<std::mutex>& lock);
+  /// Before a step of a lock-step or as-fast-as-possible run: waits, with the lock released,
+  /// until every lossless subscription's queue has room for the batches of one step, ending one
+  /// whose consumer takes none for its wait. True when the lock was let go meanwhile (the caller
+  /// checks what changed).
+  bool AwaitConsumersLocked(std::unique_lock<std::mutex>& lock);
+  /// Wakes AwaitConsumersLocked: a sender took batches or a subscription ended.
+  void NotifyRoom();
+  void UnsubscribeLocked(uint64_t subscription, const std::string& reason);
   /// The simulation stops at the start of the failing step: FAULTED with `reason`, one error
   /// record, queued commands dropped (they were for steps that will not come).
   void FaultLocked(const std::string& reason);
@@ -273,6 +311,21 @@ class ModelCore {
   std::vector<CoreListener*> listeners_;
   size_t subscribed_values_ = 0;                    // of all subscriptions
   std::map<uint64_t, size_t> subscription_values_;  // per subscription
+  // what the Model keeps of a subscription beside the recorder's counters
+  struct Feed {
+    std::chrono::milliseconds lossless_wait{0};  // 0: lossy
+    size_t capacity = 0;                         // of its queue [batches]
+    double waited_s = 0;                         // [s]
+    uint64_t undelivered_batches = 0, undelivered_samples = 0;  // failed pushes
+  };
+  std::map<uint64_t, Feed> feeds_;
+  size_t lossless_ = 0;                      // feeds with a lossless_wait
+  std::map<uint64_t, std::string> ended_;    // why the Model ended subscriptions (the last 64)
+  std::function<void(uint64_t)> consumer_wake_;
+  // AwaitConsumersLocked sleeps on room_ until room_events_ changes
+  std::mutex room_mutex_;
+  std::condition_variable room_;
+  uint64_t room_events_ = 0;
   // real-time pacing: wall clock and sim time when the current run began
   std::chrono::steady_clock::time_point run_wall_start_;
   double run_sim_start_ = 0;

@@ -340,6 +340,16 @@ bool PushPool::Remove(Kind kind, uint64_t id) {
   return true;
 }
 
+void PushPool::Due(Kind kind, uint64_t id) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = entries_.find({kind, id});
+    if (it == entries_.end()) return;
+    it->second->retry_at = Clock::time_point{};
+  }
+  wake_.notify_one();
+}
+
 void PushPool::Wake() {
   { std::lock_guard<std::mutex> lock(mutex_); }
   wake_.notify_one();
@@ -558,11 +568,32 @@ PushTarget::Outcome ObserverTarget::Push(std::string* why) {
 // ------------------------------------------------------------------------ subscriptions
 
 SubscriptionTarget::SubscriptionTarget(ModelCore& core, uint64_t subscription,
-                                       D::DataConsumer_ptr consumer)
-    : core_(core), subscription_(subscription), consumer_(D::DataConsumer::_duplicate(consumer)) {}
+                                       D::DataConsumer_ptr consumer, bool lossless)
+    : core_(core),
+      subscription_(subscription),
+      consumer_(D::DataConsumer::_duplicate(consumer)),
+      lossless_(lossless) {}
 
 PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
-  const auto batches = core_.TakeBatches(subscription_);
+  bool gone = false;
+  uint64_t queue_dropped = 0;
+  const auto batches = core_.TakeBatches(subscription_, &gone, &queue_dropped);
+  if (gone) {
+    *why = "the Model ended the subscription (the reason is logged above)";
+    return Outcome::kGone;
+  }
+  // a real-time run does not wait for a slow consumer: say what it lost, every 10 s at most
+  const auto now = std::chrono::steady_clock::now();
+  if (queue_dropped > queue_dropped_ && now - queue_logged_ >= std::chrono::seconds(10)) {
+    logging::Get("daq").warn(
+        "%ssubscription %llu: %llu samples dropped so far (its queue was full: the consumer is "
+        "slower than the simulation runs%s)",
+        lossless_ ? "lossless " : "", static_cast<unsigned long long>(subscription_),
+        static_cast<unsigned long long>(queue_dropped),
+        lossless_ ? "; the Model waits for it only in lock-step or as fast as possible" : "");
+    queue_dropped_ = queue_dropped;
+    queue_logged_ = now;
+  }
   if (batches.empty()) return Outcome::kNothing;
   for (size_t k = 0; k < batches.size(); ++k) {
     const daq::Batch& b = batches[k];
@@ -583,20 +614,29 @@ PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
       consumer_->on_samples(out);
     } catch (const CORBA::Exception& e) {
       // this batch and the rest of the backlog go; the consumer sees the gap in `batch`
+      uint64_t samples = 0;
+      for (size_t j = k; j < batches.size(); ++j) samples += batches[j].step_count;
       dropped_ += batches.size() - k;
+      core_.NoteUndelivered(subscription_, batches.size() - k, samples);
       *why = rtc::Describe(e) + " (" + std::to_string(dropped_) + " batches dropped so far)";
-      return PeerGone(e) ? Outcome::kGone : Outcome::kFailed;
+      if (lossless_) *why += "; a lossless subscription ends at its first failed push";
+      last_failure_ = *why;
+      return PeerGone(e) || lossless_ ? Outcome::kGone : Outcome::kFailed;
     }
   }
+  last_failure_.clear();
   return Outcome::kSent;
 }
 
 // ------------------------------------------------------------------------ servant
 
 ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core, const PushLimits& limits)
-    : rtc::RTObjectServant(runtime), core_(core), pool_(limits) {}
+    : rtc::RTObjectServant(runtime), core_(core), pool_(limits) {
+  // the stepping waits for a lossless consumer: its sender should push now, not at its next poll
+  core_.SetConsumerWake([this](uint64_t id) { pool_.Due(PushPool::Kind::kSubscription, id); });
+}
 
-ModelServant::~ModelServant() = default;
+ModelServant::~ModelServant() { core_.SetConsumerWake(nullptr); }
 
 void ModelServant::load_scene(const char* path) {
   try {
@@ -830,6 +870,34 @@ D::ValueSeq* ModelServant::sample(const S::StringSeq& ids) { return get(ids); }
 
 CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong every_n_steps,
                                          D::DataConsumer_ptr consumer) {
+  return Subscribe(ids, every_n_steps, consumer, false);
+}
+
+CORBA::ULongLong ModelServant::subscribe_lossless(const S::StringSeq& ids,
+                                                  CORBA::ULong every_n_steps,
+                                                  D::DataConsumer_ptr consumer) {
+  return Subscribe(ids, every_n_steps, consumer, true);
+}
+
+D::SubscriptionStatus ModelServant::subscription_status(CORBA::ULongLong subscription) {
+  try {
+    const FeedStatus f = core_.SubscriptionStatus(subscription);
+    D::SubscriptionStatus out;
+    out.lossless = f.lossless;
+    out.samples = f.samples;
+    out.batches = f.batches;
+    out.dropped_batches = f.dropped_batches;
+    out.dropped_samples = f.dropped_samples;
+    out.queued = f.queued;
+    out.waited = f.waited_s;
+    return out;
+  } catch (const UnknownId& e) {
+    throw D::UnknownId(e.what(), e.id().c_str());
+  }
+}
+
+CORBA::ULongLong ModelServant::Subscribe(const S::StringSeq& ids, CORBA::ULong every_n_steps,
+                                         D::DataConsumer_ptr consumer, bool lossless) {
   if (CORBA::is_nil(consumer)) throw D::InvalidParameter("the consumer is nil");
   const std::string client = ClientOf(consumer);
   pool_.CheckRoom(PushPool::Kind::kSubscription, client);
@@ -841,11 +909,14 @@ CORBA::ULongLong ModelServant::subscribe(const S::StringSeq& ids, CORBA::ULong e
   const size_t batch_steps = std::max<size_t>(1, static_cast<size_t>(0.05 / per_sample));
   const uint64_t id =
       Guard<D::NotAvailable>([&] {
-        return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps);
+        // a lossless consumer that takes nothing for two push deadlines is ended
+        return core_.Subscribe(FromIdl(ids), every_n_steps, batch_steps,
+                               lossless ? 2 * pool_.limits().call_timeout
+                                        : std::chrono::milliseconds(0));
       });
   try {
     pool_.Add(PushPool::Kind::kSubscription, id, client, consumer,
-              std::make_shared<SubscriptionTarget>(core_, id, consumer));
+              std::make_shared<SubscriptionTarget>(core_, id, consumer, lossless));
   } catch (const D::LimitExceeded&) {
     core_.Unsubscribe(id);  // another call of the same client took the last place meanwhile
     throw;

@@ -85,6 +85,8 @@ class PushPool {
   bool Remove(Kind kind, uint64_t id);
   /// A target has something to send.
   void Wake();
+  /// The target under `id` has something to send now (sooner than its next poll).
+  void Due(Kind kind, uint64_t id);
 
  private:
   struct Entry {
@@ -152,22 +154,29 @@ class ObserverTarget : public PushTarget, public CoreListener {
 };
 
 /// Delivers one subscription's batches to its DataConsumer. The batches wait in the recorder's
-/// bounded queue (oldest dropped first, counted there); those of a failed push are dropped and
-/// counted here: the consumer sees the gap in the batch numbers.
+/// bounded queue (oldest dropped first, counted there, logged here at most every 10 s); those of
+/// a failed push are dropped and counted here: the consumer sees the gap in the batch numbers. A
+/// lossless subscription (the stepping waits for its queue) ends at its first failed push: a
+/// consumer that is gone or misses the deadline must not hold the simulation again.
 class SubscriptionTarget : public PushTarget {
  public:
   SubscriptionTarget(ModelCore& core, uint64_t subscription,
-                     Caliper::Daq::DataConsumer_ptr consumer);
+                     Caliper::Daq::DataConsumer_ptr consumer, bool lossless = false);
   Outcome Push(std::string* why) override;
-  /// Always: the pool looks for batches every 20 ms (taking them is the check).
+  /// Always: the pool looks for batches every 20 ms (taking them is the check); a lossless one is
+  /// also made due when the stepping waits for it.
   bool HasWork() override { return true; }
-  void Detach() override { core_.Unsubscribe(subscription_); }
+  void Detach() override { core_.Unsubscribe(subscription_, last_failure_); }
 
  private:
   ModelCore& core_;
   const uint64_t subscription_;
   Caliper::Daq::DataConsumer_var consumer_;
-  uint64_t dropped_ = 0;  // batches of failed pushes
+  const bool lossless_;
+  uint64_t dropped_ = 0;         // batches of failed pushes
+  uint64_t queue_dropped_ = 0;   // samples the full queue dropped, as last logged
+  std::chrono::steady_clock::time_point queue_logged_{};
+  std::string last_failure_;     // why the last push failed ("" after one succeeded)
 };
 
 class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::RTObjectServant {
@@ -208,11 +217,19 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   CORBA::ULongLong subscribe(const Caliper::Scene::StringSeq& ids, CORBA::ULong every_n_steps,
                              Caliper::Daq::DataConsumer_ptr consumer) override;
   void unsubscribe(CORBA::ULongLong subscription) override;
+  CORBA::ULongLong subscribe_lossless(const Caliper::Scene::StringSeq& ids,
+                                      CORBA::ULong every_n_steps,
+                                      Caliper::Daq::DataConsumer_ptr consumer) override;
+  Caliper::Daq::SubscriptionStatus subscription_status(CORBA::ULongLong subscription) override;
   // ObserverRegistry
   CORBA::ULongLong add_observer(Caliper::Scene::SceneObserver_ptr observer) override;
   void remove_observer(CORBA::ULongLong id) override;
 
  private:
+  /// subscribe and subscribe_lossless.
+  CORBA::ULongLong Subscribe(const Caliper::Scene::StringSeq& ids, CORBA::ULong every_n_steps,
+                             Caliper::Daq::DataConsumer_ptr consumer, bool lossless);
+
   ModelCore& core_;
   std::atomic<uint64_t> next_observer_{1};
   PushPool pool_;  // last: its threads end before the rest goes

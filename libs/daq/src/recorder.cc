@@ -42,6 +42,7 @@ struct Recorder::Queue {
     {
       std::lock_guard<std::mutex> lock(mutex);
       if (batches.size() >= capacity) {
+        dropped_samples += batches.front().step_count;
         batches.pop_front();
         ++dropped;
       }
@@ -72,6 +73,7 @@ struct Recorder::Queue {
   std::condition_variable ready;
   std::deque<Batch> batches;
   uint64_t dropped = 0;
+  uint64_t dropped_samples = 0;
   bool closed = false;
 };
 
@@ -317,6 +319,7 @@ SubscriptionStats Recorder::Stats(SubscriptionId id) const {
   out.last_error = s.last_error;
   std::lock_guard<std::mutex> queue_lock(s.queue->mutex);
   out.dropped = s.queue->dropped;
+  out.dropped_samples = s.queue->dropped_samples;
   out.queued = s.queue->batches.size();
   return out;
 }

@@ -78,6 +78,7 @@ struct SubscriptionStats {
   uint64_t samples = 0;            // samples taken
   uint64_t batches = 0;            // batches completed (the last sequence number)
   uint64_t dropped = 0;            // batches dropped because the queue was full
+  uint64_t dropped_samples = 0;    // the samples those batches held
   size_t queued = 0;               // batches waiting to be taken
   std::vector<std::string> stale;  // ids that no longer exist
   std::string last_error;          // the last getter failure, "" when none

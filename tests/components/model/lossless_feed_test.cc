@@ -1,0 +1,209 @@
+// Lossless data subscriptions in ModelCore, without CORBA: a step request, or a run as fast as
+// possible, waits for a slow taker and loses no sample; one whose taker stops is ended after its
+// wait, with the reason, and the steps go on; a real-time run never waits and counts its drops;
+// a stop or pause ends a wait at once.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <future>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "model_core.h"
+
+namespace caliper::model {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+const char* const kPosition = "pendulum_tendon.pendulum.position";  // 3 values
+
+std::string Model(const std::string& file) {
+  const char* src = std::getenv("CALIPER_SOURCE_DIR");
+  return std::string(src ? src : ".") + "/models/" + file;
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+/// Takes a subscription's batches on its own thread, `pause` after each take, and checks that
+/// they follow one another: numbers 1, 2, 3, ... and each batch's first step right after the
+/// last sample of the one before.
+class SlowTaker {
+ public:
+  SlowTaker(ModelCore& core, uint64_t id, std::chrono::milliseconds pause)
+      : core_(core), id_(id), pause_(pause), thread_([this] { Run(); }) {}
+  ~SlowTaker() { Stop(); }
+  void Stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  uint64_t samples() const { return samples_; }
+  /// "" when every batch followed the one before, else the first break.
+  std::string breaks() {
+    Stop();
+    return breaks_;
+  }
+
+ private:
+  void Run() {
+    while (!stop_) {
+      for (const daq::Batch& b : core_.TakeBatches(id_)) {
+        if (breaks_.empty() && b.sequence != next_batch_)
+          breaks_ = "batch " + std::to_string(b.sequence) + " after " +
+                    std::to_string(next_batch_ - 1);
+        if (breaks_.empty() && next_step_ != 0 && b.first_step != next_step_)
+          breaks_ = "batch " + std::to_string(b.sequence) + " starts at step " +
+                    std::to_string(b.first_step) + ", " + std::to_string(next_step_) + " expected";
+        next_batch_ = b.sequence + 1;
+        next_step_ = b.first_step + b.step_count * b.every_n_steps;
+        samples_ += b.step_count;
+      }
+      std::this_thread::sleep_for(pause_);
+    }
+  }
+
+  ModelCore& core_;
+  const uint64_t id_;
+  const std::chrono::milliseconds pause_;
+  std::atomic<bool> stop_{false};
+  std::atomic<uint64_t> samples_{0};
+  uint64_t next_batch_ = 1;
+  uint64_t next_step_ = 0;
+  std::string breaks_;
+  std::thread thread_;
+};
+
+TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  // batches of 10 samples in a queue of 33 (256 MiB over 100,000 values of 10 samples)
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
+  SlowTaker taker(core, id, 5ms);
+  EXPECT_EQ(core.StepNow(5000), 5000u);
+  ASSERT_TRUE([&] {
+    for (int i = 0; i < 1000 && taker.samples() < 5000; ++i) std::this_thread::sleep_for(10ms);
+    return taker.samples() == 5000;
+  }()) << taker.samples() << " samples";
+  EXPECT_EQ(taker.breaks(), "");
+  const FeedStatus status = core.SubscriptionStatus(id);
+  EXPECT_TRUE(status.lossless);
+  EXPECT_EQ(status.samples, 5000u);
+  EXPECT_EQ(status.batches, 500u);
+  EXPECT_EQ(status.dropped_batches, 0u);
+  EXPECT_EQ(status.dropped_samples, 0u);
+  EXPECT_GT(status.waited_s, 0.0);  // the taker was slower than the steps: the Model waited
+}
+
+TEST(LosslessFeed, WithoutLosslessTheSameRunDropsAndCountsTheSamples) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10);
+  EXPECT_EQ(core.StepNow(5000), 5000u);  // nobody takes: the queue keeps its newest 33
+  const FeedStatus status = core.SubscriptionStatus(id);
+  EXPECT_FALSE(status.lossless);
+  EXPECT_EQ(status.batches, 500u);
+  EXPECT_EQ(status.queued, 33u);
+  EXPECT_EQ(status.dropped_batches, 500u - 33u);
+  EXPECT_EQ(status.dropped_samples, 10 * (500u - 33u));
+  EXPECT_EQ(status.waited_s, 0.0);
+}
+
+TEST(LosslessFeed, ATakerThatStopsIsEndedAfterItsWaitAndTheStepsGoOn) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10, 300ms);
+  const auto begin = Clock::now();
+  EXPECT_EQ(core.StepNow(5000), 5000u);  // nobody takes
+  const double took = Seconds(Clock::now() - begin);
+  EXPECT_GE(took, 0.3);
+  EXPECT_LT(took, 2.0);
+  try {
+    core.SubscriptionStatus(id);
+    ADD_FAILURE() << "the subscription of a stopped taker was kept";
+  } catch (const UnknownId& e) {
+    EXPECT_TRUE(Contains(e.what(), "was ended by the Model: its consumer took no batch for 300 ms"))
+        << e.what();
+  }
+  bool gone = false;
+  EXPECT_TRUE(core.TakeBatches(id, &gone).empty());
+  EXPECT_TRUE(gone);
+  // its values are free again, and a second request does not wait
+  const auto again = Clock::now();
+  EXPECT_EQ(core.StepNow(5000), 5000u);
+  EXPECT_LT(Seconds(Clock::now() - again), 0.3);
+}
+
+TEST(LosslessFeed, AsFastAsPossibleWaitsForASlowTaker) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  core.SetRealTimeFactor(0);
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
+  SlowTaker taker(core, id, 5ms);
+  core.Start();
+  for (int i = 0; i < 100 && core.status().steps < 3000; ++i) core.Advance(20ms);
+  core.Pause();
+  const uint64_t steps = core.status().steps;
+  EXPECT_GE(steps, 3000u);
+  ASSERT_TRUE([&] {
+    for (int i = 0; i < 1000 && taker.samples() < steps - steps % 10; ++i)
+      std::this_thread::sleep_for(10ms);
+    return taker.samples() == steps - steps % 10;  // the partial batch is not queued yet
+  }()) << taker.samples() << " samples of " << steps;
+  EXPECT_EQ(taker.breaks(), "");
+  EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
+  EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
+}
+
+TEST(LosslessFeed, ARealTimeRunNeverWaitsAndCountsWhatItDrops) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  core.SetRealTimeFactor(1);
+  // one sample per batch: a queue of 64 batches holds 64 ms of the run
+  const uint64_t id = core.Subscribe({kPosition}, 1, 1, 2000ms);
+  core.Start();
+  const auto begin = Clock::now();
+  while (Clock::now() - begin < 600ms) {
+    core.Advance(4ms);  // an execution context at 200 Hz
+    std::this_thread::sleep_for(5ms);
+  }
+  core.Pause();
+  const double wall = Seconds(Clock::now() - begin);
+  const Status s = core.status();
+  // kept pace with the wall clock (nobody took a batch)
+  EXPECT_GT(s.sim_time, 0.8 * wall) << s.sim_time << " s simulated in " << wall << " s";
+  const FeedStatus status = core.SubscriptionStatus(id);
+  EXPECT_EQ(status.waited_s, 0.0);
+  EXPECT_EQ(status.queued, 64u);
+  EXPECT_EQ(status.dropped_samples, status.samples - 64);
+  EXPECT_GT(status.dropped_samples, 300u);
+}
+
+TEST(LosslessFeed, AStopOrPauseEndsAWaitAtOnce) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  core.Subscribe({kPosition}, 1, 10, 10000ms);
+  for (const std::string request : {"pause", "stop"}) {
+    auto run = std::async(std::launch::async, [&] { return core.StepNow(100000); });
+    std::this_thread::sleep_for(200ms);  // the queue is full: the request waits
+    ASSERT_EQ(run.wait_for(0ms), std::future_status::timeout) << request;
+    const auto asked = Clock::now();
+    if (request == "pause")
+      core.Pause();
+    else
+      core.Stop();
+    ASSERT_EQ(run.wait_for(2s), std::future_status::ready) << request;
+    EXPECT_LT(Seconds(Clock::now() - asked), 0.5) << request;
+    EXPECT_LT(run.get(), 1000u) << request;
+  }
+}
+
+}  // namespace
+}  // namespace caliper::model
