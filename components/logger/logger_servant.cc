@@ -242,7 +242,11 @@ CORBA::ULongLong LoggerServant::add_listener(idl::LogListener_ptr listener) {
         rtc::Unreachable(listener, "LogListener", idl::LogListener::_PD_repoId, timeout);
     if (!why.empty()) throw idl::NotAvailable(why.c_str());
   }
-  return hub_.Add(listener);
+  const uint64_t id = hub_.Add(listener);
+  logging::Get("listeners").info("log listener %llu added (client %s)",
+                                 static_cast<unsigned long long>(id),
+                                 rtc::ClientOf(listener).c_str());
+  return id;
 }
 
 void LoggerServant::remove_listener(CORBA::ULongLong id) { hub_.Remove(id); }

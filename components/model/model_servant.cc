@@ -921,6 +921,9 @@ CORBA::ULongLong ModelServant::Subscribe(const S::StringSeq& ids, CORBA::ULong e
     core_.Unsubscribe(id);  // another call of the same client took the last place meanwhile
     throw;
   }
+  logging::Get("daq").info("subscription %llu added (client %s): %u ids every %u steps",
+                           static_cast<unsigned long long>(id), client.c_str(), ids.length(),
+                           std::max<CORBA::ULong>(every_n_steps, 1));
   return id;
 }
 
@@ -948,7 +951,11 @@ CORBA::ULongLong ModelServant::add_observer(S::SceneObserver_ptr observer) {
     core_.RemoveListener(target.get());
     throw;
   }
-  if (used != id) core_.RemoveListener(target.get());
+  if (used != id)
+    core_.RemoveListener(target.get());
+  else
+    logging::Get("observers").info("observer %llu added (client %s)",
+                                   static_cast<unsigned long long>(id), client.c_str());
   return used;
 }
 
