@@ -15,22 +15,63 @@ free_port() {
   die "no free port found"
 }
 
-naming_answers() {  # ADDRESS
-  timeout 5 nameclt -ORBInitRef "NameService=$1" list >/dev/null 2>&1
+# TLS for omniNames and nameclt, which are not linked with omniORB's SSL transport: it is
+# preloaded, and configured through ORB* environment variables (the key's password too: the
+# environment of a process is readable by its user and root only, its command line by all).
+SSL_TRANSPORT=$(ls /usr/lib/*/libomnisslTP4.so.2 2>/dev/null | head -1)
+
+# Finds this host's TLS identity as the components do (transport_security.h); sets TLS_CA,
+# TLS_KEY, TLS_PASS_FILE, or dies saying which launch/caliper certs commands make them.
+tls_identity() {
+  local pki=${CALIPER_PKI:-$HOME/.config/caliper/pki}
+  local id=${CALIPER_TLS_IDENTITY:-hosts/${CALIPER_HOST:-$(hostname -s)}}
+  local make="launch/caliper certs ca (once per cluster) and launch/caliper certs host ${CALIPER_HOST:-$(hostname -s)}${CALIPER_PKI:+ --dir $CALIPER_PKI}, or copy ca.pem and the host's .pem and .pass from the machine holding the CA; --insecure runs without TLS"
+  TLS_CA=$pki/ca.pem
+  case "$id" in *.pem) TLS_KEY=$id ;; *) TLS_KEY=$pki/$id.pem ;; esac
+  TLS_PASS_FILE=${TLS_KEY%.pem}.pass
+  [ -r "$TLS_CA" ] || die "network mode uses TLS: no CA certificate $TLS_CA; make it with $make"
+  [ -r "$TLS_KEY" ] || die "network mode uses TLS: no identity $TLS_KEY for this host; make it with $make"
+  [ -s "$TLS_PASS_FILE" ] || die "network mode uses TLS: no key password $TLS_PASS_FILE beside $TLS_KEY (launch/caliper certs writes both)"
+  [ -n "$SSL_TRANSPORT" ] || die "omniORB's SSL transport libomnisslTP4.so.2 is missing (apt-get install libomniorb4-2)"
 }
 
-# Starts omniNames in DIR; sets NS_PORT, NS_PID, NS_ADDR.
-start_nameserver() {  # DIR [LISTEN_ADDRESS]
-  local dir=$1 addr=${2:-127.0.0.1} try
+# runs an omniORB tool (omniNames, nameclt) with the SSL transport and this host's identity, in
+# place of the calling (sub)shell: `(tls_exec omniNames ...) &` leaves omniNames's pid in $!
+tls_exec() {  # COMMAND ARGS...
+  local password
+  password=$(cat "$TLS_PASS_FILE")
+  export LD_PRELOAD=$SSL_TRANSPORT ORBsslCAFile=$TLS_CA ORBsslKeyFile=$TLS_KEY \
+    ORBsslKeyPassword=$password ORBsslVerifyMode=peer,fail
+  exec "$@"
+}
+
+naming_answers() {  # ADDRESS
+  case "$1" in
+    *:ssliop:*) (tls_exec timeout 5 nameclt -ORBInitRef "NameService=$1" list) >/dev/null 2>&1 ;;
+    *) timeout 5 nameclt -ORBInitRef "NameService=$1" list >/dev/null 2>&1 ;;
+  esac
+}
+
+# Starts omniNames in DIR; sets NS_PORT, NS_PID, NS_ADDR. tls: on giop:ssl only (plain TCP
+# refused), with this host's identity; the address is then corbaname:ssliop:ADDRESS:PORT.
+start_nameserver() {  # DIR [LISTEN_ADDRESS [tls|plain]]
+  local dir=$1 addr=${2:-127.0.0.1} mode=${3:-plain} try
+  local -a run=(exec) proto=tcp scheme="corbaname::"
+  if [ "$mode" = tls ]; then
+    tls_identity
+    run=(tls_exec env "ORBserverTransportRule=* ssl" "ORBclientTransportRule=* ssl")
+    proto=ssl
+    scheme="corbaname:ssliop:"
+  fi
   mkdir -p "$dir"
   for try in 1 2 3; do
     NS_PORT=$(free_port)
     mkdir -p "$dir/omninames-$NS_PORT"
-    omniNames -start "$NS_PORT" -always -nohostname -datadir "$dir/omninames-$NS_PORT" \
-      -ORBendPoint "giop:tcp:$addr:$NS_PORT" -ORBgiopMaxMsgSize 268435456 \
-      >"$dir/omninames.log" 2>&1 &
+    ("${run[@]}" omniNames -start "$NS_PORT" -always -nohostname \
+      -datadir "$dir/omninames-$NS_PORT" -ORBendPoint "giop:$proto:$addr:$NS_PORT" \
+      -ORBgiopMaxMsgSize 268435456 >"$dir/omninames.log" 2>&1) &
     NS_PID=$!
-    NS_ADDR="corbaname::$addr:$NS_PORT"
+    NS_ADDR="$scheme$addr:$NS_PORT"
     for _ in $(seq 1 50); do
       naming_answers "$NS_ADDR" && return 0
       kill -0 "$NS_PID" 2>/dev/null || break

@@ -196,8 +196,8 @@ int Run(const Options& o) {
     throw std::runtime_error("--resume: no checkpoint at " + checkpoint);
 
   ctl::OmniThread omni;
-  CORBA::ORB_var orb = rtc::ClientOrb("caliper-calibrate", 10);
   const std::string address = rtc::NamingAddress(o.nameservice);
+  CORBA::ORB_var orb = rtc::ClientOrb("caliper-calibrate", 10, address);  // TLS when on a network
   ModelPool pool(
       [&] {
         CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, address);

@@ -72,8 +72,8 @@ const std::string& Client::address() {
 
 void Client::Connect() {
   if (!CORBA::is_nil(orb_)) return;
-  orb_ = rtc::ClientOrb("caliper-ctl", options_.timeout_s);
   address_ = rtc::NamingAddress(options_.nameservice);
+  orb_ = rtc::ClientOrb("caliper-ctl", options_.timeout_s, address_);  // TLS when on a network
 }
 
 }  // namespace caliper::ctl

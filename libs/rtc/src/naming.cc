@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "caliper/core/system.h"
+#include "caliper/rtc/transport_security.h"
 
 namespace caliper::rtc {
 
@@ -20,18 +21,27 @@ std::string Describe(const CORBA::Exception& e) {
     const char* minor = sys->NP_minorString();
     if (minor != nullptr) text += std::string(" (") + minor + ")";
   }
+  // a refused TLS handshake, a reference only TLS can reach: said rather than a bare COMM_FAILURE
+  if (const std::string note = TransportFailureNote(e); !note.empty()) text += ": " + note;
   return text;
 }
 
 CosNaming::NamingContext_ptr ResolveRoot(CORBA::ORB_ptr orb, const std::string& address) {
   try {
-    CORBA::Object_var obj = orb->string_to_object(address.c_str());
+    CORBA::Object_var obj = orb->string_to_object(SecureNamingAddress(address).c_str());
     CosNaming::NamingContext_var root = CosNaming::NamingContext::_narrow(obj);
     if (CORBA::is_nil(root)) throw Unreachable("no naming context at " + address);
     root->_non_existent();  // forces a round trip now rather than at first use
     return root._retn();
   } catch (const CORBA::Exception& e) {
-    throw Unreachable("cannot reach the naming service at " + address + ": " + Describe(e));
+    std::string why = Describe(e);
+    if (why.find(": ", 0) == std::string::npos) {
+      // no note from the transport: ask the service for a TLS handshake ourselves
+      const std::string probe = ProbeNamingService(address);
+      if (!probe.empty()) why += ": " + probe;
+    }
+    throw Unreachable("cannot reach the naming service at " + SecureNamingAddress(address) +
+                      ": " + why);
   }
 }
 

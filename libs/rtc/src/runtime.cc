@@ -17,6 +17,7 @@
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
 #include "caliper/rtc/rtobject_servant.h"
+#include "caliper/rtc/transport_security.h"
 
 namespace caliper::rtc {
 
@@ -33,7 +34,17 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
       {"naming.update.interval", Type::kDouble, "10", "re-registration period [s]", 0.05, 3600},
       {"corba.endpoint", Type::kString, "giop:tcp:127.0.0.1:",
        "omniORB endpoint to listen on (loopback only by default; --listen ADDR or $CALIPER_LISTEN "
-       "make it giop:tcp:ADDR:, reachable from other hosts)"},
+       "make it giop:ssl:ADDR:, reachable from other hosts over TLS, giop:tcp:ADDR: with "
+       "--insecure)"},
+      {"corba.insecure", Type::kBool, "false",
+       "network mode without TLS: plain GIOP, no authentication (also --insecure, "
+       "$CALIPER_INSECURE=1); warns loudly"},
+      {"corba.tls.pki_dir", Type::kString, "",
+       "network mode: the directory of launch/caliper certs ('' = $CALIPER_PKI, else "
+       "~/.config/caliper/pki): ca.pem, hosts/NAME.pem and .pass, users/NAME.pem and .pass"},
+      {"corba.tls.identity", Type::kString, "",
+       "network mode: the certificate shown to peers, hosts/NAME, users/NAME or a .pem path ('' = "
+       "$CALIPER_TLS_IDENTITY, else hosts/<host name>, else users/$USER)"},
       {"corba.max_message_size", Type::kDouble, "256",
        "largest GIOP message sent or received [MiB] (scenes and recordings travel by content)",
        1, 2047},
@@ -47,6 +58,9 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
       {"log.service", Type::kString, "logger0", "instance name of the Logging component"},
       {"log.spool_dir", Type::kString, "~/.cache/caliper/spool",
        "where log records wait while the Logging component is unreachable"},
+      {"log.spool_max", Type::kDouble, "64",
+       "largest spool file [MiB]; records beyond it are dropped and counted (a warning record "
+       "says how many once the spool is delivered)", 0.001, 1e6},
   };
 }
 
@@ -66,7 +80,10 @@ void PrintUsage(const ComponentType& type, const core::Config& config) {
             << "  --nameservice ADDR   naming service, e.g. corbaname::127.0.0.1:2809\n"
             << "  --instance NAME      instance base name (bound as NAME0, NAME1, ...)\n"
             << "  --listen ADDR        network mode: listen on ADDR (an address of this host that\n"
-            << "                       the others reach) instead of loopback; also $CALIPER_LISTEN\n"
+            << "                       the others reach) instead of loopback, over TLS with the\n"
+            << "                       certificates of launch/caliper certs; also $CALIPER_LISTEN\n"
+            << "  --insecure           network mode without TLS (plain, unauthenticated GIOP);\n"
+            << "                       also $CALIPER_INSECURE=1 or -o corba.insecure=true\n"
             << "  -h, --help           this text\n"
             << "  -ORB...              passed to omniORB\n\n"
             << "Configuration keys:\n"
@@ -249,8 +266,10 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     std::vector<std::string> overrides;
     if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
       overrides.push_back("corba.endpoint=" + ListenEndpoint(listen));
+    if (InsecureFromEnvironment()) overrides.push_back("corba.insecure=true");
     core::ArgumentSpec spec;
     spec.valued = {"-f", "-o", "--nameservice", "--listen", "--instance"};
+    spec.flags = {"--insecure"};
     spec.pass = [](const std::string& word) { return word.rfind("-ORB", 0) == 0 ? 2 : 0; };
     const std::vector<std::string> words(argv + 1, argv + argc);
     const core::Arguments args = core::ParseArguments(words, spec);
@@ -272,6 +291,8 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
         overrides.push_back("naming.service=" + value);
       else if (option == "--listen")
         overrides.push_back("corba.endpoint=" + ListenEndpoint(value));
+      else if (option == "--insecure")
+        overrides.push_back("corba.insecure=true");
       else
         overrides.push_back("naming.instance=" + value);
     }
@@ -293,6 +314,33 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
 
   Runtime runtime(type, config);
   runtime.naming_address_ = NamingAddress(config.GetString("naming.service"));
+
+  // loopback, or network mode over TLS (the default) or plain (--insecure)
+  TransportSecurity security;
+  try {
+    SecurityRequest request;
+    request.endpoint = config.GetString("corba.endpoint");
+    request.naming_address = runtime.naming_address_;
+    request.insecure = config.GetBool("corba.insecure");
+    request.pki_dir = config.GetString("corba.tls.pki_dir");
+    request.identity = config.GetString("corba.tls.identity");
+    request.component = true;
+    security = ResolveSecurity(request);
+  } catch (const std::exception& e) {
+    log.error("%s", e.what());
+    std::cerr << program << ": error: " << e.what() << "\n";
+    logging::Shutdown();
+    return 2;
+  }
+  if (security.transport == Transport::kInsecure) {
+    WarnInsecure(program, security.endpoint);
+    log.warn("INSECURE network mode: plain GIOP without TLS on %s, no authentication",
+             security.endpoint.c_str());
+  } else if (security.transport == Transport::kTls) {
+    log.notice("network mode over TLS on %s as %s; peers need a certificate of %s",
+               security.endpoint.c_str(), security.key_file.c_str(), security.ca_file.c_str());
+  }
+  InstallProcessSecurity(security);
   {
     std::lock_guard<std::mutex> lock(runtime.mutex_);
     runtime.instance_ = config.GetString("naming.instance");
@@ -303,8 +351,9 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
   // connection to it, so a shorter per-object deadline (the Model's pushes to observers) would
   // not hold; without it a connect is bounded by the call's own deadline
   const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
+  for (const auto& option : SecurityOrbOptions(security)) orb_args.push_back(option);
   orb_args.insert(orb_args.end(),
-                  {"-ORBendPoint", config.GetString("corba.endpoint"),
+                  {"-ORBendPoint", security.endpoint,
                    "-ORBclientCallTimeOutPeriod", std::to_string(timeout_ms),
                    "-ORBgiopMaxMsgSize",
                    std::to_string(static_cast<long>(config.GetDouble("corba.max_message_size") *
@@ -316,6 +365,7 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
   int exit_code = 0;
   try {
     runtime.orb_ = CORBA::ORB_init(orb_argc, orb_argv.data());
+    InstallTransportDiagnostics();
     CORBA::Object_var poa_obj = runtime.orb_->resolve_initial_references("RootPOA");
     runtime.poa_ = PortableServer::POA::_narrow(poa_obj);
     runtime.poa_->the_POAManager()->activate();
@@ -324,6 +374,8 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
       logging::AppenderOptions options;
       options.spool_dir = core::ExpandHome(config.GetString("log.spool_dir"));
       options.spool_name = type.name + "-" + std::to_string(getpid());
+      options.max_spool_bytes =
+          static_cast<uint64_t>(config.GetDouble("log.spool_max") * 1024 * 1024);
       logging::AddAppender(new logging::BatchingAppender(
           "log-service",
           std::make_unique<LogServiceSink>(runtime.orb_, runtime.naming_address_,
