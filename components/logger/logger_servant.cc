@@ -233,15 +233,14 @@ idl::StoredRecordSeq* LoggerServant::query(const idl::RecordFilter& q) {
 char* LoggerServant::session_file() { return CORBA::string_dup(component_.session_file().c_str()); }
 
 CORBA::ULongLong LoggerServant::add_listener(idl::LogListener_ptr listener) {
-  if (!CORBA::is_nil(listener)) {
-    // a reference to nothing would hold a place until its pushes had failed for long: refuse it
-    // now (the check leaves the reference with the pushes' own timeout, corba.call_timeout)
-    const auto timeout = std::chrono::milliseconds(
-        static_cast<long>(runtime_.config().GetDouble("corba.call_timeout") * 1000));
-    const std::string why =
-        rtc::Unreachable(listener, "LogListener", idl::LogListener::_PD_repoId, timeout);
-    if (!why.empty()) throw idl::NotAvailable(why.c_str());
-  }
+  if (CORBA::is_nil(listener)) throw idl::NotAvailable("the listener is nil");
+  // a reference to nothing would hold a place until its pushes had failed for long: refuse it
+  // now (the check leaves the reference with the pushes' own timeout, corba.call_timeout)
+  const auto timeout = std::chrono::milliseconds(
+      static_cast<long>(runtime_.config().GetDouble("corba.call_timeout") * 1000));
+  const std::string why =
+      rtc::Unreachable(listener, "LogListener", idl::LogListener::_PD_repoId, timeout);
+  if (!why.empty()) throw idl::NotAvailable(why.c_str());
   const uint64_t id = hub_.Add(listener);
   logging::Get("listeners").info("log listener %llu added (client %s)",
                                  static_cast<unsigned long long>(id),

@@ -3,6 +3,7 @@
 #include <type_traits>
 
 #include "caliper/logging/log.h"
+#include "caliper/rtc/reason.h"
 
 namespace caliper::manager {
 
@@ -23,19 +24,21 @@ void ToIdl(const ChildStatus& s, C::Child* out) {
 // `Fallback` with the reason (CORBA::INTERNAL for operations that raise nothing).
 template <class Fallback = void, class F>
 auto Guard(F&& f) -> decltype(f()) {
+  // reasons quote what the client sent (types, keys, names): bounded, whatever their size
+  using rtc::BoundedReason;
   std::string reason;
   try {
     return f();
   } catch (const CapacityReached& e) {
-    throw C::CapacityReached(e.what());
+    throw C::CapacityReached(BoundedReason(e.what()).c_str());
   } catch (const StartFailed& e) {
-    throw C::StartFailed(e.what());
+    throw C::StartFailed(BoundedReason(e.what()).c_str());
   } catch (const UnknownComponent& e) {
-    throw C::UnknownComponent(e.what());
+    throw C::UnknownComponent(BoundedReason(e.what()).c_str());
   } catch (const CORBA::Exception&) {
     throw;
   } catch (const std::exception& e) {
-    reason = std::string("internal error: ") + e.what();
+    reason = "internal error: " + BoundedReason(e.what());
   } catch (...) {
     reason = "internal error: an exception of unknown type";
   }
@@ -74,6 +77,8 @@ C::ChildSeq* ManagerServant::list() {
 }
 
 void ManagerServant::destroy(const char* instance) {
+  // children that never registered have no name yet: "" must not pick one of them
+  if (*instance == '\0') throw C::UnknownComponent("no instance name given");
   Guard<C::UnknownComponent>([&] { component_.Destroy(instance); });
 }
 

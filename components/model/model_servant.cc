@@ -10,6 +10,7 @@
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "caliper/rtc/peers.h"
+#include "caliper/rtc/reason.h"
 
 namespace caliper::model {
 
@@ -140,21 +141,24 @@ std::vector<std::string> FromIdl(const S::StringSeq& ids) {
 /// is the operation's declared "cannot serve now" exception (Simulation's or Daq's NotAvailable).
 template <class Unavailable = M::NotAvailable, class F>
 auto Guard(F&& f) -> decltype(f()) {
+  // reasons quote what the client sent (ids, names, paths): bounded, whatever their size
+  using rtc::BoundedReason;
   try {
     return f();
   } catch (const UnknownId& e) {
-    throw D::UnknownId(e.what(), e.id().c_str());
+    throw D::UnknownId(BoundedReason(e.what()).c_str(), BoundedReason(e.id()).c_str());
   } catch (const InvalidValue& e) {
-    throw D::InvalidParameter(e.what());
+    throw D::InvalidParameter(BoundedReason(e.what()).c_str());
   } catch (const NotAvailable& e) {
-    throw Unavailable(e.what());
+    throw Unavailable(BoundedReason(e.what()).c_str());
   } catch (const LimitExceeded& e) {
-    throw D::LimitExceeded(e.what(), e.limit());
+    throw D::LimitExceeded(BoundedReason(e.what()).c_str(), e.limit());
   } catch (const CORBA::UserException&) {
     throw;
   } catch (const std::exception& e) {
-    logging::Get("model").error("internal error: %s", e.what());
-    throw Unavailable((std::string("internal error: ") + e.what()).c_str());
+    const std::string reason = BoundedReason(e.what());
+    logging::Get("model").error("internal error: %s", reason.c_str());
+    throw Unavailable(("internal error: " + reason).c_str());
   } catch (...) {
     logging::Get("model").error("internal error: an exception of unknown type");
     throw Unavailable("internal error: an exception of unknown type");
@@ -713,8 +717,10 @@ void ModelServant::load_scene_data(const char* file_name, const M::Octets& data)
   } catch (const NotAvailable& e) {
     throw M::NotAvailable(e.what());  // busy with an experiment: not the file's fault
   } catch (const std::exception& e) {
-    logging::Get("model").error("load %s (sent by content) failed: %s", file_name, e.what());
-    throw M::LoadFailed(e.what());
+    const std::string reason = rtc::BoundedReason(e.what());
+    logging::Get("model").error("load %s (sent by content) failed: %s",
+                                rtc::BoundedReason(file_name).c_str(), reason.c_str());
+    throw M::LoadFailed(reason.c_str());
   } catch (...) {
     throw M::LoadFailed("internal error: an exception of unknown type");
   }
@@ -757,14 +763,16 @@ M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
     try {
       return core_.RunExperiment(e, e.scene, bytes);
     } catch (const experiment::FormatError& error) {
-      throw D::InvalidParameter(error.what());
+      throw D::InvalidParameter(rtc::BoundedReason(error.what()).c_str());
     } catch (const RunFailed& error) {
       // the fault itself was logged once, as an error, where it happened
-      logging::Get("model").info("%s", error.what());
-      throw M::RunFailed(error.what());
+      const std::string reason = rtc::BoundedReason(error.what());
+      logging::Get("model").info("%s", reason.c_str());
+      throw M::RunFailed(reason.c_str());
     } catch (const LoadError& error) {
-      logging::Get("model").error("%s", error.what());
-      throw M::LoadFailed(error.what());
+      const std::string reason = rtc::BoundedReason(error.what());
+      logging::Get("model").error("%s", reason.c_str());
+      throw M::LoadFailed(reason.c_str());
     }
   });
   return Guard([&] {

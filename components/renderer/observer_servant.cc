@@ -3,6 +3,7 @@
 #include <exception>
 
 #include "caliper/logging/log.h"
+#include "caliper/rtc/reason.h"
 
 namespace caliper::renderer {
 
@@ -107,9 +108,20 @@ R::SceneDescription FromIdl(const S::Description& scene) {
 
 void ObserverServant::on_scene(const S::Description& scene) {
   try {
+    size_t visuals = 0;
+    for (CORBA::ULong b = 0; b < scene.bodies.length(); ++b)
+      visuals += scene.bodies[b].visuals.length();
+    if (visuals > kMaxVisuals) {
+      logging::Get("renderer").error(
+          "scene with %zu visuals not shown: the renderer draws at most %zu", visuals,
+          kMaxVisuals);
+      mailbox_.PutCleared();
+      return;
+    }
     R::SceneDescription plain = FromIdl(scene);
-    logging::Get("renderer").info("scene '%s': %zu bodies, %zu tendons", plain.name.c_str(),
-                                  plain.bodies.size(), plain.tendons.size());
+    logging::Get("renderer").info("scene '%s': %zu bodies, %zu tendons",
+                                  rtc::BoundedReason(plain.name).c_str(), plain.bodies.size(),
+                                  plain.tendons.size());
     std::lock_guard<std::mutex> lock(mutex_);
     last_update_ = 0;  // a new registration (or a new Model) counts from 1 again
     mailbox_.PutScene(std::move(plain));

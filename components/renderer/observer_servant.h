@@ -16,6 +16,11 @@ namespace caliper::renderer {
 
 class ObserverServant : public virtual POA_Caliper::Scene::SceneObserver {
  public:
+  /// The most visuals a scene may have to be drawn: Coin takes about 7 KB for each, so a scene
+  /// of small visuals filling one message (256 MiB) would take tens of GB. A larger scene is not
+  /// shown (the view is cleared) and the log says why.
+  static constexpr size_t kMaxVisuals = 20000;
+
   explicit ObserverServant(SceneMailbox& mailbox) : mailbox_(mailbox) {}
   void on_scene(const Caliper::Scene::Description& scene) override;
   void on_transforms(CORBA::ULongLong update, CORBA::Double sim_time,

@@ -49,7 +49,7 @@ double ExecutionContext::rate() const {
 }
 
 ReturnCode ExecutionContext::SetRate(double rate_hz) {
-  if (!(rate_hz > 0.0 && rate_hz <= 1e6)) return ReturnCode::kBadParameter;
+  if (!(rate_hz >= kMinRateHz && rate_hz <= kMaxRateHz)) return ReturnCode::kBadParameter;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     rate_hz_ = rate_hz;

@@ -40,7 +40,7 @@ idl::ReturnCode RTObjectServant::finalize() {
 }
 
 idl::ReturnCode RTObjectServant::exit() {
-  if (runtime_.lifecycle().finalized()) return idl::PRECONDITION_NOT_MET;
+  // also once finalized: a finalized component serves nothing, and no other call ends its process
   runtime_.RequestExit();
   return idl::RTC_OK;
 }

@@ -264,7 +264,7 @@ TEST_F(LoggerProcessTest, ListenersAreBoundedAndNeitherABlockedNorAGoneOneHoldsS
     EXPECT_NE(std::string(e.reason.in()).find("at most 8 per client"), std::string::npos)
         << e.reason.in();
   }
-  EXPECT_THROW(logger_ref_->add_listener(L::LogListener::_nil()), CORBA::BAD_PARAM);
+  EXPECT_THROW(logger_ref_->add_listener(L::LogListener::_nil()), L::NotAvailable);
   // a reference to nothing takes no place: refused with the reason
   ActiveListener gone;
   gone.Deactivate();

@@ -190,6 +190,10 @@ TEST_F(ExecutionContextTest, RejectsRatesOutsideTheRange) {
   EXPECT_EQ(context.SetRate(2e6), ReturnCode::kBadParameter);
   EXPECT_EQ(context.SetRate(std::numeric_limits<double>::quiet_NaN()), ReturnCode::kBadParameter);
   EXPECT_EQ(context.SetRate(std::numeric_limits<double>::infinity()), ReturnCode::kBadParameter);
+  // positive but so slow that the period overflows the clock (it ticked ~7 million times a second)
+  EXPECT_EQ(context.SetRate(1e-300), ReturnCode::kBadParameter);
+  EXPECT_EQ(context.SetRate(std::numeric_limits<double>::denorm_min()), ReturnCode::kBadParameter);
+  EXPECT_EQ(context.SetRate(0.9e-3), ReturnCode::kBadParameter);
   EXPECT_DOUBLE_EQ(context.rate(), 100.0);
   EXPECT_EQ(component_.count(testing::kRateChanged), 0);
 }
@@ -201,6 +205,8 @@ TEST_F(ExecutionContextTest, SetRateChangesRateAndCallsOnRateChanged) {
   EXPECT_EQ(component_.count(testing::kRateChanged), 1);
   EXPECT_EQ(context.SetRate(1e6), ReturnCode::kOk);  // the upper bound is allowed
   EXPECT_EQ(component_.count(testing::kRateChanged), 2);
+  EXPECT_EQ(context.SetRate(1e-3), ReturnCode::kOk);  // and the lower one (exec.rate's)
+  EXPECT_EQ(component_.count(testing::kRateChanged), 3);
   EXPECT_EQ(lifecycle_.state(), State::kActive);
 }
 

@@ -38,8 +38,12 @@ class ExecutionContext {
   ReturnCode Stop();
   bool is_running() const;
   double rate() const;
-  /// BAD_PARAMETER unless 0 < rate_hz <= 1e6; runs on_rate_changed.
+  /// BAD_PARAMETER unless kMinRateHz <= rate_hz <= kMaxRateHz (the range of `exec.rate`: below
+  /// it a period overflows the clock and the context would tick without pause); runs
+  /// on_rate_changed.
   ReturnCode SetRate(double rate_hz);
+  static constexpr double kMinRateHz = 1e-3;
+  static constexpr double kMaxRateHz = 1e6;
   ContextKind kind() const { return kind_; }
   /// One tick now: EXTERNAL only (UNSUPPORTED on PERIODIC), and only while running.
   ReturnCode Tick();
