@@ -533,8 +533,9 @@ int Record(Client& client, std::vector<std::string>& args) {
   PortableServer::ObjectId_var oid = poa->activate_object(consumer);
   CORBA::Object_var ref = poa->id_to_reference(oid);
   D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(ref);
+  // lossless: stepping in lock-step or as fast as possible, the Model waits for this recorder
   const CORBA::ULongLong subscription =
-      Call(m, [&] { return m.model->subscribe(ids, every, consumer_ref); });
+      Call(m, [&] { return m.model->subscribe_lossless(ids, every, consumer_ref); });
 
   std::cerr << "recording " << args.size() << " id" << (args.size() == 1 ? "" : "s") << " ("
             << recording.values_per_sample() << " columns) every " << every << " step"
@@ -542,6 +543,9 @@ int Record(Client& client, std::vector<std::string>& args) {
             << (std::isfinite(duration) ? "for " + Num(duration) + " s of simulated time"
                                         : "until Ctrl-C")
             << " to " << csv_path << "\n";
+  std::cerr << "lossless: " << name << " waits for this recorder when it steps (step N, "
+            << "lock-step, as fast as possible); at a real-time factor it does not, and samples "
+            << "it drops are counted\n";
   if (status->state != M::RUNNING)
     std::cerr << name << " is " << rtc::Name(status->state)
               << ": samples come once it runs (caliper-ctl start) or steps\n";
@@ -554,7 +558,15 @@ int Record(Client& client, std::vector<std::string>& args) {
   using Clock = std::chrono::steady_clock;
   auto last_progress = Clock::now() - std::chrono::seconds(1);
   auto last_check = Clock::now();
-  std::string shown, lost, interrupted;
+  std::string shown, lost, interrupted, ended;
+  D::SubscriptionStatus counts{};  // the Model's, as last read
+  auto read_counts = [&] {
+    try {
+      counts = m.model->subscription_status(subscription);
+    } catch (const D::UnknownId& e) {
+      ended = e.reason.in();  // the Model ended it (a consumer that missed a push deadline)
+    }
+  };
   while (true) {
     {
       std::lock_guard<std::mutex> lock(consumer->mutex);
@@ -575,14 +587,23 @@ int Record(Client& client, std::vector<std::string>& args) {
       last_progress = t;
     }
     if (t - last_check >= std::chrono::seconds(1)) {
-      // a Model that went away sends nothing more: say so instead of waiting forever
+      // a Model that went away, or ended the subscription, sends nothing more: say so instead
+      // of waiting forever
       try {
-        M::SimulationStatus_var alive = m.model->status();
+        read_counts();
       } catch (const CORBA::SystemException& e) {
         lost = Client::Unreachable(m.path, e);
         break;
       }
+      if (!ended.empty()) break;
       last_check = t;
+    }
+  }
+  if (lost.empty() && ended.empty()) {
+    try {
+      read_counts();  // what the Model dropped, if anything, for the report
+    } catch (const CORBA::SystemException& e) {
+      lost = Client::Unreachable(m.path, e);
     }
   }
   consumer->Close();
@@ -610,6 +631,17 @@ int Record(Client& client, std::vector<std::string>& args) {
   else
     std::cout << "gaps: " << recording.missing_batches() << " batches never arrived (numbers "
               << recording.gaps() << "); the samples they held are missing from the file\n";
+  if (ended.empty() && lost.empty()) {
+    if (counts.dropped_samples == 0)
+      std::cout << "dropped: none (the Model's count";
+    else
+      std::cout << "dropped: " << counts.dropped_samples << " samples in "
+                << counts.dropped_batches << " batches (the Model's count; a real-time run "
+                << "does not wait for a recorder slower than the simulation";
+    if (counts.waited > 0)
+      std::cout << "; it waited " << Num(counts.waited, 3) << " s for this recorder";
+    std::cout << ")\n";
+  }
   if (!consumer->stale.empty()) {
     std::cerr << "warning: ids no longer in the Model (a scene was loaded; their values are nan):";
     for (const auto& id : consumer->stale) std::cerr << " " << id;
@@ -617,6 +649,7 @@ int Record(Client& client, std::vector<std::string>& args) {
   }
   if (!written) throw Failure("write error on " + csv_path);
   if (!lost.empty()) throw Failure(lost);
+  if (!ended.empty()) throw Failure(ended);
   if (!recording.error().empty()) throw Failure(recording.error());
   return 0;
 }
@@ -686,7 +719,12 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "stream ids to a CSV file with units, for T s of simulated time or until Ctrl-C", Record,
       "  Subscribes to the Model's data acquisition: one sample every N steps (1), one column\n"
       "  per scalar element (`time [s],arm.hand.position[0] [m],...`). Progress goes to stderr;\n"
-      "  at the end it reports the samples written and any gaps in batch numbers.\n",
+      "  at the end it reports the samples written, any gaps in batch numbers and the samples\n"
+      "  the Model dropped. Lossless: stepping in lock-step (step N, an external execution\n"
+      "  context) or as fast as possible, the Model waits for this recorder, so the file holds\n"
+      "  every sample; at a real-time factor it does not wait, and what it drops is counted.\n"
+      "  A recorder that misses the Model's push deadline (1 s; e.g. stopped) is dropped by\n"
+      "  the Model: record then exits 1 with the Model's reason.\n",
       true);
   add("save", "save FILE [--send] [--model NAME]", "export the scene with its current parameters as COLLADA",
       Save,

@@ -833,14 +833,15 @@ void ModelCore::UnsubscribeLocked(uint64_t subscription, const std::string& reas
   const std::string kind = feed->second.lossless_wait.count() > 0 ? "lossless " : "";
   try {
     const daq::SubscriptionStats stats = recorder_.Stats(subscription);
-    recorder_.Unsubscribe(subscription);
+    uint64_t unsent = 0;  // queued, and the partial batch
+    for (const daq::Batch& b : recorder_.Unsubscribe(subscription)) unsent += b.step_count;
     const uint64_t dropped = stats.dropped_samples + feed->second.undelivered_samples;
     auto& log = logging::Get("daq");
     if (!reason.empty())
-      log.warn("%ssubscription %llu ended by the Model after %llu samples (%llu dropped): %s",
+      log.warn("%ssubscription %llu ended by the Model after %llu samples (%llu never sent): %s",
                kind.c_str(), static_cast<unsigned long long>(subscription),
                static_cast<unsigned long long>(stats.samples),
-               static_cast<unsigned long long>(dropped), reason.c_str());
+               static_cast<unsigned long long>(dropped + unsent), reason.c_str());
     else if (dropped > 0)
       log.notice("%ssubscription %llu ended: %llu samples taken, %llu of them dropped (the "
                  "consumer was slower than the simulation ran)",

@@ -623,7 +623,8 @@ PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
       dropped_ += batches.size() - k;
       core_.NoteUndelivered(subscription_, batches.size() - k, samples);
       *why = rtc::Describe(e) + " (" + std::to_string(dropped_) + " batches dropped so far)";
-      if (lossless_) *why += "; a lossless subscription ends at its first failed push";
+      if (lossless_)
+        *why = "a push failed: " + *why + "; a lossless subscription ends at its first failed push";
       last_failure_ = *why;
       return PeerGone(e) || lossless_ ? Outcome::kGone : Outcome::kFailed;
     }
