@@ -25,7 +25,8 @@ SSL_TRANSPORT=$(ls /usr/lib/*/libomnisslTP4.so.2 2>/dev/null | head -1)
 tls_identity() {
   local pki=${CALIPER_PKI:-$HOME/.config/caliper/pki}
   local id=${CALIPER_TLS_IDENTITY:-hosts/${CALIPER_HOST:-$(hostname -s)}}
-  local make="launch/caliper certs ca (once per cluster) and launch/caliper certs host ${CALIPER_HOST:-$(hostname -s)}${CALIPER_PKI:+ --dir $CALIPER_PKI}, or copy ca.pem and the host's .pem and .pass from the machine holding the CA; --insecure runs without TLS"
+  local d=${CALIPER_PKI:+ --dir $CALIPER_PKI}
+  local make="launch/caliper certs ca$d (once per cluster) and launch/caliper certs host ${CALIPER_HOST:-$(hostname -s)}$d, or copy ca.pem and the host's .pem and .pass from the machine holding the CA; --insecure runs without TLS"
   TLS_CA=$pki/ca.pem
   case "$id" in *.pem) TLS_KEY=$id ;; *) TLS_KEY=$pki/$id.pem ;; esac
   TLS_PASS_FILE=${TLS_KEY%.pem}.pass
