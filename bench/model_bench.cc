@@ -125,7 +125,8 @@ int main(int argc, char** argv) {
   testing::Process model({testing::Bin("caliper-model"), "--nameservice", naming.address(), "-o",
                           "model.scene=" + root + "/models/ecce_arm.dae", "-o",
                           "exec.auto_activate=true", "-o", "log.service=none", "-o",
-                          "log.spool_dir=" + dir.path() + "/spool", "-o", "log.level=warn"},
+                          "log.spool_dir=" + dir.path() + "/spool", "-o", "log.level=warn", "-o",
+                          "model.write_dir=" + dir.path()},
                          dir.path() + "/model.out");
   const std::string ior_file = dir.path() + "/echo.ior";
   testing::Process echo({argv[0], "--echo-server", ior_file}, dir.path() + "/echo.out");

@@ -29,6 +29,7 @@
 #include "inspect.h"
 #include "batch.h"
 #include "model_verbs.h"
+#include "renderer_verbs.h"
 
 namespace caliper::ctl {
 namespace {
@@ -296,6 +297,7 @@ std::map<std::string, Verb> Verbs() {
                       "(no session needed); --export writes the imported scene back out",
                       Inspect, "files"};
   AddModelVerbs(&verbs);
+  AddRendererVerbs(&verbs);
   AddClusterVerbs(&verbs);
   AddBatchVerb(&verbs);
   return verbs;
@@ -311,6 +313,7 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
       {"components", "Components"},
       {"model", "Model (model0, or --model NAME on each verb)"},
       {"cluster", "Cluster (a manager per host starts and stops Models)"},
+      {"renderer", "Scene Renderer (renderer0, or --renderer NAME)"},
       {"files", "Files"}};
   for (const auto& [group, title] : groups) {
     std::cout << "\n" << title << ":\n";

@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "caliper/model.hh"
+#include "caliper/core/confined_path.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/rtc/idl_names.h"
@@ -151,6 +152,21 @@ M::SimulationStatus* StatusOf(const ModelRef& m) {
   return Call(m, [&] { return m.model->status(); });
 }
 
+// Whether a Model on this host takes `path` itself: it reads only below its search path and
+// writes only below its write directory (file_access); other files go by content.
+bool ModelTakesPath(const ModelRef& m, const std::string& path,
+                    core::ConfinedPaths::Access access) {
+  M::FileAccess_var files = Call(m, [&] { return m.model->file_access(); });
+  std::vector<std::string> dirs;
+  if (access == core::ConfinedPaths::Access::kRead) {
+    for (CORBA::ULong i = 0; i < files->read_dirs.length(); ++i)
+      dirs.push_back(files->read_dirs[i].in());
+  } else if (*files->write_dir.in() != '\0') {
+    dirs.push_back(files->write_dir.in());
+  }
+  return core::ConfinedPaths(dirs, "", "").Allows(path, access);
+}
+
 // Channel metadata by id (one list call).
 std::map<std::string, D::ChannelInfo> Channels(const ModelRef& m, const std::string& pattern) {
   D::ChannelInfoSeq_var list = Call(m, [&] { return m.model->list(pattern.c_str()); });
@@ -202,7 +218,8 @@ int Load(Client& client, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
   ModelRef m = Connect(client, name);
-  const bool send = ByContent(m, send_flag);
+  const bool send =
+      ByContent(m, send_flag) || !ModelTakesPath(m, path, core::ConfinedPaths::Access::kRead);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   Call(m, [&] {
     try {
@@ -219,7 +236,7 @@ int Load(Client& client, std::vector<std::string>& args) {
         m.model->load_scene(path.c_str());
       }
     } catch (const M::LoadFailed& e) {
-      std::string message = e.reason.in();
+      std::string message = (send ? path + " (sent by content): " : std::string()) + e.reason.in();
       M::SimulationStatus_var s = StatusOf(m);
       if (s->state != M::EMPTY)
         message += "\n  (" + name + " keeps " + s->scene.in() + ", " + rtc::Name(s->state) + ")";
@@ -306,7 +323,8 @@ int Save(Client& client, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
   ModelRef m = Connect(client, name);
-  const bool fetch = ByContent(m, send_flag);
+  const bool fetch =
+      ByContent(m, send_flag) || !ModelTakesPath(m, path, core::ConfinedPaths::Access::kWrite);
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   if (fetch) {
     M::Octets_var data = Call(m, [&] { return m.model->export_scene(); });
@@ -320,7 +338,8 @@ int Save(Client& client, std::vector<std::string>& args) {
   } else {
     Call(m, [&] { m.model->save_scene(path.c_str()); });
   }
-  std::cout << name << ": saved the scene with its current parameters to " << path << "\n";
+  std::cout << name << ": saved the scene with its current parameters to " << path
+            << (fetch ? " (fetched by content)" : "") << "\n";
   return 0;
 }
 
@@ -668,7 +687,8 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
   add("load", "load FILE [--send] [--model NAME]", "load a COLLADA scene into a Model", Load,
       "  On failure the Model keeps (and runs) the scene it had, and the importer's message\n"
       "  (file, line, element, problem) is printed. FILE is sent as an absolute path to a Model\n"
-      "  on this host, by content (its bytes) to one on another host or with --send.\n");
+      "  on this host that reads it (below its model.read_dirs or write directory), else by\n"
+      "  content (its bytes): to one on another host, with --send, or for files elsewhere.\n");
   for (const std::string v : {"start", "pause", "stop"}) {
     const std::string summary = v == "start"   ? "run the simulation (at the real-time factor)"
                                 : v == "pause" ? "pause the simulation"
@@ -728,8 +748,10 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       true);
   add("save", "save FILE [--send] [--model NAME]", "export the scene with its current parameters as COLLADA",
       Save,
-      "  FILE is written by the Model's process (sent as an absolute path); for a Model on\n"
-      "  another host, or with --send, the export comes back by content and is written here.\n");
+      "  FILE is written by the Model's process (sent as an absolute path) when it lies below\n"
+      "  the Model's write directory (model.write_dir, the session's directory); otherwise (a\n"
+      "  Model on another host, --send, files elsewhere) the export comes back by content and\n"
+      "  is written here.\n");
 }
 
 }  // namespace caliper::ctl

@@ -1,9 +1,15 @@
 #include "model_link.h"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
+#include "caliper/core/confined_path.h"
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/client_orb.h"
@@ -67,7 +73,25 @@ void ModelLink::LoadScene(const std::string& path) {
   const int long_ms = options_.long_call_timeout_ms;
   Queue("load " + path, [path, long_ms](Impl& i) {
     omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
-    i.model->load_scene(path.c_str());
+    // the Model reads only below its search path: other files go by content
+    M::FileAccess_var files = i.model->file_access();
+    std::vector<std::string> dirs;
+    for (CORBA::ULong k = 0; k < files->read_dirs.length(); ++k)
+      dirs.push_back(files->read_dirs[k].in());
+    if (core::ConfinedPaths(dirs, "", "").Allows(path, core::ConfinedPaths::Access::kRead)) {
+      i.model->load_scene(path.c_str());
+    } else {
+      std::ifstream in(path, std::ios::binary);
+      if (!in) throw std::runtime_error("cannot read " + path);
+      const std::string bytes((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+      if (bytes.size() > static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20))
+        throw std::runtime_error(path + " is larger than one CORBA message carries");
+      M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
+      data.length(static_cast<CORBA::ULong>(bytes.size()));
+      std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
+      i.model->load_scene_data(std::filesystem::path(path).filename().c_str(), data);
+    }
     i.channels_listed = false;
   });
 }

@@ -101,6 +101,10 @@ ChildStatus ManagerComponent::Create(
     if (key == "corba.endpoint" || key == "naming.service")
       throw StartFailed("the key '" + key + "' is set by the manager (" +
                         "its Models listen and register where it does)");
+    // the directories paths may lead into are the host's choice (README, "Trust model")
+    if (key == "model.read_dirs" || key == "model.write_dir" || key == "model.confine_scene")
+      throw StartFailed("the key '" + key + "' is set on the manager's host, not by a client " +
+                        "(it bounds the files a Model reads and writes for its clients)");
     const bool allowed =
         (key.rfind("model.", 0) == 0 && key != "model.inject_fault") ||
         key == "exec.kind" || key == "exec.rate" || key == "log.level" ||
@@ -116,6 +120,8 @@ ChildStatus ManagerComponent::Create(
       "-o", "exec.auto_activate=true",
       "-o", "log.spool_dir=" + own.GetString("log.spool_dir")};
   for (const auto& [key, value] : config) argv.insert(argv.end(), {"-o", key + "=" + value});
+  // a client's model.scene is read only from the Model's search path, as load_scene is
+  argv.insert(argv.end(), {"-o", "model.confine_scene=true"});
   const pid_t pid = supervisor_->Start(type, argv);
   const ChildStatus child = AwaitRegistration(pid);
   logging::Get("manager").info("started %s (pid %d) as %s", type.c_str(), static_cast<int>(pid),

@@ -2,12 +2,13 @@
 
 #include "caliper/logging/log.h"
 #include "fault_injection.h"
+#include "model_files.h"
 
 namespace caliper::model {
 
 std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
   using Type = core::ConfigKey::Type;
-  return {
+  std::vector<core::ConfigKey> keys = {
       {"model.scene", Type::kString, "", "COLLADA scene loaded at start ('' = none)"},
       {"model.real_time_factor", Type::kDouble, "1", "1 = real time, 0 = as fast as possible", 0,
        1e6},
@@ -18,6 +19,8 @@ std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
        "for tests of the fault path: KIND@STEP makes step STEP of the first scene built throw "
        "(KIND: simulation_fault, bad_alloc, out_of_range, runtime_error, unknown); '' = never"},
   };
+  for (const core::ConfigKey& key : ModelFiles::ConfigKeys()) keys.push_back(key);
+  return keys;
 }
 
 ModelComponent::ModelComponent(rtc::Runtime& runtime)
@@ -35,7 +38,13 @@ ModelComponent::ModelComponent(rtc::Runtime& runtime)
 }
 
 rtc::ReturnCode ModelComponent::OnInitialize() {
-  const std::string scene = runtime_.config().GetString("model.scene");
+  const ModelFiles files = ModelFiles::FromConfig(runtime_.config());
+  logging::Get("model").info("scene paths from clients: read below %s; written below %s",
+                             files.read.Describe().c_str(), files.write.Describe().c_str());
+  std::string scene = runtime_.config().GetString("model.scene");
+  // a scene a client chose (through a manager) is confined like load_scene's
+  if (!scene.empty() && runtime_.config().GetBool("model.confine_scene"))
+    scene = files.read.Resolve(scene, core::ConfinedPaths::Access::kRead).string();
   if (!scene.empty()) core_->Load(scene);  // a bad file fails initialisation with its message
   return rtc::ReturnCode::kOk;
 }

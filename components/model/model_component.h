@@ -6,6 +6,7 @@
 //   model.real_time_factor  1 = real time, 0 = as fast as possible
 //   model.autostart         start simulating once loaded and active
 //   model.tendon_contact    bend tendons around bodies they would cut through
+//   model.read_dirs, model.write_dir   where paths from clients may lead (model_files.h)
 // The execution context drives stepping: PERIODIC ticks advance the simulation by what the
 // real-time factor makes due; an EXTERNAL context steps once per tick (lock-step).
 

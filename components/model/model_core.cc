@@ -177,14 +177,20 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     if (!out.flush()) throw LoadError("cannot write the scene to " + path);
   }
+  // messages name the file as sent, not the private copy
+  auto named = [&](std::string message) {
+    for (size_t at = message.find(path); at != std::string::npos; at = message.find(path, at))
+      message.replace(at, path.size(), base);
+    return message;
+  };
   std::vector<std::string> warnings;
   sgal::Scene scene;
   try {
     scene = collada::Import(path, &warnings);
   } catch (const collada::ImportError& e) {
-    throw LoadError(e.what());
+    throw LoadError(named(e.what()));
   }
-  for (const auto& w : warnings) logging::Get("model").warn("%s", w.c_str());
+  for (const auto& w : warnings) logging::Get("model").warn("%s", named(w).c_str());
   return scene;
 }
 

@@ -636,7 +636,10 @@ PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
 // ------------------------------------------------------------------------ servant
 
 ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core, const PushLimits& limits)
-    : rtc::RTObjectServant(runtime), core_(core), pool_(limits) {
+    : rtc::RTObjectServant(runtime),
+      core_(core),
+      files_(ModelFiles::FromConfig(runtime.config())),
+      pool_(limits) {
   // the stepping waits for a lossless consumer: its sender should push now, not at its next poll
   core_.SetConsumerWake([this](uint64_t id) { pool_.Due(PushPool::Kind::kSubscription, id); });
 }
@@ -644,8 +647,19 @@ ModelServant::ModelServant(rtc::Runtime& runtime, ModelCore& core, const PushLim
 ModelServant::~ModelServant() { core_.SetConsumerWake(nullptr); }
 
 void ModelServant::load_scene(const char* path) {
+  // only below the model search path: a client must not make the Model read any file
+  std::string file;
   try {
-    core_.Load(path);
+    file = files_.read.Resolve(path, core::ConfinedPaths::Access::kRead).string();
+  } catch (const std::exception& e) {
+    logging::Get("model").warn("load_scene refused: %s", e.what());
+    throw M::LoadFailed((std::string("load_scene: ") + e.what() +
+                         "; other files are sent by content (load_scene_data, as caliper-ctl "
+                         "load does by itself)")
+                            .c_str());
+  }
+  try {
+    core_.Load(file);
   } catch (const std::exception& e) {
     logging::Get("model").error("load %s failed: %s", path, e.what());
     throw M::LoadFailed(e.what());
@@ -803,14 +817,33 @@ M::Recording* ModelServant::run_experiment(const M::Experiment& in) {
 
 void ModelServant::save_scene(const char* path) {
   Guard([&] {
+    // only into the write directory: a client must not make the Model overwrite any file
+    std::string file;
     try {
-      core_.Save(path);
+      file = files_.write.Resolve(path, core::ConfinedPaths::Access::kWrite).string();
+    } catch (const std::exception& e) {
+      logging::Get("model").warn("save_scene refused: %s", e.what());
+      throw InvalidValue(std::string("save_scene: ") + e.what() +
+                         "; other clients fetch the scene with export_scene (as caliper-ctl save "
+                         "does by itself)");
+    }
+    try {
+      core_.Save(file);
     } catch (const NotAvailable&) {
       throw;
     } catch (const std::exception& e) {
       throw InvalidValue(std::string("cannot save ") + path + ": " + e.what());
     }
   });
+}
+
+M::FileAccess* ModelServant::file_access() {
+  auto* out = new M::FileAccess;
+  const std::vector<std::string>& read = files_.read.dirs();
+  out->read_dirs.length(static_cast<CORBA::ULong>(read.size()));
+  for (CORBA::ULong i = 0; i < read.size(); ++i) out->read_dirs[i] = read[i].c_str();
+  out->write_dir = files_.write.dirs().empty() ? "" : files_.write.dirs().front().c_str();
+  return out;
 }
 
 M::ActuatorInfoSeq* ModelServant::actuators() {

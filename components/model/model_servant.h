@@ -18,6 +18,7 @@
 #include "caliper/model.hh"
 #include "caliper/rtc/rtobject_servant.h"
 #include "model_core.h"
+#include "model_files.h"
 
 namespace caliper::model {
 
@@ -199,6 +200,7 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   Caliper::Scene::Description* scene_description() override;
   void save_scene(const char* path) override;
   Caliper::Simulation::Octets* export_scene() override;
+  Caliper::Simulation::FileAccess* file_access() override;
   // ExperimentRunner
   Caliper::Simulation::Recording* run_experiment(
       const Caliper::Simulation::Experiment& run) override;
@@ -231,6 +233,7 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
                              Caliper::Daq::DataConsumer_ptr consumer, bool lossless);
 
   ModelCore& core_;
+  const ModelFiles files_;  // where paths from clients may lead (model.read_dirs, write_dir)
   std::atomic<uint64_t> next_observer_{1};
   PushPool pool_;  // last: its threads end before the rest goes
 };

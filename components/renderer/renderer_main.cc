@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <QApplication>
+#include <QBuffer>
+#include <QByteArray>
 
 #include <QTimer>
 #include <atomic>
@@ -123,16 +125,18 @@ class GuiControl : public renderer::ViewControl {
     graph_.SetCamera(camera);
   }
   void Screenshot(const std::string& path, int width, int height) override {
-    Apply(mailbox_, graph_, framed_);
-    if (graph_.body_count() == 0) throw std::runtime_error("no scene received from the Model yet");
-    FrameIfNew(graph_, viewer_, framed_, static_cast<double>(width) / height);
-    if (!offscreen_) offscreen_ = std::make_unique<render_coin::OffscreenRenderer>();
-    offscreen_->SavePng(graph_, path, width, height, /*view_all=*/false);
-    const render_coin::CameraPose c = graph_.camera_pose();
-    logging::Get("renderer").info(
-        "screenshot %s (%dx%d), camera at %.2f %.2f %.2f looking at %.2f %.2f %.2f", path.c_str(),
-        width, height, c.position[0], c.position[1], c.position[2], c.look_at[0], c.look_at[1],
-        c.look_at[2]);
+    if (!Render(width, height).save(QString::fromStdString(path), "PNG"))
+      throw std::runtime_error("cannot write the PNG '" + path + "'");
+    Logged(path, width, height);
+  }
+  std::string ScreenshotPng(int width, int height) override {
+    QByteArray bytes;
+    QBuffer buffer(&bytes);
+    buffer.open(QIODevice::WriteOnly);
+    if (!Render(width, height).save(&buffer, "PNG"))
+      throw std::runtime_error("cannot encode the PNG");
+    Logged("(sent by content)", width, height);
+    return std::string(bytes.constData(), static_cast<size_t>(bytes.size()));
   }
   void ShowConstraintAxes(bool on) override {
     graph_.SetConstraintAxesVisible(on);
@@ -140,6 +144,22 @@ class GuiControl : public renderer::ViewControl {
   }
 
  private:
+  // the current view at width x height
+  QImage Render(int width, int height) {
+    Apply(mailbox_, graph_, framed_);
+    if (graph_.body_count() == 0) throw std::runtime_error("no scene received from the Model yet");
+    FrameIfNew(graph_, viewer_, framed_, static_cast<double>(width) / height);
+    if (!offscreen_) offscreen_ = std::make_unique<render_coin::OffscreenRenderer>();
+    return offscreen_->RenderToImage(graph_, width, height, /*view_all=*/false);
+  }
+  void Logged(const std::string& where, int width, int height) {
+    const render_coin::CameraPose c = graph_.camera_pose();
+    logging::Get("renderer").info(
+        "screenshot %s (%dx%d), camera at %.2f %.2f %.2f looking at %.2f %.2f %.2f",
+        where.c_str(), width, height, c.position[0], c.position[1], c.position[2], c.look_at[0],
+        c.look_at[1], c.look_at[2]);
+  }
+
   renderer::SceneMailbox& mailbox_;
   render_coin::SceneGraph& graph_;
   bool* framed_;

@@ -1,9 +1,13 @@
 #include "renderer_servant.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <memory>
 #include <stdexcept>
 
 #include "caliper/logging/log.h"
+#include "caliper/rtc/client_orb.h"
 #include "observer_servant.h"
 
 namespace caliper::renderer {
@@ -55,14 +59,65 @@ void RendererServant::set_camera(const Caliper::Scene::Frame& pose, CORBA::Doubl
   Run([this, camera] { control_.SetCamera(camera); });
 }
 
-void RendererServant::screenshot(const char* path, CORBA::ULong width, CORBA::ULong height) {
-  const std::string file = path;
-  if (file.empty()) throw V::NotAvailable("no path for the screenshot");
+core::ConfinedPaths ScreenshotDirectory(const core::Config& config) {
+  std::string dir = config.GetString("renderer.write_dir");
+  const char* session = std::getenv("CALIPER_SESSION_DIR");
+  if (dir.empty() && session != nullptr) dir = session;
+  std::vector<std::string> dirs;
+  if (!dir.empty()) dirs.push_back(dir);
+  return core::ConfinedPaths(dirs, "renderer.write_dir", "the renderer writes screenshots");
+}
+
+namespace {
+
+void CheckSize(CORBA::ULong width, CORBA::ULong height) {
   if (width < 16 || height < 16 || width > 8192 || height > 8192)
     throw V::NotAvailable("the screenshot size must be 16 .. 8192 px on each side");
+}
+
+}  // namespace
+
+void RendererServant::screenshot(const char* path, CORBA::ULong width, CORBA::ULong height) {
+  if (*path == '\0') throw V::NotAvailable("no path for the screenshot");
+  CheckSize(width, height);
+  // only into the write directory: a client must not make the renderer overwrite any file
+  std::string file;
+  try {
+    file = files_.Resolve(path, core::ConfinedPaths::Access::kWrite).string();
+  } catch (const std::exception& e) {
+    logging::Get("renderer").warn("screenshot refused: %s", e.what());
+    throw V::NotAvailable((std::string("screenshot: ") + e.what() +
+                           "; other clients take screenshot_png (as caliper-ctl screenshot does "
+                           "by itself)")
+                              .c_str());
+  }
   Run([this, file, width, height] {
     control_.Screenshot(file, static_cast<int>(width), static_cast<int>(height));
   });
+}
+
+V::Png* RendererServant::screenshot_png(CORBA::ULong width, CORBA::ULong height) {
+  CheckSize(width, height);
+  // shared: a GUI that does not answer in time may still run it after this call has returned
+  auto result = std::make_shared<std::string>();
+  Run([this, result, width, height] {
+    *result = control_.ScreenshotPng(static_cast<int>(width), static_cast<int>(height));
+  });
+  const std::string& png = *result;
+  if (png.size() > static_cast<size_t>(0.95 * rtc::kMaxMessageBytes))
+    throw V::NotAvailable(("the PNG is " + std::to_string(png.size() >> 20) +
+                           " MiB, more than one GIOP message carries (" +
+                           std::to_string(rtc::kMaxMessageBytes >> 20) +
+                           " MiB): take a smaller one, or screenshot() into " + files_.Describe())
+                              .c_str());
+  auto* out = new V::Png(static_cast<CORBA::ULong>(png.size()));
+  out->length(static_cast<CORBA::ULong>(png.size()));
+  std::copy(png.begin(), png.end(), reinterpret_cast<char*>(out->get_buffer()));
+  return out;
+}
+
+char* RendererServant::screenshot_dir() {
+  return CORBA::string_dup(files_.dirs().empty() ? "" : files_.dirs().front().c_str());
 }
 
 void RendererServant::show_constraint_axes(CORBA::Boolean on) {

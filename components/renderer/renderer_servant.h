@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "caliper/core/confined_path.h"
 #include "caliper/render_coin/scene_description.h"
 #include "caliper/renderer.hh"
 #include "caliper/rtc/rtobject_servant.h"
@@ -20,6 +21,8 @@ class ViewControl {
   virtual void ViewAll() = 0;
   virtual void SetCamera(const render_coin::CameraPose& camera) = 0;
   virtual void Screenshot(const std::string& path, int width, int height) = 0;
+  /// The same image as the bytes of a PNG file.
+  virtual std::string ScreenshotPng(int width, int height) = 0;
   virtual void ShowConstraintAxes(bool on) = 0;
 };
 
@@ -31,14 +34,23 @@ using GuiCall = std::function<std::string(std::function<void()>)>;
 /// std::invalid_argument for a zero quaternion or an angle outside (0, pi).
 render_coin::CameraPose CameraFromFrame(const render_coin::Pose& pose, double height_angle);
 
+/// Where screenshot() may write: renderer.write_dir, else $CALIPER_SESSION_DIR (the session's
+/// directory when the launcher started the renderer), else nowhere.
+core::ConfinedPaths ScreenshotDirectory(const core::Config& config);
+
 class RendererServant : public virtual POA_Caliper::Viewer::Renderer, public rtc::RTObjectServant {
  public:
   RendererServant(rtc::Runtime& runtime, ViewControl& control, GuiCall gui)
-      : rtc::RTObjectServant(runtime), control_(control), gui_(std::move(gui)) {}
+      : rtc::RTObjectServant(runtime),
+        control_(control),
+        gui_(std::move(gui)),
+        files_(ScreenshotDirectory(runtime.config())) {}
 
   void view_all() override;
   void set_camera(const Caliper::Scene::Frame& pose, CORBA::Double height_angle_rad) override;
   void screenshot(const char* path, CORBA::ULong width, CORBA::ULong height) override;
+  Caliper::Viewer::Png* screenshot_png(CORBA::ULong width, CORBA::ULong height) override;
+  char* screenshot_dir() override;
   void show_constraint_axes(CORBA::Boolean on) override;
 
  private:
@@ -47,6 +59,7 @@ class RendererServant : public virtual POA_Caliper::Viewer::Renderer, public rtc
 
   ViewControl& control_;
   GuiCall gui_;
+  const core::ConfinedPaths files_;  // where screenshot() may write
 };
 
 }  // namespace caliper::renderer

@@ -67,7 +67,8 @@ class Renderer : public ::testing::Test {
 
   // the interactive viewer window (no --screenshot), controlled over CORBA
   std::unique_ptr<Process> StartViewer() {
-    std::vector<std::string> args = {Bin("caliper-renderer"), "-o", "renderer.check_interval=0.2"};
+    std::vector<std::string> args = {Bin("caliper-renderer"), "-o", "renderer.check_interval=0.2",
+                                     "-o", "renderer.write_dir=" + ArtifactDir(dir_.path())};
     args.insert(args.end(), common_.begin(), common_.end());
     return std::make_unique<Process>(args, dir_.path() + "/viewer.out");
   }

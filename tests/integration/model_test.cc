@@ -205,9 +205,11 @@ class ModelTest : public ::testing::Test {
  protected:
   void SetUp() override {
     naming_ = std::make_unique<NamingService>(dir_.path());
+    // load_scene reads the test data by path (other files go by content: confined_files_test)
     std::vector<std::string> argv{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
                                   "exec.auto_activate=true", "-o", "log.service=none", "-o",
-                                  "log.spool_dir=" + dir_.path() + "/spool"};
+                                  "log.spool_dir=" + dir_.path() + "/spool", "-o",
+                                  "model.read_dirs=" + Source("models") + ":" + Source("tests/data")};
     argv.insert(argv.end(), extra_args_.begin(), extra_args_.end());
     model_ = std::make_unique<Process>(argv, dir_.path() + "/model.out");
     ASSERT_TRUE(WaitFor([&] { return Ctl({"status"}).exit_code == 0; }, seconds(10)))

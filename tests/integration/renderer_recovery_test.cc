@@ -64,8 +64,10 @@ class RendererRecoveryTest : public ::testing::Test {
   /// An interactive renderer (a viewer window, no --screenshot) with the default check interval.
   std::unique_ptr<Process> StartRenderer(const std::string& log) {
     return std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-renderer"), "--nameservice", naming_->address(), "-o",
-                                 "log.service=none", "-o", "log.spool_dir=" + dir_.path() + "/spool"},
+        std::vector<std::string>{Bin("caliper-renderer"), "--nameservice", naming_->address(),
+                                 "-o", "log.service=none", "-o",
+                                 "log.spool_dir=" + dir_.path() + "/spool", "-o",
+                                 "renderer.write_dir=" + ArtifactDir(dir_.path())},
         dir_.path() + "/" + log);
   }
 

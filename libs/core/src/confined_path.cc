@@ -93,29 +93,24 @@ fs::path ConfinedPaths::Resolve(const std::string& path, Access access) const {
     throw PathRefused(shown + " is outside the directories where " + what_ + where);
   if (Components(resolved).size() == Components(*inside).size())
     throw PathRefused(shown + " names the directory " + Quoted(*inside) +
-                      " itself, not a file in it");
+                      " itself, not a file in it" + where);
 
   const fs::file_status status = fs::status(resolved, ec);
-  if (access == Access::kRead) {
-    if (!fs::exists(status)) throw PathRefused("no file " + shown);
-    if (!fs::is_regular_file(status)) throw PathRefused(shown + " is not a regular file");
-    return resolved;
+  if (!fs::exists(status)) {
+    // what does not exist must not be a dangling symbolic link: writing through one would create
+    // its target, wherever it points, and reading would read it once someone creates it
+    for (fs::path p = resolved; !p.empty() && p != p.root_path(); p = p.parent_path()) {
+      if (fs::exists(fs::status(p, ec))) break;
+      if (fs::is_symlink(fs::symlink_status(p, ec)))
+        throw PathRefused(shown + ": " + Quoted(p) + " is a symbolic link to a missing target" +
+                          where);
+    }
+    return resolved;  // a missing file is the reader's (or the writer's) to report
   }
-  if (fs::exists(status)) {
-    if (!fs::is_regular_file(status))
-      throw PathRefused(shown + " exists and is not a regular file");
-    if (fs::hard_link_count(resolved, ec) > 1)
-      throw PathRefused(shown + " has other hard links, which writing it would change too");
-    return resolved;
-  }
-  // what does not exist yet must not be a dangling symbolic link: writing through one would
-  // create its target, wherever it points
-  for (fs::path p = resolved; !p.empty() && p != p.root_path(); p = p.parent_path()) {
-    if (fs::exists(fs::status(p, ec))) break;
-    if (fs::is_symlink(fs::symlink_status(p, ec)))
-      throw PathRefused(shown + ": " + Quoted(p) +
-                        " is a symbolic link to a missing target, which writing would create");
-  }
+  // a directory, device or pipe is no file to read or write
+  if (!fs::is_regular_file(status)) throw PathRefused(shown + " is not a regular file" + where);
+  if (access == Access::kWrite && fs::hard_link_count(resolved, ec) > 1)
+    throw PathRefused(shown + " has other hard links, which writing it would change too" + where);
   return resolved;
 }
 

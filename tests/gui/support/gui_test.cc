@@ -52,16 +52,25 @@ qint64 LongestEventLoopStall(std::chrono::milliseconds duration) {
 }
 
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir) {
+  return ArtifactDir(fallback_dir) + "/" + name;
+}
+
+std::string ArtifactDir(const std::string& fallback_dir) {
   const char* dir = std::getenv("CALIPER_ARTIFACT_DIR");
-  return (dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir) + "/" + name;
+  return dir != nullptr && *dir != '\0' ? std::string(dir) : fallback_dir;
 }
 
 std::unique_ptr<Process> StartModelProcess(const std::string& address, const std::string& scene,
                                            const std::string& dir, const std::string& output) {
+  // load_scene reads the shipped models, the test data and the test's own files
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  const std::string root = source != nullptr ? source : ".";
   return std::make_unique<Process>(
       std::vector<std::string>{Bin("caliper-model"), "-o", "model.scene=" + scene, "-o",
                                "exec.auto_activate=true", "--nameservice", address, "-o",
-                               "log.service=none", "-o", "log.spool_dir=" + dir + "/spool"},
+                               "log.service=none", "-o", "log.spool_dir=" + dir + "/spool", "-o",
+                               "model.read_dirs=" + root + "/models:" + root + "/tests/data", "-o",
+                               "model.write_dir=" + dir},
       output);
 }
 

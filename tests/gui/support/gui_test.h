@@ -29,9 +29,12 @@ qint64 LongestEventLoopStall(std::chrono::milliseconds duration);
 
 /// `name` in $CALIPER_ARTIFACT_DIR (the screenshots kept by the test run), else in `fallback_dir`.
 std::string ArtifactPath(const std::string& name, const std::string& fallback_dir);
+/// The directory ArtifactPath() puts files in (a renderer's renderer.write_dir in tests).
+std::string ArtifactDir(const std::string& fallback_dir);
 
 /// caliper-model with `scene` loaded on the naming service at `address`, ACTIVE, logging to no
-/// service (its spool in `dir`/spool), its output in `output`.
+/// service (its spool in `dir`/spool), its output in `output`; load_scene reads models/,
+/// tests/data and `dir`, save_scene writes into `dir`.
 std::unique_ptr<Process> StartModelProcess(const std::string& address, const std::string& scene,
                                            const std::string& dir, const std::string& output);
 

@@ -42,9 +42,10 @@ class ConfinedPaths {
 
   /// The resolved absolute path that `path` names, or PathRefused saying why not: it lies
   /// outside every allowed directory (after `..` and symbolic links), no directory is
-  /// configured, it is empty, or it names an allowed directory itself. kRead also requires an
-  /// existing regular file; kWrite refuses a dangling symbolic link (writing through it would
-  /// create its target) and a file with other hard links (a write would change them too).
+  /// configured, it is empty, or it names an allowed directory itself. kRead refuses what exists
+  /// but is no regular file (a missing file is left to the reader to report); kWrite refuses the
+  /// same, a dangling symbolic link (writing through it would create its target) and a file with
+  /// other hard links (a write would change them too).
   std::filesystem::path Resolve(const std::string& path, Access access) const;
 
   /// Resolve() without the exception: true when it would accept `path`.

@@ -1,0 +1,31 @@
+#pragma once
+// Which files the Model's clients may name by path: load_scene reads only below the model search
+// path and the write directory, save_scene writes only below the write directory. Clients with
+// files elsewhere (or on other hosts) send and fetch scenes by content.
+//
+// Configuration:
+//   model.read_dirs   directories load_scene reads from, separated by ':' (the project's models/)
+//   model.write_dir   the directory save_scene writes into ('' = $CALIPER_SESSION_DIR, which the
+//                     launcher sets to the session's directory; without it no path is writable)
+//   model.confine_scene  model.scene too must lead below model.read_dirs (set by a manager for
+//                     the Models it starts, whose scene a client chose)
+// Relative paths start from the first read directory (load_scene) or the write directory.
+
+#include <string>
+#include <vector>
+
+#include "caliper/core/config.h"
+#include "caliper/core/confined_path.h"
+
+namespace caliper::model {
+
+struct ModelFiles {
+  core::ConfinedPaths read;   ///< model.read_dirs, then the write directory
+  core::ConfinedPaths write;  ///< the write directory alone (none when unset)
+
+  static std::vector<core::ConfigKey> ConfigKeys();
+  /// The directories that `config` (and $CALIPER_SESSION_DIR) give.
+  static ModelFiles FromConfig(const core::Config& config);
+};
+
+}  // namespace caliper::model
