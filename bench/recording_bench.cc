@@ -1,0 +1,121 @@
+// Recording benchmarks: what lossless subscriptions cost the stepping, in ModelCore without CORBA
+// (one line per figure, measured in this run). `step N` of a scene with 20 recorded ids
+// (batches of 50 samples, as the servant makes them at 1 ms), a taker thread that takes the
+// batches every millisecond or every 10 ms (the pendulum's steps outrun both):
+//   us/step  no subscription | a subscription (samples it dropped) | a lossless one (the share
+//            of the run the stepping waited for the taker)
+//   RATIO lossless_overhead_SCENE  lossless / plain subscription when the taker keeps up (the
+//            plain one dropped nothing): the cost of the check before each step
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "model_core.h"
+
+namespace {
+
+using namespace caliper::model;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+/// Takes a subscription's batches every `period` on its own thread until destroyed.
+class Taker {
+ public:
+  Taker(ModelCore& core, uint64_t id, milliseconds period)
+      : thread_([&core, id, period, this] {
+          while (!stop_) {
+            core.TakeBatches(id);
+            std::this_thread::sleep_for(period);
+          }
+        }) {}
+  ~Taker() {
+    stop_ = true;
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+struct Run {
+  double us_per_step = 0;
+  double waited_share = 0;  // of the wall time
+  uint64_t dropped = 0;     // samples
+};
+
+/// `step N` on a fresh core: `mode` 0 without a subscription, 1 with one, 2 with a lossless one.
+Run Once(const std::string& scene, const std::vector<std::string>& ids, uint64_t steps, int mode,
+         milliseconds period) {
+  ModelCore core;
+  core.Load(scene);
+  uint64_t id = 0;
+  if (mode > 0) id = core.Subscribe(ids, 1, 50, mode == 2 ? milliseconds(2000) : milliseconds(0));
+  std::unique_ptr<Taker> taker;
+  if (mode > 0) taker = std::make_unique<Taker>(core, id, period);
+  Run run;
+  const auto begin = Clock::now();
+  core.StepNow(steps);
+  const double wall = std::chrono::duration<double>(Clock::now() - begin).count();
+  run.us_per_step = 1e6 * wall / static_cast<double>(steps);
+  if (mode > 0) {
+    const FeedStatus s = core.SubscriptionStatus(id);
+    run.waited_share = s.waited_s / wall;
+    run.dropped = s.dropped_samples;
+  }
+  return run;
+}
+
+/// The three modes in turn, five times (so that other load on the machine hits all alike); the
+/// median of each.
+std::vector<Run> Measure(const std::string& scene, const std::vector<std::string>& ids,
+                         uint64_t steps, milliseconds period) {
+  std::vector<std::vector<Run>> runs(3);
+  for (int r = 0; r < 5; ++r)
+    for (int mode = 0; mode < 3; ++mode) runs[mode].push_back(Once(scene, ids, steps, mode, period));
+  std::vector<Run> out;
+  for (auto& m : runs) {
+    std::sort(m.begin(), m.end(),
+              [](const Run& a, const Run& b) { return a.us_per_step < b.us_per_step; });
+    out.push_back(m[2]);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main() {
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  const std::string root = source != nullptr ? source : CALIPER_SOURCE_DIR_DEFAULT;
+  // a step of the arm costs about 20 times one of the pendulum: as many wall seconds for each
+  for (const auto& [name, steps] : {std::pair<std::string, uint64_t>{"ecce_arm", 2000},
+                                    std::pair<std::string, uint64_t>{"pendulum_tendon", 20000}}) {
+    const std::string scene = root + "/models/" + name + ".dae";
+    // 20 dynamic ids of the scene
+    std::vector<std::string> ids;
+    {
+      ModelCore core;
+      core.Load(scene);
+      for (const auto& c : core.Channels(""))
+        if (!c.is_static && ids.size() < 20) ids.push_back(c.id);
+    }
+    for (const int period : {1, 10}) {
+      const std::vector<Run> r = Measure(scene, ids, steps, milliseconds(period));
+      std::printf(
+          "%-16s step %llu, taker every %2d ms: us/step  none %.2f | subscription %.2f (%llu "
+          "samples dropped) | lossless %.2f (%llu dropped; waited %.0f %% of the run)\n",
+          name.c_str(), static_cast<unsigned long long>(steps), period, r[0].us_per_step,
+          r[1].us_per_step, static_cast<unsigned long long>(r[1].dropped), r[2].us_per_step,
+          static_cast<unsigned long long>(r[2].dropped), 100 * r[2].waited_share);
+      if (period == 1 && r[1].dropped == 0)
+        std::printf("RATIO lossless_overhead_%s %.3f (lossless / plain, a taker that keeps up)\n",
+                    name.c_str(), r[2].us_per_step / r[1].us_per_step);
+    }
+  }
+  return 0;
+}
