@@ -68,6 +68,10 @@ fs::path ConfinedPaths::Resolve(const std::string& path, Access access) const {
     throw PathRefused(Quoted(path) + " is refused: no directory is configured where " + what_ +
                       " (set " + key_ + ")");
   if (path.empty()) throw PathRefused("an empty path is refused" + where);
+  // longer than the kernel opens (PATH_MAX): refused without repeating it in the message
+  if (path.size() >= 4096)
+    throw PathRefused("a path of " + std::to_string(path.size()) +
+                      " bytes is refused: longer than any the system opens (4095)" + where);
 
   // relative paths against the first directory; symbolic links and `..` as the kernel takes them
   fs::path given(path);

@@ -170,6 +170,9 @@ TEST_F(ConfinedPathsTest, RefusesDirectoriesEmptyPathsAndAnEmptyConfiguration) {
             "'" + allowed_ + "/sub' is not a regular file (" + allowed_ + "; set by test.dirs)");
   EXPECT_TRUE(Contains(Refusal(c, allowed_ + "/sub", Access::kWrite), "is not a regular file"));
   EXPECT_TRUE(Contains(Refusal(c, "", Access::kRead), "an empty path is refused"));
+  const std::string why = Refusal(c, allowed_ + "/" + std::string(10 << 20, 'x'), Access::kWrite);
+  EXPECT_TRUE(Contains(why, "bytes is refused: longer than any the system opens")) << why.size();
+  EXPECT_LT(why.size(), 1000u);
 
   const ConfinedPaths none({}, "model.write_dir", "the Model writes scenes");
   EXPECT_EQ(Refusal(none, "/tmp/x.dae", Access::kWrite),
