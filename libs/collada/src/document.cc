@@ -401,7 +401,7 @@ Document ReadDocument(const std::string& path) {
   const core::ClassicLocaleScope classic;  // the DOM reads numbers with sscanf and streams
   DomLoad load;
   for (int attempt : attempts) {
-    load = attempt == 150 ? LoadWithDom150(path) : LoadWithDom141(path);
+    load = attempt == 150 ? LoadWithDom150(path, doc.zipped) : LoadWithDom141(path, doc.zipped);
     if (load.root || !load.wrong_version) {
       doc.version = attempt == 150 ? "1.5.0" : "1.4.1";
       break;

@@ -25,6 +25,8 @@ struct Dom141 {
 
 }  // namespace
 
-DomLoad LoadWithDom141(const std::string& path) { return LoadWithDom<Dom141>(path); }
+DomLoad LoadWithDom141(const std::string& path, bool zipped) {
+  return LoadWithDom<Dom141>(path, zipped);
+}
 
 }  // namespace caliper::collada::internal

@@ -25,7 +25,9 @@ struct Dom150 {
 
 }  // namespace
 
-DomLoad LoadWithDom150(const std::string& path) { return LoadWithDom<Dom150>(path); }
+DomLoad LoadWithDom150(const std::string& path, bool zipped) {
+  return LoadWithDom<Dom150>(path, zipped);
+}
 
 void WriteWithDom150(const Element& root, const std::string& path) {
   WriteWithDom<Dom150>(root, path);

@@ -21,8 +21,10 @@ struct DomLoad {
   bool wrong_version = false;         // the DOM said the file is of the other schema version
 };
 
-DomLoad LoadWithDom141(const std::string& path);
-DomLoad LoadWithDom150(const std::string& path);
+/// `zipped`: a .zae, read with a DAE of its own (the DOM extracts it to a temporary directory
+/// that the DAE's destructor removes); a .dae is read with one DAE per version for the process.
+DomLoad LoadWithDom141(const std::string& path, bool zipped);
+DomLoad LoadWithDom150(const std::string& path, bool zipped);
 
 /// Writes a tree whose root is <COLLADA> through the 1.5.0 DOM; throws std::runtime_error.
 void WriteWithDom150(const Element& root, const std::string& path);

@@ -469,6 +469,22 @@ TEST(ColladaImportTest, RejectsAWordThatIsNotANumberInANumericList) {
       << fraction;
 }
 
+TEST(ColladaImportTest, ReadsAFileAgainAfterItChanged) {
+  // the DOM's DAE is kept between imports (one per schema version): each import must read the
+  // file as it is now, not the document the DAE read before from the same path
+  const std::string path = std::filesystem::temp_directory_path().string() + "/changing.dae";
+  std::filesystem::copy_file(Data("minimal.dae"), path,
+                             std::filesystem::copy_options::overwrite_existing);
+  EXPECT_EQ(Load(path).bodies.size(), 2u);
+  std::filesystem::copy_file(Data("malformed_negative_mass.dae"), path,
+                             std::filesystem::copy_options::overwrite_existing);
+  EXPECT_NE(ErrorOf(path).find("mass -2.5"), std::string::npos);
+  std::filesystem::copy_file(Data("minimal.dae"), path,
+                             std::filesystem::copy_options::overwrite_existing);
+  EXPECT_EQ(Load(path).bodies.size(), 2u);
+  std::remove(path.c_str());
+}
+
 TEST(ColladaImportTest, NamesLinesBeyondSixteenBits) {
   // libxml2's nodes keep 16-bit lines: a long file (a large mesh before the physics) still
   // names the right one, for the elements and for malformed XML
