@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <optional>
 #include <set>
@@ -135,11 +137,14 @@ std::vector<StoredRecord> LogStore::Submit(const std::vector<logging::Record>& r
     struct stat before;
     const bool sized = stat(path_.c_str(), &before) == 0;
     // one write per batch: a record reaches the file whole or, after a crash, is cut off whole
+    errno = 0;
     file_ << text;
     file_.flush();
     if (!file_) {
       // drop what could not be written and cut off any fragment that was, then start afresh
+      const int error = errno;
       std::string why = "cannot write session log " + path_;
+      if (error != 0) why += ": " + std::string(std::strerror(error));
       file_.close();
       if (!sized || truncate(path_.c_str(), before.st_size) != 0)
         why += " (a partial line may be left in it)";

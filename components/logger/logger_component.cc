@@ -69,7 +69,38 @@ std::vector<StoredRecord> LoggerComponent::Submit(const std::vector<logging::Rec
   if (!store_) throw NotAccepting("the logger is not initialized");
   if (!own && runtime_.lifecycle().state() != rtc::State::kActive)
     throw NotAccepting("the logger is not ACTIVE");
-  auto stored = store_->Submit(records);
+  std::vector<StoredRecord> stored;
+  try {
+    stored = store_->Submit(records);
+  } catch (const std::runtime_error& e) {
+    // a full disk: the senders keep the batch in their spools and send it again
+    bool first = false;
+    {
+      std::lock_guard<std::mutex> lock(write_mutex_);
+      ++refused_batches_;
+      if (!write_failing_) {
+        first = write_failing_ = true;
+        failing_since_us_ = core::NowMicros();
+      }
+    }
+    if (first)
+      logging::Get("store").error(
+          "%s; records are refused until it can be written again (their senders keep them in "
+          "their spools, within log.spool_max, and send them again)",
+          e.what());
+    throw NotAccepting(e.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(write_mutex_);
+    if (write_failing_ && !stored.empty()) {
+      write_failing_ = false;
+      logging::Get("store").notice(
+          "session log %s written again after %.1f s; %llu batches were refused meanwhile",
+          store_->path().c_str(), (core::NowMicros() - failing_since_us_) / 1e6,
+          static_cast<unsigned long long>(refused_batches_));
+      refused_batches_ = 0;
+    }
+  }
   std::lock_guard<std::mutex> lock(listener_mutex_);
   if (listener_ && !stored.empty()) listener_(stored);
   return stored;

@@ -45,6 +45,11 @@ class LoggerComponent : public rtc::Component {
  private:
   rtc::Runtime& runtime_;
   std::unique_ptr<LogStore> store_;
+  // whether the session log could not be written (a full disk): reported once, and its end
+  std::mutex write_mutex_;
+  bool write_failing_ = false;
+  int64_t failing_since_us_ = 0;
+  uint64_t refused_batches_ = 0;
   mutable std::mutex listener_mutex_;
   std::function<void(const std::vector<StoredRecord>&)> listener_;
 };

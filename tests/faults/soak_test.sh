@@ -58,6 +58,7 @@ PID[record]=$REC_PID
 NAMES=(naming logger model controller sample renderer plotter logviewer main record)
 echo "soak: $MINUTES min ($TOTAL s, warm-up $WARMUP s), controller at $CTRL_RATE Hz; readings every $SAMPLE_EVERY s"
 steps0=$(model_steps)
+steps0_at=$(now)
 
 # readings: WORK/readings/NAME: lines "t rss_kib fds threads"
 mkdir -p "$WORK/readings"
@@ -77,6 +78,7 @@ while [ "$t" -lt "$TOTAL" ]; do
 done
 for n in "${NAMES[@]}"; do reading "$n" "$t"; done
 steps1=$(model_steps)
+steps1_at=$(now)
 kill -INT "$REC_PID"
 wait "$REC_PID"
 rec_rc=$?
@@ -113,11 +115,11 @@ for n in "${NAMES[@]}"; do
 done
 echo
 [ -z "$dead" ] || fail "died during the soak:$dead"
-rate=$(echo "($steps1 - $steps0) / $TOTAL" | bc -l | xargs printf '%.1f')
+rate=$(echo "($steps1 - $steps0) / ($steps1_at - $steps0_at)" | bc -l | xargs printf '%.1f')
 if [ "$(echo "$rate > 950" | bc -l)" = 1 ]; then pass "the Model stepped $rate steps/s (real time: 1000)"
 else fail "the Model stepped only $rate steps/s (real time: 1000)"; fi
 rows=$(($(wc -l <"$WORK/record.csv") - 1))
-echo "recording: $rows rows; $(tail -n 2 "$WORK/record.err" | tr '\r\n' '  ')"
+echo "recording: $rows rows; $(tr '\r' '\n' <"$WORK/record.err" | grep -v '^recording: t =' | grep . | xargs)"
 # caliper-ctl record ends with 0 when stopped by Ctrl-C and nothing went wrong
 [ "$rec_rc" = 0 ] && [ "$rows" -gt $((TOTAL * 80)) ] && pass "the recording ran all along ($rows rows)" ||
   fail "the recording: exit $rec_rc, $rows rows (expected about $((TOTAL * 100)))"

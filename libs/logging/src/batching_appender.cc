@@ -71,6 +71,7 @@ void BatchingAppender::Append(Record record) {
   std::lock_guard<std::mutex> lock(mutex_);
   record.seq = next_seq_++;
   ++stats_.appended;
+  if (identity_.source.empty()) identity_ = record;
   if (stopped_) {  // the sender is gone: straight to the spool
     SpoolLocked({record});
     return;
@@ -85,18 +86,36 @@ bool BatchingAppender::HasBacklog() const {
 
 void BatchingAppender::SpoolLocked(const std::vector<Record>& records) {
   if (records.empty()) return;
-  std::ofstream out(spool_path_, std::ios::app | std::ios::binary);
   std::string text;
-  for (const auto& r : records) text += FormatLine(r) + '\n';
+  size_t kept = 0;
+  for (const auto& r : records) {
+    std::string line = FormatLine(r) + '\n';
+    if (spool_written_ + text.size() + line.size() > options_.max_spool_bytes) break;
+    text += line;
+    ++kept;
+  }
+  if (kept < records.size()) {
+    if (dropped_unreported_ == 0)
+      std::fprintf(stderr,
+                   "caliper: log spool %s is at its bound of %.3g MiB (log.spool_max): records "
+                   "are dropped and counted until the Logging component takes them\n",
+                   spool_path_.c_str(), options_.max_spool_bytes / 1048576.0);
+    dropped_unreported_ += records.size() - kept;
+    stats_.dropped += records.size() - kept;
+  }
+  if (text.empty()) return;
+  std::ofstream out(spool_path_, std::ios::app | std::ios::binary);
   out << text;
   out.flush();
   if (!out) {
     std::fprintf(stderr, "caliper: cannot write log spool %s: %zu records lost\n",
-                 spool_path_.c_str(), records.size());
+                 spool_path_.c_str(), kept);
+    dropped_unreported_ += kept;
+    stats_.dropped += kept;
     return;
   }
   spool_written_ += text.size();
-  stats_.spooled += records.size();
+  stats_.spooled += kept;
 }
 
 bool BatchingAppender::TrySend(const std::vector<Record>& batch) {
@@ -175,6 +194,20 @@ void BatchingAppender::Run() {
       const bool ok = ReplayBacklog();
       lock.lock();
       stats_.reachable = ok;
+      if (ok && !HasBacklog() && dropped_unreported_ > 0) {
+        // the sink has everything that was kept: say what was not
+        Record warning = identity_;
+        warning.time_us = core::NowMicros();
+        warning.priority = kWarn;
+        warning.category = "caliper.logging.spool";
+        warning.seq = next_seq_++;
+        warning.message = std::to_string(dropped_unreported_) +
+                          " log records of this process were dropped while the Logging "
+                          "component was unreachable: its spool was at its bound (log.spool_max) "
+                          "or could not be written";
+        dropped_unreported_ = 0;
+        queue_.push_back(std::move(warning));
+      }
       if (!ok) {
         if (stopping) break;
         next_retry_ = Clock::now() + options_.retry_interval;

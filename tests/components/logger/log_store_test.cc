@@ -7,6 +7,8 @@
 #include <time.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -308,7 +310,9 @@ TEST_F(LogStoreTest, FailedWriteStoresNothingSoThatTheRetryIsTaken) {
       store.Submit({MakeRecord("a", 2), MakeRecord("b", 1)});
       ADD_FAILURE() << "a write past the file size limit succeeded";
     } catch (const std::runtime_error& e) {
-      EXPECT_EQ(std::string(e.what()), "cannot write session log " + store.path());
+      // the system's reason is named (EFBIG here; ENOSPC on a full disk)
+      EXPECT_EQ(std::string(e.what()),
+                "cannot write session log " + store.path() + ": " + std::strerror(EFBIG));
     }
   }
   EXPECT_EQ(fs::file_size(store.path()), good_size);  // no fragment left in the file

@@ -248,6 +248,36 @@ TEST_F(BatchingAppenderTest, SpoolsWhileSinkIsUnreachable) {
   EXPECT_EQ(SpoolSeqs(appender->spool_path()), Range(1, 20));
 }
 
+TEST_F(BatchingAppenderTest, DropsRecordsBeyondTheSpoolBoundAndSaysHowManyOnceDelivered) {
+  sink_->SetReachable(false);
+  options_.max_spool_bytes = 1000;  // a few records' lines
+  auto appender = MakeAppender();
+  AppendMessages(*appender, 1, 200);
+  ASSERT_TRUE(Eventually(
+      *appender, [&] { return appender->stats().spooled + appender->stats().dropped == 200; },
+      milliseconds(2000)));
+  const auto kept = appender->stats().spooled;
+  EXPECT_GT(kept, 0u);
+  EXPECT_LE(fs::file_size(appender->spool_path()), 1000u);  // the bound holds
+  EXPECT_EQ(appender->stats().dropped, 200 - kept);
+
+  // the sink is back: what was kept arrives in order, then one warning with the count
+  sink_->SetReachable(true);
+  ASSERT_TRUE(Eventually(
+      *appender, [&] { return sink_->Seqs().size() == kept + 1; }, milliseconds(2000)))
+      << sink_->Seqs().size() << " of " << kept + 1 << ", dropped " << appender->stats().dropped;
+  const auto seqs = sink_->Seqs();
+  EXPECT_EQ(std::vector<uint64_t>(seqs.begin(), seqs.end() - 1), Range(1, static_cast<int>(kept)));
+  EXPECT_EQ(seqs.back(), 201u);  // numbered after the dropped ones: the gap is theirs
+  const Record warning = sink_->stored_batches().back().back();
+  EXPECT_EQ(warning.priority, kWarn);
+  EXPECT_EQ(warning.message.rfind(std::to_string(200 - kept) + " log records of this process were "
+                                  "dropped", 0),
+            0u)
+      << warning.message;
+  EXPECT_FALSE(fs::exists(appender->spool_path()));
+}
+
 TEST_F(BatchingAppenderTest, RetriesUnreachableSinkPeriodically) {
   sink_->SetReachable(false);
   auto appender = MakeAppender();

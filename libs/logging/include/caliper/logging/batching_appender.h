@@ -42,6 +42,9 @@ struct AppenderOptions {
   std::chrono::milliseconds flush_interval{20};   ///< longest a record waits to be batched
   std::chrono::milliseconds retry_interval{300};  ///< wait between attempts on an unreachable sink
   bool replay_orphans = true;          ///< also replay spools left by processes that died
+  /// the own spool file's bound [bytes]: records that do not fit are dropped and counted, and a
+  /// warning record saying how many goes to the sink once the spool is delivered
+  uint64_t max_spool_bytes = uint64_t{64} << 20;
 };
 
 class BatchingAppender : public log4cpp::AppenderSkeleton {
@@ -50,6 +53,7 @@ class BatchingAppender : public log4cpp::AppenderSkeleton {
     uint64_t appended = 0;  ///< records handed to the appender
     uint64_t sent = 0;      ///< records the sink accepted (including replayed ones)
     uint64_t spooled = 0;   ///< records written to the spool file
+    uint64_t dropped = 0;   ///< records dropped: the spool was at its bound or not writable
     bool reachable = true;  ///< whether the last Send succeeded
   };
 
@@ -107,6 +111,8 @@ class BatchingAppender : public log4cpp::AppenderSkeleton {
   uint64_t spool_written_ = 0;  ///< bytes in the own spool file
   uint64_t spool_replayed_ = 0; ///< bytes of it already delivered
   uint64_t orphan_offset_ = 0;
+  uint64_t dropped_unreported_ = 0;  ///< dropped since the last warning record (under mutex_)
+  Record identity_;                  ///< the last record's source fields, for that warning
 
   std::thread thread_;
 };
