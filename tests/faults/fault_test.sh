@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --freeze) FREEZE=$2; shift 2 ;;
     --keep) KEEP=1; shift ;;
-    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "usage: fault_test.sh [--freeze S] [--keep]"; exit 2 ;;
   esac
 done
