@@ -77,7 +77,8 @@ std::vector<Run> Measure(const std::string& scene, const std::vector<std::string
                          uint64_t steps, milliseconds period) {
   std::vector<std::vector<Run>> runs(3);
   for (int r = 0; r < 5; ++r)
-    for (int mode = 0; mode < 3; ++mode) runs[mode].push_back(Once(scene, ids, steps, mode, period));
+    for (int mode = 0; mode < 3; ++mode)
+      runs[mode].push_back(Once(scene, ids, steps, mode, period));
   std::vector<Run> out;
   for (auto& m : runs) {
     std::sort(m.begin(), m.end(),

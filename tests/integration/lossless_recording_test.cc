@@ -90,17 +90,16 @@ class SlowConsumer : public virtual POA_Caliper::Daq::DataConsumer {
     if (b.batch != next_batch_) {
       ++gaps_;
       if (first_break_.empty())
-        first_break_ = "batch " + std::to_string(b.batch) + " after " +
-                       std::to_string(next_batch_ - 1);
+        first_break_ =
+            "batch " + std::to_string(b.batch) + " after " + std::to_string(next_batch_ - 1);
     } else if (next_step_ != 0 && b.first_step != next_step_ && first_break_.empty()) {
       first_break_ = "batch " + std::to_string(b.batch) + " starts at step " +
-                     std::to_string(b.first_step) + ", " + std::to_string(next_step_) +
-                     " expected";
+                     std::to_string(b.first_step) + ", " + std::to_string(next_step_) + " expected";
     }
     for (CORBA::ULong i = 0; i < count; ++i) {
       if (b.times[i] <= last_time_ && first_break_.empty())
-        first_break_ = "time " + std::to_string(b.times[i]) + " after " +
-                       std::to_string(last_time_);
+        first_break_ =
+            "time " + std::to_string(b.times[i]) + " after " + std::to_string(last_time_);
       last_time_ = b.times[i];
     }
     next_batch_ = b.batch + 1;
@@ -143,12 +142,11 @@ class LosslessRecordingTest : public ::testing::Test {
     const char* source = std::getenv("CALIPER_SOURCE_DIR");
     // the shipped model.conf: an execution context at 200 Hz, real time
     model_ = std::make_unique<Process>(
-        std::vector<std::string>{
-            Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
-            "model.scene=" + std::string(source != nullptr ? source : ".") +
-                "/models/pendulum_tendon.dae",
-            "-o", "exec.auto_activate=true", "-o", "log.service=none", "-o",
-            "log.spool_dir=" + dir_.path() + "/spool"},
+        std::vector<std::string>{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
+                                 "model.scene=" + std::string(source != nullptr ? source : ".") +
+                                     "/models/pendulum_tendon.dae",
+                                 "-o", "exec.auto_activate=true", "-o", "log.service=none", "-o",
+                                 "log.spool_dir=" + dir_.path() + "/spool"},
         dir_.path() + "/model.out");
     ASSERT_TRUE(WaitFor(
         [&] {
@@ -214,7 +212,8 @@ TEST_F(LosslessRecordingTest, StepTwentyThousandDeliversEverySampleInOrderToASlo
   const CORBA::ULongLong id = model()->subscribe_lossless(Ids({kTension, kPosition}), 1, ref);
   const double took = Step(20000);
   ASSERT_TRUE(WaitFor([&] { return consumer->samples() >= 20000; }, seconds(20)))
-      << consumer->samples() << " samples\n" << model_->Output();
+      << consumer->samples() << " samples\n"
+      << model_->Output();
   EXPECT_EQ(consumer->samples(), 20000u);
   EXPECT_EQ(consumer->gaps(), 0u);
   EXPECT_EQ(consumer->first_break(), "");
@@ -240,8 +239,7 @@ TEST_F(LosslessRecordingTest, TheSameRunWithoutLosslessDropsAndCountsWhatItDropp
   ASSERT_TRUE(WaitFor(
       [&] {
         status = model()->subscription_status(id);
-        return status.queued == 0 &&
-               consumer->samples() + status.dropped_samples == status.samples;
+        return status.queued == 0 && consumer->samples() + status.dropped_samples == status.samples;
       },
       seconds(10)))
       << consumer->samples() << " received, " << status.dropped_samples << " dropped of "
@@ -307,8 +305,8 @@ TEST_F(LosslessRecordingTest, ARealTimeRunKeepsPaceWithASlowConsumerAndReportsTh
   EXPECT_EQ(status.waited, 0.0) << "a real-time run must not wait for a consumer";
   EXPECT_GT(status.dropped_samples, 500u);
   EXPECT_GT(consumer->gaps(), 0u);
-  EXPECT_TRUE(WaitFor([&] { return Contains(model_->Output(), "samples dropped so far"); },
-                      seconds(5)))
+  EXPECT_TRUE(
+      WaitFor([&] { return Contains(model_->Output(), "samples dropped so far"); }, seconds(5)))
       << model_->Output();
   model()->unsubscribe(id);
   EXPECT_TRUE(WaitFor([&] { return Contains(model_->Output(), "of them dropped"); }, seconds(5)))

@@ -1,7 +1,7 @@
-// Lossless data subscriptions in ModelCore, without CORBA: a step request, or a run as fast as
-// possible, waits for a slow taker and loses no sample; one whose taker stops is ended after its
-// wait, with the reason, and the steps go on; a real-time run never waits and counts its drops;
-// a stop or pause ends a wait at once.
+// Lossless data subscriptions in ModelCore, without CORBA: a step request, lock-step ticks and a
+// run as fast as possible wait for a slow taker and lose no sample; one whose taker stops is
+// ended after its wait, with the reason, and the steps go on; a real-time run never waits and
+// counts its drops; a stop or pause ends a wait at once.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -57,8 +57,8 @@ class SlowTaker {
     while (!stop_) {
       for (const daq::Batch& b : core_.TakeBatches(id_)) {
         if (breaks_.empty() && b.sequence != next_batch_)
-          breaks_ = "batch " + std::to_string(b.sequence) + " after " +
-                    std::to_string(next_batch_ - 1);
+          breaks_ =
+              "batch " + std::to_string(b.sequence) + " after " + std::to_string(next_batch_ - 1);
         if (breaks_.empty() && next_step_ != 0 && b.first_step != next_step_)
           breaks_ = "batch " + std::to_string(b.sequence) + " starts at step " +
                     std::to_string(b.first_step) + ", " + std::to_string(next_step_) + " expected";
@@ -81,6 +81,12 @@ class SlowTaker {
   std::thread thread_;
 };
 
+/// Waits (at most 10 s) until `taker` has `n` samples; false when it never had.
+bool WaitForSamples(const SlowTaker& taker, uint64_t n) {
+  for (int i = 0; i < 1000 && taker.samples() < n; ++i) std::this_thread::sleep_for(10ms);
+  return taker.samples() == n;
+}
+
 TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   ModelCore core;
   core.Load(Model("pendulum_tendon.dae"));
@@ -88,10 +94,7 @@ TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
   SlowTaker taker(core, id, 5ms);
   EXPECT_EQ(core.StepNow(5000), 5000u);
-  ASSERT_TRUE([&] {
-    for (int i = 0; i < 1000 && taker.samples() < 5000; ++i) std::this_thread::sleep_for(10ms);
-    return taker.samples() == 5000;
-  }()) << taker.samples() << " samples";
+  ASSERT_TRUE(WaitForSamples(taker, 5000)) << taker.samples() << " samples";
   EXPECT_EQ(taker.breaks(), "");
   const FeedStatus status = core.SubscriptionStatus(id);
   EXPECT_TRUE(status.lossless);
@@ -152,11 +155,24 @@ TEST(LosslessFeed, AsFastAsPossibleWaitsForASlowTaker) {
   core.Pause();
   const uint64_t steps = core.status().steps;
   EXPECT_GE(steps, 3000u);
-  ASSERT_TRUE([&] {
-    for (int i = 0; i < 1000 && taker.samples() < steps - steps % 10; ++i)
-      std::this_thread::sleep_for(10ms);
-    return taker.samples() == steps - steps % 10;  // the partial batch is not queued yet
-  }()) << taker.samples() << " samples of " << steps;
+  // the partial batch is not queued yet
+  ASSERT_TRUE(WaitForSamples(taker, steps - steps % 10))
+      << taker.samples() << " samples of " << steps;
+  EXPECT_EQ(taker.breaks(), "");
+  EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
+  EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
+}
+
+TEST(LosslessFeed, LockStepTicksWaitForASlowTaker) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
+  SlowTaker taker(core, id, 5ms);
+  core.Start();
+  for (int i = 0; i < 3000; ++i) core.Tick();  // an external execution context
+  core.Pause();
+  EXPECT_EQ(core.status().steps, 3000u);
+  ASSERT_TRUE(WaitForSamples(taker, 3000)) << taker.samples() << " samples";
   EXPECT_EQ(taker.breaks(), "");
   EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
   EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
