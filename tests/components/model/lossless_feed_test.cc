@@ -21,6 +21,9 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 const char* const kPosition = "pendulum_tendon.pendulum.position";  // 3 values
+// a slow taker: 31 batches of 10 samples (what the queue holds before the stepping waits) take
+// at most 5 ms of stepping here, and under 50 ms with sanitizers, so the stepping always waits
+constexpr std::chrono::milliseconds kTakerPause{50};
 
 std::string Model(const std::string& file) {
   const char* src = std::getenv("CALIPER_SOURCE_DIR");
@@ -92,7 +95,7 @@ TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   core.Load(Model("pendulum_tendon.dae"));
   // batches of 10 samples in a queue of 33 (256 MiB over 100,000 values of 10 samples)
   const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
-  SlowTaker taker(core, id, 5ms);
+  SlowTaker taker(core, id, kTakerPause);
   EXPECT_EQ(core.StepNow(5000), 5000u);
   ASSERT_TRUE(WaitForSamples(taker, 5000)) << taker.samples() << " samples";
   EXPECT_EQ(taker.breaks(), "");
@@ -149,7 +152,7 @@ TEST(LosslessFeed, AsFastAsPossibleWaitsForASlowTaker) {
   core.Load(Model("pendulum_tendon.dae"));
   core.SetRealTimeFactor(0);
   const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
-  SlowTaker taker(core, id, 5ms);
+  SlowTaker taker(core, id, kTakerPause);
   core.Start();
   for (int i = 0; i < 100 && core.status().steps < 3000; ++i) core.Advance(20ms);
   core.Pause();
@@ -167,7 +170,7 @@ TEST(LosslessFeed, LockStepTicksWaitForASlowTaker) {
   ModelCore core;
   core.Load(Model("pendulum_tendon.dae"));
   const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
-  SlowTaker taker(core, id, 5ms);
+  SlowTaker taker(core, id, kTakerPause);
   core.Start();
   for (int i = 0; i < 3000; ++i) core.Tick();  // an external execution context
   core.Pause();
