@@ -10,6 +10,7 @@
 
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/transport_security.h"
 #include "log_viewer_window.h"
 
 namespace {
@@ -76,7 +77,13 @@ int main(int argc, char** argv) {
   const QStringList rest = QApplication::arguments();
   if (rest.size() > 1) return UsageError("unexpected argument '" + rest[1].toStdString() + "'");
 
-  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-logviewer");
+  CORBA::ORB_var orb;
+  try {
+    orb = caliper::rtc::ClientOrb("caliper-logviewer");
+  } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
+    std::cerr << "caliper-logviewer: error: " << e.what() << "\n";
+    return 2;
+  }
 
   int status = 0;
   {

@@ -20,6 +20,7 @@
 
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/transport_security.h"
 #include "main_window.h"
 #include "model_link.h"
 
@@ -72,7 +73,13 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-main");
+  CORBA::ORB_var orb;
+  try {
+    orb = caliper::rtc::ClientOrb("caliper-main");
+  } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
+    std::cerr << "caliper-main: error: " << e.what() << "\n";
+    return 2;
+  }
 
   int status = 0;
   {

@@ -14,6 +14,7 @@
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/transport_security.h"
 #include "daq_link.h"
 #include "plot_layout.h"
 #include "plotter_window.h"
@@ -113,7 +114,13 @@ int main(int argc, char** argv) {
 
   // what the data consumer logs goes to stderr (the launcher's session log)
   caliper::logging::Initialize("plotter", caliper::logging::kWarn);
-  CORBA::ORB_var orb = caliper::rtc::ClientOrb("caliper-plotter");
+  CORBA::ORB_var orb;
+  try {
+    orb = caliper::rtc::ClientOrb("caliper-plotter");
+  } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
+    std::cerr << "caliper-plotter: error: " << e.what() << "\n";
+    return 2;
+  }
   // no call of this process waits longer than the link's call timeout (the naming service's
   // included; the link bounds its calls to the Model itself)
   omniORB::setClientCallTimeout(static_cast<CORBA::ULong>(options.call_timeout_ms));
