@@ -6,8 +6,9 @@
 # threads (/proc/PID/task) are read every 5 s. After the warm-up (a quarter of the run, at most
 # 60 s) memory must stay flat, at most 5 MiB of growth from the start to the end of the measured
 # part (each the median of three readings), and descriptors and threads must not grow (the least
-# of the last three readings against the least of the first three: a short-lived connection does
-# not count). Prints one row per process and PASS or FAIL.
+# of the last three readings against the most in the first half of the measured part: omniORB
+# opens and closes connections, and their threads, on demand). Prints one row per process and
+# PASS or FAIL (fd0 and threads0 in the table are those first-half maxima).
 #
 # Bounded caches are filled during the warm-up so that they do not pass for growth: the plotter
 # keeps 10,000 samples per curve (its layout's buffer), the logger 2,000 records in memory.
@@ -18,7 +19,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --minutes) MINUTES=$2; shift 2 ;;
     --keep) KEEP=1; shift ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "usage: soak_test.sh [--minutes M] [--keep]"; exit 2 ;;
   esac
 done
@@ -98,9 +99,13 @@ for n in "${NAMES[@]}"; do
   rss0=$(head -3 <<<"$measured" | awk '{print $2}' | median3)
   rss1=$(tail -3 <<<"$measured" | awk '{print $2}' | median3)
   rssmax=$(awk '{print $2}' <<<"$measured" | sort -n | tail -1)
-  fd0=$(head -3 <<<"$measured" | awk '{print $3}' | min3)
+  # descriptors and threads: omniORB opens a connection (and a thread serving it) on demand and
+  # closes idle ones, so counts move by one or two either way; growth is an end (the least of the
+  # last three readings) above everything seen in the first half of the measured part
+  half=$(($(wc -l <<<"$measured") / 2))
+  fd0=$(head -n "$half" <<<"$measured" | awk '{print $3}' | sort -n | tail -1)
   fd1=$(tail -3 <<<"$measured" | awk '{print $3}' | min3)
-  th0=$(head -3 <<<"$measured" | awk '{print $4}' | min3)
+  th0=$(head -n "$half" <<<"$measured" | awk '{print $4}' | sort -n | tail -1)
   th1=$(tail -3 <<<"$measured" | awk '{print $4}' | min3)
   growth=$((rss1 - rss0))
   verdict=ok
