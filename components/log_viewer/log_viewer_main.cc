@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
 
   CORBA::ORB_var orb;
   try {
-    orb = caliper::rtc::ClientOrb("caliper-logviewer");
+    orb = caliper::rtc::ClientOrb("caliper-logviewer", 0, options.link.nameservice);
   } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
     std::cerr << "caliper-logviewer: error: " << e.what() << "\n";
     return 2;

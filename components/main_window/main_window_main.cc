@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
            "                    [--no-tools] [--tools LIST] [--plot IDS]... [--arrange]\n"
            "                    [MODEL_FILE]\n"
            "  The Main Window: simulation control, parameters, components, and the other tools.\n"
-           "  --nameservice ADDR  the naming service (default: omniORB's configuration)\n"
+           "  --nameservice ADDR  the naming service, corbaname::HOST:PORT (default:\n"
+           "                      $CALIPER_NAMESERVICE, else corbaname::127.0.0.1:2809)\n"
            "  --model INSTANCE    the Model's instance name (default model0)\n"
            "  --no-tools          do not reopen the tools that were open last time\n"
            "  --tools LIST        open these tools (comma separated: "
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
 
   CORBA::ORB_var orb;
   try {
-    orb = caliper::rtc::ClientOrb("caliper-main");
+    orb = caliper::rtc::ClientOrb("caliper-main", 0, options.nameservice);
   } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
     std::cerr << "caliper-main: error: " << e.what() << "\n";
     return 2;

@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   caliper::logging::Initialize("plotter", caliper::logging::kWarn);
   CORBA::ORB_var orb;
   try {
-    orb = caliper::rtc::ClientOrb("caliper-plotter");
+    orb = caliper::rtc::ClientOrb("caliper-plotter", 0, options.nameservice);
   } catch (const caliper::rtc::SecurityError& e) {  // network mode without usable certificates
     std::cerr << "caliper-plotter: error: " << e.what() << "\n";
     return 2;

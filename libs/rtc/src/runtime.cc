@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <signal.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -321,6 +322,11 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     SecurityRequest request;
     request.endpoint = config.GetString("corba.endpoint");
     request.naming_address = runtime.naming_address_;
+    // endpoints passed through to omniORB (-ORBendPoint giop:tcp::) count as its own
+    for (size_t i = 1; i + 1 < orb_args.size(); ++i)
+      if (strcasecmp(orb_args[i].c_str(), "-ORBendPoint") == 0 ||
+          strcasecmp(orb_args[i].c_str(), "-ORBendPointNoPublish") == 0)
+        request.extra_endpoints.push_back(orb_args[i + 1]);
     request.insecure = config.GetBool("corba.insecure");
     request.pki_dir = config.GetString("corba.tls.pki_dir");
     request.identity = config.GetString("corba.tls.identity");

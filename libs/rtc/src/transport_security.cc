@@ -5,6 +5,7 @@
 #include <netdb.h>
 #include <poll.h>
 #include <pwd.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -323,7 +324,14 @@ bool InsecureFromEnvironment() {
 }
 
 bool IsLoopbackHost(const std::string& host) {
-  return host.rfind("127.", 0) == 0 || host == "::1" || host == "localhost";
+  // addresses as numbers only: a host name such as 127.example.com may point anywhere
+  if (strcasecmp(host.c_str(), "localhost") == 0) return true;
+  in_addr v4{};
+  if (inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  if (inet_pton(AF_INET6, host.c_str(), &v6) == 1)
+    return IN6_IS_ADDR_LOOPBACK(&v6) || (IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127);
+  return false;
 }
 
 std::string AddressHost(const std::string& address) {
@@ -337,15 +345,27 @@ TransportSecurity ResolveSecurity(const SecurityRequest& request) {
   std::string proto, host;
   SplitEndpoint(request.endpoint, &proto, &host);
   s.network_endpoint = (proto == "tcp" || proto == "ssl") && !IsLoopbackHost(host);
+  // endpoints passed to omniORB as they are (-ORBendPoint): one on a network address makes the
+  // process a network one as much as its own endpoint does
+  std::string extra_network, extra_ssl;
+  for (const std::string& endpoint : request.extra_endpoints) {
+    std::string extra_proto, extra_host;
+    SplitEndpoint(endpoint, &extra_proto, &extra_host);
+    if ((extra_proto == "tcp" || extra_proto == "ssl") && !IsLoopbackHost(extra_host) &&
+        extra_network.empty())
+      extra_network = endpoint;
+    if (extra_proto == "ssl" && extra_ssl.empty()) extra_ssl = endpoint;
+  }
   const std::string naming_host = AddressHost(request.naming_address);
   const bool naming_tls = AddressProtocol(request.naming_address) == "ssliop";
   const bool network = s.network_endpoint || proto == "ssl" || naming_tls ||
+                       !extra_network.empty() || !extra_ssl.empty() ||
                        (!naming_host.empty() && !IsLoopbackHost(naming_host));
   if (!network) return s;
   if (request.insecure) {
-    if (proto == "ssl")
+    if (proto == "ssl" || !extra_ssl.empty())
       throw SecurityError("--insecure (plain network mode) with the TLS endpoint " +
-                          request.endpoint + ": drop one of them");
+                          (proto == "ssl" ? request.endpoint : extra_ssl) + ": drop one of them");
     if (naming_tls)
       throw SecurityError("--insecure (plain network mode) with the TLS naming service " +
                           request.naming_address + ": drop --insecure (CALIPER_INSECURE)");
@@ -363,10 +383,12 @@ TransportSecurity ResolveSecurity(const SecurityRequest& request) {
   const std::string dir_arg = request.pki_dir.empty() && std::getenv("CALIPER_PKI") == nullptr
                                   ? ""
                                   : " --dir " + s.pki_dir;
-  const std::string why = "network mode uses TLS with certificates (" +
-                          (s.network_endpoint ? "listening on " + request.endpoint
-                                              : "naming service " + request.naming_address) +
-                          "): ";
+  const std::string why =
+      "network mode uses TLS with certificates (" +
+      (s.network_endpoint       ? "listening on " + request.endpoint
+       : !extra_network.empty() ? "listening on " + extra_network + " (-ORBendPoint)"
+                                : "naming service " + request.naming_address) +
+      "): ";
   s.ca_file = s.pki_dir + "/ca.pem";
   if (!Readable(s.ca_file))
     throw SecurityError(why + "there is no CA certificate " + s.ca_file + "; " +
@@ -428,12 +450,9 @@ std::vector<std::string> SecurityOrbOptions(const TransportSecurity& security) {
   sslContext::verify_mode = SSL_VERIFY_PEER | SSL_VERIFY_FAIL_IF_NO_PEER_CERT;
   sslContext::verify_callback = VerifyCallback;
   sslContext::info_callback = InfoCallback;
-  std::vector<std::string> options = {"-ORBclientTransportRule", "* ssl"};
-  if (security.network_endpoint) {
-    options.push_back("-ORBserverTransportRule");
-    options.push_back("* ssl");
-  }
-  return options;
+  // TLS only, in and out, whatever the endpoints: a plain one passed as -ORBendPoint, set in
+  // $ORBendPoint or in omniORB's configuration file listens, but refuses every connection
+  return {"-ORBclientTransportRule", "* ssl", "-ORBserverTransportRule", "* ssl"};
 }
 
 void InstallProcessSecurity(const TransportSecurity& security) {

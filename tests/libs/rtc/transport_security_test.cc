@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace caliper::rtc {
 namespace {
@@ -87,6 +88,65 @@ TEST_F(TransportSecurityTest, RemoteNamingServiceAloneMeansTls) {
   EXPECT_EQ(s.transport, Transport::kTls);
   EXPECT_EQ(s.endpoint, "giop:tcp:127.0.0.1:");  // listens on loopback still
   EXPECT_FALSE(s.network_endpoint);
+}
+
+TEST_F(TransportSecurityTest, AHostNameStartingWith127IsANetworkAddress) {
+  SecurityRequest r = Network();
+  r.endpoint = "giop:tcp:127.foo.example.com:";
+  r.naming_address = "corbaname::127.0.0.1:2809";
+  const TransportSecurity s = ResolveSecurity(r);
+  EXPECT_EQ(s.transport, Transport::kTls);
+  EXPECT_EQ(s.endpoint, "giop:ssl:127.foo.example.com:");
+  EXPECT_TRUE(s.network_endpoint);
+  r.pki_dir = dir_ + "/nowhere";  // and without certificates: refused, not plain GIOP
+  EXPECT_NE(ErrorOf(r).find("listening on giop:tcp:127.foo.example.com:"), std::string::npos)
+      << ErrorOf(r);
+}
+
+TEST_F(TransportSecurityTest, LocalhostIsLoopback) {
+  SecurityRequest r;
+  r.endpoint = "giop:tcp:localhost:";
+  r.naming_address = "corbaname::localhost:2809";
+  r.pki_dir = dir_ + "/nowhere";
+  EXPECT_EQ(ResolveSecurity(r).transport, Transport::kLoopback);
+}
+
+TEST_F(TransportSecurityTest, APassedNetworkEndpointMeansNetworkMode) {
+  SecurityRequest r;
+  r.endpoint = "giop:tcp:127.0.0.1:";
+  r.naming_address = "corbaname::127.0.0.1:2809";
+  r.pki_dir = dir_ + "/nowhere";
+  r.extra_endpoints = {"giop:unix:", "giop:tcp:127.0.0.1:5000"};
+  EXPECT_EQ(ResolveSecurity(r).transport, Transport::kLoopback);
+  r.extra_endpoints.push_back("giop:tcp::");  // every interface
+  const std::string error = ErrorOf(r);
+  EXPECT_NE(error.find("listening on giop:tcp:: (-ORBendPoint)"), std::string::npos) << error;
+  r.pki_dir = dir_ + "/pki";
+  r.identity = "hosts/h1";
+  EXPECT_EQ(ResolveSecurity(r).transport, Transport::kTls);
+  r.insecure = true;
+  EXPECT_EQ(ResolveSecurity(r).transport, Transport::kInsecure);
+  r.extra_endpoints = {"giop:ssl:127.0.0.1:"};
+  EXPECT_NE(ErrorOf(r).find("with the TLS endpoint giop:ssl:127.0.0.1:"), std::string::npos);
+}
+
+TEST_F(TransportSecurityTest, TlsRefusesPlainGiopOnEveryEndpoint) {
+  // listening on loopback (a remote naming service) or on the network, with or without plain
+  // endpoints passed through: the server rule is there in every case
+  for (const std::string endpoint : {"giop:tcp:198.51.100.1:", "giop:tcp:127.0.0.1:"}) {
+    SecurityRequest r = Network();
+    r.endpoint = endpoint;
+    r.extra_endpoints = {"giop:tcp::"};
+    const TransportSecurity s = ResolveSecurity(r);
+    ASSERT_EQ(s.transport, Transport::kTls) << endpoint;
+    const std::vector<std::string> options = SecurityOrbOptions(s);
+    const std::vector<std::string> expected = {"-ORBclientTransportRule", "* ssl",
+                                               "-ORBserverTransportRule", "* ssl"};
+    EXPECT_EQ(options, expected) << endpoint;
+  }
+  // SecurityOrbOptions made TLS this process's transport: back to loopback for the other tests
+  InstallProcessSecurity(TransportSecurity{});
+  EXPECT_EQ(ProcessSecurity().transport, Transport::kLoopback);
 }
 
 TEST_F(TransportSecurityTest, InsecureStaysPlain) {
@@ -173,10 +233,26 @@ TEST(AddressTest, HostOfNamingAddresses) {
   EXPECT_EQ(AddressHost("corbaloc:iiop:1.2@10.0.0.2:2809/NameService"), "10.0.0.2");
   EXPECT_EQ(AddressHost("corbaname::[::1]:2809"), "::1");
   EXPECT_EQ(AddressHost("IOR:0102"), "");
+}
+
+TEST(AddressTest, LoopbackIsAnAddressNotAPrefix) {
   EXPECT_TRUE(IsLoopbackHost("127.0.0.1"));
+  EXPECT_TRUE(IsLoopbackHost("127.1.2.3"));
   EXPECT_TRUE(IsLoopbackHost("::1"));
+  EXPECT_TRUE(IsLoopbackHost("0:0:0:0:0:0:0:1"));
+  EXPECT_TRUE(IsLoopbackHost("::ffff:127.0.0.1"));
+  EXPECT_TRUE(IsLoopbackHost("localhost"));
+  EXPECT_TRUE(IsLoopbackHost("LocalHost"));
   EXPECT_FALSE(IsLoopbackHost("10.0.0.1"));
+  EXPECT_FALSE(IsLoopbackHost("128.0.0.1"));
+  EXPECT_FALSE(IsLoopbackHost("::2"));
+  EXPECT_FALSE(IsLoopbackHost("::ffff:10.0.0.1"));
   EXPECT_FALSE(IsLoopbackHost(""));  // every interface
+  // host names other than localhost may point anywhere: network addresses
+  EXPECT_FALSE(IsLoopbackHost("127.foo.example.com"));
+  EXPECT_FALSE(IsLoopbackHost("127.0.0.1.example.com"));
+  EXPECT_FALSE(IsLoopbackHost("localhost.example.com"));
+  EXPECT_FALSE(IsLoopbackHost("127.1"));  // not a dotted quad: a name to resolve
 }
 
 TEST(AddressTest, PlainNamingAddressUnchangedWithoutTls) {

@@ -4,9 +4,12 @@
 // libomnisslTP4), or on a network in plain GIOP when asked explicitly (--insecure).
 //
 // Network mode: the process listens on an address other than loopback (--listen ADDR,
-// $CALIPER_LISTEN, corba.endpoint) or its naming service is not on loopback. TLS then:
-//  - listens on giop:ssl:ADDR: and refuses plain TCP (serverTransportRule "* ssl"), calls out
-//    over TLS only (clientTransportRule), naming addresses corbaname::H:P mean corbaname:ssliop:H:P;
+// $CALIPER_LISTEN, corba.endpoint, a -ORBendPoint option) or its naming service is not on
+// loopback. Loopback means 127.0.0.0/8, ::1 or the name localhost: any other host name is a
+// network address. TLS then:
+//  - listens on giop:ssl:ADDR: and refuses plain TCP on every endpoint, also one passed as
+//    -ORBendPoint (serverTransportRule "* ssl"), calls out over TLS only (clientTransportRule),
+//    naming addresses corbaname::H:P mean corbaname:ssliop:H:P;
 //  - proves itself with an identity made by `launch/caliper certs`: PKI/hosts/NAME.pem (a
 //    component; NAME = the host it binds under) or PKI/users/NAME.pem (a client; NAME = $USER),
 //    with the key's password in NAME.pass beside it; PKI is $CALIPER_PKI, else
@@ -40,6 +43,7 @@ enum class Transport {
 struct SecurityRequest {
   std::string endpoint;        ///< the omniORB endpoint it listens on, e.g. giop:tcp:127.0.0.1:
   std::string naming_address;  ///< its naming service (corbaname::HOST:PORT)
+  std::vector<std::string> extra_endpoints;  ///< -ORBendPoint options passed through to omniORB
   bool insecure = false;       ///< --insecure, corba.insecure, $CALIPER_INSECURE
   std::string pki_dir;         ///< '' = $CALIPER_PKI, else ~/.config/caliper/pki
   std::string identity;        ///< '' = $CALIPER_TLS_IDENTITY, else the default below
@@ -66,9 +70,10 @@ bool InsecureFromEnvironment();
 /// an ssl endpoint with --insecure) and std::invalid_argument for a malformed endpoint.
 TransportSecurity ResolveSecurity(const SecurityRequest& request);
 
-/// The -ORB options (name, value pairs flattened) for `security` besides the endpoint: transport
-/// rules over TLS. Over TLS it also configures omniORB's SSL context (CA, key, password,
-/// verification of the peer, handshake diagnostics) for the ORB about to be initialised.
+/// The -ORB options (name, value pairs flattened) for `security` besides the endpoint: over TLS
+/// the transport rules that refuse plain GIOP in and out, whatever the endpoints. Over TLS it
+/// also configures omniORB's SSL context (CA, key, password, verification of the peer,
+/// handshake diagnostics) for the ORB about to be initialised.
 std::vector<std::string> SecurityOrbOptions(const TransportSecurity& security);
 
 /// Records `security` as this process's (for SecureNamingAddress and the diagnostics) and
@@ -89,7 +94,8 @@ std::string SecureNamingAddress(const std::string& address);
 /// The HOST of corbaname:[PROTOCOL]:HOST:PORT[...] or corbaloc:..., '' when it has none.
 std::string AddressHost(const std::string& address);
 
-/// True for 127.x.y.z, ::1 and localhost.
+/// True for the addresses 127.0.0.0/8, ::1 (and ::ffff:127.x.y.z) and the name localhost;
+/// false for any other name (127.example.com too) and for '' (every interface).
 bool IsLoopbackHost(const std::string& host);
 
 /// Why a call that failed with `e` may have failed at the transport, for the caller's message:
