@@ -135,6 +135,30 @@ XmlParse ParseXml(const std::string& path, const std::string* text) {
   return out;
 }
 
+// Collada-DOM dereferences a null pointer (daeMetaElement::place) when an element of a simple
+// type holds an element of its own name (<p><p/></p>, <translate><translate/></translate>,
+// <unit><unit/></unit>; found by fuzzing). The first element directly inside one of the same name,
+// unless COLLADA nests it so (nodes, animations, FX arrays, MathML's apply); nullptr when none.
+const xmlNode* SelfNested(const xmlNode* top) {
+  static const std::string_view kNesting[] = {"node", "animation", "array", "apply"};
+  std::vector<const xmlNode*> stack{top};
+  while (!stack.empty()) {
+    const xmlNode* n = stack.back();
+    stack.pop_back();
+    const std::string_view name = Chars(n->name);
+    const bool may_nest =
+        std::find(std::begin(kNesting), std::end(kNesting), name) != std::end(kNesting);
+    for (const xmlNode* c = n->children; c != nullptr; c = c->next) {
+      if (c->type != XML_ELEMENT_NODE) continue;
+      const bool same_ns = c->ns == nullptr ? n->ns == nullptr
+                                            : n->ns != nullptr && xmlStrEqual(c->ns->href, n->ns->href);
+      if (!may_nest && same_ns && std::string_view(Chars(c->name)) == name) return c;
+      stack.push_back(c);
+    }
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 std::string_view Element::local_name() const { return LocalName(name); }
@@ -383,6 +407,13 @@ Document ReadDocument(const std::string& path) {
     xml = ParseXml(path, nullptr);
     if (!xml.doc) throw ReadError("malformed XML: " + xml.problem, xml.line);
     const xmlNode* top = xmlDocGetRootElement(xml.doc.get());
+    if (const xmlNode* nested = SelfNested(top); nested != nullptr) {
+      const auto big = xml.big_lines.find(nested);
+      const std::string name = Chars(nested->name);
+      throw ReadError("<" + name + "> inside <" + name +
+                          ">: COLLADA does not nest this element in itself",
+                      big != xml.big_lines.end() ? big->second : nested->line);
+    }
     for (const xmlAttr* a = top->properties; a != nullptr; a = a->next)
       if (a->ns == nullptr && std::string_view(Chars(a->name)) == "version")
         doc.declared_version = AttributeOf(a).second;

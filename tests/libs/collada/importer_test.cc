@@ -469,6 +469,15 @@ TEST(ColladaImportTest, RejectsAWordThatIsNotANumberInANumericList) {
       << fraction;
 }
 
+TEST(ColladaImportTest, RejectsAnElementInsideOneOfItsOwnNameBeforeTheDomCrashes) {
+  // Collada-DOM dereferenced a null pointer on <p><p/></p> (found by fuzzing)
+  const std::string message = ErrorOf(Data("malformed_p_inside_p.dae"));
+  EXPECT_NE(message.find("malformed_p_inside_p.dae:28: <p> inside <p>: COLLADA does not nest "
+                         "this element in itself"),
+            std::string::npos)
+      << message;
+}
+
 TEST(ColladaImportTest, ReadsAFileAgainAfterItChanged) {
   // the DOM's DAE is kept between imports (one per schema version): each import must read the
   // file as it is now, not the document the DAE read before from the same path
