@@ -55,6 +55,8 @@ naming_answers() {  # ADDRESS
 
 # Starts omniNames in DIR; sets NS_PORT, NS_PID, NS_ADDR. tls: on giop:ssl only (plain TCP
 # refused), with this host's identity; the address is then corbaname:ssliop:ADDRESS:PORT.
+# Messages up to 4 MiB (omniORB refuses larger ones): a reference with its TLS profile takes
+# under a kilobyte, a binding's name a few dozen bytes; the components' messages go elsewhere.
 start_nameserver() {  # DIR [LISTEN_ADDRESS [tls|plain]]
   local dir=$1 addr=${2:-127.0.0.1} mode=${3:-plain} try
   local -a run=(exec) proto=tcp scheme="corbaname::"
@@ -70,7 +72,7 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [tls|plain]]
     mkdir -p "$dir/omninames-$NS_PORT"
     ("${run[@]}" omniNames -start "$NS_PORT" -always -nohostname \
       -datadir "$dir/omninames-$NS_PORT" -ORBendPoint "giop:$proto:$addr:$NS_PORT" \
-      -ORBgiopMaxMsgSize 268435456 >"$dir/omninames.log" 2>&1) &
+      -ORBgiopMaxMsgSize 4194304 >"$dir/omninames.log" 2>&1) &
     NS_PID=$!
     NS_ADDR="$scheme$addr:$NS_PORT"
     for _ in $(seq 1 50); do

@@ -6,18 +6,21 @@
 #   hostc 198.51.100.3: clients that must be refused: one without a certificate, mallory with a
 #                       certificate of another CA (trusting only hers, or ours too)
 # Certificates by `launch/caliper certs`; hostb gets only ca.pem and its own identity, copied.
-# Checks: a batch of experiments passes over TLS; every network port of hosta and hostb answers a
-# TLS handshake with its host's certificate and asks for a client certificate of our CA; plain
-# GIOP to the naming service and to a Model is refused; the refused clients get a message that
-# says why, from the naming service and from a Model reached directly (its reference bound in the
-# intruder's own naming service). Needs root (ip netns); without it the test is skipped (exit 77)
-# and says why.
+# Checks: a batch of experiments passes over TLS; every network port of hosta and hostb (naming
+# service, logger, Models, manager) answers a TLS handshake with its host's certificate, asks for
+# a client certificate of our CA, and refuses a real handshake without a certificate (alert
+# "certificate required") and with one of another CA (alert "unknown CA"); plain GIOP to the
+# naming service and to a Model is refused, and so is a plain endpoint added with -ORBendPoint;
+# the refused clients get a message that says why, from the naming service and from a Model, the
+# logger and the manager reached directly (their references bound in the intruder's own naming
+# service). Needs root (ip netns); without it the test is skipped (exit 77) and says why.
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 TAG=tl$$
 NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 WORK=$(mktemp -d)
+trap cleanup EXIT  # cleanup is defined below; also when the test skips
 FAILS=0
 
 skip() { echo "SKIPPED: $*"; exit 77; }
@@ -57,7 +60,6 @@ command -v ip >/dev/null || skip "no 'ip' command (apt-get install iproute2)"
 command -v openssl >/dev/null || { echo "FAIL: no openssl command (launch/deps.txt lists it)"; exit 1; }
 ip netns add "$TAG-probe" 2>/dev/null || skip "this kernel or container does not allow 'ip netns add'"
 ip netns del "$TAG-probe"
-trap cleanup EXIT
 started=$SECONDS
 
 # ---------------------------------------------------------------- the hosts
@@ -129,36 +131,101 @@ if [ $rc -eq 0 ] && [ "$done_rows" -eq 6 ]; then pass "alice's batch of 6 experi
 else cat "$WORK/batch.out"; fail "the batch exited $rc with $done_rows of 6 runs done"; fi
 
 # ---------------------------------------------------------------- every network port is TLS
-ports=0 tls=0
+# s_client CLIENT-OPTIONS... against ADDR:PORT from hostc; -ign_eof keeps it reading after the
+# handshake until the server closes: a TLS 1.3 server refuses a client certificate (or its
+# absence) after the client's side of the handshake, with an alert the client must wait for
+s_client() {  # ADDR:PORT OUT [OPTIONS...]
+  local to=$1 out=$2; shift 2
+  in_ns c timeout 5 openssl s_client -ign_eof -connect "$to" -CAfile "$WORK/pki-a/ca.pem" "$@" \
+    </dev/null >"$out" 2>&1
+}
+ports=0 tls=0 nocert=0 foreign=0 owners=""
 for h in a b; do
   addr=198.51.100.$([ $h = a ] && echo 1 || echo 2)
   for port in $(in_ns $h ss -ltnH | awk -v a="$addr:" 'index($4, a) == 1 {sub(/.*:/, "", $4); print $4}' | sort -u); do
     ports=$((ports + 1))
-    in_ns c timeout 5 openssl s_client -connect "$addr:$port" -CAfile "$WORK/pki-a/ca.pem" \
-      </dev/null >"$WORK/s_client.out" 2>&1
+    owner=$(in_ns $h ss -ltnpH "sport = :$port" | grep -o 'users:(("[^"]*"' | cut -d'"' -f2 | head -1)
+    owners="$owners $owner"
+    s_client "$addr:$port" "$WORK/s_client.out"
     if grep -q "subject=O = Caliper, OU = host, CN = host$h" "$WORK/s_client.out" &&
         grep -q "Verify return code: 0 (ok)" "$WORK/s_client.out" &&
         grep -q "Caliper CA" <(sed -n '/Acceptable client certificate CA names/,/^[A-Z]/p' "$WORK/s_client.out"); then
       tls=$((tls + 1))
     else
-      echo "port $addr:$port:"; head -20 "$WORK/s_client.out"
+      echo "port $addr:$port ($owner):"; head -20 "$WORK/s_client.out"
     fi
+    # the same handshake, which sent no certificate, refused by the server
+    if grep -q "alert certificate required" "$WORK/s_client.out"; then nocert=$((nocert + 1))
+    else echo "port $addr:$port ($owner) without a certificate:"; grep -i "alert\|error\|Verify" "$WORK/s_client.out"; fi
+    # mallory's certificate, of another CA
+    s_client "$addr:$port" "$WORK/s_client-m.out" -cert "$WORK/pki-m/users/mallory.pem" \
+      -pass "file:$WORK/pki-m/users/mallory.pass"
+    if grep -q "alert unknown ca" "$WORK/s_client-m.out"; then foreign=$((foreign + 1))
+    else echo "port $addr:$port ($owner) with another CA's certificate:"; grep -i "alert\|error\|Verify" "$WORK/s_client-m.out"; fi
   done
 done
-[ "$ports" -ge 5 ] && [ "$tls" -eq "$ports" ] &&
+owners=$(echo "$owners" | xargs -n1 | sort | uniq -c | xargs)
+echo "network ports: $owners"
+for p in omniNames caliper-logger caliper-model caliper-manager; do
+  [[ " $owners " == *" $p "* ]] || fail "no network port of $p among the ports checked"
+done
+[ "$ports" -ge 6 ] && [ "$tls" -eq "$ports" ] &&
   pass "all $ports ports on 198.51.100.1-2 answer TLS with their host's certificate and ask for one of our CA" ||
   fail "$tls of $ports network ports answer a TLS handshake as expected"
+[ "$ports" -ge 6 ] && [ "$nocert" -eq "$ports" ] &&
+  pass "all $ports ports refuse a TLS handshake without a client certificate (alert 'certificate required')" ||
+  fail "$nocert of $ports network ports refuse a client without a certificate"
+[ "$ports" -ge 6 ] && [ "$foreign" -eq "$ports" ] &&
+  pass "all $ports ports refuse a client certificate of another CA (alert 'unknown CA')" ||
+  fail "$foreign of $ports network ports refuse a certificate of another CA"
+# the control: alice's certificate is not refused (the connection stays up until timeout ends it)
+s_client "198.51.100.1:$NS_PORT" "$WORK/s_client-alice.out" -cert "$WORK/pki-a/users/alice.pem" \
+  -pass "file:$WORK/pki-a/users/alice.pass"
+if ! grep -qi "alert" "$WORK/s_client-alice.out" && grep -q "Verify return code: 0 (ok)" "$WORK/s_client-alice.out"; then
+  pass "the same handshake with alice's certificate is accepted by the naming service"
+else
+  fail "alice's certificate refused by the naming service:"; grep -i "alert\|error" "$WORK/s_client-alice.out"
+fi
 model_port=$(in_ns b ss -ltnpH | grep caliper-model | awk '{sub(/.*:/, "", $4); print $4}' | head -1)
+[ -n "$model_port" ] || fail "no port of a caliper-model on hostb"
 
 # ---------------------------------------------------------------- plain GIOP refused
 in_ns c timeout 10 nameclt -ORBInitRef "NameService=corbaname::198.51.100.1:$NS_PORT" list \
   >"$WORK/plain-ns.out" 2>&1
 expect_refused "plain GIOP to the naming service is refused" "$WORK/plain-ns.out" $? "COMM_FAILURE\|TRANSIENT"
-in_ns c timeout 10 nameclt -ORBInitRef "NameService=corbaloc::198.51.100.2:$model_port/NameService" list \
-  >"$WORK/plain-model.out" 2>&1
-rc=$?
-if grep -q "OBJECT_NOT_EXIST" "$WORK/plain-model.out"; then fail "a Model answered plain GIOP"
-else expect_refused "plain GIOP to a Model (port $model_port) is refused" "$WORK/plain-model.out" $rc "COMM_FAILURE\|TRANSIENT"; fi
+plain_giop() {  # WHAT ADDR:PORT: a plain GIOP request to a port that must refuse it
+  in_ns c timeout 10 nameclt -ORBInitRef "NameService=corbaloc::$2/NameService" list \
+    >"$WORK/plain.out" 2>&1
+  local rc=$?
+  if grep -q "OBJECT_NOT_EXIST" "$WORK/plain.out"; then fail "$1 answered plain GIOP"
+  else expect_refused "plain GIOP to $1 ($2) is refused" "$WORK/plain.out" $rc "COMM_FAILURE\|TRANSIENT"; fi
+}
+[ -n "$model_port" ] && plain_giop "a Model" "198.51.100.2:$model_port"
+# a plain endpoint added with -ORBendPoint listens, but over TLS refuses plain GIOP as well: next
+# to --listen (the Model serves alice on its TLS endpoint), and in a Model that listens on
+# loopback only, in TLS mode for its naming service (no TLS endpoint: it serves nobody)
+extra_model() {  # INSTANCE PORT [OPTIONS...]
+  local instance=$1 port=$2; shift 2
+  # shellcheck disable=SC2046
+  in_ns b env $(host_env b) "$BIN/caliper-model" --nameservice "$NS" --instance "$instance" "$@" \
+    -o "log.spool_dir=$WORK/spool" -ORBendPoint "giop:tcp:198.51.100.2:$port" \
+    >"$WORK/$instance.out" 2>&1 &
+  for _ in $(seq 1 100); do grep -q "is up as" "$WORK/$instance.out" 2>/dev/null && break; sleep 0.1; done
+  if in_ns b ss -ltnpH "sport = :$port" | grep -q caliper-model; then
+    plain_giop "a Model's extra -ORBendPoint giop:tcp:198.51.100.2:$port (${*:-listening on loopback})" "198.51.100.2:$port"
+  else
+    cat "$WORK/$instance.out"; fail "no Model listening on the extra endpoint 198.51.100.2:$port"
+  fi
+}
+extra_model extra 2999 --listen 198.51.100.2
+alice status --model hostb/extra0 >"$WORK/extra-status.out" 2>&1 &&
+  pass "that Model serves alice over TLS" || { cat "$WORK/extra-status.out"; fail "the Model with an extra endpoint"; }
+extra_model extraloop 2998
+# in loopback mode, a network endpoint passed to omniORB means network mode, here without a PKI
+in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$WORK/none" "$BIN/caliper-model" \
+  --nameservice corbaname::127.0.0.1:2809 -ORBendPoint giop:tcp:: >"$WORK/extra-nopki.out" 2>&1
+expect_refused "-ORBendPoint giop:tcp:: without certificates" "$WORK/extra-nopki.out" $? \
+  "network mode uses TLS with certificates (listening on giop:tcp:: (-ORBendPoint)): there is no CA"
 
 # ---------------------------------------------------------------- refused clients: the naming service
 in_ns c env CALIPER_HOST=hostc CALIPER_INSECURE=1 "$BIN/caliper-ctl" --nameservice \
@@ -178,30 +245,48 @@ in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$WORK/pki-m2" CALIPER_TLS_IDENTITY=u
 expect_refused "another CA trusting ours, naming service" "$WORK/mallory2-ns.out" $? \
   "refused the TLS handshake (alert '.*'): it accepts only certificates of its own CA"
 
-# ---------------------------------------------------------------- refused clients: a Model directly
-# its reference, bound under the same name in the intruders' own naming services on hostc
-ior=$(in_ns a bash -c "export $(host_env a); source '$SRC/launch/naming.sh'; tls_identity;
-  (tls_exec nameclt -ORBInitRef 'NameService=$NS' resolve hostb.host_cxt/model0.rtc)" 2>"$WORK/ior.err")
-[[ "$ior" == IOR:* ]] || { cat "$WORK/ior.err"; fail "could not resolve hostb's model0 over TLS"; }
-bind_model() {  # ADDRESS-VARIABLE MODE PKI IDENTITY
-  in_ns c bash -c "export CALIPER_PKI=$3 CALIPER_TLS_IDENTITY=$4; source '$SRC/launch/naming.sh';
-    start_nameserver '$WORK/ns-$2' 127.0.0.1 $2 || exit 1; [ $2 = tls ] && tls_identity;
-    run() { if [ $2 = tls ]; then (tls_exec \"\$@\"); else \"\$@\"; fi; }
+# ---------------------------------------------------------------- refused clients: components directly
+# their references (hostb's model0 and manager0, hosta's logger0), bound under the same names in
+# the intruders' own naming services on hostc
+binds=""
+for path in hostb.host_cxt/model0.rtc hostb.host_cxt/manager0.rtc hosta.host_cxt/logger0.rtc; do
+  ior=$(in_ns a bash -c "export $(host_env a); source '$SRC/launch/naming.sh'; tls_identity;
+    (tls_exec nameclt -ORBInitRef 'NameService=$NS' resolve $path)" 2>"$WORK/ior.err")
+  [[ "$ior" == IOR:* ]] || { cat "$WORK/ior.err"; fail "could not resolve $path over TLS"; }
+  binds="$binds run nameclt -ORBInitRef NameService=\$NS_ADDR bind $path '$ior' >/dev/null &&"
+  [ "$path" = hostb.host_cxt/model0.rtc ] && model_ior=$ior
+done
+# the naming service takes messages up to 4 MiB (launch/naming.sh): a reference is far smaller
+echo "note: hostb's model0 reference with its TLS profile: $(( (${#model_ior} - 4) / 2 )) bytes"
+bind_refs() {  # MODE PKI IDENTITY
+  in_ns c bash -c "export CALIPER_PKI=$2 CALIPER_TLS_IDENTITY=$3; source '$SRC/launch/naming.sh';
+    start_nameserver '$WORK/ns-$1' 127.0.0.1 $1 || exit 1; [ $1 = tls ] && tls_identity;
+    run() { if [ $1 = tls ]; then (tls_exec \"\$@\"); else \"\$@\"; fi; }
     run nameclt -ORBInitRef NameService=\$NS_ADDR bind_new_context hostb.host_cxt >/dev/null &&
-    run nameclt -ORBInitRef NameService=\$NS_ADDR bind hostb.host_cxt/model0.rtc '$ior' >/dev/null &&
-    echo \$NS_ADDR" 2>"$WORK/bind-$2.err" | tail -1
+    run nameclt -ORBInitRef NameService=\$NS_ADDR bind_new_context hosta.host_cxt >/dev/null &&
+    $binds echo \$NS_ADDR" 2>"$WORK/bind-$1.err" | tail -1
 }
-plain_ns=$(bind_model plain plain "" "")
-evil_ns=$(bind_model evil tls "$WORK/pki-m2" hosts/evil)
+plain_ns=$(bind_refs plain "" "")
+evil_ns=$(bind_refs tls "$WORK/pki-m2" hosts/evil)
 [ -n "$plain_ns" ] && [ -n "$evil_ns" ] || { cat "$WORK"/bind-*.err; fail "the intruders' naming services"; }
-in_ns c env CALIPER_HOST=hostc "$BIN/caliper-ctl" --nameservice "$plain_ns" status --model hostb/model0 \
-  >"$WORK/nocert-model.out" 2>&1
+nocert() { in_ns c env CALIPER_HOST=hostc "$BIN/caliper-ctl" --nameservice "$plain_ns" "$@"; }
+mallory() { in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$WORK/pki-m2" CALIPER_TLS_IDENTITY=users/mallory \
+  "$BIN/caliper-ctl" --nameservice "$evil_ns" "$@"; }
+nocert status --model hostb/model0 >"$WORK/nocert-model.out" 2>&1
 expect_refused "no certificate, a Model directly" "$WORK/nocert-model.out" $? \
-  "(on 198.51.100.2) is reachable only over TLS with a certificate of its cluster's CA"
-in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$WORK/pki-m2" CALIPER_TLS_IDENTITY=users/mallory \
-  "$BIN/caliper-ctl" --nameservice "$evil_ns" status --model hostb/model0 >"$WORK/mallory-model.out" 2>&1
+  "(on [^)]*198.51.100.2[^)]*) is reachable only over TLS with a certificate of its cluster's CA"
+mallory status --model hostb/model0 >"$WORK/mallory-model.out" 2>&1
 expect_refused "another CA, a Model directly" "$WORK/mallory-model.out" $? \
   "198.51.100.2:[0-9]* refused the TLS handshake (alert '.*'): it accepts only certificates of its own CA"
+for who in hostb/manager0 hosta/logger0; do
+  addr=198.51.100.$([ "${who%%/*}" = hosta ] && echo 1 || echo 2)
+  nocert state "$who" >"$WORK/nocert-${who#*/}.out" 2>&1
+  expect_refused "no certificate, $who directly" "$WORK/nocert-${who#*/}.out" $? \
+    "(on [^)]*$addr[^)]*) is reachable only over TLS with a certificate of its cluster's CA"
+  mallory state "$who" >"$WORK/mallory-${who#*/}.out" 2>&1
+  expect_refused "another CA, $who directly" "$WORK/mallory-${who#*/}.out" $? \
+    "$addr:[0-9]* refused the TLS handshake (alert '.*'): it accepts only certificates of its own CA"
+done
 # and alice, with the same reference from the same place, is served
 in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$WORK/pki-a" CALIPER_TLS_IDENTITY=users/alice CALIPER_LISTEN=198.51.100.3 \
   "$BIN/caliper-ctl" --nameservice "$NS" status --model hostb/model0 >"$WORK/alice-c.out" 2>&1 &&

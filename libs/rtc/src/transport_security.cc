@@ -16,6 +16,7 @@
 #include <openssl/ssl.h>
 #include <openssl/x509.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <chrono>
@@ -25,6 +26,7 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
 #include "caliper/core/system.h"
 
@@ -50,9 +52,11 @@ thread_local std::string t_verify_error;
 // the peer of this thread's last handshake, and when it began
 thread_local std::string t_peer;
 thread_local Clock::time_point t_peer_when;
-// a process without TLS: the last reference this thread decoded that has only a TLS address
-// (its plain IIOP port is 0), which that process's calls cannot reach
-thread_local HandshakeNote t_tls_only;
+// a process without TLS: the hosts of the references this thread decoded lately that have only
+// a TLS address (their plain IIOP port is 0), which that process's calls cannot reach; several
+// when it decoded several (a listing), since a failed call does not say which object it was for
+constexpr size_t kMaxTlsOnlyHosts = 8;
+thread_local std::vector<HandshakeNote> t_tls_only;
 
 std::string Trim(std::string s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
@@ -215,8 +219,13 @@ CORBA::Boolean DecodeIor(omni::omniInterceptors::decodeIOR_T::info_T& info) {
   if (!info.has_iiop_body || info.iiop.address.port != 0) return true;
   for (CORBA::ULong i = 0; i < info.iiop.components.length(); ++i)
     if (info.iiop.components[i].tag == IOP::TAG_SSL_SEC_TRANS) {
-      t_tls_only.text = info.iiop.address.host.in();
-      t_tls_only.when = Clock::now();
+      const std::string host = info.iiop.address.host.in();
+      auto seen = std::find_if(t_tls_only.begin(), t_tls_only.end(),
+                               [&](const HandshakeNote& n) { return n.text == host; });
+      if (seen != t_tls_only.end()) t_tls_only.erase(seen);
+      if (t_tls_only.size() == kMaxTlsOnlyHosts) t_tls_only.erase(t_tls_only.begin());
+      t_tls_only.push_back({host, Clock::now()});
+      break;
     }
   return true;
 }
@@ -517,13 +526,19 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
   const std::string mode = ProcessSecurity().transport == Transport::kInsecure
                                ? "--insecure / CALIPER_INSECURE"
                                : "loopback mode";
-  if (ProcessSecurity().transport != Transport::kTls && !t_tls_only.text.empty() &&
-      Clock::now() - t_tls_only.when < std::chrono::seconds(60) &&
+  std::string hosts;  // of the TLS-only references decoded in the last minute, oldest first
+  size_t count = 0;
+  for (const HandshakeNote& n : t_tls_only)
+    if (Clock::now() - n.when < std::chrono::seconds(60)) {
+      hosts += (hosts.empty() ? "" : ", ") + n.text;
+      ++count;
+    }
+  if (ProcessSecurity().transport != Transport::kTls && count > 0 &&
       (minor == "TRANSIENT_ConnectFailed" || minor == "TRANSIENT_NoUsableProfile")) {
-    const std::string host = t_tls_only.text;
-    t_tls_only.text.clear();
-    return "the object (on " + host + ") is reachable only over TLS with a certificate of its "
-           "cluster's CA; this process runs without TLS (" + mode + ")";
+    t_tls_only.clear();
+    return "the object (on " + std::string(count > 1 ? "one of " : "") + hosts +
+           ") is reachable only over TLS with a certificate of its cluster's CA; this process "
+           "runs without TLS (" + mode + ")";
   }
   if (minor == "TRANSIENT_NoUsableProfile") {
     if (ProcessSecurity().transport == Transport::kTls)
