@@ -3,29 +3,37 @@
 #   hosta 198.51.100.1: naming service and the batch client
 #   hostb 198.51.100.2, hostc 198.51.100.3: a manager each, with two Models
 # joined by a bridge that lives in a namespace of its own. Every process runs inside a
-# namespace; the root namespace never sends to the test addresses. Checks: network mode is
-# reachable from another host and loopback mode is not; 20 experiments survive a SIGKILLed Model
-# and a link down for a few seconds, each result exists once and equals a single-host run bit for
-# bit; the manager reports the dead Model; components register again after the naming service
-# restarts. Needs root (ip netns); without it the test is skipped (exit 77) and says why.
+# namespace; the root namespace never sends to the test addresses. Everything on the network
+# talks TLS with client certificates (network mode's default): `launch/caliper certs` makes a CA,
+# an identity per host (the naming service, the managers and their Models use their host's) and
+# one for the user alice (the batch client). Checks: network mode is reachable from another host
+# over TLS, and plain GIOP is refused; loopback mode is not reachable; 20 experiments survive a
+# SIGKILLed Model and a link down for a few seconds, each result exists once and equals a
+# single-host run bit for bit; the manager reports the dead Model; components register again
+# after the naming service restarts. Needs root (ip netns); without it the test is skipped
+# (exit 77) and says why.
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 TAG=cl$$
 NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 WORK=$(mktemp -d)
-NS=corbaname::198.51.100.1:2809
+trap cleanup EXIT  # cleanup is defined below; also when the test skips
+NS=corbaname:ssliop:198.51.100.1:2809
+PKI=$WORK/pki
 FAILS=0
-# plain network mode (what --insecure gives): this test is about faults and results; TLS between
-# the hosts is tls_test.sh's
-export CALIPER_INSECURE=1
+unset CALIPER_INSECURE CALIPER_TLS_IDENTITY CALIPER_LISTEN
 
 skip() { echo "SKIPPED: $*"; exit 77; }
 fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
 pass() { echo "ok: $*"; }
 in_ns() { local n=$1; shift; ip netns exec "$TAG-$n" "$@"; }
-# caliper-ctl from host A with the naming service on A
-ctl() { in_ns a env CALIPER_HOST=hosta "$BIN/caliper-ctl" --nameservice "$NS" "$@"; }
+# caliper-ctl from host A with the naming service on A, as the user alice
+ctl() { in_ns a env CALIPER_HOST=hosta CALIPER_PKI="$PKI" CALIPER_TLS_IDENTITY=users/alice \
+  "$BIN/caliper-ctl" --nameservice "$NS" "$@"; }
+# an omniORB tool (omniNames, nameclt) on host A with hosta's identity (launch/naming.sh)
+tls_tool() { in_ns a env CALIPER_PKI="$PKI" CALIPER_TLS_IDENTITY=hosts/hosta bash -c \
+  "source '$SRC/launch/naming.sh'; tls_identity; tls_exec \"\$@\"" tls_tool "$@"; }
 
 cleanup() {
   local n p
@@ -41,7 +49,7 @@ cleanup() {
 command -v ip >/dev/null || skip "no 'ip' command (apt-get install iproute2)"
 ip netns add "$TAG-probe" 2>/dev/null || skip "this kernel or container does not allow 'ip netns add'"
 ip netns del "$TAG-probe"
-trap cleanup EXIT
+command -v openssl >/dev/null || { echo "FAIL: no openssl command (launch/deps.txt lists it)"; exit 1; }
 
 # ---------------------------------------------------------------- the hosts
 for n in "${NETS[@]}"; do ip netns add "$n" || { echo "FAIL: ip netns add $n"; exit 1; }; done
@@ -58,23 +66,31 @@ for h in a b c; do
   i=$((i + 1))
 done
 
+# ---------------------------------------------------------------- certificates
+{ launcher() { bash "$SRC/launch/caliper" certs "$@" --dir "$PKI"; }
+  launcher ca && launcher host hosta && launcher host hostb && launcher host hostc &&
+    launcher user alice; } >"$WORK/certs.out" 2>&1 ||
+  { cat "$WORK/certs.out"; echo "FAIL: launch/caliper certs"; exit 1; }
+
+# the naming service over TLS only, as launch/naming.sh starts it (the same pid: tls_exec execs)
 start_naming() {  # DATADIR
   mkdir -p "$1"
-  in_ns a omniNames -start 2809 -always -nohostname -datadir "$1" \
-    -ORBendPoint giop:tcp:198.51.100.1:2809 >>"$WORK/naming-service.out" 2>&1 &
+  tls_tool env "ORBserverTransportRule=* ssl" "ORBclientTransportRule=* ssl" \
+    omniNames -start 2809 -always -nohostname -datadir "$1" \
+    -ORBendPoint giop:ssl:198.51.100.1:2809 -ORBgiopMaxMsgSize 4194304 >>"$WORK/naming-service.out" 2>&1 &
   NAMING_PID=$!
   for _ in $(seq 1 50); do
-    in_ns a nameclt -ORBInitRef "NameService=$NS" list >/dev/null 2>&1 && return 0
+    tls_tool nameclt -ORBInitRef "NameService=$NS" list >/dev/null 2>&1 && return 0
     sleep 0.1
   done
-  echo "FAIL: omniNames did not start on hosta"; exit 1
+  echo "FAIL: omniNames did not start on hosta"; cat "$WORK/naming-service.out"; exit 1
 }
 start_naming "$WORK/names1"
 
 # managers on B and C, listening on their own addresses
 for h in b c; do
   addr=198.51.100.$([ $h = b ] && echo 2 || echo 3)
-  in_ns $h env CALIPER_HOST=host$h CALIPER_LISTEN=$addr "$BIN/caliper-manager" \
+  in_ns $h env CALIPER_HOST=host$h CALIPER_PKI="$PKI" CALIPER_LISTEN=$addr "$BIN/caliper-manager" \
     --nameservice "$NS" -o manager.max_models=2 -o "manager.output_dir=$WORK/$h" \
     -o "log.spool_dir=$WORK/spool" -o naming.update.interval=0.5 >"$WORK/manager-$h.out" 2>&1 &
 done
@@ -88,12 +104,21 @@ models=$(grep -c '^model' "$WORK/ls.out")
 [ "$models" -eq 4 ] && pass "4 Models on hostb and hostc" || { cat "$WORK/ls.out"; fail "expected 4 Models, found $models"; }
 
 # ---------------------------------------------------------------- network mode vs loopback
-if ctl status --model hostc/model0 >/dev/null 2>&1; then pass "a network-mode Model on hostc answers hosta"
+if ctl status --model hostc/model0 >/dev/null 2>&1; then pass "a network-mode Model on hostc answers hosta over TLS"
 else fail "hostc/model0 does not answer from hosta"; fi
 if in_ns b ss -ltn | grep -q '198.51.100.2:'; then pass "hostb's Models listen on 198.51.100.2"
 else fail "nothing listens on 198.51.100.2 in hostb"; fi
-# a component in the default (loopback) mode: bound in the naming service but unreachable
-in_ns c env CALIPER_HOST=hostc "$BIN/caliper-model" --nameservice "$NS" --instance loopback \
+# without TLS: hostc's Models refuse plain GIOP, and so does the naming service
+port=$(in_ns c ss -ltnpH | grep caliper-model | awk '{sub(/.*:/, "", $4); print $4}' | head -1)
+for to in "198.51.100.3:${port:-none}" 198.51.100.1:2809; do
+  out=$(in_ns a timeout 10 nameclt -ORBInitRef "NameService=corbaloc::$to/NameService" list 2>&1)
+  if [ -n "$port" ] && ! grep -q OBJECT_NOT_EXIST <<<"$out" && grep -q "COMM_FAILURE\|TRANSIENT" <<<"$out"; then
+    pass "plain GIOP to $to refused ($(grep -o 'COMM_FAILURE\|TRANSIENT' <<<"$out" | head -1))"
+  else fail "plain GIOP to $to not refused: $out"; fi
+done
+# a component without --listen (in TLS mode for its naming service, but listening on loopback
+# only): bound in the naming service but unreachable
+in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$PKI" "$BIN/caliper-model" --nameservice "$NS" --instance loopback \
   -o "log.spool_dir=$WORK/spool" >"$WORK/loopback.out" 2>&1 &
 for _ in $(seq 1 100); do grep -q "is up as" "$WORK/loopback.out" && break; sleep 0.1; done
 lpid=$(in_ns c ss -ltnpH | grep -v 198.51.100 | sed -n 's/.*pid=\([0-9]*\).*/\1/p' | head -1)

@@ -204,9 +204,11 @@ void InfoCallback(const SSL* ssl, int where, int ret) {
     Note("the certificate of " + peer + " is not signed by the cluster's CA (" + ca +
          "): " + t_verify_error + "; it belongs to another cluster, or its CA is not ours");
     t_verify_error.clear();
-  } else {
+  } else if (SSL_in_init(ssl)) {
     Note("the TLS handshake with " + peer + " failed (we sent alert '" + alert + "')");
   }
+  // an alert of ours on an established connection: the peer died or the connection broke
+  // mid-message (a killed peer), which the exception itself says
 }
 
 void LogWithoutSslNotice(const char* message) {
