@@ -149,7 +149,7 @@ in_ns a "$BIN/caliper-model" --nameservice corbaname::127.0.0.1:2810 -o "log.spo
   >"$WORK/local-model.out" 2>&1 &
 in_ns a "$BIN/caliper-ctl" --nameservice corbaname::127.0.0.1:2810 batch "$WORK/runs.json" \
   --out "$WORK/reference" >"$WORK/reference.out" 2>&1 || { cat "$WORK/reference.out"; fail "the single-host batch"; }
-echo "reference: $(tail -2 "$WORK/reference.out" | head -1)"
+echo "reference: $(grep ' runs done' "$WORK/reference.out" | tail -1)"
 
 # ---------------------------------------------------------------- the cluster run, with faults
 ctl batch "$WORK/runs.json" --out "$WORK/cluster" --stall-timeout 2 >"$WORK/cluster.out" 2>"$WORK/cluster.err" &
