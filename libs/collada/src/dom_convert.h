@@ -14,6 +14,7 @@
 
 #include "document.h"
 #include "dom_io.h"
+#include "dom_paths.h"
 
 namespace caliper::collada::internal {
 
@@ -108,6 +109,9 @@ DAE& SharedDae() {
 /// Opens `path` with a DAE of the version `Dom` describes.
 template <typename Dom>
 DomLoad LoadWithDom(const std::string& path, bool zipped) {
+  // the DOM must open the file named, and extract a .zae only inside its temporary directory
+  CheckDomPath(path);
+  if (zipped) CheckZaeArchive(path);
   DomLoad result;
   CollectingErrorHandler handler;
   {
@@ -164,6 +168,7 @@ inline void BuildDomElement(const Element& in, daeElement* out, bool opaque) {
 /// Writes a <COLLADA> tree with a DAE of the version `Dom` describes.
 template <typename Dom>
 void WriteWithDom(const Element& root, const std::string& path) {
+  CheckDomPath(path);
   CollectingErrorHandler handler;
   bool ok = false;
   {

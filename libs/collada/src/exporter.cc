@@ -9,6 +9,7 @@
 
 #include "caliper_extra.h"
 #include "document.h"
+#include "dom_paths.h"
 #include "extension.h"
 #include "math3d.h"
 #include "mesh_util.h"
@@ -471,6 +472,11 @@ void Export(const sgal::Scene& scene, const std::string& path) {
     std::string message = path + ": the scene is not sound:";
     for (const auto& p : problems) message += "\n  " + p;
     throw ExportError(message);
+  }
+  try {
+    internal::CheckDomPath(path);
+  } catch (const std::exception& e) {
+    throw ExportError(path + ": " + e.what());
   }
   {
     std::ofstream probe(path, std::ios::app);
