@@ -8,8 +8,8 @@
 
 namespace caliper::fuzz {
 
-/// Writes `size` bytes to a file of this process (under $TMPDIR, /tmp by default; the directory
-/// is removed at exit) named `name`, replacing what the previous input left there, and returns
+/// Writes `size` bytes to a file of this process (under $TMPDIR, else /dev/shm when writable,
+/// else /tmp; the directory is removed at exit) named `name`, replacing what the previous input left there, and returns
 /// its path. Aborts when the file cannot be written: a run without its input would test nothing.
 std::string WriteInput(const uint8_t* data, size_t size, const std::string& name);
 
