@@ -164,7 +164,8 @@ bool ModelTakesPath(const ModelRef& m, const std::string& path,
   } else if (*files->write_dir.in() != '\0') {
     dirs.push_back(files->write_dir.in());
   }
-  return core::ConfinedPaths(dirs, "", "").Allows(path, access);
+  // the Model's COLLADA library reads names as URIs: it refuses '#', '?' and '%'
+  return core::ConfinedPaths(dirs, "", "", true).Allows(path, access);
 }
 
 // Channel metadata by id (one list call).

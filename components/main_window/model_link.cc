@@ -78,7 +78,7 @@ void ModelLink::LoadScene(const std::string& path) {
     std::vector<std::string> dirs;
     for (CORBA::ULong k = 0; k < files->read_dirs.length(); ++k)
       dirs.push_back(files->read_dirs[k].in());
-    if (core::ConfinedPaths(dirs, "", "").Allows(path, core::ConfinedPaths::Access::kRead)) {
+    if (core::ConfinedPaths(dirs, "", "", true).Allows(path, core::ConfinedPaths::Access::kRead)) {
       i.model->load_scene(path.c_str());
     } else {
       std::ifstream in(path, std::ios::binary);

@@ -171,7 +171,8 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
     throw LoadError(file_name + ": a scene sent by content must be named *.dae or *.zae");
   if (bytes.empty()) throw LoadError(file_name + ": the scene sent is empty");
   ScratchDirectory scratch;
-  const std::string path = scratch.path() + "/" + base;
+  // a plain name for the copy: the importer refuses names it would read as URIs ('#', '%')
+  const std::string path = scratch.path() + "/scene" + ending;
   {
     std::ofstream out(path, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));

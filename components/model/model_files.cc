@@ -11,8 +11,9 @@ std::vector<core::ConfigKey> ModelFiles::ConfigKeys() {
        "directories load_scene reads scenes from, separated by ':' (relative paths start from the "
        "first; the write directory is readable too; other files are sent by content)"},
       {"model.write_dir", Type::kString, "",
-       "the directory save_scene writes into ('' = $CALIPER_SESSION_DIR, the session's directory "
-       "when the launcher started the Model; unset = none: clients fetch export_scene)"},
+       "the directory save_scene writes into ('' = $CALIPER_FILES_DIR, the session's files/ "
+       "directory when the launcher started the Model; unset = none: clients fetch "
+       "export_scene)"},
       {"model.confine_scene", Type::kBool, "false",
        "model.scene too must lead below model.read_dirs (a manager sets it for the Models it "
        "starts: there a client chose the scene)"},
@@ -21,15 +22,15 @@ std::vector<core::ConfigKey> ModelFiles::ConfigKeys() {
 
 ModelFiles ModelFiles::FromConfig(const core::Config& config) {
   std::string write_dir = config.GetString("model.write_dir");
-  const char* session = std::getenv("CALIPER_SESSION_DIR");
-  if (write_dir.empty() && session != nullptr) write_dir = session;
+  const char* files = std::getenv("CALIPER_FILES_DIR");
+  if (write_dir.empty() && files != nullptr) write_dir = files;
   std::vector<std::string> read_dirs = core::SplitSearchPath(config.GetString("model.read_dirs"));
   if (!write_dir.empty()) read_dirs.push_back(write_dir);
-  return ModelFiles{
-      core::ConfinedPaths(read_dirs, "model.read_dirs, model.write_dir", "the Model reads scenes"),
-      core::ConfinedPaths(
-          write_dir.empty() ? std::vector<std::string>{} : std::vector<std::string>{write_dir},
-          "model.write_dir", "the Model writes scenes")};
+  return ModelFiles{core::ConfinedPaths(read_dirs, "model.read_dirs, model.write_dir",
+                                        "the Model reads scenes", true),
+                    core::ConfinedPaths(write_dir.empty() ? std::vector<std::string>{}
+                                                          : std::vector<std::string>{write_dir},
+                                        "model.write_dir", "the Model writes scenes", true)};
 }
 
 }  // namespace caliper::model

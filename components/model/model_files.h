@@ -5,8 +5,9 @@
 //
 // Configuration:
 //   model.read_dirs   directories load_scene reads from, separated by ':' (the project's models/)
-//   model.write_dir   the directory save_scene writes into ('' = $CALIPER_SESSION_DIR, which the
-//                     launcher sets to the session's directory; without it no path is writable)
+//   model.write_dir   the directory save_scene writes into ('' = $CALIPER_FILES_DIR, which the
+//                     launcher sets to the session's files/ directory, away from the session
+//                     log and the naming service's data; without it no path is writable)
 //   model.confine_scene  model.scene too must lead below model.read_dirs (set by a manager for
 //                     the Models it starts, whose scene a client chose)
 // Relative paths start from the first read directory (load_scene) or the write directory.
@@ -24,7 +25,7 @@ struct ModelFiles {
   core::ConfinedPaths write;  ///< the write directory alone (none when unset)
 
   static std::vector<core::ConfigKey> ConfigKeys();
-  /// The directories that `config` (and $CALIPER_SESSION_DIR) give.
+  /// The directories that `config` (and $CALIPER_FILES_DIR) give.
   static ModelFiles FromConfig(const core::Config& config);
 };
 

@@ -1,6 +1,7 @@
 #include "model_servant.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <variant>
@@ -163,6 +164,18 @@ auto Guard(F&& f) -> decltype(f()) {
     logging::Get("model").error("internal error: an exception of unknown type");
     throw Unavailable("internal error: an exception of unknown type");
   }
+}
+
+// the largest GIOP message this process sends or receives (corba.max_message_size) [bytes]
+double MaxMessageBytes(const core::Config& config) {
+  return config.GetDouble("corba.max_message_size") * (1 << 20);
+}
+
+// bytes in MiB with one decimal, for messages
+std::string Mib(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", bytes / (1 << 20));
+  return text;
 }
 
 }  // namespace
@@ -715,12 +728,12 @@ S::Description* ModelServant::scene_description() {
       for (const auto& v : b.visuals) count(v.geometry);
       for (const auto& shape : b.shapes) count(shape.geometry);
     }
-    if (bytes > 0.9 * rtc::kMaxMessageBytes)
-      throw NotAvailable("the scene description is about " +
-                         std::to_string(static_cast<long>(bytes / (1 << 20))) + " MiB of meshes (" +
+    const double limit = MaxMessageBytes(runtime_.config());
+    if (bytes > 0.9 * limit)
+      throw NotAvailable("the scene description is about " + Mib(bytes) + " MiB of meshes (" +
                          std::to_string(meshes.size()) + " meshes), more than one GIOP message " +
-                         "carries (" + std::to_string(rtc::kMaxMessageBytes >> 20) +
-                         " MiB, corba.max_message_size): simplify the meshes");
+                         "carries (" + Mib(limit) + " MiB, corba.max_message_size): simplify " +
+                         "the meshes or raise the limit");
     return ToIdl(*scene);
   });
 }
@@ -744,10 +757,10 @@ void ModelServant::load_scene_data(const char* file_name, const M::Octets& data)
 M::Octets* ModelServant::export_scene() {
   return Guard([&] {
     const std::string bytes = core_.ExportBytes();
-    if (bytes.size() > static_cast<size_t>(0.95 * rtc::kMaxMessageBytes))
-      throw NotAvailable("the exported scene is " + std::to_string(bytes.size() >> 20) +
-                         " MiB, more than one GIOP message carries (" +
-                         std::to_string(rtc::kMaxMessageBytes >> 20) +
+    const double limit = MaxMessageBytes(runtime_.config());
+    if (static_cast<double>(bytes.size()) > 0.95 * limit)
+      throw NotAvailable("the exported scene is " + Mib(static_cast<double>(bytes.size())) +
+                         " MiB, more than one GIOP message carries (" + Mib(limit) +
                          " MiB, corba.max_message_size): save it to a file on the Model's host");
     auto* out = new M::Octets(static_cast<CORBA::ULong>(bytes.size()));
     out->length(static_cast<CORBA::ULong>(bytes.size()));

@@ -20,9 +20,9 @@ std::vector<core::ConfigKey> RendererComponent::ConfigKeys() {
       {"renderer.show_constraint_axes", Type::kBool, "false",
        "draw the hinge and slider axes of the constraints"},
       {"renderer.write_dir", Type::kString, "",
-       "the directory the screenshot operation writes into ('' = $CALIPER_SESSION_DIR, the "
-       "session's directory when the launcher started the renderer; unset = none: clients take "
-       "screenshot_png)"},
+       "the directory the screenshot operation writes into ('' = $CALIPER_FILES_DIR, the "
+       "session's files/ directory when the launcher started the renderer; unset = none: "
+       "clients take screenshot_png)"},
   };
 }
 

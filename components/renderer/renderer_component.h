@@ -11,7 +11,7 @@
 //   renderer.max_fps          largest frame rate of the view [Hz]
 //   renderer.width, renderer.height   size of screenshots [px]
 //   renderer.show_constraint_axes     draw the hinge and slider axes (false; also over CORBA)
-//   renderer.write_dir        where the screenshot operation may write ('' = $CALIPER_SESSION_DIR,
+//   renderer.write_dir        where the screenshot operation may write ('' = $CALIPER_FILES_DIR,
 //                             else nowhere); relative paths start from it
 
 #include <chrono>

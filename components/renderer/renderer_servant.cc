@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <stdexcept>
@@ -61,8 +62,8 @@ void RendererServant::set_camera(const Caliper::Scene::Frame& pose, CORBA::Doubl
 
 core::ConfinedPaths ScreenshotDirectory(const core::Config& config) {
   std::string dir = config.GetString("renderer.write_dir");
-  const char* session = std::getenv("CALIPER_SESSION_DIR");
-  if (dir.empty() && session != nullptr) dir = session;
+  const char* files = std::getenv("CALIPER_FILES_DIR");
+  if (dir.empty() && files != nullptr) dir = files;
   std::vector<std::string> dirs;
   if (!dir.empty()) dirs.push_back(dir);
   return core::ConfinedPaths(dirs, "renderer.write_dir", "the renderer writes screenshots");
@@ -104,12 +105,17 @@ V::Png* RendererServant::screenshot_png(CORBA::ULong width, CORBA::ULong height)
     *result = control_.ScreenshotPng(static_cast<int>(width), static_cast<int>(height));
   });
   const std::string& png = *result;
-  if (png.size() > static_cast<size_t>(0.95 * rtc::kMaxMessageBytes))
-    throw V::NotAvailable(("the PNG is " + std::to_string(png.size() >> 20) +
-                           " MiB, more than one GIOP message carries (" +
-                           std::to_string(rtc::kMaxMessageBytes >> 20) +
-                           " MiB): take a smaller one, or screenshot() into " + files_.Describe())
+  // the configured limit of this process's messages, not the clients' default
+  const double limit = runtime_.config().GetDouble("corba.max_message_size") * (1 << 20);
+  if (static_cast<double>(png.size()) > 0.95 * limit) {
+    char sizes[96];
+    std::snprintf(sizes, sizeof sizes, "%.1f MiB, more than one GIOP message carries (%.1f MiB",
+                  static_cast<double>(png.size()) / (1 << 20), limit / (1 << 20));
+    throw V::NotAvailable((std::string("the PNG is ") + sizes +
+                           ", corba.max_message_size): take a smaller one, or screenshot() into " +
+                           files_.Describe())
                               .c_str());
+  }
   auto* out = new V::Png(static_cast<CORBA::ULong>(png.size()));
   out->length(static_cast<CORBA::ULong>(png.size()));
   std::copy(png.begin(), png.end(), reinterpret_cast<char*>(out->get_buffer()));

@@ -34,7 +34,7 @@ using GuiCall = std::function<std::string(std::function<void()>)>;
 /// std::invalid_argument for a zero quaternion or an angle outside (0, pi).
 render_coin::CameraPose CameraFromFrame(const render_coin::Pose& pose, double height_angle);
 
-/// Where screenshot() may write: renderer.write_dir, else $CALIPER_SESSION_DIR (the session's
+/// Where screenshot() may write: renderer.write_dir, else $CALIPER_FILES_DIR (the session's files/
 /// directory when the launcher started the renderer), else nowhere.
 core::ConfinedPaths ScreenshotDirectory(const core::Config& config);
 

@@ -15,6 +15,7 @@
 #include "caliper/model.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
+#include "corpus.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -203,7 +204,7 @@ TEST_F(ConfinedFilesTest, SaveSceneWritesOnlyBelowTheWriteDirectory) {
 }
 
 TEST_F(ConfinedFilesTest, WithoutAWriteDirectoryNoPathIsWritable) {
-  ::unsetenv("CALIPER_SESSION_DIR");
+  ::unsetenv("CALIPER_FILES_DIR");
   StartModel({"-o", "model.read_dirs=" + root_ + "/models"});
   M::FileAccess_var files = ref_->file_access();
   EXPECT_EQ(std::string(files->write_dir.in()), "");
@@ -218,10 +219,12 @@ TEST_F(ConfinedFilesTest, WithoutAWriteDirectoryNoPathIsWritable) {
   EXPECT_FALSE(fs::exists(root_ + "/session/x.dae"));
 }
 
-TEST_F(ConfinedFilesTest, TheSessionDirectoryIsTheDefaultWriteDirectory) {
-  ::setenv("CALIPER_SESSION_DIR", (root_ + "/session").c_str(), 1);
+TEST_F(ConfinedFilesTest, TheSessionsFilesDirectoryIsTheDefaultWriteDirectory) {
+  // the launcher exports its session's files/ directory (not the session's own, where the
+  // session log and the naming service's data are)
+  ::setenv("CALIPER_FILES_DIR", (root_ + "/session").c_str(), 1);
   StartModel({});
-  ::unsetenv("CALIPER_SESSION_DIR");
+  ::unsetenv("CALIPER_FILES_DIR");
   M::FileAccess_var files = ref_->file_access();
   EXPECT_EQ(std::string(files->write_dir.in()), root_ + "/session");
   ASSERT_EQ(files->read_dirs.length(), 2u);
@@ -230,6 +233,101 @@ TEST_F(ConfinedFilesTest, TheSessionDirectoryIsTheDefaultWriteDirectory) {
   EXPECT_EQ(LoadRefusal("ecce_arm.dae"), "");
   EXPECT_EQ(SaveRefusal("tuned.dae"), "");
   EXPECT_TRUE(fs::is_regular_file(root_ + "/session/tuned.dae"));
+}
+
+TEST_F(ConfinedFilesTest, NamesTheColladaLibraryReadsAsUrisAreRefused) {
+  // Collada-DOM takes a file name as a URI: it opened 'link#x' as 'link' (cut at '#', as at '?')
+  // and 'l%69nk' as 'link', so the file checked (missing, inside) was not the one written
+  StartConfinedModel();
+  ASSERT_EQ(LoadRefusal("pendulum.dae"), "");
+  fs::create_symlink(root_ + "/outside/victim.txt", root_ + "/session/link");
+  fs::create_symlink(root_ + "/outside/pendulum.dae", root_ + "/models/link");
+  for (const std::string& name : {std::string("link#x"), std::string("link?x"),
+                                  std::string("l%69nk"), std::string("link%20")}) {
+    const std::string saved = SaveRefusal(name);
+    EXPECT_TRUE(Contains(saved, "save_scene: '" + name + "' (resolved: '" + root_ + "/session/" +
+                                    name + "') holds '"))
+        << saved;
+    EXPECT_TRUE(Contains(saved,
+                         "the Model writes scenes with a library that reads file names as "
+                         "URIs, which would open another file"))
+        << saved;
+    EXPECT_FALSE(fs::exists(root_ + "/session/" + name)) << name;
+    const std::string loaded = LoadRefusal(name);
+    EXPECT_TRUE(Contains(loaded, "load_scene: '" + name + "'")) << loaded;
+    EXPECT_TRUE(Contains(loaded, "which would open another file")) << loaded;
+  }
+  EXPECT_EQ(ReadFile(root_ + "/outside/victim.txt"), "precious\n");
+  EXPECT_EQ(Scene(), root_ + "/models/pendulum.dae");
+  // a file named so inside the directories: caliper-ctl goes by content, and writes that name
+  fs::copy_file(root_ + "/models/pendulum.dae", root_ + "/models/pend#1.dae");
+  const auto load = Ctl({"load", root_ + "/models/pend#1.dae"});
+  ASSERT_EQ(load.exit_code, 0) << load.err;
+  EXPECT_EQ(Scene(), "pend#1.dae (sent by content)");
+  const auto save = Ctl({"save", root_ + "/session/saved#1.dae"});
+  ASSERT_EQ(save.exit_code, 0) << save.err;
+  EXPECT_TRUE(Contains(save.out, "(fetched by content)")) << save.out;
+  EXPECT_TRUE(fs::is_regular_file(root_ + "/session/saved#1.dae"));
+  EXPECT_EQ(ReadFile(root_ + "/outside/victim.txt"), "precious\n");
+}
+
+TEST_F(ConfinedFilesTest, ARejectedArchiveIsNamedAndWritesNothingOutside) {
+  // a .zae sent by content whose entry leads out of Collada-DOM's temporary directory: the
+  // Model's TMPDIR is root/t/u, so '../../slipped.txt' would land in root/t
+  fs::create_directories(root_ + "/t/u");
+  const std::string zae = root_ + "/outside/slip.zae";
+  const std::string make =
+      "python3 -c \"import sys, zipfile\n"
+      "with zipfile.ZipFile(sys.argv[1], 'w') as z:\n"
+      "    z.writestr('manifest.xml', '<dae_root>./p.dae</dae_root>')\n"
+      "    z.writestr('p.dae', open(sys.argv[2]).read())\n"
+      "    z.writestr('../../slipped.txt', 'outside')\" " +
+      zae + " " + root_ + "/models/pendulum.dae";
+  ASSERT_EQ(std::system(make.c_str()), 0) << make;
+  const char* old_tmp = std::getenv("TMPDIR");
+  const std::string saved_tmp = old_tmp != nullptr ? old_tmp : "";
+  ::setenv("TMPDIR", (root_ + "/t/u").c_str(), 1);
+  StartConfinedModel();
+  if (old_tmp != nullptr) {
+    ::setenv("TMPDIR", saved_tmp.c_str(), 1);
+  } else {
+    ::unsetenv("TMPDIR");
+  }
+  const std::string bytes = ReadFile(zae);
+  M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
+  data.length(static_cast<CORBA::ULong>(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
+  try {
+    ref_->load_scene_data("slip.zae", data);
+    ADD_FAILURE() << "the archive loaded";
+  } catch (const M::LoadFailed& e) {
+    EXPECT_TRUE(Contains(e.reason.in(),
+                         "slip.zae: the archive's entry '../../slipped.txt' is "
+                         "refused: its name has a '..' component"))
+        << e.reason.in();
+  }
+  EXPECT_FALSE(fs::exists(root_ + "/t/slipped.txt"));
+  EXPECT_FALSE(fs::exists(root_ + "/slipped.txt"));
+}
+
+TEST_F(ConfinedFilesTest, AReplyLargerThanTheConfiguredMessageSizeIsRefusedWithTheSizes) {
+  // corba.max_message_size = 1 MiB: the scene description and the export of a 2.9 MB robot do
+  // not fit; the Model says so (a bare MARSHAL before, the check used the 256 MiB default)
+  const std::string corpus = CorpusDir();
+  ASSERT_FALSE(corpus.empty()) << "the COLLADA corpus (CALIPER_CORPUS) is needed";
+  fs::copy_file(corpus + "/collada/collada_robots/barrett-hand.zae", root_ + "/models/hand.zae");
+  StartModel({"-o", "model.read_dirs=" + root_ + "/models", "-o", "corba.max_message_size=1"});
+  ASSERT_EQ(LoadRefusal("hand.zae"), "");
+  try {
+    M::Octets_var bytes = ref_->export_scene();
+    ADD_FAILURE() << "export_scene answered " << bytes->length() << " bytes";
+  } catch (const M::NotAvailable& e) {
+    EXPECT_TRUE(Contains(e.reason.in(),
+                         "MiB, more than one GIOP message carries (1.0 MiB, "
+                         "corba.max_message_size)"))
+        << e.reason.in();
+  }
+  EXPECT_FALSE(ref_->_non_existent());
 }
 
 TEST_F(ConfinedFilesTest, CtlLoadAndSaveGoByContentWhereTheModelRefusesThePath) {

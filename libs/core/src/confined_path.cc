@@ -45,8 +45,9 @@ bool IsWithin(const fs::path& path, const fs::path& dir) {
   return true;
 }
 
-ConfinedPaths::ConfinedPaths(std::vector<std::string> dirs, std::string key, std::string what)
-    : key_(std::move(key)), what_(std::move(what)) {
+ConfinedPaths::ConfinedPaths(std::vector<std::string> dirs, std::string key, std::string what,
+                             bool read_as_uri)
+    : key_(std::move(key)), what_(std::move(what)), read_as_uri_(read_as_uri) {
   for (const std::string& d : dirs) {
     if (Trim(d).empty()) continue;
     fs::path p = fs::absolute(ExpandHome(Trim(d))).lexically_normal();
@@ -81,6 +82,15 @@ fs::path ConfinedPaths::Resolve(const std::string& path, Access access) const {
   if (ec) throw PathRefused(Quoted(path) + " cannot be resolved: " + ec.message() + where);
   const std::string shown =
       Quoted(path) + (resolved == fs::path(path) ? "" : " (resolved: " + Quoted(resolved) + ")");
+  // a reader of URIs would cut the name at '#' or '?' or decode '%XX': another file than this
+  if (read_as_uri_) {
+    const std::string both = path + resolved.string();
+    const size_t special = both.find_first_of("#?%");
+    if (special != std::string::npos)
+      throw PathRefused(shown + " holds '" + both[special] + "': " + what_ +
+                        " with a library that reads file names as URIs, which would open " +
+                        "another file; give a name without '#', '?' or '%'" + where);
+  }
 
   const fs::path* inside = nullptr;
   std::vector<fs::path> allowed;

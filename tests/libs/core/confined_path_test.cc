@@ -162,6 +162,32 @@ TEST_F(ConfinedPathsTest, RefusesWritingAFileWithOtherHardLinks) {
   EXPECT_TRUE(c.Allows(allowed_ + "/scene.dae", Access::kRead));
 }
 
+TEST_F(ConfinedPathsTest, ForAReaderOfUrisRefusesNamesAUriReadsOtherwise) {
+  // Collada-DOM opens 'link#x' as 'link' and 'a%20b' as 'a b': the file checked must be the one
+  // opened
+  const ConfinedPaths uri({allowed_}, "test.dirs", "tests read", true);
+  fs::create_symlink(root_ + "/outside/secret.dae", allowed_ + "/link");
+  for (const std::string& name :
+       std::vector<std::string>{"link#x", "link?x", "scene%2edae", "a%20b.dae"}) {
+    const std::string why = Refusal(uri, name, Access::kWrite);
+    EXPECT_TRUE(Contains(why, "'" + name + "' (resolved: '" + allowed_ + "/" + name + "') holds '"))
+        << why;
+    EXPECT_TRUE(Contains(why,
+                         "tests read with a library that reads file names as URIs, which "
+                         "would open another file; give a name without '#', '?' or '%' (" +
+                             allowed_ + "; set by test.dirs)"))
+        << why;
+    EXPECT_FALSE(uri.Allows(allowed_ + "/" + name, Access::kRead));
+    // a reader of file names takes them as they are
+    EXPECT_EQ(Refusal(Allowed(), name, Access::kWrite), "") << name;
+  }
+  // a link inside whose target's name holds one
+  std::ofstream(allowed_ + "/odd#name.dae") << "inside\n";
+  fs::create_symlink(allowed_ + "/odd#name.dae", allowed_ + "/plain.dae");
+  EXPECT_TRUE(Contains(Refusal(uri, "plain.dae", Access::kRead), "holds '#'"));
+  EXPECT_EQ(Refusal(uri, "scene.dae", Access::kRead), "");
+}
+
 TEST_F(ConfinedPathsTest, RefusesDirectoriesEmptyPathsAndAnEmptyConfiguration) {
   const ConfinedPaths c = Allowed();
   EXPECT_TRUE(Contains(Refusal(c, allowed_, Access::kWrite), "names the directory")) << allowed_;

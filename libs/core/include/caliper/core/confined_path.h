@@ -6,7 +6,8 @@
 // taken physically (std::filesystem::weakly_canonical), relative paths against the first allowed
 // directory. The result must lie inside an allowed directory, compared component by component
 // (`/data/allowed-evil` is not inside `/data/allowed`). The file is then opened by that resolved
-// path, never by the path as sent, so a link the check did not see is never followed.
+// path, never by the path as sent, so a link the check did not see is never followed; for a
+// reader that takes file names as URIs, names that a URI would read otherwise are refused.
 
 #include <filesystem>
 #include <stdexcept>
@@ -38,11 +39,15 @@ class ConfinedPaths {
   /// resolved again at every check, so one created or moved later counts as it is then); the
   /// first is the base of relative paths. `key`: the configuration key that lists them, named in
   /// refusals. `what`: who reads or writes, for messages (e.g. "the Model reads scenes").
-  ConfinedPaths(std::vector<std::string> dirs, std::string key, std::string what);
+  /// `read_as_uri`: the reader takes file names as URIs (Collada-DOM cuts them at '#' and '?' and
+  /// decodes '%XX'), so a path holding '#', '?' or '%' is refused: it would open another file.
+  ConfinedPaths(std::vector<std::string> dirs, std::string key, std::string what,
+                bool read_as_uri = false);
 
   /// The resolved absolute path that `path` names, or PathRefused saying why not: it lies
   /// outside every allowed directory (after `..` and symbolic links), no directory is
-  /// configured, it is empty, or it names an allowed directory itself. kRead refuses what exists
+  /// configured, it is empty, it names an allowed directory itself, or (`read_as_uri`) it holds
+  /// '#', '?' or '%', as sent or resolved. kRead refuses what exists
   /// but is no regular file (a missing file is left to the reader to report); kWrite refuses the
   /// same, a dangling symbolic link (writing through it would create its target) and a file with
   /// other hard links (a write would change them too).
@@ -61,6 +66,7 @@ class ConfinedPaths {
   std::vector<std::string> dirs_;
   std::string key_;
   std::string what_;
+  bool read_as_uri_ = false;
 };
 
 }  // namespace caliper::core
