@@ -5,10 +5,11 @@
 # (default 10). Each process's resident memory (VmRSS), open file descriptors (/proc/PID/fd) and
 # threads (/proc/PID/task) are read every 5 s. After the warm-up (a quarter of the run, at most
 # 60 s) memory must stay flat, at most 5 MiB of growth from the start to the end of the measured
-# part (each the median of three readings), and descriptors and threads must not grow (the least
-# of the last three readings against the most in the first half of the measured part: omniORB
-# opens and closes connections, and their threads, on demand). Prints one row per process and
-# PASS or FAIL (fd0 and threads0 in the table are those first-half maxima).
+# part (each the median of three readings), and descriptors and threads must not grow: the median
+# of the last third of the measured readings against the median of the first third, at most one
+# more (omniORB opens a connection, a socket and the thread serving it, on demand and closes idle
+# ones: a 10-minute run read the sample's threads 7 then 8). Prints one row per process and PASS or
+# FAIL (fd0/fd1 and threads0/threads1 in the table are those medians).
 #
 # Bounded caches are filled during the warm-up so that they do not pass for growth: the plotter
 # keeps 10,000 samples per curve (its layout's buffer), the logger 2,000 records in memory.
@@ -19,7 +20,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --minutes) MINUTES=$2; shift 2 ;;
     --keep) KEEP=1; shift ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "usage: soak_test.sh [--minutes M] [--keep]"; exit 2 ;;
   esac
 done
@@ -86,8 +87,8 @@ rec_rc=$?
 REC_PID=""
 
 # the table
-median3() { sort -n | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
-min3() { sort -n | head -1; }
+# the median of integers, one a line (the lower middle of an even count)
+median() { sort -n | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 printf '\n%-10s %8s %8s %8s %8s %6s %6s %8s %8s  %s\n' process "RSS0" "RSS1" "RSSmax" "growth" fd0 fd1 threads0 threads1 verdict
 printf '%-10s %8s %8s %8s %8s %6s %6s %8s %8s\n' "" MiB MiB MiB MiB "" "" "" ""
 dead=""
@@ -96,22 +97,23 @@ for n in "${NAMES[@]}"; do
   if ! kill -0 "${PID[$n]}" 2>/dev/null && [ "$n" != record ]; then dead="$dead $n"; fi
   measured=$(awk -v w="$WARMUP" '$1 >= w' "$f" 2>/dev/null)
   [ "$(wc -l <<<"$measured")" -ge 6 ] || { fail "$n: too few readings after the warm-up"; continue; }
-  rss0=$(head -3 <<<"$measured" | awk '{print $2}' | median3)
-  rss1=$(tail -3 <<<"$measured" | awk '{print $2}' | median3)
+  rss0=$(head -3 <<<"$measured" | awk '{print $2}' | median)
+  rss1=$(tail -3 <<<"$measured" | awk '{print $2}' | median)
   rssmax=$(awk '{print $2}' <<<"$measured" | sort -n | tail -1)
-  # descriptors and threads: omniORB opens a connection (and a thread serving it) on demand and
-  # closes idle ones, so counts move by one or two either way; growth is an end (the least of the
-  # last three readings) above everything seen in the first half of the measured part
-  half=$(($(wc -l <<<"$measured") / 2))
-  fd0=$(head -n "$half" <<<"$measured" | awk '{print $3}' | sort -n | tail -1)
-  fd1=$(tail -3 <<<"$measured" | awk '{print $3}' | min3)
-  th0=$(head -n "$half" <<<"$measured" | awk '{print $4}' | sort -n | tail -1)
-  th1=$(tail -3 <<<"$measured" | awk '{print $4}' | min3)
+  # descriptors and threads: the median of the last third of the measured readings against the
+  # median of the first third (a spike early or late does not move a median; a slow leak does).
+  # omniORB opens a connection (a socket and the thread serving it) on demand and closes idle
+  # ones: one more is allowed, measured (the sample's threads 7 then 8 in a 10-minute run)
+  third=$(($(wc -l <<<"$measured") / 3))
+  fd0=$(head -n "$third" <<<"$measured" | awk '{print $3}' | median)
+  fd1=$(tail -n "$third" <<<"$measured" | awk '{print $3}' | median)
+  th0=$(head -n "$third" <<<"$measured" | awk '{print $4}' | median)
+  th1=$(tail -n "$third" <<<"$measured" | awk '{print $4}' | median)
   growth=$((rss1 - rss0))
   verdict=ok
   [ "$growth" -le 5120 ] || verdict="RSS +$((growth / 1024)) MiB"
-  [ "$fd1" -le "$fd0" ] || verdict="$verdict fds +$((fd1 - fd0))"
-  [ "$th1" -le "$th0" ] || verdict="$verdict threads +$((th1 - th0))"
+  [ "$fd1" -le $((fd0 + 1)) ] || verdict="$verdict fds +$((fd1 - fd0))"
+  [ "$th1" -le $((th0 + 1)) ] || verdict="$verdict threads +$((th1 - th0))"
   verdict=${verdict#ok }
   mib() { echo "scale=1; $1 / 1024" | bc | sed 's/^\./0./; s/^-\./-0./'; }
   printf '%-10s %8s %8s %8s %8s %6s %6s %8s %8s  %s\n' "$n" "$(mib "$rss0")" "$(mib "$rss1")" \

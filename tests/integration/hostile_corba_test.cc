@@ -1,9 +1,12 @@
 // Every operation of every servant called over the IDL with values that try to hurt: a million
 // ids, 10 MB strings, NaN and infinities in every double, unknown and empty names, nil and wrong
 // references, and sixteen clients at once. Each call must end in a user exception with a reason
-// or a bounded answer; the process stays alive, answers afterwards, and its resident memory stays
-// within a generous bound. Also omniORB's message limit (corba.max_message_size): a larger request
-// is refused with a system exception and the server answers the next call.
+// or a bounded answer; the process stays alive, answers afterwards, and its resident memory grows
+// by at most what the test measured and a quarter more (and by little over a second round of the
+// same calls). An out-of-range enum (the renderer's ShapeKind) ends in MARSHAL from omniORB and
+// the renderer answers on. Also omniORB's message limit (corba.max_message_size): a larger
+// request is refused with a system exception and the server answers the next call. No call is
+// timed: one that hangs ends in the client's 20 s call timeout, a system exception.
 //
 // The components run as real processes with a private omniNames. The renderer's SceneObserver is
 // reached through a stand-in Model bound in the naming service (the renderer registers with it);
@@ -12,6 +15,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -31,6 +35,7 @@
 #include "caliper/renderer.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
+#include "hostile_twin.hh"  // observer.idl with one ShapeKind more (tests/integration/CMakeLists.txt)
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -53,12 +58,22 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 const std::vector<double> kNonFinite = {kNaN, kInf, -kInf};
 constexpr size_t kMillion = 1000000;
 const std::string kTenMegabytes(10u << 20, 'a');
-/// Growth of a server's resident memory over a test that we call bounded [kB]. Decoding a message
-/// of a million small elements takes several times its size at once, and the allocator keeps much
-/// of it for later; a leak shows in the second of two equal rounds instead (kRoundGrowthKb).
-constexpr long kRssGrowthKb = 512 * 1024;
-/// Growth of resident memory over a second round of the same hostile calls [kB].
-constexpr long kRoundGrowthKb = 32 * 1024;
+/// Growth of a server's resident memory over one test [kB]: the most each test measured on this
+/// machine (printed as "[ measure  ]") and a quarter more, at least 8 MiB. Decoding a message of
+/// a million small elements takes several times its size at once, and the allocator keeps much
+/// of it for later, so some are large; a leak shows in the second of two equal rounds
+/// (kRoundGrowthKb).
+constexpr long MiB = 1024;
+/// The servers started here allocate from one malloc arena and map blocks of 128 KiB and more
+/// apart, returned at once when freed: with glibc's defaults (an arena per thread, up to 8 per
+/// core, and a threshold that rises to 32 MiB as blocks are freed) the memory a million-element
+/// decode leaves behind depends on which of omniORB's threads served it and on what came before,
+/// and a test's growth varied from 17 to 148 MiB between runs.
+const bool kOneArena =
+    setenv("MALLOC_ARENA_MAX", "1", 1) == 0 && setenv("MALLOC_MMAP_THRESHOLD_", "131072", 1) == 0;
+/// Growth of resident memory over a second round of the same hostile calls [kB] (measured: 5 MiB
+/// for the experiments, under 1 MiB for the logger's million records).
+constexpr long kRoundGrowthKb = 16 * 1024;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -219,14 +234,15 @@ class Component {
 
   CORBA::Object_ptr object() const { return object_.in(); }
   Process& process() { return *process_; }
-  /// Alive, answering get_component_profile, and not grown past `rss_before` + kRssGrowthKb.
-  void ExpectHealthy(long rss_before) {
+  /// Alive, answering get_component_profile, and not grown past `rss_before` + `growth_kb`.
+  void ExpectHealthy(long rss_before, long growth_kb) {
+    EXPECT_TRUE(kOneArena);
     ASSERT_TRUE(process_->Running()) << process_->Output();
     R::LightweightRTObject_var rt = R::LightweightRTObject::_narrow(object_);
     R::ComponentProfile_var profile;
     EXPECT_NO_THROW(profile = rt->get_component_profile());
     const long rss = RssKb(process_->pid());
-    EXPECT_LT(rss - rss_before, kRssGrowthKb)
+    EXPECT_LT(rss - rss_before, growth_kb)
         << instance_ << ": " << rss_before << " kB before, " << rss << " kB after";
     std::printf("[ measure  ] %s resident memory %ld kB before, %ld kB after\n", instance_.c_str(),
                 rss_before, rss);
@@ -331,7 +347,7 @@ class HostileModelTest : public ::testing::Test {
 
   void TearDown() override {
     if (!model_ || !ref_) return;  // SetUp failed and said why
-    model_->ExpectHealthy(rss_before_);
+    model_->ExpectHealthy(rss_before_, rss_growth_kb_);
     EXPECT_NO_THROW(M::SimulationStatus_var(ref_->status())) << model_->process().Output();
     model_->process().Signal(SIGTERM);
     EXPECT_EQ(model_->process().Wait(seconds(10)), 0) << model_->process().Output();
@@ -352,9 +368,11 @@ class HostileModelTest : public ::testing::Test {
   std::unique_ptr<Component> model_;
   M::Model_var ref_;
   long rss_before_ = 0;
+  long rss_growth_kb_ = 8 * MiB;  // each test that sends millions sets its own
 };
 
 TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) {
+  rss_growth_kb_ = 8 * MiB;  // measured: 0.9 MiB (10 MB names and scenes)
   const std::string scene = Scene();
   // loading by path: empty, 10 MB, a directory; the previous scene stays loaded
   EXPECT_REFUSED(ref_->load_scene(""), "");
@@ -397,8 +415,8 @@ TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) 
                       : verb == 'r' ? ref_->reset()
                                     : ref_->start());
 
-  // the most steps one call asks for ends when another client pauses it
-  const auto begin = std::chrono::steady_clock::now();
+  // the most steps one call asks for ends when another client pauses it (no bound in time: a
+  // pause that did not end it would show as the client's 20 s call timeout, a system exception)
   std::atomic<CORBA::ULong> ran{0};
   std::thread stepper([&] {
     try {
@@ -413,11 +431,11 @@ TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) 
   stepper.join();
   EXPECT_GT(ran.load(), 100u);
   EXPECT_LT(ran.load(), std::numeric_limits<CORBA::ULong>::max());
-  EXPECT_LT(std::chrono::steady_clock::now() - begin, seconds(12));
   EXPECT_ANSWERED(ref_->stop());
 }
 
 TEST_F(HostileModelTest, MotorsAndParametersRefuseUnknownNamesNonFiniteValuesAndMillions) {
+  rss_growth_kb_ = 64 * MiB;  // measured: 26 to 46 MiB (a million commands, ids)
   M::ActuatorInfoSeq_var actuators = ref_->actuators();
   ASSERT_GT(actuators->length(), 0u);
   const std::string motor = actuators[0].name.in();
@@ -501,6 +519,7 @@ TEST_F(HostileModelTest, MotorsAndParametersRefuseUnknownNamesNonFiniteValuesAnd
 }
 
 TEST_F(HostileModelTest, SceneSubscriptionsObserversAndExperimentsRefuseHostileValues) {
+  rss_growth_kb_ = 184 * MiB;  // measured: 103 to 142 MiB (experiments of millions)
   EXPECT_ANSWERED(S::Description_var(ref_->scene_description()));
   EXPECT_ANSWERED(M::Octets_var(ref_->export_scene()));
   EXPECT_REFUSED(ref_->save_scene(""), "");
@@ -605,9 +624,10 @@ TEST_F(HostileModelTest, SceneSubscriptionsObserversAndExperimentsRefuseHostileV
                        }));
   // twice: what the first round leaves in the allocator is reused by the second, a leak is not
   long rss_after_first = 0;
+  // (no bound in time per call: one that hung would end in the client's 20 s call timeout, a
+  // system exception)
   for (int round = 0; round < 2; ++round) {
     for (auto& [what, experiment] : hostile) {
-      const auto begin = std::chrono::steady_clock::now();
       const Outcome o = Try([&] { M::Recording_var(ref_->run_experiment(experiment)); });
       // a command from +inf s on never applies: answered like one after the end
       if (what == "command time inf")
@@ -615,7 +635,6 @@ TEST_F(HostileModelTest, SceneSubscriptionsObserversAndExperimentsRefuseHostileV
       else
         EXPECT_EQ(o.kind, Outcome::kUser) << what << ": " << o;
       EXPECT_LT(o.reason.size(), 64u * 1024) << what;
-      EXPECT_LT(std::chrono::steady_clock::now() - begin, seconds(5)) << what;
     }
     const long rss = RssKb(model_->process().pid());
     if (round == 0) rss_after_first = rss;
@@ -632,6 +651,7 @@ TEST_F(HostileModelTest, LifecycleAndExecutionContextRefuseHostileArguments) {
 }
 
 TEST_F(HostileModelTest, SixteenClientsHammeringMixedOperationsAreAllAnswered) {
+  rss_growth_kb_ = 8 * MiB;  // measured: 0.7 MiB (16 connections and their threads)
   D::ChannelInfoSeq_var channels = ref_->list("*");
   const std::string first = channels[0].id.in();
   M::ActuatorInfoSeq_var actuators = ref_->actuators();
@@ -881,7 +901,7 @@ TEST(HostileLogger, EveryOperationAnswersHostileRecordsQueriesAndListeners) {
   HammerLifecycle(ref);
 
   EXPECT_EQ(ref->submit(L::RecordSeq()), 0u);
-  logger.ExpectHealthy(rss_before);
+  logger.ExpectHealthy(rss_before, 480 * MiB);  // measured: 377 MiB (a million records, twice)
 }
 
 // ------------------------------------------------------------------------ Manager
@@ -926,15 +946,14 @@ TEST(HostileManager, CreateAndDestroyRefuseUnknownTypesHugeConfigurationsAndName
                  "set by the manager");
   EXPECT_REFUSED(C::Child_var(ref->create("model", config({{"model.inject_fault", "x"}}))),
                  "not one a client");
-  // values the child refuses, or that no command line carries: StartFailed with the reason,
-  // within the start timeout, and no child left running
+  // values the child refuses, or that no command line carries: StartFailed with the reason, and
+  // no child left running (a create that waited past the start timeout of 10 s and never ended
+  // would show as the client's 20 s call timeout, a system exception)
   for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
            {"exec.rate", "nan"}, {"exec.rate", "-inf"}, {"model.scene", kTenMegabytes}}) {
-    const auto begin = std::chrono::steady_clock::now();
     const Outcome o = Try([&] { C::Child_var(ref->create("model", config({{key, value}}))); });
     EXPECT_EQ(o.kind, Outcome::kUser) << key << "=" << Head(value) << ": " << o;
     EXPECT_LT(o.reason.size(), 64u * 1024) << key;
-    EXPECT_LT(std::chrono::steady_clock::now() - begin, seconds(12)) << key;
   }
   EXPECT_EQ(ref->running(), 0u);
   for (const std::string& name : {std::string(), std::string("nosuch0"), kTenMegabytes})
@@ -942,7 +961,7 @@ TEST(HostileManager, CreateAndDestroyRefuseUnknownTypesHugeConfigurationsAndName
   EXPECT_ANSWERED(C::ChildSeq_var(ref->list()));
   EXPECT_EQ(ref->capacity(), 1u);
   HammerLifecycle(ref);
-  manager.ExpectHealthy(rss_before);
+  manager.ExpectHealthy(rss_before, 80 * MiB);  // measured: 61 MiB (a million entries)
 }
 
 // ------------------------------------------------------------------------ Sample component
@@ -962,7 +981,7 @@ TEST(HostileSample, TheLifecycleOfAPlainComponentRefusesHostileArguments) {
   EXPECT_EQ(rt->finalize(), R::PRECONDITION_NOT_MET);
   EXPECT_EQ(rt->initialize(), R::PRECONDITION_NOT_MET);
   EXPECT_FALSE(rt->is_alive(R::ExecutionContext::_nil()));
-  sample.ExpectHealthy(rss_before);
+  sample.ExpectHealthy(rss_before, 8 * MiB);  // measured: 0.2 MiB
   EXPECT_EQ(rt->exit(), R::RTC_OK);
   EXPECT_EQ(sample.process().Wait(seconds(10)), 0) << sample.process().Output();
 }
@@ -1087,6 +1106,33 @@ S::Description HostileScene(double v, CORBA::ULong bodies) {
   return d;
 }
 
+/// A scene of one box, through the twin of observer.idl whose ShapeKind has one kind more
+/// (NOT_A_SHAPE, 8): the same bytes on the wire as the real Description, any kind in its place.
+HostileTwin::Scene::Description TwinScene(HostileTwin::Scene::ShapeKind kind) {
+  namespace T = HostileTwin::Scene;
+  T::Description d;
+  d.name = "twin";
+  d.source = "";
+  d.time_step = 1e-3;
+  d.bodies.length(1);
+  T::Body& body = d.bodies[0];
+  body.name = "b0";
+  body.pose.px = body.pose.py = body.pose.pz = 0;
+  body.pose.qw = 1;
+  body.pose.qx = body.pose.qy = body.pose.qz = 0;
+  body.moving = true;
+  body.visuals.length(1);
+  T::Visual& visual = body.visuals[0];
+  visual.name = "box";
+  visual.geometry.kind = kind;
+  visual.geometry.dims.length(3);
+  for (CORBA::ULong i = 0; i < 3; ++i) visual.geometry.dims[i] = 0.1;
+  visual.geometry.mesh = -1;
+  visual.pose = body.pose;
+  visual.r = visual.g = visual.b = visual.a = 1;
+  return d;
+}
+
 TEST(HostileRenderer, RendererAndItsObserverAnswerHostileScenesCamerasAndScreenshots) {
   if (const std::string why = NoDisplay("the renderer needs X with GLX"); !why.empty())
     GTEST_SKIP() << why;
@@ -1184,13 +1230,32 @@ TEST(HostileRenderer, RendererAndItsObserverAnswerHostileScenesCamerasAndScreens
   EXPECT_TRUE(
       WaitFor([&] { return Contains(renderer.process().Output(), "not shown"); }, seconds(10)))
       << renderer.process().Output();
+  // an out-of-range ShapeKind: omniORB checks enums as it unmarshals a request, so the renderer
+  // never sees it: the client gets MARSHAL (nothing done), and the renderer answers on. (The
+  // SceneObserver's scene is the one enum a client sends to a server; the other enums of our IDL
+  // are only answers.) First the twin with a real kind, to show that it is understood.
+  {
+    CORBA::String_var ior = Orb()->object_to_string(observer);
+    CORBA::Object_var object = Orb()->string_to_object(ior);
+    HostileTwin::Scene::SceneObserver_var twin = HostileTwin::Scene::SceneObserver::_narrow(object);
+    ASSERT_FALSE(CORBA::is_nil(twin));
+    const Outcome box = Try([&] { twin->on_scene(TwinScene(HostileTwin::Scene::BOX)); });
+    EXPECT_EQ(box.kind, Outcome::kOk) << "a valid scene through the twin: " << box;
+    const Outcome bad = Try([&] { twin->on_scene(TwinScene(HostileTwin::Scene::NOT_A_SHAPE)); });
+    EXPECT_EQ(bad.kind, Outcome::kSystem) << "ShapeKind 8: " << bad;
+    EXPECT_TRUE(Contains(bad.name, "MARSHAL")) << "ShapeKind 8: " << bad;
+    std::printf("[ measure  ] on_scene with ShapeKind 8: %s\n", bad.name.c_str());
+    EXPECT_TRUE(renderer.process().Running()) << renderer.process().Output();
+    EXPECT_ANSWERED(observer->on_scene(HostileScene(1, 5)));
+    EXPECT_ANSWERED(ref->screenshot((dir.path() + "/after_enum.png").c_str(), 64, 64));
+  }
   EXPECT_ANSWERED(observer->on_scene_cleared());
   EXPECT_ANSWERED(observer->on_scene_cleared());
   EXPECT_ANSWERED(ref->screenshot((dir.path() + "/cleared.png").c_str(), 64, 64));
   HammerLifecycle(ref);
   // the window's thread drew all of it: the renderer still renders
   EXPECT_ANSWERED(ref->view_all());
-  renderer.ExpectHealthy(rss_before);
+  renderer.ExpectHealthy(rss_before, 256 * MiB);  // measured: 166 to 193 MiB (20,000 bodies)
 }
 
 }  // namespace
