@@ -139,6 +139,18 @@ TEST_F(ConfinedScreenshotTest, WritesOnlyBelowTheWriteDirectory) {
   EXPECT_TRUE(renderer_process_->Running()) << renderer_process_->Output();
 }
 
+TEST_F(ConfinedScreenshotTest, WritesTheFileNamedEvenWithCharactersAUriReadsOtherwise) {
+  // the renderer writes by file name (QImage::save), not through a URI: 'shot#1.png' is that file,
+  // not 'shot' (a link out, which the Model's COLLADA library would have followed)
+  fs::create_symlink(root_ + "/outside/victim.png", root_ + "/session/shot");
+  fs::create_symlink(root_ + "/outside/victim.png", root_ + "/session/shot a.png");
+  for (const std::string name : {"shot#1.png", "shot?x.png", "shot%20a.png"}) {
+    EXPECT_EQ(Refusal(name), "") << name;
+    EXPECT_EQ(PngSize(ReadFile(root_ + "/session/" + name)), std::make_pair(320u, 240u)) << name;
+  }
+  EXPECT_EQ(ReadFile(root_ + "/outside/victim.png"), "precious\n");
+}
+
 TEST_F(ConfinedScreenshotTest, ScreenshotPngReturnsTheImageByContent) {
   V::Png_var png = renderer_->screenshot_png(200, 150);
   const std::string bytes(reinterpret_cast<const char*>(png->get_buffer()), png->length());
