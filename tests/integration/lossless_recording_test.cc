@@ -321,11 +321,12 @@ TEST_F(LosslessRecordingTest, ARealTimeRunKeepsPaceWithASlowConsumerAndReportsTh
   EXPECT_EQ(status.dropped_samples, 50 * status.dropped_batches);
   EXPECT_LE(received + status.dropped_samples + 50 * status.queued, status.samples);
   EXPECT_GT(consumer->gaps(), 0u);
-  std::printf("[ measure  ] real time: %.2f s simulated in %.2f s (factor %.2f), %llu of %llu "
-              "samples dropped\n",
-              s->sim_time, wall, s->achieved_real_time_factor,
-              static_cast<unsigned long long>(status.dropped_samples),
-              static_cast<unsigned long long>(status.samples));
+  std::printf(
+      "[ measure  ] real time: %.2f s simulated in %.2f s (factor %.2f), %llu of %llu "
+      "samples dropped\n",
+      s->sim_time, wall, s->achieved_real_time_factor,
+      static_cast<unsigned long long>(status.dropped_samples),
+      static_cast<unsigned long long>(status.samples));
   EXPECT_TRUE(
       WaitFor([&] { return Contains(model_->Output(), "samples dropped so far"); }, seconds(5)))
       << model_->Output();
