@@ -13,7 +13,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using caliper::fuzz::Check;
-  const std::string path = caliper::fuzz::WriteInput(data, size, "input.dae");
+  const caliper::fuzz::InputFile input(data, size, "input.dae");
+  const std::string& path = input.path();
   std::vector<std::string> warnings;
   caliper::collada::FileInfo info;
   try {

@@ -32,7 +32,8 @@ std::vector<ConfigKey> Schema() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using caliper::fuzz::Check;
-  const std::string path = caliper::fuzz::WriteInput(data, size, "input.conf");
+  const caliper::fuzz::InputFile input(data, size, "input.conf");
+  const std::string& path = input.path();
   caliper::core::Config config(Schema());
   try {
     config.LoadFile(path);

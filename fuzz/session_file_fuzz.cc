@@ -12,7 +12,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using caliper::fuzz::Check;
-  const std::string path = caliper::fuzz::WriteInput(data, size, "input.log");
+  const caliper::fuzz::InputFile input(data, size, "input.log");
+  const std::string& path = input.path();
   const auto contents = caliper::log_viewer::ReadSessionFile(path);
   Check(contents.records.size() + contents.malformed <= contents.lines, "more records than lines");
   Check(contents.problems.size() <= caliper::log_viewer::SessionFileContents::kMaxProblems,
