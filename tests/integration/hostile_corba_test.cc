@@ -33,17 +33,13 @@
 #include "caliper/logging.hh"
 #include "caliper/model.hh"
 #include "caliper/renderer.hh"
-#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "hostile_twin.hh"  // observer.idl with one ShapeKind more (tests/integration/CMakeLists.txt)
-#include "support/process.h"
+#include "support/corba.h"
 
 namespace caliper::testing {
 namespace {
 
-namespace M = ::Caliper::Simulation;
-namespace S = ::Caliper::Scene;
-namespace D = ::Caliper::Daq;
 namespace R = ::Caliper::RTC;
 namespace L = ::Caliper::Logging;
 namespace C = ::Caliper::Cluster;
@@ -75,10 +71,6 @@ const bool kOneArena =
 /// for the experiments, under 1 MiB for the logger's million records).
 constexpr long kRoundGrowthKb = 16 * 1024;
 
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 /// The head of a long text, for failure messages.
 std::string Head(const std::string& text) {
   return text.size() <= 300
@@ -95,26 +87,12 @@ long RssKb(pid_t pid) {
   return -1;
 }
 
-CORBA::ORB_ptr Orb() {
-  // every call gives up after 20 s: a server that hangs shows as TIMEOUT, never as a stuck test
-  static CORBA::ORB_ptr orb = [] {
-    CORBA::ORB_ptr o = rtc::ClientOrb("hostile_corba_test", 20);
-    CORBA::Object_var obj = o->resolve_initial_references("RootPOA");
-    PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-    PortableServer::POAManager_var manager = poa->the_POAManager();
-    manager->activate();
-    return o;
-  }();
-  return orb;
-}
+/// Every call gives up after 20 s: a server that hangs shows as TIMEOUT, never as a stuck test.
+CORBA::ORB_ptr Orb() { return ServingClientOrb("hostile_corba_test", 20); }
 
 /// Activates a servant in the test's root POA (which then owns it) and returns its reference.
 CORBA::Object_ptr Activate(PortableServer::ServantBase* servant) {
-  CORBA::Object_var obj = Orb()->resolve_initial_references("RootPOA");
-  PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-  PortableServer::ObjectId_var id = poa->activate_object(servant);
-  servant->_remove_ref();
-  return poa->id_to_reference(id);
+  return caliper::testing::Activate(Orb(), servant);
 }
 
 // ------------------------------------------------------------------------ outcomes

@@ -19,16 +19,10 @@
 #include <thread>
 #include <vector>
 
-#include "caliper/model.hh"
-#include "caliper/rtc/naming.h"
-#include "support/process.h"
+#include "support/corba.h"
 
 namespace caliper::testing {
 namespace {
-
-namespace M = ::Caliper::Simulation;
-namespace S = ::Caliper::Scene;
-namespace D = ::Caliper::Daq;
 
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
@@ -37,45 +31,13 @@ using std::chrono::seconds;
 const char* const kTension = "pendulum_tendon.line.tendon.tension";
 const char* const kPosition = "pendulum_tendon.frame.position";
 
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-// ------------------------------------------------------------------------ the test's ORB
-
-class OrbEnvironment : public ::testing::Environment {
- public:
-  static CORBA::ORB_ptr orb() {
-    static CORBA::ORB_var orb = [] {
-      std::vector<std::string> args = {"lossless_recording_test", "-ORBendPoint",
-                                       "giop:tcp:127.0.0.1:", "-ORBclientCallTimeOutPeriod",
-                                       "30000"};
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      int argc = static_cast<int>(argv.size());
-      CORBA::ORB_var o = CORBA::ORB_init(argc, argv.data());
-      CORBA::Object_var obj = o->resolve_initial_references("RootPOA");
-      PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-      poa->the_POAManager()->activate();
-      created() = true;
-      return o;
-    }();
-    return orb.in();
-  }
-  void TearDown() override {
-    if (created()) orb()->destroy();
-  }
-
- private:
-  static bool& created() {
-    static bool created = false;
-    return created;
-  }
-};
-
-const auto* const kOrbEnvironment = ::testing::AddGlobalTestEnvironment(new OrbEnvironment);
+/// The test's ORB, serving the consumers; calls give up after 30 s.
+CORBA::ORB_ptr Orb() {
+  return TestOrb({"lossless_recording_test", "-ORBendPoint", "giop:tcp:127.0.0.1:",
+                  "-ORBclientCallTimeOutPeriod", "30000"});
+}
 
 /// A DataConsumer that takes `delay` over each batch and checks that the samples follow one
 /// another: batch numbers 1, 2, 3, ... and each batch's first step right after the last sample
@@ -135,51 +97,13 @@ class SlowConsumer : public virtual POA_Caliper::Daq::DataConsumer {
 
 // ------------------------------------------------------------------------ fixture
 
-class LosslessRecordingTest : public ::testing::Test {
+class LosslessRecordingTest : public ModelProcessTest {
  protected:
-  void SetUp() override {
-    OrbEnvironment::orb();
-    naming_ = std::make_unique<NamingService>(dir_.path());
-    const char* source = std::getenv("CALIPER_SOURCE_DIR");
-    // the shipped model.conf: an execution context at 200 Hz, real time
-    model_ = std::make_unique<Process>(
-        std::vector<std::string>{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
-                                 "model.scene=" + std::string(source != nullptr ? source : ".") +
-                                     "/models/pendulum_tendon.dae",
-                                 "-o", "exec.auto_activate=true", "-o", "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model.out");
-    ASSERT_TRUE(WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root =
-                rtc::ResolveRoot(OrbEnvironment::orb(), naming_->address());
-            model_ref_ = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(model_ref_) &&
-                   M::SimulationStatus_var(model_ref_->status())->state == M::STOPPED;
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20)))
-        << model_->Output();
-  }
-
-  void TearDown() override {
-    if (!model_) return;  // SetUp failed before starting it (and said why)
-    model_->Signal(SIGTERM);
-    EXPECT_EQ(model_->Wait(seconds(10)), 0) << model_->Output();
-  }
-
-  M::Model_ptr model() { return model_ref_.in(); }
+  LosslessRecordingTest() : ModelProcessTest(&Orb) {}
 
   /// A consumer served by this process (its POA owns it; it lives until the ORB goes).
   D::DataConsumer_ptr Serve(SlowConsumer* consumer) {
-    CORBA::Object_var obj = OrbEnvironment::orb()->resolve_initial_references("RootPOA");
-    PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-    PortableServer::ObjectId_var id = poa->activate_object(consumer);
-    consumer->_remove_ref();
-    CORBA::Object_var ref = poa->id_to_reference(id);
+    CORBA::Object_var ref = Activate(Orb(), consumer);
     return D::DataConsumer::_narrow(ref);
   }
 
@@ -189,11 +113,6 @@ class LosslessRecordingTest : public ::testing::Test {
     EXPECT_EQ(model()->step(n), n);
     return Seconds(Clock::now() - begin);
   }
-
-  TempDir dir_;
-  std::unique_ptr<NamingService> naming_;
-  std::unique_ptr<Process> model_;
-  M::Model_var model_ref_;
 };
 
 S::StringSeq Ids(std::initializer_list<const char*> ids) {

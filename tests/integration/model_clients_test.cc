@@ -19,16 +19,11 @@
 #include <thread>
 #include <vector>
 
-#include "caliper/model.hh"
-#include "caliper/rtc/naming.h"
-#include "support/process.h"
+#include "support/corba.h"
 
 namespace caliper::testing {
 namespace {
 
-namespace M = ::Caliper::Simulation;
-namespace S = ::Caliper::Scene;
-namespace D = ::Caliper::Daq;
 namespace R = ::Caliper::RTC;
 
 using std::chrono::milliseconds;
@@ -39,10 +34,6 @@ constexpr CORBA::ULongLong kObserversPerClient = 16;
 constexpr CORBA::ULongLong kSubscriptionsPerClient = 32;
 constexpr CORBA::ULongLong kTotal = 256;   // observers, and subscriptions, over all clients
 const char* const kTension = "pendulum_tendon.line.tendon.tension";
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 /// Threads of a process (entries of /proc/PID/task).
 int Threads(pid_t pid) {
@@ -177,43 +168,9 @@ class GatedObserver : public virtual POA_Caliper::Scene::SceneObserver {
 
 // ------------------------------------------------------------------------ fixture
 
-class ModelClientsTest : public ::testing::Test {
+class ModelClientsTest : public ModelProcessTest {
  protected:
-  void SetUp() override {
-    Orb::Get();
-    naming_ = std::make_unique<NamingService>(dir_.path());
-    const char* source = std::getenv("CALIPER_SOURCE_DIR");
-    model_ = std::make_unique<Process>(
-        std::vector<std::string>{
-            Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
-            "model.scene=" + std::string(source != nullptr ? source : ".") +
-                "/models/pendulum_tendon.dae",
-            "-o", "exec.auto_activate=true", "-o", "log.service=none", "-o",
-            "log.spool_dir=" + dir_.path() + "/spool"},
-        dir_.path() + "/model.out");
-    ASSERT_TRUE(WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root =
-                rtc::ResolveRoot(Orb::Get().orb(), naming_->address());
-            model_ref_ = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(model_ref_) &&
-                   M::SimulationStatus_var(model_ref_->status())->state == M::STOPPED;
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20)))
-        << model_->Output();
-  }
-
-  void TearDown() override {
-    if (!model_) return;  // SetUp failed before starting it (and said why)
-    model_->Signal(SIGTERM);
-    EXPECT_EQ(model_->Wait(seconds(10)), 0) << model_->Output();
-  }
-
-  M::Model_ptr model() { return model_ref_.in(); }
+  ModelClientsTest() : ModelProcessTest([] { return Orb::Get().orb(); }) {}
 
   /// A fresh observer counting into `transforms`, reached through `client`'s address.
   S::SceneObserver_ptr NewObserver(const std::string& key, int client,
@@ -225,11 +182,6 @@ class ModelClientsTest : public ::testing::Test {
     CORBA::Object_var obj = Orb::Get().Activate(new CountingConsumer(batches), key, client);
     return D::DataConsumer::_unchecked_narrow(obj);
   }
-
-  TempDir dir_;
-  std::unique_ptr<NamingService> naming_;
-  std::unique_ptr<Process> model_;
-  M::Model_var model_ref_;
 };
 
 // ------------------------------------------------------------------------ observers

@@ -18,14 +18,10 @@
 #include <vector>
 
 #include "caliper/rtc/naming.h"
-#include "support/process.h"
+#include "support/corba.h"
 
 namespace caliper::testing {
 namespace {
-
-namespace M = ::Caliper::Simulation;
-namespace S = ::Caliper::Scene;
-namespace D = ::Caliper::Daq;
 
 using std::chrono::milliseconds;
 using std::chrono::seconds;
@@ -35,10 +31,6 @@ const char* const kPendulum = "models/pendulum_tendon.dae";
 const char* const kMass = "pendulum_tendon.pendulum.mass";
 const char* const kTension = "pendulum_tendon.line.tendon.tension";
 const char* const kPosition = "pendulum_tendon.pendulum.position";
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 std::string Source(const std::string& relative) {
   const char* dir = std::getenv("CALIPER_SOURCE_DIR");
@@ -81,43 +73,11 @@ std::vector<std::string> Split(const std::string& line, char separator) {
 
 // ------------------------------------------------------------------------ the test's ORB
 
-/// One ORB for the whole program (omniORB has one per process), with its RootPOA active, for
-/// the observers this test serves; destroyed after the last test.
-class OrbEnvironment : public ::testing::Environment {
- public:
-  static CORBA::ORB_ptr orb() {
-    static CORBA::ORB_var orb = [] {
-      std::vector<std::string> args = {"model_test", "-ORBendPoint",
-                                       "giop:tcp:127.0.0.1:", "-ORBclientCallTimeOutPeriod",
-                                       "10000", "-ORBgiopMaxMsgSize", "268435456"};
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      int argc = static_cast<int>(argv.size());
-      CORBA::ORB_var o = CORBA::ORB_init(argc, argv.data());
-      CORBA::Object_var obj = o->resolve_initial_references("RootPOA");
-      PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-      poa->the_POAManager()->activate();
-      created() = true;
-      return o;
-    }();
-    return orb.in();
-  }
-  static PortableServer::POA_ptr poa() {
-    CORBA::Object_var obj = orb()->resolve_initial_references("RootPOA");
-    return PortableServer::POA::_narrow(obj);
-  }
-  void TearDown() override {
-    if (created()) orb()->destroy();
-  }
-
- private:
-  static bool& created() {
-    static bool created = false;
-    return created;
-  }
-};
-
-const auto* const kOrbEnvironment = ::testing::AddGlobalTestEnvironment(new OrbEnvironment);
+/// The test's ORB, serving the observers; calls give up after 10 s.
+CORBA::ORB_ptr Orb() {
+  return TestOrb({"model_test", "-ORBendPoint", "giop:tcp:127.0.0.1:",
+                  "-ORBclientCallTimeOutPeriod", "10000", "-ORBgiopMaxMsgSize", "268435456"});
+}
 
 /// A SceneObserver that keeps what it receives; `delay` makes on_transforms slow.
 class RecordingObserver : public virtual POA_Caliper::Scene::SceneObserver {
@@ -176,7 +136,7 @@ class RecordingObserver : public virtual POA_Caliper::Scene::SceneObserver {
 class ActiveObserver {
  public:
   explicit ActiveObserver(milliseconds delay = milliseconds(0))
-      : servant_(new RecordingObserver(delay)), poa_(OrbEnvironment::poa()) {
+      : servant_(new RecordingObserver(delay)), poa_(RootPoa(Orb())) {
     id_ = poa_->activate_object(servant_);
     CORBA::Object_var obj = poa_->id_to_reference(id_);
     ref_ = S::SceneObserver::_narrow(obj);
@@ -243,7 +203,7 @@ class ModelTest : public ::testing::Test {
   M::Model_ptr Model() {
     if (CORBA::is_nil(model_ref_)) {
       CosNaming::NamingContext_var root =
-          rtc::ResolveRoot(OrbEnvironment::orb(), naming_->address());
+          rtc::ResolveRoot(Orb(), naming_->address());
       const rtc::ComponentEntry entry = rtc::FindComponent(root, "model0");
       model_ref_ = M::Model::_narrow(entry.object);
     }
@@ -467,12 +427,13 @@ TEST_F(ModelTest, WithoutASceneEveryCallRaisesItsDeclaredNotAvailableWithTheReas
     void on_samples(const D::SampleBatch&) override {}
   };
   auto* consumer = new Discard;
-  PortableServer::ObjectId_var oid = OrbEnvironment::poa()->activate_object(consumer);
+  PortableServer::POA_var poa = RootPoa(Orb());
+  PortableServer::ObjectId_var oid = poa->activate_object(consumer);
   consumer->_remove_ref();
-  CORBA::Object_var consumer_obj = OrbEnvironment::poa()->id_to_reference(oid);
+  CORBA::Object_var consumer_obj = poa->id_to_reference(oid);
   D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(consumer_obj);
   expect_daq_unavailable("subscribe", [&] { Model()->subscribe(ids, 1, consumer_ref); });
-  OrbEnvironment::poa()->deactivate_object(oid);
+  poa->deactivate_object(oid);
   // the Simulation interfaces' operations raise Simulation's NotAvailable
   const auto expect_unavailable = [](const char* what, const std::function<void()>& call) {
     try {

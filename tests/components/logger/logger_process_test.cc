@@ -12,9 +12,8 @@
 #include <vector>
 
 #include "caliper/logging.hh"
-#include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
-#include "support/process.h"
+#include "support/corba.h"
 
 namespace caliper::testing {
 namespace {
@@ -25,23 +24,10 @@ using std::chrono::seconds;
 constexpr const char* kInstance = "attacker0";
 constexpr size_t kMaxListenersPerClient = 8;  // the logger's bound for one client process
 
-CORBA::ORB_ptr Orb() {
-  // every call of this test gives up after 10 s: a logger that blocks shows as TIMEOUT
-  static CORBA::ORB_ptr orb = [] {
-    CORBA::ORB_ptr o = rtc::ClientOrb("logger_process_test", 10);
-    CORBA::Object_var obj = o->resolve_initial_references("RootPOA");
-    PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
-    PortableServer::POAManager_var manager = poa->the_POAManager();
-    manager->activate();
-    return o;
-  }();
-  return orb;
-}
+/// Every call of this test gives up after 10 s: a logger that blocks shows as TIMEOUT.
+CORBA::ORB_ptr Orb() { return ServingClientOrb("logger_process_test", 10); }
 
-PortableServer::POA_ptr Poa() {
-  CORBA::Object_var obj = Orb()->resolve_initial_references("RootPOA");
-  return PortableServer::POA::_narrow(obj);
-}
+PortableServer::POA_ptr Poa() { return RootPoa(Orb()); }
 
 L::Record MakeRecord(const std::string& source, CORBA::ULongLong seq, const std::string& message) {
   L::Record r;

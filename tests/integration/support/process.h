@@ -90,6 +90,11 @@ std::string Bin(const std::string& name);
 /// Polls `condition` every 20 ms until it holds or `timeout` passes; returns its last value.
 bool WaitFor(const std::function<bool()>& condition, std::chrono::milliseconds timeout);
 
+/// Whether `text` contains `part`.
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
 /// The whole content of a file ("" when missing).
 std::string ReadFile(const std::string& path);
 

@@ -1,0 +1,106 @@
+#include "support/corba.h"
+
+#include <csignal>
+#include <cstdlib>
+
+#include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/naming.h"
+
+namespace caliper::testing {
+namespace {
+
+using std::chrono::seconds;
+
+bool& TestOrbCreated() {
+  static bool created = false;
+  return created;
+}
+
+/// Destroys the ORB TestOrb made after the last test.
+class TestOrbEnvironment : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (TestOrbCreated()) TestOrb({})->destroy();
+  }
+};
+
+const auto* const kTestOrbEnvironment =
+    ::testing::AddGlobalTestEnvironment(new TestOrbEnvironment);
+
+void ActivateRootPoa(CORBA::ORB_ptr orb) {
+  PortableServer::POA_var poa = RootPoa(orb);
+  PortableServer::POAManager_var manager = poa->the_POAManager();
+  manager->activate();
+}
+
+}  // namespace
+
+CORBA::ORB_ptr TestOrb(const std::vector<std::string>& args) {
+  static CORBA::ORB_var orb = [&] {
+    std::vector<std::string> copy = args;
+    std::vector<char*> argv;
+    for (auto& a : copy) argv.push_back(a.data());
+    int argc = static_cast<int>(argv.size());
+    CORBA::ORB_var o = CORBA::ORB_init(argc, argv.data());
+    ActivateRootPoa(o);
+    TestOrbCreated() = true;
+    return o;
+  }();
+  return orb.in();
+}
+
+CORBA::ORB_ptr ServingClientOrb(const char* program, double call_timeout_s) {
+  static CORBA::ORB_ptr orb = [&] {
+    CORBA::ORB_ptr o = rtc::ClientOrb(program, call_timeout_s);
+    ActivateRootPoa(o);
+    return o;
+  }();
+  return orb;
+}
+
+PortableServer::POA_ptr RootPoa(CORBA::ORB_ptr orb) {
+  CORBA::Object_var obj = orb->resolve_initial_references("RootPOA");
+  return PortableServer::POA::_narrow(obj);
+}
+
+CORBA::Object_ptr Activate(CORBA::ORB_ptr orb, PortableServer::ServantBase* servant) {
+  PortableServer::POA_var poa = RootPoa(orb);
+  PortableServer::ObjectId_var id = poa->activate_object(servant);
+  servant->_remove_ref();
+  return poa->id_to_reference(id);
+}
+
+void ModelProcessTest::SetUp() {
+  orb_();
+  naming_ = std::make_unique<NamingService>(dir_.path());
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  // the shipped model.conf: an execution context at 200 Hz, real time
+  model_ = std::make_unique<Process>(
+      std::vector<std::string>{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
+                               "model.scene=" + std::string(source != nullptr ? source : ".") +
+                                   "/models/pendulum_tendon.dae",
+                               "-o", "exec.auto_activate=true", "-o", "log.service=none", "-o",
+                               "log.spool_dir=" + dir_.path() + "/spool"},
+      dir_.path() + "/model.out");
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(orb_(), naming_->address());
+          model_ref_ = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
+          return !CORBA::is_nil(model_ref_) &&
+                 M::SimulationStatus_var(model_ref_->status())->state == M::STOPPED;
+        } catch (...) {
+          return false;
+        }
+      },
+      seconds(20)))
+      << model_->Output();
+}
+
+void ModelProcessTest::TearDown() {
+  if (!model_) return;  // SetUp failed before starting it (and said why)
+  model_->Signal(SIGTERM);
+  EXPECT_EQ(model_->Wait(seconds(10)), 0) << model_->Output();
+}
+
+}  // namespace caliper::testing
