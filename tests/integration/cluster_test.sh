@@ -16,18 +16,14 @@ set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 TAG=cl$$
-NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 WORK=$(mktemp -d)
-trap cleanup EXIT  # cleanup is defined below; also when the test skips
+# shellcheck source=support/netns.sh
+source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # NETS, FAILS, skip, fail, pass, in_ns, cleanup
+trap cleanup EXIT  # also when the test skips
 NS=corbaname:ssliop:198.51.100.1:2809
 PKI=$WORK/pki
-FAILS=0
 unset CALIPER_INSECURE CALIPER_TLS_IDENTITY CALIPER_LISTEN
 
-skip() { echo "SKIPPED: $*"; exit 77; }
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
-in_ns() { local n=$1; shift; ip netns exec "$TAG-$n" "$@"; }
 # caliper-ctl from host A with the naming service on A, as the user alice
 ctl() { in_ns a env CALIPER_HOST=hosta CALIPER_PKI="$PKI" CALIPER_TLS_IDENTITY=users/alice \
   "$BIN/caliper-ctl" --nameservice "$NS" "$@"; }
@@ -35,36 +31,11 @@ ctl() { in_ns a env CALIPER_HOST=hosta CALIPER_PKI="$PKI" CALIPER_TLS_IDENTITY=u
 tls_tool() { in_ns a env CALIPER_PKI="$PKI" CALIPER_TLS_IDENTITY=hosts/hosta bash -c \
   "source '$SRC/launch/naming.sh'; tls_identity; tls_exec \"\$@\"" tls_tool "$@"; }
 
-cleanup() {
-  local n p
-  for n in "${NETS[@]}"; do
-    for p in $(ip netns pids "$n" 2>/dev/null); do kill -KILL "$p" 2>/dev/null; done
-  done
-  sleep 0.2
-  for n in "${NETS[@]}"; do ip netns del "$n" 2>/dev/null; done
-  rm -rf "$WORK"
-}
-
-[ "$(id -u)" = 0 ] || skip "network namespaces need root (run the tests as root, as CI does)"
-command -v ip >/dev/null || skip "no 'ip' command (apt-get install iproute2)"
-ip netns add "$TAG-probe" 2>/dev/null || skip "this kernel or container does not allow 'ip netns add'"
-ip netns del "$TAG-probe"
+netns_require
 command -v openssl >/dev/null || { echo "FAIL: no openssl command (launch/deps.txt lists it)"; exit 1; }
 
 # ---------------------------------------------------------------- the hosts
-for n in "${NETS[@]}"; do ip netns add "$n" || { echo "FAIL: ip netns add $n"; exit 1; }; done
-ip -n "$TAG-br" link add br0 type bridge
-ip -n "$TAG-br" link set br0 up
-ip -n "$TAG-br" link set lo up
-i=1
-for h in a b c; do
-  ip -n "$TAG-br" link add "v$h" type veth peer name eth0 netns "$TAG-$h"
-  ip -n "$TAG-br" link set "v$h" master br0 up
-  ip -n "$TAG-$h" addr add "198.51.100.$i/24" dev eth0
-  ip -n "$TAG-$h" link set eth0 up
-  ip -n "$TAG-$h" link set lo up  # down by default: omniORB would then publish the host name
-  i=$((i + 1))
-done
+netns_hosts
 
 # ---------------------------------------------------------------- certificates
 { launcher() { bash "$SRC/launch/caliper" certs "$@" --dir "$PKI"; }

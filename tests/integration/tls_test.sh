@@ -18,15 +18,11 @@ set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 TAG=tl$$
-NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 WORK=$(mktemp -d)
-trap cleanup EXIT  # cleanup is defined below; also when the test skips
-FAILS=0
+# shellcheck source=support/netns.sh
+source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # NETS, FAILS, skip, fail, pass, in_ns, cleanup
+trap cleanup EXIT  # also when the test skips
 
-skip() { echo "SKIPPED: $*"; exit 77; }
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
-in_ns() { local n=$1; shift; ip netns exec "$TAG-$n" "$@"; }
 launcher() { bash "$SRC/launch/caliper" "$@"; }
 # the launcher's environment on host N: its own PKI directory, state and session folders
 host_env() {  # N
@@ -45,37 +41,12 @@ expect_refused() {  # WHAT OUTPUT-FILE RC PATTERN
   fi
 }
 
-cleanup() {
-  local n p
-  for n in "${NETS[@]}"; do
-    for p in $(ip netns pids "$n" 2>/dev/null); do kill -KILL "$p" 2>/dev/null; done
-  done
-  sleep 0.2
-  for n in "${NETS[@]}"; do ip netns del "$n" 2>/dev/null; done
-  rm -rf "$WORK"
-}
-
-[ "$(id -u)" = 0 ] || skip "network namespaces need root (run the tests as root, as CI does)"
-command -v ip >/dev/null || skip "no 'ip' command (apt-get install iproute2)"
+netns_require
 command -v openssl >/dev/null || { echo "FAIL: no openssl command (launch/deps.txt lists it)"; exit 1; }
-ip netns add "$TAG-probe" 2>/dev/null || skip "this kernel or container does not allow 'ip netns add'"
-ip netns del "$TAG-probe"
 started=$SECONDS
 
 # ---------------------------------------------------------------- the hosts
-for n in "${NETS[@]}"; do ip netns add "$n" || { echo "FAIL: ip netns add $n"; exit 1; }; done
-ip -n "$TAG-br" link add br0 type bridge
-ip -n "$TAG-br" link set br0 up
-ip -n "$TAG-br" link set lo up
-i=1
-for h in a b c; do
-  ip -n "$TAG-br" link add "v$h" type veth peer name eth0 netns "$TAG-$h"
-  ip -n "$TAG-br" link set "v$h" master br0 up
-  ip -n "$TAG-$h" addr add "198.51.100.$i/24" dev eth0
-  ip -n "$TAG-$h" link set eth0 up
-  ip -n "$TAG-$h" link set lo up
-  i=$((i + 1))
-done
+netns_hosts
 
 # ---------------------------------------------------------------- certificates
 # the cluster's CA on hosta, identities for hosta, hostb and alice; hostb gets copies
