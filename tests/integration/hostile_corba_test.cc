@@ -744,31 +744,10 @@ TEST(HostileMessageSize, ARequestOverTheLimitIsASystemExceptionAndTheServerGoesO
 // ------------------------------------------------------------------------ Logger
 
 L::Record Record(const std::string& source, CORBA::ULongLong seq, const std::string& message) {
-  L::Record r;
-  r.time_us = 1700000000000000;
-  r.priority = 600;
-  r.category = "caliper.test.hostile";
-  r.instance = "hostile0";
-  r.host = "localhost";
-  r.pid = 1;
-  r.source = source.c_str();
-  r.seq = seq;
-  r.message = message.c_str();
-  return r;
+  return TestRecord("hostile0", source, seq, message);
 }
 
-L::RecordFilter AllRecords() {
-  L::RecordFilter q;
-  q.max_priority = 700;
-  q.category_prefix = "";
-  q.instance = "";
-  q.regex = "";
-  q.from_time_us = 0;
-  q.to_time_us = 0;
-  q.after_serial = 0;
-  q.limit = 0;
-  return q;
-}
+L::RecordFilter AllRecords() { return RecordsOf("", ""); }
 
 class NullListener : public virtual POA_Caliper::Logging::LogListener {
  public:

@@ -30,17 +30,7 @@ CORBA::ORB_ptr Orb() { return ServingClientOrb("logger_process_test", 10); }
 PortableServer::POA_ptr Poa() { return RootPoa(Orb()); }
 
 L::Record MakeRecord(const std::string& source, CORBA::ULongLong seq, const std::string& message) {
-  L::Record r;
-  r.time_us = 1700000000000000;
-  r.priority = 600;
-  r.category = "caliper.test.hostile";
-  r.instance = kInstance;
-  r.host = "localhost";
-  r.pid = 1;
-  r.source = source.c_str();
-  r.seq = seq;
-  r.message = message.c_str();
-  return r;
+  return TestRecord(kInstance, source, seq, message);
 }
 
 L::RecordSeq Batch(const std::vector<L::Record>& records) {
@@ -50,18 +40,8 @@ L::RecordSeq Batch(const std::vector<L::Record>& records) {
   return seq;
 }
 
-L::RecordFilter Ours(const std::string& regex) {
-  L::RecordFilter q;
-  q.max_priority = 700;
-  q.category_prefix = "";
-  q.instance = kInstance;  // not the logger's own records
-  q.regex = regex.c_str();
-  q.from_time_us = 0;
-  q.to_time_us = 0;
-  q.after_serial = 0;
-  q.limit = 0;
-  return q;
-}
+/// The records this test submitted (not the logger's own) matching `regex`.
+L::RecordFilter Ours(const std::string& regex) { return RecordsOf(kInstance, regex); }
 
 std::vector<std::string> Messages(const L::StoredRecordSeq& records) {
   std::vector<std::string> out;

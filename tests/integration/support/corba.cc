@@ -70,6 +70,34 @@ CORBA::Object_ptr Activate(CORBA::ORB_ptr orb, PortableServer::ServantBase* serv
   return poa->id_to_reference(id);
 }
 
+::Caliper::Logging::Record TestRecord(const std::string& instance, const std::string& source,
+                                      CORBA::ULongLong seq, const std::string& message) {
+  ::Caliper::Logging::Record r;
+  r.time_us = 1700000000000000;
+  r.priority = 600;
+  r.category = "caliper.test.hostile";
+  r.instance = instance.c_str();
+  r.host = "localhost";
+  r.pid = 1;
+  r.source = source.c_str();
+  r.seq = seq;
+  r.message = message.c_str();
+  return r;
+}
+
+::Caliper::Logging::RecordFilter RecordsOf(const std::string& instance, const std::string& regex) {
+  ::Caliper::Logging::RecordFilter q;
+  q.max_priority = 700;
+  q.category_prefix = "";
+  q.instance = instance.c_str();
+  q.regex = regex.c_str();
+  q.from_time_us = 0;
+  q.to_time_us = 0;
+  q.after_serial = 0;
+  q.limit = 0;
+  return q;
+}
+
 void ModelProcessTest::SetUp() {
   orb_();
   naming_ = std::make_unique<NamingService>(dir_.path());

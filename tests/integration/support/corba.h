@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "caliper/logging.hh"
 #include "caliper/model.hh"
 #include "support/process.h"
 
@@ -32,6 +33,15 @@ PortableServer::POA_ptr RootPoa(CORBA::ORB_ptr orb);
 
 /// Activates `servant` in the RootPOA of `orb` (which then owns it); returns its reference.
 CORBA::Object_ptr Activate(CORBA::ORB_ptr orb, PortableServer::ServantBase* servant);
+
+/// A log record of `instance` (priority 600, category caliper.test.hostile, host localhost, pid
+/// 1, a fixed time) from `source` with sequence number `seq`.
+::Caliper::Logging::Record TestRecord(const std::string& instance, const std::string& source,
+                                      CORBA::ULongLong seq, const std::string& message);
+
+/// A query of every record up to priority 700 of `instance` ("" = any) whose message matches
+/// `regex` ("" = any), at any time, unlimited.
+::Caliper::Logging::RecordFilter RecordsOf(const std::string& instance, const std::string& regex);
 
 /// A fixture running caliper-model with the shipped pendulum_tendon.dae (its execution context
 /// active: 200 Hz, real time; no log service) bound as model0 in a private naming service, reached
