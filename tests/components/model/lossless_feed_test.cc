@@ -92,6 +92,15 @@ bool WaitForSamples(const SlowTaker& taker, uint64_t n) {
   return taker.samples() == n;
 }
 
+/// `taker` gets `n` samples of subscription `id` (within 10 s), each after the one before, and
+/// none dropped: the Model waited for it.
+void ExpectEverySampleAfterAWait(ModelCore& core, uint64_t id, SlowTaker& taker, uint64_t n) {
+  ASSERT_TRUE(WaitForSamples(taker, n)) << taker.samples() << " samples of " << n;
+  EXPECT_EQ(taker.breaks(), "");
+  EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
+  EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
+}
+
 TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   ModelCore core;
   core.Load(Model("pendulum_tendon.dae"));
@@ -166,11 +175,7 @@ TEST(LosslessFeed, AsFastAsPossibleWaitsForASlowTaker) {
   const uint64_t steps = core.status().steps;
   EXPECT_GE(steps, 3000u);
   // the partial batch is not queued yet
-  ASSERT_TRUE(WaitForSamples(taker, steps - steps % 10))
-      << taker.samples() << " samples of " << steps;
-  EXPECT_EQ(taker.breaks(), "");
-  EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
-  EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
+  ExpectEverySampleAfterAWait(core, id, taker, steps - steps % 10);
 }
 
 TEST(LosslessFeed, LockStepTicksWaitForASlowTaker) {
@@ -182,10 +187,7 @@ TEST(LosslessFeed, LockStepTicksWaitForASlowTaker) {
   for (int i = 0; i < 3000; ++i) core.Tick();  // an external execution context
   core.Pause();
   EXPECT_EQ(core.status().steps, 3000u);
-  ASSERT_TRUE(WaitForSamples(taker, 3000)) << taker.samples() << " samples";
-  EXPECT_EQ(taker.breaks(), "");
-  EXPECT_EQ(core.SubscriptionStatus(id).dropped_samples, 0u);
-  EXPECT_GT(core.SubscriptionStatus(id).waited_s, 0.0);
+  ExpectEverySampleAfterAWait(core, id, taker, 3000);
 }
 
 TEST(LosslessFeed, ARealTimeRunNeverWaitsAndCountsWhatItDrops) {
