@@ -13,13 +13,9 @@
 # after the naming service restarts. Needs root (ip netns); without it the test is skipped
 # (exit 77) and says why.
 set -uo pipefail
-BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
-SRC=${CALIPER_SOURCE_DIR:?}
 TAG=cl$$
-WORK=$(mktemp -d)
 # shellcheck source=support/netns.sh
-source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # NETS, FAILS, skip, fail, pass, in_ns, cleanup
-trap cleanup EXIT  # also when the test skips
+source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # BIN, SRC, WORK, skip, fail, pass, in_ns...
 NS=corbaname:ssliop:198.51.100.1:2809
 PKI=$WORK/pki
 unset CALIPER_INSECURE CALIPER_TLS_IDENTITY CALIPER_LISTEN

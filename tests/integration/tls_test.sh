@@ -15,13 +15,9 @@
 # logger and the manager reached directly (their references bound in the intruder's own naming
 # service). Needs root (ip netns); without it the test is skipped (exit 77) and says why.
 set -uo pipefail
-BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
-SRC=${CALIPER_SOURCE_DIR:?}
 TAG=tl$$
-WORK=$(mktemp -d)
 # shellcheck source=support/netns.sh
-source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # NETS, FAILS, skip, fail, pass, in_ns, cleanup
-trap cleanup EXIT  # also when the test skips
+source "$(dirname "${BASH_SOURCE[0]}")/support/netns.sh"  # BIN, SRC, WORK, skip, fail, pass, in_ns...
 
 launcher() { bash "$SRC/launch/caliper" "$@"; }
 # the launcher's environment on host N: its own PKI directory, state and session folders

@@ -2,11 +2,17 @@
 # tests/integration/cluster_test.sh and tls_test.sh):
 #   hosta 198.51.100.1, hostb 198.51.100.2, hostc 198.51.100.3 (eth0/24 and lo up each)
 # joined by a bridge (br0) that lives in a namespace of its own. The sourcing script sets TAG (a
-# prefix unique to the run, e.g. cl$$) and WORK (a directory of its own) first; cleanup kills
-# every process in the namespaces, deletes them and removes WORK. Also skip/fail/pass and in_ns.
+# prefix unique to the run, e.g. cl$$) first. Sets BIN and SRC (from CALIPER_BIN_DIR and
+# CALIPER_SOURCE_DIR) and WORK, a new temporary directory; on exit, also when the test skips,
+# cleanup kills every process in the namespaces, deletes them and removes WORK. Also FAILS,
+# skip/fail/pass and in_ns.
 
+BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
+SRC=${CALIPER_SOURCE_DIR:?}
+WORK=$(mktemp -d)
 NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 FAILS=0
+trap cleanup EXIT  # cleanup is defined below
 
 skip() { echo "SKIPPED: $*"; exit 77; }
 fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
