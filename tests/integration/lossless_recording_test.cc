@@ -35,8 +35,8 @@ double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).coun
 
 /// The test's ORB, serving the consumers; calls give up after 30 s.
 CORBA::ORB_ptr Orb() {
-  return TestOrb({"lossless_recording_test", "-ORBendPoint", "giop:tcp:127.0.0.1:",
-                  "-ORBclientCallTimeOutPeriod", "30000"});
+  return TestOrb({"lossless_recording_test", "-ORBendPoint",
+                  "giop:tcp:127.0.0.1:", "-ORBclientCallTimeOutPeriod", "30000"});
 }
 
 /// A DataConsumer that takes `delay` over each batch and checks that the samples follow one

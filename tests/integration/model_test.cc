@@ -202,8 +202,7 @@ class ModelTest : public ::testing::Test {
   /// The Model over CORBA, for what ctl does not do (observers).
   M::Model_ptr Model() {
     if (CORBA::is_nil(model_ref_)) {
-      CosNaming::NamingContext_var root =
-          rtc::ResolveRoot(Orb(), naming_->address());
+      CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming_->address());
       const rtc::ComponentEntry entry = rtc::FindComponent(root, "model0");
       model_ref_ = M::Model::_narrow(entry.object);
     }

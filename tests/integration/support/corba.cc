@@ -24,8 +24,7 @@ class TestOrbEnvironment : public ::testing::Environment {
   }
 };
 
-const auto* const kTestOrbEnvironment =
-    ::testing::AddGlobalTestEnvironment(new TestOrbEnvironment);
+const auto* const kTestOrbEnvironment = ::testing::AddGlobalTestEnvironment(new TestOrbEnvironment);
 
 void ActivateRootPoa(CORBA::ORB_ptr orb) {
   PortableServer::POA_var poa = RootPoa(orb);
