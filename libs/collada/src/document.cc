@@ -65,14 +65,6 @@ void AssignNodes(const Element& e, const xmlNode* node,
   }
 }
 
-// What one parse by libxml2 gave: the tree, or the first fatal error and its line.
-struct XmlParse {
-  XmlDocument doc;
-  int line = 0;
-  std::string problem;
-  std::unordered_map<const xmlNode*, int> big_lines;  // elements from line 65535 on
-};
-
 // the parser's context as the callbacks below get it
 struct ParseState {
   startElementNsSAX2Func start = nullptr;  // libxml2's own tree builder
@@ -160,6 +152,19 @@ const xmlNode* SelfNested(const xmlNode* top) {
 }
 
 }  // namespace
+
+XmlParse PreScanXml(const std::string& name, const std::string* text) {
+  XmlParse xml = ParseXml(name, text);
+  if (!xml.doc) throw ReadError("malformed XML: " + xml.problem, xml.line);
+  if (const xmlNode* nested = SelfNested(xmlDocGetRootElement(xml.doc.get())); nested != nullptr) {
+    const auto big = xml.big_lines.find(nested);
+    const std::string element = Chars(nested->name);
+    throw ReadError("<" + element + "> inside <" + element +
+                        ">: COLLADA does not nest this element in itself",
+                    big != xml.big_lines.end() ? big->second : nested->line);
+  }
+  return xml;
+}
 
 std::string_view Element::local_name() const { return LocalName(name); }
 
@@ -401,19 +406,12 @@ Document ReadDocument(const std::string& path) {
   std::lock_guard<std::mutex> lock(DomMutex());
   // malformed XML never reaches the DOM (its reader can loop forever on some: a start tag left
   // open inside character data, found by fuzzing): libxml2 reads the file first and says what
-  // is wrong where; its tree also gives the elements' lines, which the DOM does not keep
+  // is wrong where; its tree also gives the elements' lines, which the DOM does not keep (the
+  // documents inside a .zae get the same check from CheckZaeArchive, before the DOM unzips them)
   XmlParse xml;
   if (!doc.zipped) {
-    xml = ParseXml(path, nullptr);
-    if (!xml.doc) throw ReadError("malformed XML: " + xml.problem, xml.line);
+    xml = PreScanXml(path, nullptr);
     const xmlNode* top = xmlDocGetRootElement(xml.doc.get());
-    if (const xmlNode* nested = SelfNested(top); nested != nullptr) {
-      const auto big = xml.big_lines.find(nested);
-      const std::string name = Chars(nested->name);
-      throw ReadError("<" + name + "> inside <" + name +
-                          ">: COLLADA does not nest this element in itself",
-                      big != xml.big_lines.end() ? big->second : nested->line);
-    }
     for (const xmlAttr* a = top->properties; a != nullptr; a = a->next)
       if (a->ns == nullptr && std::string_view(Chars(a->name)) == "version")
         doc.declared_version = AttributeOf(a).second;

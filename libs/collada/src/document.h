@@ -124,6 +124,22 @@ class Document {
   mutable std::unordered_map<const Element*, const _xmlNode*> nodes_;
 };
 
+/// What libxml2 made of a document: its tree (null when not well-formed) and the lines of its
+/// elements from line 65535 on (xmlNode keeps 16 bits).
+struct XmlParse {
+  XmlDocument doc;
+  int line = 0;
+  std::string problem;
+  std::unordered_map<const _xmlNode*, int> big_lines;
+};
+
+/// The check a COLLADA document passes before Collada-DOM reads it (malformed XML can make the
+/// DOM's reader loop without end, an element directly inside one of its own name makes it
+/// dereference a null pointer): libxml2 reads the file `name` or, when given, `text` (`name` then
+/// names it, e.g. "x.zae:scene/robot.dae"). Throws ReadError with the reason (libxml2's, or the
+/// element nested in itself) and its line; returns libxml2's tree.
+XmlParse PreScanXml(const std::string& name, const std::string* text);
+
 /// Loads `path` with the Collada-DOM of the document's schema version (its version attribute, or
 /// each in turn for .zae archives) once libxml2 found it well-formed. Throws ReadError when
 /// libxml2 or the DOM cannot read it.

@@ -4,6 +4,7 @@
 #include <unzip.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,8 @@
 #include <stdexcept>
 #include <string_view>
 #include <vector>
+
+#include "document.h"
 
 namespace caliper::collada::internal {
 
@@ -104,6 +107,7 @@ int ZCALLBACK MemoryError(voidpf, voidpf) { return 0; }
 
 // an archive's entries walked the way Collada-DOM extracts them
 struct Walk {
+  std::string archive;           // the archive's file name, for messages
   unsigned long long bytes = 0;  // extracted so far, nested archives included
   unsigned long entries = 0;
   std::set<std::string> files;  // the files' names as extracted, normalised
@@ -155,6 +159,26 @@ std::string ReadEntry(unzFile zip, std::string_view name, Walk* walk) {
   return content;
 }
 
+bool IsDae(std::string_view name) {
+  if (name.size() < 4) return false;
+  std::string ext(name.substr(name.size() - 4));
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".dae";
+}
+
+// a document the DOM would read from the archive gets the check a .dae file gets before the DOM
+// sees it (malformed XML, an element nested in itself: the DOM loops or crashes on them)
+void PreScanEntry(const Walk& walk, const std::string& shown, const std::string& content) {
+  try {
+    PreScanXml(walk.archive + ":" + Printable(shown), &content);
+  } catch (const ReadError& e) {
+    throw std::runtime_error(
+        "the archive's entry '" + Printable(shown) + "' is refused: " +
+        (e.line() > 0 ? "line " + std::to_string(e.line()) + ": " : std::string()) + e.what() +
+        " (checked before Collada-DOM extracts and reads it)");
+  }
+}
+
 void WalkArchive(unzFile zip, const std::string& prefix, int depth, Walk* walk) {
   unz_global_info global;
   if (unzGetGlobalInfo(zip, &global) != UNZ_OK)
@@ -190,6 +214,8 @@ void WalkArchive(unzFile zip, const std::string& prefix, int depth, Walk* walk) 
           RefuseEntry(
               shown, "it is an archive nested more than " + std::to_string(kMaxZaeDepth) + " deep");
         WalkArchive(inner, shown + "/", depth + 1, walk);
+      } else if (IsDae(name)) {
+        PreScanEntry(*walk, shown, content);
       } else if (depth == 0 && key == "manifest.xml") {
         walk->has_manifest = true;
         walk->manifest = std::move(content);
@@ -200,8 +226,8 @@ void WalkArchive(unzFile zip, const std::string& prefix, int depth, Walk* walk) 
   }
 }
 
-// the root document manifest.xml names, found as Collada-DOM finds it
-void CheckManifest(const std::string& manifest) {
+// the root document manifest.xml names, found as Collada-DOM finds it; returns its name
+std::string CheckManifest(const std::string& manifest) {
   const std::string problem = "the archive's manifest.xml is refused: ";
   std::unique_ptr<xmlTextReader, void (*)(xmlTextReaderPtr)> reader(
       xmlReaderForMemory(manifest.data(), static_cast<int>(manifest.size()), "manifest.xml",
@@ -228,6 +254,27 @@ void CheckManifest(const std::string& manifest) {
     throw std::runtime_error(named + "has a '..' component, which leads out of the archive");
   if (root.find_first_of("#?%") != std::string::npos)
     throw std::runtime_error(named + "holds '#', '?' or '%', which Collada-DOM reads as a URI's");
+  return root;
+}
+
+// a root document whose name does not end in .dae was not checked during the walk
+void PreScanRoot(unzFile zip, const std::string& root, Walk* walk) {
+  const std::string wanted = std::filesystem::path(root).lexically_normal().string();
+  if (IsDae(wanted) || walk->files.count(wanted) == 0) return;  // checked, or not there
+  walk->bytes = 0;
+  if (unzGoToFirstFile(zip) != UNZ_OK) throw std::runtime_error("cannot read the archive again");
+  do {
+    unz_file_info info;
+    std::vector<char> raw(1 << 16);
+    if (unzGetCurrentFileInfo(zip, &info, raw.data(), static_cast<uLong>(raw.size()), nullptr, 0,
+                              nullptr, 0) != UNZ_OK)
+      throw std::runtime_error("cannot read the archive again");
+    const std::string name(raw.data(), std::min<size_t>(info.size_filename, raw.size()));
+    if (std::filesystem::path(name).lexically_normal().string() == wanted) {
+      PreScanEntry(*walk, name, ReadEntry(zip, name, walk));
+      return;
+    }
+  } while (unzGoToNextFile(zip) == UNZ_OK);
 }
 
 }  // namespace
@@ -251,12 +298,13 @@ void CheckZaeArchive(const std::string& path) {
   std::unique_ptr<void, int (*)(unzFile)> zip(unzOpen(path.c_str()), unzClose);
   if (!zip) throw std::runtime_error("not a zip archive (a .zae is one)");
   Walk walk;
+  walk.archive = Printable(std::filesystem::path(path).filename().string());
   WalkArchive(zip.get(), "", 0, &walk);
   if (!walk.has_manifest)
     throw std::runtime_error(
         "the archive has no manifest.xml (Collada-DOM "
         "finds the root document through it)");
-  CheckManifest(walk.manifest);
+  PreScanRoot(zip.get(), CheckManifest(walk.manifest), &walk);
 }
 
 }  // namespace caliper::collada::internal

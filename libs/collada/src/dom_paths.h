@@ -16,8 +16,10 @@ void CheckDomPath(const std::string& path);
 /// whose name is empty, absolute, has a `..` component, a NUL, or more bytes than the DOM reads
 /// (255); a symbolic link; two entries of one name; a manifest.xml whose first element is not
 /// <dae_root> (the DOM loops without end on it) or whose root document is absolute, has `..`, '#',
-/// '?' or '%'. Archives inside (which the DOM extracts too) are checked the same way, at most
-/// kMaxZaeDepth deep; the entries may extract to kMaxZaeBytes in all.
+/// '?' or '%'; a document the DOM would read (each .dae entry, and the root document) that fails
+/// the check a .dae file gets first (PreScanXml: malformed XML, an element nested in itself),
+/// named with its line and element. Archives inside (which the DOM extracts too) are checked the
+/// same way, at most kMaxZaeDepth deep; the entries may extract to kMaxZaeBytes in all.
 void CheckZaeArchive(const std::string& path);
 
 constexpr int kMaxZaeDepth = 3;

@@ -216,6 +216,47 @@ TEST_F(DomPathsTest, RefusesAManifestTheDomWouldRecurseOnWithoutEnd) {
   EXPECT_TRUE(Contains(Refusal(none), "the archive has no manifest.xml")) << Refusal(none);
 }
 
+TEST_F(DomPathsTest, RefusesADocumentInsideThatWouldCrashTheDom) {
+  // the DOM unzips a .zae itself: the .dae inside gets the libxml2 check a .dae file gets, before
+  // the DOM reads it (a <p> inside a <p> made it dereference a null pointer)
+  const std::string crash = ReadFile(Source("tests/data/collada/malformed_p_inside_p.dae"));
+  ASSERT_NE(crash.find("<p>0 1 2<p/></p>"), std::string::npos);
+  const std::string path = root_ + "/in/crash.zae";
+  WriteZip(path, {{"manifest.xml", Manifest("./scene/robot.dae")},
+                  {"scene/", ""},
+                  {"scene/robot.dae", crash}});
+  std::string why = Refusal(path);
+  EXPECT_TRUE(Contains(why, path + ": the archive's entry 'scene/robot.dae' is refused: line 28: "
+                                   "<p> inside <p>: COLLADA does not nest this element in itself"))
+      << why;
+  // any .dae the DOM extracts, not only the root document, also inside an archive inside
+  why = Refusal(Archive("other.zae", {{"extra/", ""}, {"extra/other.DAE", crash}}));
+  EXPECT_TRUE(Contains(why, "entry 'extra/other.DAE' is refused: line 28: <p> inside <p>")) << why;
+  const std::string inner = Zip(root_ + "/in/inner.zip", {{"deep.dae", crash}});
+  why = Refusal(Archive("nested_crash.zae", {{"inner.zip", inner}}));
+  EXPECT_TRUE(Contains(why, "entry 'inner.zip/deep.dae' is refused: line 28: <p> inside <p>"))
+      << why;
+  // a root document whose name does not end in .dae
+  const std::string named = root_ + "/in/named.zae";
+  WriteZip(named, {{"manifest.xml", Manifest("scene.xml")}, {"scene.xml", crash}});
+  why = Refusal(named);
+  EXPECT_TRUE(Contains(why, "entry 'scene.xml' is refused: line 28: <p> inside <p>")) << why;
+  // malformed XML (the DOM's reader can loop on some) with libxml2's reason and line
+  const std::string broken = root_ + "/in/broken.zae";
+  WriteZip(broken,
+           {{"manifest.xml", Manifest("a.dae")}, {"a.dae", "<COLLADA>\n<asset>\n</COLLADA>"}});
+  why = Refusal(broken);
+  EXPECT_TRUE(Contains(why, "entry 'a.dae' is refused: line 3: malformed XML: ")) << why;
+  // the same scene without the inner <p> loads from an archive
+  std::string fixed = crash;
+  fixed.replace(fixed.find("<p>0 1 2<p/></p>"), 16, "<p>0 1 2</p>");
+  const std::string fine = root_ + "/in/fixed.zae";
+  WriteZip(fine, {{"manifest.xml", Manifest("./scene/robot.dae")},
+                  {"scene/", ""},
+                  {"scene/robot.dae", fixed}});
+  EXPECT_EQ(Refusal(fine), "");
+}
+
 TEST_F(DomPathsTest, RefusesFileNamesTheDomReadsAsUris) {
   // the file named holds the pendulum; the file the DOM would open instead holds another scene
   const std::string arm = ReadFile(Source("models/two_link_antagonistic.dae"));
