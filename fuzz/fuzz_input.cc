@@ -29,6 +29,21 @@ InputFile::InputFile(const uint8_t* data, size_t size, const std::string& name)
 
 InputFile::~InputFile() { std::remove(path_.c_str()); }
 
+std::vector<std::string> Parts(const uint8_t* data, size_t size, size_t count) {
+  static const std::string kSeparator = "\n@@\n";
+  const std::string all(reinterpret_cast<const char*>(data), size);
+  std::vector<std::string> out;
+  size_t from = 0;
+  while (out.size() + 1 < count) {
+    const size_t at = all.find(kSeparator, from);
+    if (at == std::string::npos) break;
+    out.push_back(all.substr(from, at - from));
+    from = at + kSeparator.size();
+  }
+  out.push_back(all.substr(from));
+  return out;
+}
+
 void Check(bool ok, const std::string& what) {
   if (ok) return;
   std::fprintf(stderr, "fuzz: check failed: %s\n", what.c_str());

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace caliper::fuzz {
 
@@ -24,6 +25,11 @@ class InputFile {
  private:
   std::string path_;
 };
+
+/// The input cut at each line `@@` (the separator "\n@@\n"), for the targets that read several
+/// files (a file and the files it names): at most `count` parts, the last one keeping any further
+/// separators; fewer when the input has fewer.
+std::vector<std::string> Parts(const uint8_t* data, size_t size, size_t count);
 
 /// Prints `what` and aborts when `ok` is false: libFuzzer saves the input as a crash, the replay
 /// fails.

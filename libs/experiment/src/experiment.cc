@@ -112,7 +112,7 @@ void Apply(const ptree& node, const Where& where, Experiment* out,
   if (auto v = node.get_child_optional("set"))
     for (const auto& [id, value] : *v) {
       if (id.empty()) where.Fail("set", "expected an object {\"id\": value, ...}");
-      auto same = [&](const Override& o) { return o.id == id; };
+      auto same = [&key = id](const Override& o) { return o.id == key; };
       out->overrides.erase(std::remove_if(out->overrides.begin(), out->overrides.end(), same),
                            out->overrides.end());
       out->overrides.push_back({id, Numbers(value, where, "set." + id)});
@@ -151,12 +151,20 @@ void Apply(const ptree& node, const Where& where, Experiment* out,
   }
 }
 
-// One experiment per combination of the sweep's values, named NAME-K.
+// One experiment per combination of the sweep's values, named NAME-K; at most kMaxRuns in the
+// file (a few hundred bytes of sweep would otherwise ask for billions of runs and exhaust memory).
 void Expand(const Experiment& base,
             const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& sweep,
-            std::vector<Experiment>* out) {
+            const Where& where, std::vector<Experiment>* out) {
   size_t total = 1;
-  for (const auto& [id, options] : sweep) total *= options.size();
+  for (const auto& [id, options] : sweep) {
+    if (!options.empty() && total > (kMaxRuns - out->size()) / options.size())
+      where.Fail("sweep", "more than " + std::to_string(kMaxRuns) +
+                              " runs in the file (the product of the numbers of values)");
+    total *= options.size();
+  }
+  if (sweep.empty() && out->size() >= kMaxRuns)
+    where.Fail("experiments", "more than " + std::to_string(kMaxRuns) + " runs in the file");
   if (sweep.empty() || total == 0) {
     if (sweep.empty()) out->push_back(base);
     return;
@@ -253,7 +261,7 @@ std::vector<Experiment> LoadFile(const std::string& path) {
   std::vector<Experiment> out;
   const auto list = root.get_child_optional("experiments");
   if (!list) {
-    Expand(defaults, sweep, &out);
+    Expand(defaults, sweep, where, &out);
   } else {
     if (!list->empty() && !IsList(*list)) where.Fail("experiments", "expected a list of objects");
     int index = 0;
@@ -267,7 +275,7 @@ std::vector<Experiment> LoadFile(const std::string& path) {
       where.experiment = e.name;
       if (entry.count("experiments")) where.Fail("experiments", "experiments do not nest");
       Apply(entry, where, &e, &own_sweep);
-      Expand(e, own_sweep, &out);
+      Expand(e, own_sweep, where, &out);
     }
   }
   if (out.empty()) where.Fail("experiments", "no experiment in the file");

@@ -520,6 +520,34 @@ TEST_F(ExperimentFileTest, RejectsNestedExperiments) {
             path + ": experiment 'outer': experiments: experiments do not nest");
 }
 
+// a sweep of `keys` keys of ten values each: 10^keys runs
+std::string TenValueSweep(int keys) {
+  std::string sweep = R"("sweep": {)";
+  for (int k = 0; k < keys; ++k)
+    sweep += (k ? ", " : "") + std::string("\"k") + std::to_string(k) +
+             R"(": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10])";
+  return sweep + "}";
+}
+
+TEST_F(ExperimentFileTest, AcceptsUpToTheMostRunsAndRefusesMore) {
+  ASSERT_EQ(kMaxRuns, 10000u);
+  const auto runs = LoadFile(Write("big.json", std::string("{") + kRequired + ", " +
+                                                   TenValueSweep(4) + "}"));
+  EXPECT_EQ(runs.size(), 10000u);
+  // a few hundred bytes asking for a billion runs (it exhausted memory): refused before expanding
+  const std::string bomb = Write("bomb.json", std::string("{") + kRequired + ", " +
+                                                  TenValueSweep(9) + "}");
+  EXPECT_EQ(ErrorOf([&] { LoadFile(bomb); }),
+            bomb + ": sweep: more than 10000 runs in the file (the product of the numbers of "
+                   "values)");
+  // the limit counts every experiment of the file
+  const std::string two = Write("two.json", std::string("{") + kRequired + ", " +
+                                                TenValueSweep(4) + R"(, "experiments": [{}, {}]})");
+  EXPECT_EQ(ErrorOf([&] { LoadFile(two); }),
+            two + ": experiment 'run2': sweep: more than 10000 runs in the file (the product of "
+                  "the numbers of values)");
+}
+
 TEST(Validate, AcceptsAValidExperiment) {
   EXPECT_EQ(ErrorOf([] { Validate(Valid()); }), "");
 }

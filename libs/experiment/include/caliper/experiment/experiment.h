@@ -17,6 +17,7 @@
 //     "experiments": [{"name": "light", "set": {...}}, ...]
 //   }
 
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -69,8 +70,11 @@ struct Recording {
   std::vector<double> data;
 };
 
+/// The most runs an experiment file may expand to (its experiments times their sweeps).
+constexpr size_t kMaxRuns = 10000;
+
 /// Reads an experiment file (format above); scene and CSV paths come out absolute. Throws
-/// FormatError naming the file, the experiment and what is wrong.
+/// FormatError naming the file, the experiment and what is wrong (also for more than kMaxRuns).
 std::vector<Experiment> LoadFile(const std::string& path);
 
 /// A command schedule from CSV: a header line, then `time [s],actuator,value` per line.
