@@ -136,7 +136,11 @@ Spec LoadSpec(const std::string& path) {
                                      boost::property_tree::path(e.name, '\0'))
                                : boost::none;
     if (!file) Fail(path, "measured: no file for experiment '" + e.name + "'");
-    spec.measured.push_back(LoadMeasured(Resolve(*file, path)));
+    try {
+      spec.measured.push_back(LoadMeasured(Resolve(*file, path)));
+    } catch (const SpecError& error) {
+      Fail(path, "measured: '" + e.name + "': " + error.what());
+    }
   }
   const auto parameters = root.get_child_optional("parameters");
   if (!parameters || parameters->empty()) Fail(path, "parameters: name at least one to fit");
@@ -154,6 +158,10 @@ Spec LoadSpec(const std::string& path) {
     p.log_scale = scale == "log";
     if (!(p.lower < p.upper)) Fail(where, "lower must be below upper");
     if (p.log_scale && !(p.lower > 0)) Fail(where, "a log scale needs lower > 0");
+    // the search space's span: finite, or every value mapped from it would be inf or NaN
+    if (!std::isfinite(p.log_scale ? p.upper / p.lower : p.upper - p.lower))
+      Fail(where, p.log_scale ? "upper / lower is too large for a log scale"
+                              : "upper - lower is too large");
     spec.parameters.push_back(p);
   }
   if (const auto channels = root.get_child_optional("channels"))
@@ -188,7 +196,11 @@ Spec LoadSpec(const std::string& path) {
     if (!(spec.optimiser.sigma0 > 0 && spec.optimiser.sigma0 <= 1))
       Fail(where, "sigma0 is in (0, 1] (the search space is scaled to [0, 1])");
   }
-  spec.seed = static_cast<uint64_t>(Number(root.get<std::string>("seed", "1"), path + ": seed"));
+  const double seed = Number(root.get<std::string>("seed", "1"), path + ": seed");
+  // exactly representable whole numbers only (a cast of a negative or larger one is undefined)
+  if (!(seed >= 0 && seed <= 9007199254740992.0 && seed == std::floor(seed)))
+    Fail(path + ": seed", "a whole number in [0, 2^53]");
+  spec.seed = static_cast<uint64_t>(seed);
   return spec;
 }
 

@@ -99,6 +99,12 @@ TEST_F(CalibrationFiles, ErrorsNameTheFileAndTheProblem) {
       {base + R"(, "parameters": [{"id": "x", "lower": "one", "upper": 2}])", "'one' is not a finite number"},
       {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "optimiser": {"algorithm": "mine"})", "cmaes or xnes"},
       {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "colour": 1)", "unknown key 'colour'"},
+      // found by fuzzing (tests/data/fuzz/calibration_spec/regressions): a negative seed was cast
+      // to an unsigned (undefined), spans too wide mapped every value to inf or NaN
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "seed": -1)", "seed: a whole number in [0, 2^53]"},
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "seed": 1e300)", "seed: a whole number in [0, 2^53]"},
+      {base + R"(, "parameters": [{"id": "x", "lower": -1e308, "upper": 1e308}])", "'x': upper - lower is too large"},
+      {base + R"(, "parameters": [{"id": "x", "lower": 1e-300, "upper": 1e300, "scale": "log"}])", "'x': upper / lower is too large for a log scale"},
   };
   for (const auto& c : cases) {
     Write("cal.json", "{" + c.body + "}");
@@ -106,6 +112,15 @@ TEST_F(CalibrationFiles, ErrorsNameTheFileAndTheProblem) {
     EXPECT_NE(error.find(cal), std::string::npos) << error;
     EXPECT_NE(error.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << error;
   }
+}
+
+TEST_F(CalibrationFiles, MeasuredCsvErrorsNameTheCalibrationFileTheExperimentAndTheLine) {
+  Write("runs.json", kRuns);
+  Write("a.csv", kMeasured);
+  const std::string bad = Write("bad.csv", "time [s],x [m]\n0,1\n0.5,oops\n");
+  const std::string cal = Write("cal.json", R"({"experiments": "runs.json",
+    "measured": {"a": "a.csv", "b": "bad.csv"}, "parameters": [{"id": "x", "lower": 1, "upper": 2}]})");
+  EXPECT_EQ(ErrorOf(cal), cal + ": measured: 'b': " + bad + ":3 column 2: 'oops' is not a finite number");
 }
 
 TEST_F(CalibrationFiles, MeasuredCsvErrorsNameTheLine) {
