@@ -88,7 +88,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       Check(c.time_s >= 0 && !c.actuator.empty(), e.name + ": a command before 0 s or unnamed");
     for (const auto& o : e.overrides) {
       Check(!o.id.empty(), e.name + ": an override without an id");
-      for (double v : o.values) Check(std::isfinite(v), e.name + ": override " + o.id + " not finite");
+      for (double v : o.values)
+        Check(std::isfinite(v), e.name + ": override " + o.id + " not finite");
     }
     try {
       Check(ex::StepCount(e.duration_s, 1e-3) >= 1 || e.duration_s < 5e-4,

@@ -119,8 +119,10 @@ TEST_F(CalibrationFiles, MeasuredCsvErrorsNameTheCalibrationFileTheExperimentAnd
   Write("a.csv", kMeasured);
   const std::string bad = Write("bad.csv", "time [s],x [m]\n0,1\n0.5,oops\n");
   const std::string cal = Write("cal.json", R"({"experiments": "runs.json",
-    "measured": {"a": "a.csv", "b": "bad.csv"}, "parameters": [{"id": "x", "lower": 1, "upper": 2}]})");
-  EXPECT_EQ(ErrorOf(cal), cal + ": measured: 'b': " + bad + ":3 column 2: 'oops' is not a finite number");
+    "measured": {"a": "a.csv", "b": "bad.csv"},
+    "parameters": [{"id": "x", "lower": 1, "upper": 2}]})");
+  EXPECT_EQ(ErrorOf(cal),
+            cal + ": measured: 'b': " + bad + ":3 column 2: 'oops' is not a finite number");
 }
 
 TEST_F(CalibrationFiles, MeasuredCsvErrorsNameTheLine) {

@@ -531,21 +531,19 @@ std::string TenValueSweep(int keys) {
 
 TEST_F(ExperimentFileTest, AcceptsUpToTheMostRunsAndRefusesMore) {
   ASSERT_EQ(kMaxRuns, 10000u);
-  const auto runs = LoadFile(Write("big.json", std::string("{") + kRequired + ", " +
-                                                   TenValueSweep(4) + "}"));
+  const std::string too_many =
+      "sweep: more than 10000 runs in the file (the product of the numbers of values)";
+  const auto runs =
+      LoadFile(Write("big.json", std::string("{") + kRequired + ", " + TenValueSweep(4) + "}"));
   EXPECT_EQ(runs.size(), 10000u);
   // a few hundred bytes asking for a billion runs (it exhausted memory): refused before expanding
-  const std::string bomb = Write("bomb.json", std::string("{") + kRequired + ", " +
-                                                  TenValueSweep(9) + "}");
-  EXPECT_EQ(ErrorOf([&] { LoadFile(bomb); }),
-            bomb + ": sweep: more than 10000 runs in the file (the product of the numbers of "
-                   "values)");
+  const std::string bomb =
+      Write("bomb.json", std::string("{") + kRequired + ", " + TenValueSweep(9) + "}");
+  EXPECT_EQ(ErrorOf([&] { LoadFile(bomb); }), bomb + ": " + too_many);
   // the limit counts every experiment of the file
-  const std::string two = Write("two.json", std::string("{") + kRequired + ", " +
-                                                TenValueSweep(4) + R"(, "experiments": [{}, {}]})");
-  EXPECT_EQ(ErrorOf([&] { LoadFile(two); }),
-            two + ": experiment 'run2': sweep: more than 10000 runs in the file (the product of "
-                  "the numbers of values)");
+  const std::string two = Write("two.json", std::string("{") + kRequired + ", " + TenValueSweep(4) +
+                                                R"(, "experiments": [{}, {}]})");
+  EXPECT_EQ(ErrorOf([&] { LoadFile(two); }), two + ": experiment 'run2': " + too_many);
 }
 
 TEST(Validate, AcceptsAValidExperiment) {
