@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <unordered_map>
 
 #include "caliper/core/numbers.h"
@@ -311,54 +312,47 @@ int Document::LineOf(const Element& element) const {
   return big != big_lines_.end() ? big->second : it->second->line;
 }
 
-std::vector<std::string> Document::RestoreAttributes(Element* subtree) {
+void Document::ForEachInFile(Element* subtree,
+                             const std::function<void(Element*, const _xmlNode*)>& visit) {
   IndexNodes();
-  std::vector<std::string> restored;
   std::vector<Element*> stack{subtree};
   while (!stack.empty()) {
     Element* e = stack.back();
     stack.pop_back();
     for (auto& c : e->children) stack.push_back(c.get());
     const auto it = nodes_.find(e);
-    if (it == nodes_.end()) continue;
-    for (const xmlAttr* a = it->second->properties; a != nullptr; a = a->next) {
+    if (it != nodes_.end()) visit(e, it->second);  // one the DOM made up is not in the file
+  }
+}
+
+std::vector<std::string> Document::RestoreAttributes(Element* subtree) {
+  std::vector<std::string> restored;
+  ForEachInFile(subtree, [&](Element* e, const xmlNode* node) {
+    for (const xmlAttr* a = node->properties; a != nullptr; a = a->next) {
       auto [name, value] = AttributeOf(a);
       if (e->HasAttribute(name)) continue;
       restored.push_back(name + " = " + value);
       e->attributes.emplace_back(std::move(name), std::move(value));
     }
-  }
+  });
   return restored;
 }
 
 void Document::RestoreNames() {
   if (!root) return;
-  IndexNodes();
-  std::vector<Element*> stack{root.get()};
-  while (!stack.empty()) {
-    Element* e = stack.back();
-    stack.pop_back();
-    for (auto& c : e->children) stack.push_back(c.get());
-    const auto it = nodes_.find(e);
-    if (it == nodes_.end() || !e->HasAttribute("name")) continue;
-    for (const xmlAttr* a = it->second->properties; a != nullptr; a = a->next)
+  ForEachInFile(root.get(), [&](Element* e, const xmlNode* node) {
+    if (!e->HasAttribute("name")) return;
+    for (const xmlAttr* a = node->properties; a != nullptr; a = a->next)
       if (a->ns == nullptr && std::string_view(Chars(a->name)) == "name")
         e->Set("name", AttributeOf(a).second);
-  }
+  });
 }
 
 void Document::CheckNumbers() {
   if (!root) return;
-  IndexNodes();
-  std::vector<Element*> stack{root.get()};
-  while (!stack.empty()) {
-    Element* e = stack.back();
-    stack.pop_back();
-    for (auto& c : e->children) stack.push_back(c.get());
-    if (!e->numeric) continue;
-    const auto it = nodes_.find(e);
-    if (it == nodes_.end()) continue;  // an element the DOM made up has no text in the file
-    xmlChar* content = xmlNodeGetContent(it->second);
+  ForEachInFile(root.get(), [&](Element* e, const xmlNode* node) {
+    if (!e->numeric) return;
+    xmlChar* content = xmlNodeGetContent(node);
     const std::string text = content == nullptr ? "" : Chars(content);
     xmlFree(content);
     const bool decimals = e->local_name() == "float_array";
@@ -387,7 +381,7 @@ void Document::CheckNumbers() {
       i = j;
     }
     e->numbers = std::move(values);
-  }
+  });
 }
 
 std::mutex& DomMutex() {

@@ -3,6 +3,7 @@
 // readers (dom141.cc, dom150.cc) produce and the writer (dom150.cc) consumes. The importer and
 // exporter work on this tree only, so that no Collada-DOM type leaks out of those two sources.
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -116,6 +117,9 @@ class Document {
  private:
   // matches each element to its node in libxml2's tree
   void IndexNodes() const;
+  // calls `visit` with each element of `subtree` (depth first) that has a node in libxml2's tree,
+  // and that node
+  void ForEachInFile(Element* subtree, const std::function<void(Element*, const _xmlNode*)>& visit);
 
   std::unordered_map<std::string_view, const Element*> ids_;
   XmlDocument xml_;
