@@ -28,6 +28,12 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr size_t kPendingBatches = 256;  // held while a subscribe call is under way
 constexpr size_t kHeldBatches = 256;     // held after a reset or reload until the layout is checked
+// times and values kept in the inbox, and in `held`, beyond which the oldest batches are dropped
+// (the newest is always kept): a batch may carry a million samples, and a few thousand of those
+// waiting for a busy GUI took a gigabyte (hostile_corba_test)
+constexpr size_t kMaxQueuedValues = size_t{8} << 20;
+
+size_t ValuesOf(const ReceivedBatch& b) { return b.times.size() + b.data.size(); }
 
 // thrown between two calls of a poll when the link closes: the poll ends without further calls
 struct Closing {};
@@ -64,6 +70,8 @@ struct DaqLink::Shared {
   bool checking = false;
   std::deque<ReceivedBatch> held;
   std::deque<ReceivedBatch> inbox;
+  size_t held_values = 0;   // ValuesOf the batches in `held`
+  size_t inbox_values = 0;  // ValuesOf the batches in `inbox`
   size_t inbox_capacity = 4096;
   uint64_t next_batch = 1;
   uint64_t received = 0;
@@ -76,8 +84,11 @@ struct DaqLink::Shared {
 
   // with the mutex held
   void Deliver(ReceivedBatch&& b) {
+    inbox_values += ValuesOf(b);
     inbox.push_back(std::move(b));
-    while (inbox.size() > inbox_capacity) {
+    while (inbox.size() > inbox_capacity ||
+           (inbox_values > kMaxQueuedValues && inbox.size() > 1)) {
+      inbox_values -= ValuesOf(inbox.front());
       inbox.pop_front();
       ++dropped;
     }
@@ -101,8 +112,10 @@ struct DaqLink::Shared {
       Deliver(std::move(b));
       return;
     }
+    held_values += ValuesOf(b);
     held.push_back(std::move(b));
-    while (held.size() > kHeldBatches) {
+    while (held.size() > kHeldBatches || (held_values > kMaxQueuedValues && held.size() > 1)) {
+      held_values -= ValuesOf(held.front());
       held.pop_front();
       ++dropped;
     }
@@ -113,6 +126,7 @@ struct DaqLink::Shared {
     checking = false;
     for (auto& b : held) Deliver(std::move(b));
     held.clear();
+    held_values = 0;
   }
 
   // with the mutex held: the subscription ends, what it holds cannot be read
@@ -120,6 +134,7 @@ struct DaqLink::Shared {
     checking = false;
     discarded += held.size();
     held.clear();
+    held_values = 0;
   }
 
   void Receive(ReceivedBatch&& b) {
@@ -223,6 +238,7 @@ std::vector<ReceivedBatch> DaqLink::TakeBatches() {
   std::vector<ReceivedBatch> out(std::make_move_iterator(shared_->inbox.begin()),
                                  std::make_move_iterator(shared_->inbox.end()));
   shared_->inbox.clear();
+  shared_->inbox_values = 0;
   return out;
 }
 

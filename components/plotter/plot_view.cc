@@ -22,6 +22,14 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const QColor kStaleColor(150, 150, 150);
 
+// Qwt divides an axis into ticks by adding steps to its lower end: on an interval that is not
+// finite, or too narrow for its magnitude (a 10 s window at t = 1e308), that never ends and
+// allocated until std::bad_alloc (hostile_corba_test). Such an interval is not set.
+bool Divisible(double lo, double hi) {
+  return std::isfinite(lo) && std::isfinite(hi) && std::isfinite(hi - lo) && hi > lo &&
+         hi - lo > 1e-9 * std::max(std::abs(lo), std::abs(hi));
+}
+
 }  // namespace
 
 QString PaletteColor(size_t n) {
@@ -195,7 +203,7 @@ void PlotView::Draw(const SampleStore& store, double t0, double t1, bool fit_val
   }
   const QString y_title = units.join("  ");
   if (axisTitle(QwtPlot::yLeft).text() != y_title) setAxisTitle(QwtPlot::yLeft, y_title);
-  setAxisScale(QwtPlot::xBottom, t0, t1);
+  if (Divisible(t0, t1)) setAxisScale(QwtPlot::xBottom, t0, t1);
   if (!fit_values) return;
   if (!autoscale_) {
     setAxisScale(QwtPlot::yLeft, y_min_, y_max_);
@@ -204,7 +212,8 @@ void PlotView::Draw(const SampleStore& store, double t0, double t1, bool fit_val
     const double level = std::max(std::abs(lo), std::abs(hi));
     double margin = 0.05 * (hi - lo);
     if (hi - lo <= 1e-12 + 1e-9 * level) margin = std::max(0.1 * level, 1e-3);
-    setAxisScale(QwtPlot::yLeft, lo - margin, hi + margin);
+    if (Divisible(lo - margin, hi + margin))
+      setAxisScale(QwtPlot::yLeft, lo - margin, hi + margin);
   }
 }
 

@@ -10,9 +10,12 @@
 //
 // The components run as real processes with a private omniNames. The renderer's SceneObserver is
 // reached through a stand-in Model bound in the naming service (the renderer registers with it);
-// the renderer needs X with GLX and is skipped without DISPLAY (CI starts Xvfb).
+// so are the Graph Plotter's DataConsumer (it subscribes to a stand-in Model) and the Log
+// Viewer's LogListener (it registers with a stand-in Logger). The renderer needs X with GLX, the
+// plotter and the log viewer X: skipped without DISPLAY (CI starts Xvfb).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -1214,6 +1217,377 @@ TEST(HostileRenderer, RendererAndItsObserverAnswerHostileScenesCamerasAndScreens
   // the window's thread drew all of it: the renderer still renders
   EXPECT_ANSWERED(ref->view_all());
   renderer.ExpectHealthy(rss_before, 256 * MiB);  // measured: 166 to 193 MiB (20,000 bodies)
+}
+
+
+// ------------------------------------------------------------------------ GUI tools' servants
+
+/// A stand-in for a component a GUI tool connects to: a Dynamic (DSI) servant of `repo_id` whose
+/// operations `answer` serves (it reads the request's arguments and sets its result, and returns
+/// false for an operation it does not know: NO_IMPLEMENT). Serves nothing else, so that it does
+/// not follow every change of the IDL. It is also each of `bases` to _is_a (a client that narrows
+/// to a base interface asks: DSI knows only the primary one).
+class StandIn : public PortableServer::DynamicImplementation {
+ public:
+  using Answer = std::function<bool(const std::string&, CORBA::ServerRequest_ptr)>;
+  StandIn(const char* repo_id, std::vector<std::string> bases, Answer answer)
+      : repo_id_(repo_id), bases_(std::move(bases)), answer_(std::move(answer)) {}
+
+  CORBA::Boolean _is_a(const char* id) override {
+    return std::find(bases_.begin(), bases_.end(), id) != bases_.end() ||
+           PortableServer::DynamicImplementation::_is_a(id);
+  }
+
+  void invoke(CORBA::ServerRequest_ptr request) override {
+    if (!answer_(request->operation(), request)) throw CORBA::NO_IMPLEMENT(0, CORBA::COMPLETED_NO);
+  }
+  char* _primary_interface(const PortableServer::ObjectId&, PortableServer::POA_ptr) override {
+    return CORBA::string_dup(repo_id_);
+  }
+
+ private:
+  const char* repo_id_;
+  std::vector<std::string> bases_;
+  Answer answer_;
+};
+
+/// Reads a DSI request's in arguments of the types `types`; the list stays the request's.
+CORBA::NVList_ptr Arguments(CORBA::ServerRequest_ptr request,
+                            const std::vector<CORBA::TypeCode_ptr>& types) {
+  CORBA::NVList_ptr args = CORBA::NVList::_nil();
+  Orb()->create_list(0, args);
+  for (CORBA::TypeCode_ptr type : types) {
+    CORBA::Any arg;
+    arg.replace(type, nullptr);
+    args->add_value("", arg, CORBA::ARG_IN);
+  }
+  request->arguments(args);
+  return args;
+}
+
+/// Activates `stand_in` and binds it as `instance` in the naming service at `naming`.
+void BindStandIn(StandIn* stand_in, const NamingService& naming, const std::string& instance) {
+  CORBA::Object_var ref = Activate(stand_in);
+  CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming.address());
+  CosNaming::Name host;
+  host.length(1);
+  host[0].id = core::HostName().c_str();
+  host[0].kind = "host_cxt";
+  try {
+    CosNaming::NamingContext_var created = root->bind_new_context(host);
+  } catch (const CosNaming::NamingContext::AlreadyBound&) {
+  }
+  root->rebind(rtc::ComponentName(core::HostName(), instance), ref);
+}
+
+/// The highest VmRSS of a process [kB] while it lives, sampled every 20 ms.
+class PeakRss {
+ public:
+  explicit PeakRss(pid_t pid)
+      : thread_([this, pid] {
+          while (!stop_) {
+            peak_ = std::max(peak_.load(), RssKb(pid));
+            std::this_thread::sleep_for(milliseconds(20));
+          }
+        }) {}
+  ~PeakRss() {
+    stop_ = true;
+    thread_.join();
+  }
+  long kb() const { return peak_; }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::atomic<long> peak_{0};
+  std::thread thread_;
+};
+
+/// A GUI tool that served hostile calls: alive, `normal` (a call of the same operation with
+/// plain values) answered, and its resident memory, once its GUI thread has taken in what came
+/// (RSS level over half a second, at most 10 s), not grown past `rss_before` + `growth_kb`, nor
+/// its highest (`peak`) past `rss_before` + `peak_growth_kb`.
+void ExpectToolHealthy(Process& tool, const std::string& name, long rss_before, long growth_kb,
+                       const PeakRss& peak, long peak_growth_kb,
+                       const std::function<void()>& normal) {
+  EXPECT_TRUE(kOneArena);
+  ASSERT_TRUE(tool.Running()) << tool.Output();
+  const Outcome o = Try(normal);
+  EXPECT_EQ(o.kind, Outcome::kOk) << name << ", a plain call after the hostile ones: " << o;
+  long rss = RssKb(tool.pid());
+  for (int k = 0; k < 20; ++k) {
+    std::this_thread::sleep_for(milliseconds(500));
+    const long now = RssKb(tool.pid());
+    if (std::labs(now - rss) < 1024) break;
+    rss = now;
+  }
+  EXPECT_TRUE(tool.Running()) << tool.Output();
+  rss = RssKb(tool.pid());
+  EXPECT_LT(rss - rss_before, growth_kb)
+      << name << ": " << rss_before << " kB before, " << rss << " kB after";
+  EXPECT_LT(peak.kb() - rss_before, peak_growth_kb)
+      << name << ": " << rss_before << " kB before, at most " << peak.kb() << " kB";
+  std::printf("[ measure  ] %s resident memory %ld kB before, %ld kB after, at most %ld kB\n",
+              name.c_str(), rss_before, rss, peak.kb());
+}
+
+/// A batch of `samples` samples of subscription `sub` whose times and values are all `v`.
+D::SampleBatch Batch(CORBA::ULongLong sub, CORBA::ULongLong number, size_t samples, double v,
+                     CORBA::ULong values_per_sample = 1, size_t values = ~size_t{0}) {
+  D::SampleBatch b;
+  b.subscription = sub;
+  b.batch = number;
+  b.first_step = number;
+  b.times.length(static_cast<CORBA::ULong>(samples));
+  for (CORBA::ULong i = 0; i < samples; ++i) b.times[i] = std::isnan(v) || std::isinf(v) ? v : v + i;
+  b.values_per_sample = values_per_sample;
+  if (values == ~size_t{0}) values = samples * values_per_sample;
+  b.data.length(static_cast<CORBA::ULong>(values));
+  for (CORBA::ULong i = 0; i < values; ++i) b.data[i] = v;
+  b.layout = 1;
+  return b;
+}
+
+TEST(HostilePlotter, ThePlottersDataConsumerTakesHostileBatches) {
+  if (const std::string why = NoDisplay("the plotter is a Qt window"); !why.empty())
+    GTEST_SKIP() << why;
+  TempDir dir;
+  NamingService naming(dir.path());
+  // the stand-in Model: one scalar channel x, STOPPED; subscribe hands the consumer to the test
+  std::mutex mutex;
+  D::DataConsumer_var consumer;
+  std::atomic<int> unsubscribed{0};
+  constexpr CORBA::ULongLong kSubscription = 7;
+  auto* stand_in = new StandIn(M::Model::_PD_repoId, {}, [&](const std::string& op,
+                                                         CORBA::ServerRequest_ptr request) {
+    CORBA::Any result;
+    if (op == "status") {
+      Arguments(request, {});
+      M::SimulationStatus s;
+      s.state = M::STOPPED;
+      s.scene = "standin.dae";
+      s.sim_time = 0;
+      s.steps = 0;
+      s.time_step = 1e-3;
+      s.real_time_factor = s.achieved_real_time_factor = 1;
+      s.last_error = "";
+      result <<= s;
+    } else if (op == "channels") {
+      Arguments(request, {CORBA::_tc_string});
+      D::ChannelInfoSeq infos;
+      infos.length(1);
+      infos[0].id = "x";
+      infos[0].unit = "m";
+      infos[0].rows = infos[0].cols = 1;
+      infos[0].writable = false;
+      infos[0].is_static = false;
+      infos[0].description = "a stand-in's channel";
+      result <<= infos;
+    } else if (op == "subscribe") {
+      CORBA::NVList_ptr args =
+          Arguments(request, {S::_tc_StringSeq, CORBA::_tc_ulong, D::_tc_DataConsumer});
+      D::DataConsumer_ptr c = D::DataConsumer::_nil();
+      *(args->item(2)->value()) >>= c;
+      std::lock_guard<std::mutex> lock(mutex);
+      consumer = D::DataConsumer::_duplicate(c);
+      result <<= kSubscription;
+    } else if (op == "unsubscribe") {
+      Arguments(request, {CORBA::_tc_ulonglong});
+      ++unsubscribed;
+      return true;
+    } else {
+      return false;
+    }
+    request->set_result(result);
+    return true;
+  });
+  PortableServer::ServantBase_var keep(stand_in);
+  stand_in->_add_ref();  // kept for the test, beyond the POA's reference
+  BindStandIn(stand_in, naming, "standin0");
+  Process plotter({Bin("caliper-plotter"), "--nameservice", naming.address(), "--model",
+                   "standin0", "--ids", "x", "--geometry", "640x480+0+0"},
+                  dir.path() + "/plotter.out");
+  auto captured = [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return D::DataConsumer::_duplicate(consumer);
+  };
+  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(D::DataConsumer_var(captured())); },
+                      seconds(15)))
+      << plotter.Output();
+  D::DataConsumer_var ref = captured();
+  CORBA::ULongLong number = 0;
+  EXPECT_ANSWERED(ref->on_samples(Batch(kSubscription, ++number, 10, 0.0)));
+  std::this_thread::sleep_for(milliseconds(300));
+  const long rss_before = RssKb(plotter.pid());
+  const PeakRss peak(plotter.pid());
+
+  // a million samples, then a million whose every time and value is NaN, infinite or huge (a
+  // time axis of 10 s at 1e308 sent Qwt's tick loop on until std::bad_alloc when drawn)
+  EXPECT_ANSWERED(ref->on_samples(Batch(kSubscription, ++number, kMillion, 1.0)));
+  for (const double v : {kNaN, kInf, -kInf, 1e308, -1e308, 0.0})
+    EXPECT_ANSWERED(ref->on_samples(Batch(kSubscription, ++number, kMillion, v)));
+  // layouts that do not fit: too few values, none a sample, more than the plot's one, and every
+  // unsigned one (a product with the sample count past 2^64); a million samples of no values
+  for (const auto& [per, values] : std::vector<std::pair<CORBA::ULong, size_t>>{
+           {1, 0}, {1, 10}, {0, kMillion}, {1000, kMillion}, {~0u, 3}, {1u << 31, 2}, {2, 1}})
+    EXPECT_ANSWERED(ref->on_samples(Batch(kSubscription, ++number, kMillion, 5.0, per, values)));
+  EXPECT_ANSWERED(ref->on_samples(Batch(kSubscription, ++number, 0, 0.0, 1, kMillion)));
+  // batch numbers and Model layouts that jump, go back or wrap
+  for (const CORBA::ULongLong n : std::vector<CORBA::ULongLong>{0, ~0ull, ~0ull - 1, 1}) {
+    D::SampleBatch b = Batch(kSubscription, n, 100, 2.0);
+    for (const CORBA::ULongLong layout : std::vector<CORBA::ULongLong>{0, ~0ull, 2}) {
+      b.layout = layout;
+      EXPECT_ANSWERED(ref->on_samples(b));
+    }
+  }
+  // a million stale ids, and one of 10 MB
+  {
+    D::SampleBatch b = Batch(kSubscription, ++number, 10, 3.0);
+    b.stale_ids = Ids(kMillion, "x");
+    EXPECT_ANSWERED(ref->on_samples(b));
+    b.stale_ids = Ids(1, kTenMegabytes);
+    EXPECT_ANSWERED(ref->on_samples(b));
+  }
+  // subscriptions that are not the plotter's (it ends them at the stand-in: a bounded number)
+  for (const CORBA::ULongLong sub : std::vector<CORBA::ULongLong>{0, 8, ~0ull})
+    EXPECT_ANSWERED(ref->on_samples(Batch(sub, 1, kMillion, 1.0)));
+  for (CORBA::ULongLong sub = 100; sub < 1100; ++sub)
+    EXPECT_ANSWERED(ref->on_samples(Batch(sub, 1, 1, 1.0)));
+  // the same million-sample batch again and again: the inbox holds batches, the store samples
+  const D::SampleBatch big = Batch(kSubscription, 0, kMillion, 10.0);
+  for (int k = 0; k < 8; ++k) {
+    D::SampleBatch b = big;
+    b.batch = ++number;
+    EXPECT_ANSWERED(ref->on_samples(b));
+  }
+  ExpectToolHealthy(plotter, "caliper-plotter", rss_before, 256 * MiB, peak, 512 * MiB,
+                    [&] { ref->on_samples(Batch(kSubscription, ++number, 10, 2e7)); });
+  std::printf("[ measure  ] the plotter ended %d foreign subscriptions at the stand-in\n",
+              unsubscribed.load());
+  EXPECT_LE(unsubscribed.load(), 1100 + 10);
+}
+
+/// A log record whose every field may be hostile.
+L::StoredRecord Stored(CORBA::ULongLong serial, const std::string& message,
+                       const std::string& name = "standin") {
+  L::StoredRecord r;
+  r.serial = serial;
+  r.rec = TestRecord("standin0", name, serial, message);
+  r.rec.category = ("caliper." + name).c_str();
+  return r;
+}
+
+TEST(HostileLogViewer, TheLogViewersListenerTakesHostileRecords) {
+  if (const std::string why = NoDisplay("the log viewer is a Qt window"); !why.empty())
+    GTEST_SKIP() << why;
+  TempDir dir;
+  NamingService naming(dir.path());
+  // the stand-in Logger: a session file, no stored records; add_listener hands the listener over
+  std::mutex mutex;
+  L::LogListener_var listener;
+  auto* stand_in = new StandIn(L::Logger::_PD_repoId, {L::LogService::_PD_repoId}, [&](const std::string& op,
+                                                          CORBA::ServerRequest_ptr request) {
+    CORBA::Any result;
+    if (op == "session_file") {
+      Arguments(request, {});
+      result <<= "/nonexistent/caliper-standin.log";
+    } else if (op == "query") {
+      Arguments(request, {L::_tc_RecordFilter});
+      result <<= L::StoredRecordSeq();
+    } else if (op == "add_listener") {
+      CORBA::NVList_ptr args = Arguments(request, {L::_tc_LogListener});
+      L::LogListener_ptr l = L::LogListener::_nil();
+      *(args->item(0)->value()) >>= l;
+      std::lock_guard<std::mutex> lock(mutex);
+      listener = L::LogListener::_duplicate(l);
+      result <<= CORBA::ULongLong{1};
+    } else if (op == "remove_listener") {
+      Arguments(request, {CORBA::_tc_ulonglong});
+      return true;
+    } else {
+      return false;
+    }
+    request->set_result(result);
+    return true;
+  });
+  PortableServer::ServantBase_var keep(stand_in);
+  stand_in->_add_ref();  // kept for the test, beyond the POA's reference
+  BindStandIn(stand_in, naming, "standin0");
+  Process viewer({Bin("caliper-logviewer"), "--nameservice", naming.address(), "--logger",
+                  "standin0", "--geometry", "640x480+0+0"},
+                 dir.path() + "/logviewer.out");
+  auto captured = [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return L::LogListener::_duplicate(listener);
+  };
+  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(L::LogListener_var(captured())); },
+                      seconds(15)))
+      << viewer.Output();
+  L::LogListener_var ref = captured();
+  CORBA::ULongLong serial = 0;
+  auto records = [&](size_t n, const std::string& message, const std::string& name = "standin") {
+    L::StoredRecordSeq seq;
+    seq.length(static_cast<CORBA::ULong>(n));
+    for (CORBA::ULong i = 0; i < n; ++i) seq[i] = Stored(++serial, message, name);
+    return seq;
+  };
+  EXPECT_ANSWERED(ref->on_records(records(3, "plain")));
+  std::this_thread::sleep_for(milliseconds(300));
+  const long rss_before = RssKb(viewer.pid());
+  const PeakRss peak(viewer.pid());
+
+  // a million records; records of 10 MB messages and names
+  EXPECT_ANSWERED(ref->on_records(records(kMillion, "a million")));
+  EXPECT_ANSWERED(ref->on_records(records(3, kTenMegabytes)));
+  {
+    L::StoredRecordSeq seq = records(4, "ten megabytes of names");
+    seq[0].rec.category = kTenMegabytes.c_str();
+    seq[1].rec.instance = kTenMegabytes.c_str();
+    seq[2].rec.host = kTenMegabytes.c_str();
+    seq[3].rec.source = kTenMegabytes.c_str();
+    EXPECT_ANSWERED(ref->on_records(seq));
+  }
+  // times, priorities, pids and sequence numbers at their extremes; empty names
+  {
+    L::StoredRecordSeq seq = records(8, "extremes");
+    const CORBA::LongLong times[] = {std::numeric_limits<CORBA::LongLong>::min(),
+                                     std::numeric_limits<CORBA::LongLong>::max(), -1, 0};
+    const CORBA::Long numbers[] = {std::numeric_limits<CORBA::Long>::min(),
+                                   std::numeric_limits<CORBA::Long>::max(), -1, 0};
+    for (CORBA::ULong i = 0; i < 8; ++i) {
+      seq[i].rec.time_us = times[i % 4];
+      seq[i].rec.priority = numbers[i % 4];
+      seq[i].rec.pid = numbers[(i + 1) % 4];
+      seq[i].rec.seq = i % 2 == 0 ? 0 : ~0ull;
+      seq[i].rec.source = "extremes";  // its seq of 2^64-1 makes the rest of it duplicates
+      if (i >= 4) seq[i].rec.category = seq[i].rec.instance = seq[i].rec.source = "";
+    }
+    EXPECT_ANSWERED(ref->on_records(seq));
+  }
+  // ten thousand distinct categories and components (each a node of the viewer's source tree)
+  {
+    L::StoredRecordSeq seq = records(10000, "names");
+    for (CORBA::ULong i = 0; i < 10000; ++i) {
+      const std::string name = "n" + std::to_string(i);
+      seq[i].rec.category = ("caliper." + name + ".x").c_str();
+      seq[i].rec.instance = name.c_str();
+    }
+    EXPECT_ANSWERED(ref->on_records(seq));
+  }
+  // serials repeated, going back, 0, and a gap (the viewer asks the stand-in, which has none)
+  {
+    L::StoredRecordSeq seq = records(4, "serials");
+    seq[0].serial = 0;
+    seq[1].serial = 1;
+    seq[2].serial = seq[3].serial;
+    EXPECT_ANSWERED(ref->on_records(seq));
+    serial += 1000;
+    EXPECT_ANSWERED(ref->on_records(records(10, "after a gap")));
+  }
+  EXPECT_ANSWERED(ref->on_records(L::StoredRecordSeq()));
+  // the viewer keeps a million records (LogModel::max_records): measured 744 MiB for them
+  ExpectToolHealthy(viewer, "caliper-logviewer", rss_before, 1024 * MiB, peak, 1280 * MiB,
+                    [&] { ref->on_records(records(3, "plain again")); });
+  EXPECT_TRUE(Contains(viewer.Output(), "following standin0")) << viewer.Output();
 }
 
 }  // namespace
