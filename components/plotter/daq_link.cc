@@ -29,8 +29,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr size_t kPendingBatches = 256;  // held while a subscribe call is under way
 constexpr size_t kHeldBatches = 256;     // held after a reset or reload until the layout is checked
 // times and values kept in the inbox, and in `held`, beyond which the oldest batches are dropped
-// (the newest is always kept): a batch may carry a million samples, and a few thousand of those
-// waiting for a busy GUI took a gigabyte (hostile_corba_test)
+// (the newest is always kept): a batch may carry a million samples, and 4096 of those waiting for
+// a busy GUI would take 64 GB (hostile_corba_test sends such batches)
 constexpr size_t kMaxQueuedValues = size_t{8} << 20;
 
 size_t ValuesOf(const ReceivedBatch& b) { return b.times.size() + b.data.size(); }
