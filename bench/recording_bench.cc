@@ -114,7 +114,7 @@ int main() {
           r[1].us_per_step, static_cast<unsigned long long>(r[1].dropped), r[2].us_per_step,
           static_cast<unsigned long long>(r[2].dropped), 100 * r[2].waited_share);
       if (period == 1 && r[1].dropped == 0)
-        std::printf("RATIO lossless_overhead_%s %.3f (lossless / plain, a taker that keeps up)\n",
+        std::printf("RATIO lossless_overhead_%s %.3f (target <= 1.05; lossless / plain, a taker that keeps up)\n",
                     name.c_str(), r[2].us_per_step / r[1].us_per_step);
     }
   }
