@@ -57,12 +57,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 const std::vector<double> kNonFinite = {kNaN, kInf, -kInf};
 constexpr size_t kMillion = 1000000;
 const std::string kTenMegabytes(10u << 20, 'a');
-/// Growth of a server's resident memory over one test [kB]: the most each test measured on this
-/// machine (printed as "[ measure  ]") and a quarter more, at least 32 MiB (a few 10 MB inputs
-/// pass through a server's buffers at once: measured growth of 1 to 19 MiB for them). Decoding a message of
-/// a million small elements takes several times its size at once, and the allocator keeps much
-/// of it for later, so some are large; a leak shows in the second of two equal rounds
-/// (kRoundGrowthKb).
+/// Growth of a server's resident memory over one test [kB]: about twice the most each test
+/// measured on this machine (printed as "[ measure  ]"), at least 32 MiB: under load (a CI run,
+/// builds beside it) the allocator keeps more of what a million-element decode took at once
+/// (Motors: 26 to 101 MiB between runs), so a bound near the measured figure failed by chance.
+/// What it catches is memory kept per hostile input (a million ids or 10 MB strings kept would
+/// exceed it many times); a leak shows in the second of two equal rounds (kRoundGrowthKb).
 constexpr long MiB = 1024;
 /// The servers started here allocate from one malloc arena and map blocks of 128 KiB and more
 /// apart, returned at once when freed: with glibc's defaults (an arena per thread, up to 8 per
@@ -71,9 +71,10 @@ constexpr long MiB = 1024;
 /// and a test's growth varied from 17 to 148 MiB between runs.
 const bool kOneArena =
     setenv("MALLOC_ARENA_MAX", "1", 1) == 0 && setenv("MALLOC_MMAP_THRESHOLD_", "131072", 1) == 0;
-/// Growth of resident memory over a second round of the same hostile calls [kB] (measured: 5 MiB
-/// for the experiments, under 1 MiB for the logger's million records).
-constexpr long kRoundGrowthKb = 16 * 1024;
+/// Growth of resident memory over a second round of the same hostile calls [kB] (measured: 0 to
+/// 5 MiB alone, up to 36 MiB under load; a round keeping its million ids or 10 MB strings would
+/// add far more).
+constexpr long kRoundGrowthKb = 64 * 1024;
 
 /// The head of a long text, for failure messages.
 std::string Head(const std::string& text) {
@@ -354,7 +355,7 @@ class HostileModelTest : public ::testing::Test {
 };
 
 TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) {
-  rss_growth_kb_ = 32 * MiB;  // measured: 0.9 to 19 MiB (10 MB names and scenes)
+  rss_growth_kb_ = 64 * MiB;  // measured: 0.9 to 19 MiB (10 MB names and scenes)
   const std::string scene = Scene();
   // loading by path: empty, 10 MB, a directory; the previous scene stays loaded
   EXPECT_REFUSED(ref_->load_scene(""), "");
@@ -417,7 +418,7 @@ TEST_F(HostileModelTest, SimulationControlRefusesBadScenesAndNonFiniteSettings) 
 }
 
 TEST_F(HostileModelTest, MotorsAndParametersRefuseUnknownNamesNonFiniteValuesAndMillions) {
-  rss_growth_kb_ = 64 * MiB;  // measured: 26 to 46 MiB (a million commands, ids)
+  rss_growth_kb_ = 192 * MiB;  // measured: 26 to 101 MiB (a million commands, ids)
   M::ActuatorInfoSeq_var actuators = ref_->actuators();
   ASSERT_GT(actuators->length(), 0u);
   const std::string motor = actuators[0].name.in();
@@ -501,7 +502,7 @@ TEST_F(HostileModelTest, MotorsAndParametersRefuseUnknownNamesNonFiniteValuesAnd
 }
 
 TEST_F(HostileModelTest, SceneSubscriptionsObserversAndExperimentsRefuseHostileValues) {
-  rss_growth_kb_ = 184 * MiB;  // measured: 103 to 142 MiB (experiments of millions)
+  rss_growth_kb_ = 320 * MiB;  // measured: 103 to 142 MiB (experiments of millions)
   EXPECT_ANSWERED(S::Description_var(ref_->scene_description()));
   EXPECT_ANSWERED(M::Octets_var(ref_->export_scene()));
   EXPECT_REFUSED(ref_->save_scene(""), "");
@@ -633,7 +634,7 @@ TEST_F(HostileModelTest, LifecycleAndExecutionContextRefuseHostileArguments) {
 }
 
 TEST_F(HostileModelTest, SixteenClientsHammeringMixedOperationsAreAllAnswered) {
-  rss_growth_kb_ = 32 * MiB;  // measured: 0.7 MiB (16 connections and their threads)
+  rss_growth_kb_ = 64 * MiB;  // measured: 0.7 MiB (16 connections and their threads)
   D::ChannelInfoSeq_var channels = ref_->list("*");
   const std::string first = channels[0].id.in();
   M::ActuatorInfoSeq_var actuators = ref_->actuators();
@@ -862,7 +863,7 @@ TEST(HostileLogger, EveryOperationAnswersHostileRecordsQueriesAndListeners) {
   HammerLifecycle(ref);
 
   EXPECT_EQ(ref->submit(L::RecordSeq()), 0u);
-  logger.ExpectHealthy(rss_before, 480 * MiB);  // measured: 377 MiB (a million records, twice)
+  logger.ExpectHealthy(rss_before, 768 * MiB);  // measured: 377 MiB (a million records, twice)
 }
 
 // ------------------------------------------------------------------------ Manager
@@ -922,7 +923,7 @@ TEST(HostileManager, CreateAndDestroyRefuseUnknownTypesHugeConfigurationsAndName
   EXPECT_ANSWERED(C::ChildSeq_var(ref->list()));
   EXPECT_EQ(ref->capacity(), 1u);
   HammerLifecycle(ref);
-  manager.ExpectHealthy(rss_before, 80 * MiB);  // measured: 61 MiB (a million entries)
+  manager.ExpectHealthy(rss_before, 160 * MiB);  // measured: 61 MiB (a million entries)
 }
 
 // ------------------------------------------------------------------------ Sample component
@@ -1216,7 +1217,7 @@ TEST(HostileRenderer, RendererAndItsObserverAnswerHostileScenesCamerasAndScreens
   HammerLifecycle(ref);
   // the window's thread drew all of it: the renderer still renders
   EXPECT_ANSWERED(ref->view_all());
-  renderer.ExpectHealthy(rss_before, 256 * MiB);  // measured: 166 to 193 MiB (20,000 bodies)
+  renderer.ExpectHealthy(rss_before, 384 * MiB);  // measured: 166 to 193 MiB (20,000 bodies)
 }
 
 
