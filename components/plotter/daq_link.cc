@@ -86,8 +86,7 @@ struct DaqLink::Shared {
   void Deliver(ReceivedBatch&& b) {
     inbox_values += ValuesOf(b);
     inbox.push_back(std::move(b));
-    while (inbox.size() > inbox_capacity ||
-           (inbox_values > kMaxQueuedValues && inbox.size() > 1)) {
+    while (inbox.size() > inbox_capacity || (inbox_values > kMaxQueuedValues && inbox.size() > 1)) {
       inbox_values -= ValuesOf(inbox.front());
       inbox.pop_front();
       ++dropped;

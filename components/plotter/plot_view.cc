@@ -1,10 +1,5 @@
 #include "plot_view.h"
 
-#include <QPen>
-#include <algorithm>
-#include <cmath>
-#include <limits>
-
 #include <qwt_legend.h>
 #include <qwt_plot_canvas.h>
 #include <qwt_plot_curve.h>
@@ -14,6 +9,11 @@
 #include <qwt_scale_widget.h>
 #include <qwt_symbol.h>
 #include <qwt_text.h>
+
+#include <QPen>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace caliper::plotter {
 
@@ -212,8 +212,7 @@ void PlotView::Draw(const SampleStore& store, double t0, double t1, bool fit_val
     const double level = std::max(std::abs(lo), std::abs(hi));
     double margin = 0.05 * (hi - lo);
     if (hi - lo <= 1e-12 + 1e-9 * level) margin = std::max(0.1 * level, 1e-3);
-    if (Divisible(lo - margin, hi + margin))
-      setAxisScale(QwtPlot::yLeft, lo - margin, hi + margin);
+    if (Divisible(lo - margin, hi + margin)) setAxisScale(QwtPlot::yLeft, lo - margin, hi + margin);
   }
 }
 

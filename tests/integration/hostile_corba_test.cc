@@ -1220,7 +1220,6 @@ TEST(HostileRenderer, RendererAndItsObserverAnswerHostileScenesCamerasAndScreens
   renderer.ExpectHealthy(rss_before, 384 * MiB);  // measured: 166 to 193 MiB (20,000 bodies)
 }
 
-
 // ------------------------------------------------------------------------ GUI tools' servants
 
 /// A stand-in for a component a GUI tool connects to: a Dynamic (DSI) servant of `repo_id` whose
@@ -1339,7 +1338,8 @@ D::SampleBatch Batch(CORBA::ULongLong sub, CORBA::ULongLong number, size_t sampl
   b.batch = number;
   b.first_step = number;
   b.times.length(static_cast<CORBA::ULong>(samples));
-  for (CORBA::ULong i = 0; i < samples; ++i) b.times[i] = std::isnan(v) || std::isinf(v) ? v : v + i;
+  for (CORBA::ULong i = 0; i < samples; ++i)
+    b.times[i] = std::isnan(v) || std::isinf(v) ? v : v + i;
   b.values_per_sample = values_per_sample;
   if (values == ~size_t{0}) values = samples * values_per_sample;
   b.data.length(static_cast<CORBA::ULong>(values));
@@ -1358,61 +1358,60 @@ TEST(HostilePlotter, ThePlottersDataConsumerTakesHostileBatches) {
   D::DataConsumer_var consumer;
   std::atomic<int> unsubscribed{0};
   constexpr CORBA::ULongLong kSubscription = 7;
-  auto* stand_in = new StandIn(M::Model::_PD_repoId, {}, [&](const std::string& op,
-                                                         CORBA::ServerRequest_ptr request) {
-    CORBA::Any result;
-    if (op == "status") {
-      Arguments(request, {});
-      M::SimulationStatus s;
-      s.state = M::STOPPED;
-      s.scene = "standin.dae";
-      s.sim_time = 0;
-      s.steps = 0;
-      s.time_step = 1e-3;
-      s.real_time_factor = s.achieved_real_time_factor = 1;
-      s.last_error = "";
-      result <<= s;
-    } else if (op == "channels") {
-      Arguments(request, {CORBA::_tc_string});
-      D::ChannelInfoSeq infos;
-      infos.length(1);
-      infos[0].id = "x";
-      infos[0].unit = "m";
-      infos[0].rows = infos[0].cols = 1;
-      infos[0].writable = false;
-      infos[0].is_static = false;
-      infos[0].description = "a stand-in's channel";
-      result <<= infos;
-    } else if (op == "subscribe") {
-      CORBA::NVList_ptr args =
-          Arguments(request, {S::_tc_StringSeq, CORBA::_tc_ulong, D::_tc_DataConsumer});
-      D::DataConsumer_ptr c = D::DataConsumer::_nil();
-      *(args->item(2)->value()) >>= c;
-      std::lock_guard<std::mutex> lock(mutex);
-      consumer = D::DataConsumer::_duplicate(c);
-      result <<= kSubscription;
-    } else if (op == "unsubscribe") {
-      Arguments(request, {CORBA::_tc_ulonglong});
-      ++unsubscribed;
-      return true;
-    } else {
-      return false;
-    }
-    request->set_result(result);
-    return true;
-  });
+  auto* stand_in = new StandIn(
+      M::Model::_PD_repoId, {}, [&](const std::string& op, CORBA::ServerRequest_ptr request) {
+        CORBA::Any result;
+        if (op == "status") {
+          Arguments(request, {});
+          M::SimulationStatus s;
+          s.state = M::STOPPED;
+          s.scene = "standin.dae";
+          s.sim_time = 0;
+          s.steps = 0;
+          s.time_step = 1e-3;
+          s.real_time_factor = s.achieved_real_time_factor = 1;
+          s.last_error = "";
+          result <<= s;
+        } else if (op == "channels") {
+          Arguments(request, {CORBA::_tc_string});
+          D::ChannelInfoSeq infos;
+          infos.length(1);
+          infos[0].id = "x";
+          infos[0].unit = "m";
+          infos[0].rows = infos[0].cols = 1;
+          infos[0].writable = false;
+          infos[0].is_static = false;
+          infos[0].description = "a stand-in's channel";
+          result <<= infos;
+        } else if (op == "subscribe") {
+          CORBA::NVList_ptr args =
+              Arguments(request, {S::_tc_StringSeq, CORBA::_tc_ulong, D::_tc_DataConsumer});
+          D::DataConsumer_ptr c = D::DataConsumer::_nil();
+          *(args->item(2)->value()) >>= c;
+          std::lock_guard<std::mutex> lock(mutex);
+          consumer = D::DataConsumer::_duplicate(c);
+          result <<= kSubscription;
+        } else if (op == "unsubscribe") {
+          Arguments(request, {CORBA::_tc_ulonglong});
+          ++unsubscribed;
+          return true;
+        } else {
+          return false;
+        }
+        request->set_result(result);
+        return true;
+      });
   PortableServer::ServantBase_var keep(stand_in);
   stand_in->_add_ref();  // kept for the test, beyond the POA's reference
   BindStandIn(stand_in, naming, "standin0");
-  Process plotter({Bin("caliper-plotter"), "--nameservice", naming.address(), "--model",
-                   "standin0", "--ids", "x", "--geometry", "640x480+0+0"},
+  Process plotter({Bin("caliper-plotter"), "--nameservice", naming.address(), "--model", "standin0",
+                   "--ids", "x", "--geometry", "640x480+0+0"},
                   dir.path() + "/plotter.out");
   auto captured = [&] {
     std::lock_guard<std::mutex> lock(mutex);
     return D::DataConsumer::_duplicate(consumer);
   };
-  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(D::DataConsumer_var(captured())); },
-                      seconds(15)))
+  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(D::DataConsumer_var(captured())); }, seconds(15)))
       << plotter.Output();
   D::DataConsumer_var ref = captured();
   CORBA::ULongLong number = 0;
@@ -1485,31 +1484,32 @@ TEST(HostileLogViewer, TheLogViewersListenerTakesHostileRecords) {
   // the stand-in Logger: a session file, no stored records; add_listener hands the listener over
   std::mutex mutex;
   L::LogListener_var listener;
-  auto* stand_in = new StandIn(L::Logger::_PD_repoId, {L::LogService::_PD_repoId}, [&](const std::string& op,
-                                                          CORBA::ServerRequest_ptr request) {
-    CORBA::Any result;
-    if (op == "session_file") {
-      Arguments(request, {});
-      result <<= "/nonexistent/caliper-standin.log";
-    } else if (op == "query") {
-      Arguments(request, {L::_tc_RecordFilter});
-      result <<= L::StoredRecordSeq();
-    } else if (op == "add_listener") {
-      CORBA::NVList_ptr args = Arguments(request, {L::_tc_LogListener});
-      L::LogListener_ptr l = L::LogListener::_nil();
-      *(args->item(0)->value()) >>= l;
-      std::lock_guard<std::mutex> lock(mutex);
-      listener = L::LogListener::_duplicate(l);
-      result <<= CORBA::ULongLong{1};
-    } else if (op == "remove_listener") {
-      Arguments(request, {CORBA::_tc_ulonglong});
-      return true;
-    } else {
-      return false;
-    }
-    request->set_result(result);
-    return true;
-  });
+  auto* stand_in = new StandIn(L::Logger::_PD_repoId, {L::LogService::_PD_repoId},
+                               [&](const std::string& op, CORBA::ServerRequest_ptr request) {
+                                 CORBA::Any result;
+                                 if (op == "session_file") {
+                                   Arguments(request, {});
+                                   result <<= "/nonexistent/caliper-standin.log";
+                                 } else if (op == "query") {
+                                   Arguments(request, {L::_tc_RecordFilter});
+                                   result <<= L::StoredRecordSeq();
+                                 } else if (op == "add_listener") {
+                                   CORBA::NVList_ptr args =
+                                       Arguments(request, {L::_tc_LogListener});
+                                   L::LogListener_ptr l = L::LogListener::_nil();
+                                   *(args->item(0)->value()) >>= l;
+                                   std::lock_guard<std::mutex> lock(mutex);
+                                   listener = L::LogListener::_duplicate(l);
+                                   result <<= CORBA::ULongLong{1};
+                                 } else if (op == "remove_listener") {
+                                   Arguments(request, {CORBA::_tc_ulonglong});
+                                   return true;
+                                 } else {
+                                   return false;
+                                 }
+                                 request->set_result(result);
+                                 return true;
+                               });
   PortableServer::ServantBase_var keep(stand_in);
   stand_in->_add_ref();  // kept for the test, beyond the POA's reference
   BindStandIn(stand_in, naming, "standin0");
@@ -1520,8 +1520,7 @@ TEST(HostileLogViewer, TheLogViewersListenerTakesHostileRecords) {
     std::lock_guard<std::mutex> lock(mutex);
     return L::LogListener::_duplicate(listener);
   };
-  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(L::LogListener_var(captured())); },
-                      seconds(15)))
+  ASSERT_TRUE(WaitFor([&] { return !CORBA::is_nil(L::LogListener_var(captured())); }, seconds(15)))
       << viewer.Output();
   L::LogListener_var ref = captured();
   CORBA::ULongLong serial = 0;
