@@ -205,7 +205,10 @@ void InfoCallback(const SSL* ssl, int where, int ret) {
          "): " + t_verify_error + "; it belongs to another cluster, or its CA is not ours");
     t_verify_error.clear();
   } else if (SSL_in_init(ssl)) {
-    Note("the TLS handshake with " + peer + " failed (we sent alert '" + alert + "')");
+    // no refusal by the peer and no certificate of its we refused: what it sent broke off or made
+    // no sense (a peer killed mid-handshake, or no TLS on that port), not a question of CAs
+    Note("the connection to " + peer + " broke off during the TLS handshake (we sent alert '" +
+         alert + "'): the peer closed it or died, or does not speak TLS there");
   }
   // an alert of ours on an established connection: the peer died or the connection broke
   // mid-message (a killed peer), which the exception itself says
