@@ -14,6 +14,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
+#include "caliper/urdf/model_file.h"
 #include "caliper/core/arguments.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
@@ -253,7 +254,9 @@ int Inspect(Client&, std::vector<std::string>& args) {
   collada::FileInfo info;
   sgal::Scene scene;
   try {
-    scene = collada::Import(path, &warnings, &info);
+    scene = model_file::FormatOf(path) == model_file::Format::kUrdf
+                ? model_file::Import(path, &warnings)
+                : collada::Import(path, &warnings, &info);
   } catch (const collada::ImportError& e) {
     for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
     throw Failure(std::string("not imported: ") + e.what());
@@ -293,8 +296,9 @@ std::map<std::string, Verb> Verbs() {
       " bytes, searched anywhere in the message\n"
       "  --limit N     the logger returns at most 10000 records per query\n";
   verbs["inspect"] = {"inspect FILE [--export OUT.dae]",
-                      "report what a COLLADA file (.dae, .zae) holds, or why it does not import "
-                      "(no session needed); --export writes the imported scene back out",
+                      "report what a model file (COLLADA .dae, .zae or URDF .urdf) holds, or why "
+                      "it does not import (no session needed); --export writes the imported scene "
+                      "as COLLADA",
                       Inspect, "files"};
   AddModelVerbs(&verbs);
   AddRendererVerbs(&verbs);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "caliper/actuators/actuator.h"
+#include "caliper/urdf/model_file.h"
 
 namespace caliper::ctl {
 
@@ -224,14 +225,19 @@ void PrintSceneReport(const std::string& path, const sgal::Scene& scene,
                       std::ostream& out) {
   const int w = kNameWidth;
   out << std::left << std::setw(w) << "file" << path << "\n";
-  out << std::setw(w) << "format"
-      << "COLLADA " << (info.version.empty() ? "?" : info.version)
-      << (info.zipped ? " (.zae archive)" : "")
-      << (info.authoring_tool.empty() ? "" : ", written by " + info.authoring_tool) << "\n";
-  out << std::setw(w) << "units"
-      << "<unit meter=\"" << Num(info.meter) << "\""
-      << (info.unit_name.empty() ? "" : " name=\"" + info.unit_name + "\"") << ">, " << info.up_axis
-      << "; shown in SI (m, kg, s, N), angles in deg, Z up\n";
+  if (model_file::FormatOf(path) == model_file::Format::kUrdf) {
+    out << std::setw(w) << "format" << "URDF (joints at 0; fixed joints merged into the parent)\n";
+    out << std::setw(w) << "units" << "SI (m, kg, s, N) as URDF has them, angles shown in deg, Z up\n";
+  } else {
+    out << std::setw(w) << "format"
+        << "COLLADA " << (info.version.empty() ? "?" : info.version)
+        << (info.zipped ? " (.zae archive)" : "")
+        << (info.authoring_tool.empty() ? "" : ", written by " + info.authoring_tool) << "\n";
+    out << std::setw(w) << "units"
+        << "<unit meter=\"" << Num(info.meter) << "\""
+        << (info.unit_name.empty() ? "" : " name=\"" + info.unit_name + "\"") << ">, "
+        << info.up_axis << "; shown in SI (m, kg, s, N), angles in deg, Z up\n";
+  }
   out << std::setw(w) << "scene" << scene.name << "\n";
   out << std::setw(w) << "gravity" << Vec(scene.gravity) << " m/s^2\n";
   out << std::setw(w) << "settings"

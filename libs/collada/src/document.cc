@@ -167,6 +167,41 @@ XmlParse PreScanXml(const std::string& name, const std::string* text) {
   return xml;
 }
 
+namespace {
+
+// libxml2's node and its subtree as elements.
+std::unique_ptr<Element> ElementOf(const xmlNode* node) {
+  auto e = std::make_unique<Element>(node->ns != nullptr && node->ns->prefix != nullptr
+                                         ? Chars(node->ns->prefix) + (":" + std::string(Chars(node->name)))
+                                         : std::string(Chars(node->name)));
+  for (const xmlAttr* a = node->properties; a != nullptr; a = a->next)
+    e->attributes.push_back(AttributeOf(a));
+  for (const xmlNode* c = node->children; c != nullptr; c = c->next) {
+    if (c->type == XML_ELEMENT_NODE) {
+      e->children.push_back(ElementOf(c));
+      e->children.back()->parent = e.get();
+    } else if ((c->type == XML_TEXT_NODE || c->type == XML_CDATA_SECTION_NODE) &&
+               c->content != nullptr) {
+      e->text += Chars(c->content);
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+Document ReadPlainXml(const std::string& path) {
+  XmlParse xml = ParseXml(path, nullptr);
+  if (!xml.doc) throw ReadError("malformed XML: " + xml.problem, xml.line);
+  const xmlNode* top = xmlDocGetRootElement(xml.doc.get());
+  if (top == nullptr) throw ReadError("no root element", 0);
+  Document doc;
+  doc.path = path;
+  doc.root = ElementOf(top);
+  doc.SetXml(std::move(xml.doc), std::move(xml.big_lines));
+  return doc;
+}
+
 std::string_view Element::local_name() const { return LocalName(name); }
 
 const std::string* Element::FindAttribute(std::string_view attribute) const {

@@ -144,6 +144,12 @@ struct XmlParse {
 /// element nested in itself) and its line; returns libxml2's tree.
 XmlParse PreScanXml(const std::string& name, const std::string* text);
 
+/// Reads an XML file that is not COLLADA (a URDF, a side file of Caliper data) into the same
+/// element tree, every element with its line: attributes, character data (never numeric) and
+/// children as written. Throws ReadError with libxml2's reason and line when it is not
+/// well-formed.
+Document ReadPlainXml(const std::string& path);
+
 /// Loads `path` with the Collada-DOM of the document's schema version (its version attribute, or
 /// each in turn for .zae archives) once libxml2 found it well-formed. Throws ReadError when
 /// libxml2 or the DOM cannot read it.

@@ -22,6 +22,7 @@ class ExtensionReader {
   explicit ExtensionReader(Context& ctx) : ctx_(ctx) {}
 
   void Read(const Element& technique) {
+    technique_ = &technique;
     for (const auto& c : technique.children) {
       const std::string_view n = c->local_name();
       if (n == "settings")
@@ -76,7 +77,9 @@ class ExtensionReader {
   // Metres per number of an element's lengths: the unit attribute of the element or of the
   // nearest enclosing one in the technique, else the document's unit.
   double LengthScale(const Element& e) {
-    for (const Element* k = &e; k != nullptr && k->local_name() != "technique"; k = k->parent) {
+    // up to the technique itself (a <caliper> element of a URDF file has no <technique> above it)
+    for (const Element* k = &e; k != nullptr; k = k == technique_ ? nullptr : k->parent) {
+      if (k->local_name() == "technique") break;
       const std::string* unit = k->FindAttribute("unit");
       if (unit == nullptr) continue;
       const Unit u = ParseUnitOf(*k, *unit);
@@ -299,6 +302,7 @@ class ExtensionReader {
   }
 
   Context& ctx_;
+  const Element* technique_ = nullptr;  // the technique being read
 };
 
 // Adds a vector as the character data of a new <tag>.
@@ -311,6 +315,11 @@ Element* AddVector(Element* parent, const char* tag, const Eigen::Vector3d& v) {
 void ImportExtension(Context& ctx) {
   ExtensionReader reader(ctx);
   for (const Element* technique : CaliperTechniques(*ctx.doc.root)) reader.Read(*technique);
+}
+
+void ImportTechnique(Context& ctx, const Element& technique) {
+  ExtensionReader reader(ctx);
+  reader.Read(technique);
 }
 
 void ExportExtension(const sgal::Scene& scene, Element* technique) {

@@ -13,6 +13,10 @@ namespace caliper::collada::internal {
 /// fewer than two points and dangling names throw ImportError.
 void ImportExtension(Context& ctx);
 
+/// Reads one element holding the technique's children (a <technique profile="CALIPER">, or the
+/// <caliper> element of another file format) into ctx.scene, with the same checks.
+void ImportTechnique(Context& ctx, const Element& technique);
+
 /// Writes the Caliper technique of a scene (settings, obstacles, tendons, actuators with every
 /// parameter in its unit, couplings) under `technique`. Throws std::invalid_argument for an
 /// actuator of an unknown kind.

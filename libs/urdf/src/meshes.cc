@@ -1,0 +1,196 @@
+#include "meshes.h"
+
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+
+#include <assimp/Importer.hpp>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include "caliper/urdf/importer.h"
+
+namespace caliper::urdf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The <name> a package.xml gives its package; "" when it has none or cannot be read.
+std::string PackageName(const fs::path& manifest) {
+  std::error_code ec;
+  if (!fs::is_regular_file(manifest, ec)) return "";
+  xmlDocPtr doc = xmlReadFile(manifest.c_str(), nullptr,
+                              XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING);
+  if (doc == nullptr) return "";
+  std::string name;
+  const xmlNode* root = xmlDocGetRootElement(doc);
+  for (const xmlNode* c = root != nullptr ? root->children : nullptr; c != nullptr; c = c->next) {
+    if (c->type != XML_ELEMENT_NODE || std::strcmp(reinterpret_cast<const char*>(c->name), "name"))
+      continue;
+    xmlChar* text = xmlNodeGetContent(c);
+    if (text != nullptr) name = reinterpret_cast<const char*>(text);
+    xmlFree(text);
+    break;
+  }
+  xmlFreeDoc(doc);
+  const size_t b = name.find_first_not_of(" \t\r\n");
+  const size_t e = name.find_last_not_of(" \t\r\n");
+  return b == std::string::npos ? "" : name.substr(b, e - b + 1);
+}
+
+// The folders that are package `name` in or directly below `dir`: `dir` itself or a subfolder
+// whose package.xml names it, or a subfolder called `name`.
+std::vector<fs::path> PackagesIn(const fs::path& dir, const std::string& name) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return out;
+  if (PackageName(dir / "package.xml") == name) out.push_back(dir);
+  if (fs::is_directory(dir / name, ec)) out.push_back(dir / name);
+  // a bounded look at the subfolders: a package path may name a large workspace
+  size_t looked = 0;
+  for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end;
+       !ec && it != end && looked < 10000; it.increment(ec), ++looked) {
+    if (!it->is_directory(ec) || it->path().filename() == name) continue;
+    if (PackageName(it->path() / "package.xml") == name) out.push_back(it->path());
+  }
+  return out;
+}
+
+void SplitInto(const char* list, std::vector<std::string>* out) {
+  if (list == nullptr) return;
+  const std::string s(list);
+  size_t start = 0;
+  while (start <= s.size()) {
+    const size_t end = std::min(s.find(':', start), s.size());
+    if (end > start) out->push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> PackagePathFromEnvironment() {
+  std::vector<std::string> out;
+  SplitInto(std::getenv("CALIPER_PACKAGE_PATH"), &out);
+  SplitInto(std::getenv("ROS_PACKAGE_PATH"), &out);
+  return out;
+}
+
+std::string ResolveMesh(const std::string& reference, const std::string& urdf_path,
+                        const std::vector<std::string>& package_path,
+                        std::vector<std::string>* tried) {
+  std::vector<std::string> ignored;
+  if (tried == nullptr) tried = &ignored;
+  std::error_code ec;
+  const fs::path base = fs::path(urdf_path).parent_path();
+  auto found = [&](const fs::path& p) {
+    tried->push_back(p.string());
+    return fs::is_regular_file(p, ec);
+  };
+  const std::string package_scheme = "package://";
+  const std::string file_scheme = "file://";
+  if (reference.compare(0, package_scheme.size(), package_scheme) == 0) {
+    const std::string rest = reference.substr(package_scheme.size());
+    const size_t slash = rest.find('/');
+    const std::string name = rest.substr(0, slash);
+    const std::string inside = slash == std::string::npos ? "" : rest.substr(slash + 1);
+    if (name.empty() || inside.empty()) {
+      tried->push_back("(not a package reference: package://NAME/PATH)");
+      return "";
+    }
+    for (const auto& dir : package_path)
+      for (const auto& package : PackagesIn(dir, name))
+        if (found(package / inside)) return (package / inside).string();
+    if (package_path.empty())
+      tried->push_back("(no package path: $CALIPER_PACKAGE_PATH and $ROS_PACKAGE_PATH are empty)");
+    // the folders above the URDF: a robot kept inside its own package resolves without a path
+    bool above = false;
+    for (fs::path up = fs::absolute(base, ec); !up.empty(); up = up.parent_path()) {
+      if (PackageName(up / "package.xml") == name) {
+        above = true;
+        if (found(up / inside)) return (up / inside).string();
+      }
+      if (up == up.parent_path()) break;
+    }
+    if (!above)
+      tried->push_back("(no folder above " + base.string() + " is package '" + name + "')");
+    return "";
+  }
+  fs::path p = reference;
+  if (reference.compare(0, file_scheme.size(), file_scheme) == 0)
+    p = reference.substr(file_scheme.size());
+  if (p.is_relative()) p = base / p;
+  return found(p) ? p.string() : "";
+}
+
+namespace internal {
+
+MeshFile MeshLoader::Load(const std::string& file, const Eigen::Vector3d& scale) {
+  const auto key = std::make_tuple(file, scale.x(), scale.y(), scale.z());
+  if (const auto it = scaled_.find(key); it != scaled_.end()) return it->second;
+  auto raw = files_.find(file);
+  if (raw == files_.end()) {
+    Assimp::Importer importer;
+    // ROS ignores a mesh file's up axis; its unit (COLLADA <unit meter>) is applied
+    importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+    // lines and points are of no use to a body
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const aiScene* scene =
+        importer.ReadFile(file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                    aiProcess_PreTransformVertices | aiProcess_SortByPType);
+    if (scene == nullptr)
+      throw std::runtime_error("assimp cannot read it: " + std::string(importer.GetErrorString()));
+    auto mesh = std::make_shared<sgal::Mesh>();
+    MeshFile out;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh* am = scene->mMeshes[m];
+      const auto first = static_cast<uint32_t>(mesh->vertices.size());
+      for (unsigned v = 0; v < am->mNumVertices; ++v) {
+        const aiVector3D& p = am->mVertices[v];
+        mesh->vertices.emplace_back(p.x, p.y, p.z);
+        if (am->mNormals != nullptr)
+          mesh->normals.emplace_back(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+      }
+      for (unsigned f = 0; f < am->mNumFaces; ++f) {
+        const aiFace& face = am->mFaces[f];
+        if (face.mNumIndices != 3) continue;
+        mesh->triangles.push_back(
+            {first + face.mIndices[0], first + face.mIndices[1], first + face.mIndices[2]});
+      }
+      aiColor4D diffuse;
+      if (!out.color && am->mMaterialIndex < scene->mNumMaterials &&
+          scene->mMaterials[am->mMaterialIndex]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) ==
+              AI_SUCCESS)
+        out.color = Eigen::Vector4f(diffuse.r, diffuse.g, diffuse.b, diffuse.a);
+    }
+    if (mesh->normals.size() != mesh->vertices.size()) mesh->normals.clear();
+    if (mesh->triangles.empty()) throw std::runtime_error("it holds no triangles");
+    for (const auto& v : mesh->vertices)
+      if (!v.allFinite()) throw std::runtime_error("it holds a vertex that is not a finite number");
+    out.mesh = std::move(mesh);
+    raw = files_.emplace(file, std::move(out)).first;
+  }
+  MeshFile result = raw->second;
+  if (scale != Eigen::Vector3d::Ones()) {
+    auto mesh = std::make_shared<sgal::Mesh>(*result.mesh);
+    const Eigen::Vector3f s = scale.cast<float>();
+    for (auto& v : mesh->vertices) v = v.cwiseProduct(s);
+    // normals go with the inverse transpose; a mirror turns the triangles inside out
+    for (auto& n : mesh->normals) n = n.cwiseQuotient(s).normalized();
+    if (s.prod() < 0)
+      for (auto& t : mesh->triangles) std::swap(t[1], t[2]);
+    result.mesh = std::move(mesh);
+  }
+  scaled_.emplace(key, result);
+  return result;
+}
+
+}  // namespace internal
+}  // namespace caliper::urdf
