@@ -449,6 +449,13 @@ class Writer {
         const double v[3] = {s.stiffness, s.damping, s.rest};
         t->Add("spring", FormatNumbers(v, 3))->Set("dof", kDofNames[i]);
       }
+    // dry friction has no COLLADA element: N or N m per degree of freedom (a hinge's or slider's
+    // one without dof)
+    for (int i = 0; i < (one_dof ? 1 : 6); ++i) {
+      if (c.friction[i] == 0) continue;
+      Element* f = t->Add("friction", FormatNumber(c.friction[i]));
+      if (!one_dof) f->Set("dof", kDofNames[i]);
+    }
   }
 
   const sgal::Scene& scene_;

@@ -763,6 +763,18 @@ bool ReadConstraintExtra(Context& ctx, const Element& owner, sgal::Constraint* c
           ctx.Fail(e.get(), "unknown degree of freedom '" + dof + "' (0-5 or x, y, z, rx, ry, rz)");
         const auto v = ctx.Numbers(*e, 3);
         c->springs[slot] = sgal::JointSpring{v[0], v[1], v[2]};
+      } else if (n == "friction") {
+        const std::string dof = e->Attribute("dof", "0");
+        int slot = -1;
+        for (int i = 0; i < 6; ++i)
+          if (dof == kDofNames[i] || dof == std::to_string(i)) slot = i;
+        if (slot < 0)
+          ctx.Fail(e.get(), "unknown degree of freedom '" + dof + "' (0-5 or x, y, z, rx, ry, rz)");
+        const double friction = ctx.Numbers(*e, 1)[0];
+        if (!(friction >= 0) || !std::isfinite(friction))
+          ctx.Fail(e.get(), "joint friction " + e->Trimmed() +
+                                " (N or N m) must be finite and not negative");
+        c->friction[slot] = friction;
       } else {
         ctx.Warn(e.get(),
                  "unknown element <" + std::string(n) + "> in a constraint's Caliper technique");

@@ -188,6 +188,7 @@ class BulletScene : public sgal::PhysicsScene {
   void EvaluateTendons();
   void ApplyTendonForces();
   void ApplyJointSprings();
+  void ApplyJointFriction();
   void CheckState();
   void BuildParameters();
   // the state at the start of a step (bodies, tendons, actuators), and putting it back
@@ -656,6 +657,46 @@ void BulletScene::ApplyJointSprings() {
   }
 }
 
+void BulletScene::ApplyJointFriction() {
+  // Dry friction as PyBullet models it: a velocity motor aiming at rest whose impulse per step is
+  // bounded by friction * dt, so the solver holds the joint while the load stays below the
+  // friction and brakes it with exactly the friction above. Set every step: the friction (a
+  // parameter) and the time step may change between steps. Engine units: forces scale with the
+  // world scale, torques with its square. At a hinge or slider limit, the limit's row takes over.
+  for (auto& j : joints_) {
+    const sgal::Constraint& c = *j.desc;
+    switch (c.kind) {
+      case sgal::ConstraintKind::kHinge: {
+        auto* hinge = static_cast<btHingeConstraint*>(j.constraint.get());
+        // Bullet's hinge motor takes an impulse per step, its other motors a force
+        const double impulse = c.friction[0] * scale_ * scale_ * dt_;
+        hinge->enableAngularMotor(c.friction[0] > 0, 0, static_cast<btScalar>(impulse));
+        break;
+      }
+      case sgal::ConstraintKind::kSlider: {
+        auto* slider = static_cast<btSliderConstraint*>(j.constraint.get());
+        slider->setPoweredLinMotor(c.friction[0] > 0);
+        slider->setTargetLinMotorVelocity(0);
+        slider->setMaxLinMotorForce(static_cast<btScalar>(c.friction[0] * scale_));
+        break;
+      }
+      case sgal::ConstraintKind::kGeneric6Dof: {
+        auto* g = static_cast<btGeneric6DofSpring2Constraint*>(j.constraint.get());
+        for (int i = 0; i < 6; ++i) {
+          g->enableMotor(i, c.friction[i] > 0);
+          g->setTargetVelocity(i, 0);
+          const double unit = i < 3 ? scale_ : scale_ * scale_;
+          g->setMaxMotorForce(i, static_cast<btScalar>(c.friction[i] * unit));
+        }
+        break;
+      }
+      case sgal::ConstraintKind::kBall:
+      case sgal::ConstraintKind::kFixed:
+        break;
+    }
+  }
+}
+
 void BulletScene::CheckState() {
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
@@ -794,6 +835,7 @@ void BulletScene::Step() {
     ApplyTendonForces();
     stage_ = {StepStage::kWorld, -1};
     ApplyJointSprings();
+    ApplyJointFriction();
     world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
     CheckState();
     CacheBodyPoses();
@@ -898,6 +940,15 @@ void BulletScene::BuildParameters() {
         [spring] { return spring->damping; }, [spring, n](double v) {
           if (v < 0) throw std::invalid_argument(n + ".spring_damping: must not be negative");
           spring->damping = v;
+        });
+    double* friction = &scene_.constraints[k].friction[0];
+    add(
+        {n + ".friction", hinge ? "N m" : "N", true, true}, [friction] { return *friction; },
+        [friction, n, hinge](double v) {
+          if (v < 0)
+            throw std::invalid_argument(n + ".friction: must not be negative (" +
+                                        (hinge ? "N m" : "N") + ")");
+          *friction = v;
         });
   }
   for (auto& t : tendons_) {

@@ -131,6 +131,10 @@ std::vector<std::string> Validate(const Scene& s) {
     const std::string where = "constraint '" + c.name + "'";
     if (c.body_a.empty() || !s.FindBody(c.body_a)) error(where + ": no body '" + c.body_a + "'");
     if (!body_exists(c.body_b)) error(where + ": no body '" + c.body_b + "'");
+    for (size_t i = 0; i < c.friction.size(); ++i)
+      if (!(c.friction[i] >= 0) || !std::isfinite(c.friction[i]))
+        error(where + ": friction[" + std::to_string(i) + "] = " + std::to_string(c.friction[i]) +
+              " (N or N m) must be finite and not negative");
   }
   for (const auto& o : s.obstacles) {
     if (!body_exists(o.body))

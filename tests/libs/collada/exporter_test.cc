@@ -200,7 +200,9 @@ TEST_F(ColladaExportTest, RoundTripsEveryShapeKindConstraintKindAndBodyType) {
     c.collide_connected = i % 2 == 1;
     c.limits[0] = {-0.5, 0.25 * i};
     c.springs[0] = {10.0 + i, 0.5, 0.1};
+    c.friction[0] = 0.05 * (i + 1);  // [N m] or [N]
     if (c.kind == sgal::ConstraintKind::kGeneric6Dof) {
+      c.friction[4] = 0.7;
       for (int k = 1; k < 6; ++k)
         c.limits[k] = k % 2 ? sgal::Limit{-0.1 * k, 0.2 * k} : sgal::Limit{};
       c.springs[4] = {3, 0.2, -0.3};

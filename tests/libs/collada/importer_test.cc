@@ -441,6 +441,9 @@ TEST(ColladaImportTest, RejectsMalformedFilesNamingFileLineElementAndProblem) {
        {"malformed_unknown_parameter.dae:", "unknown parameter 'stifness'"}},
       {"malformed_dangling_tendon_body.dae",
        {"malformed_dangling_tendon_body.dae:", "unknown body 'no_such_body'"}},
+      {"malformed_negative_friction.dae",
+       {"malformed_negative_friction.dae:86:", "friction", "-0.5",
+        "(N or N m) must be finite and not negative"}},
       {"no_such_file.dae", {"no_such_file.dae", "cannot open"}},
   };
   for (const auto& c : cases) {

@@ -123,6 +123,7 @@ class SceneComparison {
       Num(wl + " spring stiffness", x.springs[i].stiffness, y.springs[i].stiffness);
       Num(wl + " spring damping", x.springs[i].damping, y.springs[i].damping);
       Num(wl + " spring rest", x.springs[i].rest, y.springs[i].rest);
+      Num(wl + " friction", x.friction[i], y.friction[i]);
     }
   }
 

@@ -77,6 +77,17 @@ TEST(Validate, NamesEachProblemAndItsElement) {
   EXPECT_TRUE(HasError(errors, "actuator 'm': parameter stiffness is not finite"));
 }
 
+TEST(Validate, RejectsNegativeOrNonFiniteJointFriction) {
+  Scene s = TwoBodies();
+  s.constraints[0].friction[0] = 0.3;
+  EXPECT_TRUE(Validate(s).empty());
+  s.constraints[0].friction[0] = -0.1;
+  s.constraints[0].friction[4] = NAN;
+  const auto errors = Validate(s);
+  EXPECT_TRUE(HasError(errors, "constraint 'hinge': friction[0] = -0.100000 (N or N m) must be"));
+  EXPECT_TRUE(HasError(errors, "constraint 'hinge': friction[4] = nan"));
+}
+
 TEST(Validate, RejectsInertiaThatIsNotPositiveDefinite) {
   Scene s = TwoBodies();
   s.bodies[0].inertia.tensor = Eigen::Vector3d(1, 1, -1).asDiagonal();

@@ -151,6 +151,9 @@ struct Constraint {
   // hinge and slider use index 0; generic 6-DOF: 0-2 translation x, y, z, 3-5 rotation x, y, z
   std::array<Limit, 6> limits;
   std::array<JointSpring, 6> springs;
+  // Coulomb (dry) friction of each degree of freedom, in the limits' order: the most torque [N m]
+  // (rotations) or force [N] (translations) the joint resists motion with; 0 = none
+  std::array<double, 6> friction{};
   bool collide_connected = false;  // whether the two bodies still collide with each other
 };
 
