@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "caliper/sgal/kinematics.h"
+#include "caliper/urdf/importer.h"
 #include "corpus.h"
 #include "corpus_robots.h"
 #include "mujoco_urdf.h"
@@ -95,8 +97,73 @@ TEST_P(MujocoReads, FuseStaticDropsTheMassWeldedToTheWorld) {
   EXPECT_EQ(merged.body_count(), robot().moving());
 }
 
+sgal::Scene ImportRobot(const CorpusRobot& robot) {
+  urdf::Options options;
+  options.package_path = PackageDirs();
+  std::vector<std::string> warnings;
+  return urdf::Import(UrdfPath(robot), &warnings, options);
+}
+
+TEST_P(MujocoReads, SameTotalMassAsCaliper) {
+  CALIPER_REQUIRE_CORPUS();
+  MujocoUrdf mujoco(UrdfPath(robot()), PackageDirs(), compiler());
+  double caliper = 0;  // [kg]
+  for (const sgal::Body& body : ImportRobot(robot()).bodies) caliper += body.inertia.mass;
+  EXPECT_NEAR(caliper, mujoco.total_mass(), 1e-9);
+}
+
+TEST_P(MujocoReads, SameMovingJointsAsCaliper) {
+  CALIPER_REQUIRE_CORPUS();
+  MujocoUrdf mujoco(UrdfPath(robot()), PackageDirs(), compiler());
+  std::set<std::string> caliper;
+  for (const sgal::Constraint& c : ImportRobot(robot()).constraints) {
+    if (c.kind == sgal::ConstraintKind::kHinge || c.kind == sgal::ConstraintKind::kSlider) {
+      caliper.insert(c.name);
+    }
+  }
+  const std::vector<std::string> names = mujoco.joint_names();
+  EXPECT_EQ(static_cast<int>(caliper.size()), mujoco.joint_count());
+  EXPECT_EQ(caliper, std::set<std::string>(names.begin(), names.end()));
+}
+
+// Caliper is given the leaders only, so that its couplings place the followers; MuJoCo, which
+// ignores <mimic>, every joint with the followers computed from the file's <mimic> elements.
+TEST_P(MujocoReads, SameBodyPositionsIn20RandomConfigurations) {
+  CALIPER_REQUIRE_CORPUS();
+  MujocoUrdf mujoco(UrdfPath(robot()), PackageDirs(), compiler());
+  const sgal::Scene scene = ImportRobot(robot());
+  const std::vector<UrdfJoint> joints = ReadUrdfJoints(UrdfPath(robot()));
+  std::set<std::string> followers;
+  for (const UrdfJoint& j : joints) {
+    if (!j.mimic.empty()) followers.insert(j.name);
+  }
+  double worst = 0;  // [m]
+  int compared = 0;
+  for (const auto& q : RandomConfigurations(joints, 20, 20261125)) {
+    std::map<std::string, double> leaders;
+    for (const auto& [name, value] : q) {
+      if (!followers.count(name)) leaders[name] = value;
+    }
+    const std::vector<sgal::Pose> poses = sgal::ForwardKinematics(scene, leaders);
+    const std::map<std::string, Eigen::Vector3d> reference = mujoco.BodyPositions(q);
+    ASSERT_EQ(poses.size(), scene.bodies.size());
+    for (size_t b = 0; b < poses.size(); ++b) {
+      const auto it = reference.find(scene.bodies[b].name);
+      ASSERT_NE(it, reference.end()) << "MuJoCo has no body " << scene.bodies[b].name;
+      const double error = (poses[b].position - it->second).norm();
+      worst = std::max(worst, error);
+      ++compared;
+      EXPECT_LT(error, 1e-6) << scene.bodies[b].name << " at " << poses[b].position.transpose()
+                             << " m, MuJoCo " << it->second.transpose() << " m";
+    }
+  }
+  EXPECT_EQ(compared, 20 * robot().merged_bodies());
+  std::printf("%s: %d body positions compared, largest difference %.3g m\n", robot().name, compared,
+              worst);
+}
+
 INSTANTIATE_TEST_SUITE_P(Corpus, MujocoReads, ::testing::ValuesIn(kReadable),
-                         [](const auto& info) { return std::string(info.param.robot); });
+                         [](const auto& p) { return std::string(p.param.robot); });
 
 // Kinova's meshes are COLLADA only; MuJoCo 2.2.2 reads STL and OBJ meshes.
 TEST(MujocoRefuses, KinovaForItsColladaMeshes) {
