@@ -103,7 +103,7 @@ std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
   std::vector<double> values;
   pool.WithModel([&](M::Model_ptr model) {
     try {
-      model->load_scene_data(fs::path(spec.experiments.front().scene).filename().c_str(),
+      model->load_scene_data(ctl::SceneFileName(spec.experiments.front().scene).c_str(),
                              ctl::ToOctets(bytes));
       ::Caliper::Scene::StringSeq ids;
       ids.length(static_cast<CORBA::ULong>(spec.parameters.size()));

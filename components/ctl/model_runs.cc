@@ -4,11 +4,10 @@
 #include <signal.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 
 #include "caliper/rtc/client_orb.h"
+#include "caliper/urdf/model_file.h"
 
 namespace caliper::ctl {
 
@@ -35,16 +34,21 @@ std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std:
   return out;
 }
 
-std::string ReadScene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("scene " + path + " cannot be read");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+std::string ReadScene(const std::string& path, std::vector<std::string>* warnings) {
+  // ImportError and ExportError (std::runtime_error) name the file
+  const std::string bytes = model_file::ContentToSend(path, warnings).bytes;
   const size_t limit = static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20);
   if (bytes.size() > limit)
     throw std::runtime_error(path + " is " + std::to_string(bytes.size() >> 20) +
                              " MiB: scenes travel in one CORBA message of at most " +
                              std::to_string(limit >> 20) + " MiB");
   return bytes;
+}
+
+std::string SceneFileName(const std::string& path) {
+  if (model_file::FormatOf(path) == model_file::Format::kUrdf)
+    return std::filesystem::path(path).stem().string() + ".dae";
+  return std::filesystem::path(path).filename().string();
 }
 
 M::Octets ToOctets(const std::string& bytes) {
@@ -57,7 +61,7 @@ M::Octets ToOctets(const std::string& bytes) {
 M::Experiment ToIdl(const experiment::Experiment& e, const std::string& bytes) {
   M::Experiment out;
   out.name = e.name.c_str();
-  out.scene_file_name = std::filesystem::path(e.scene).filename().c_str();
+  out.scene_file_name = SceneFileName(e.scene).c_str();
   out.scene_data = ToOctets(bytes);
   out.overrides.length(static_cast<CORBA::ULong>(e.overrides.size()));
   for (CORBA::ULong i = 0; i < e.overrides.size(); ++i) {

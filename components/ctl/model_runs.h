@@ -31,9 +31,16 @@ struct ModelEntry {
 /// The Models whose instance (model1) or INSTANCE@HOST matches the glob.
 std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std::string& glob);
 
-/// A scene file's bytes; std::runtime_error when it cannot be read or exceeds what one message
-/// carries (rtc::kMaxMessageBytes less 1 MiB), naming the file and the sizes.
-std::string ReadScene(const std::string& path);
+/// The bytes to send for a scene file by content: a .dae's or .zae's own, a .urdf's robot
+/// imported here and exported as COLLADA (model_file::ContentToSend; its import warnings go to
+/// `warnings` when not null). std::runtime_error when it cannot be read, imported or exported, or
+/// exceeds what one message carries (rtc::kMaxMessageBytes less 1 MiB), naming the file and the
+/// sizes.
+std::string ReadScene(const std::string& path, std::vector<std::string>* warnings = nullptr);
+
+/// The file name a scene sent by content carries: the file's own, NAME.dae for NAME.urdf (what
+/// ReadScene sends for it).
+std::string SceneFileName(const std::string& path);
 
 /// A file's bytes as an IDL octet sequence.
 ::Caliper::Simulation::Octets ToOctets(const std::string& bytes);

@@ -27,6 +27,7 @@
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/rtc/idl_names.h"
+#include "caliper/urdf/model_file.h"
 #include "csv_recording.h"
 #include "model_runs.h"
 
@@ -165,7 +166,19 @@ bool ModelTakesPath(const ModelRef& m, const std::string& path,
     dirs.push_back(files->write_dir.in());
   }
   // the Model's COLLADA library reads names as URIs: it refuses '#', '?' and '%'
-  return core::ConfinedPaths(dirs, "", "", true).Allows(path, access);
+  const core::ConfinedPaths confined(dirs, "", "", true);
+  if (!confined.Allows(path, access)) return false;
+  if (access == core::ConfinedPaths::Access::kWrite) return true;
+  // a URDF whose meshes lie elsewhere the Model refuses as a whole: convert and send it here
+  std::vector<std::string> others;
+  try {
+    others = model_file::FilesRead(path);
+  } catch (const collada::ImportError&) {
+    return true;  // not XML: the Model reports it, naming the file
+  }
+  for (const auto& file : others)
+    if (!confined.Allows(file, access)) return false;
+  return true;
 }
 
 // Channel metadata by id (one list call).
@@ -226,13 +239,14 @@ int Load(Client& client, std::vector<std::string>& args) {
     try {
       if (send) {
         std::string bytes;
+        std::vector<std::string> warnings;
         try {
-          bytes = ReadScene(path);
+          bytes = ReadScene(path, &warnings);  // a URDF converted to COLLADA here
         } catch (const std::runtime_error& e) {
           throw Failure(e.what());
         }
-        m.model->load_scene_data(std::filesystem::path(path).filename().c_str(),
-                                 ToOctets(bytes));
+        for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+        m.model->load_scene_data(SceneFileName(path).c_str(), ToOctets(bytes));
       } else {
         m.model->load_scene(path.c_str());
       }
@@ -685,11 +699,15 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
     verb.takes_interrupt = takes_interrupt;
     (*verbs)[name] = verb;
   };
-  add("load", "load FILE [--send] [--model NAME]", "load a COLLADA scene into a Model", Load,
+  add("load", "load FILE [--send] [--model NAME]",
+      "load a scene (COLLADA .dae, .zae or URDF .urdf) into a Model", Load,
       "  On failure the Model keeps (and runs) the scene it had, and the importer's message\n"
       "  (file, line, element, problem) is printed. FILE is sent as an absolute path to a Model\n"
-      "  on this host that reads it (below its model.read_dirs or write directory), else by\n"
-      "  content (its bytes): to one on another host, with --send, or for files elsewhere.\n");
+      "  on this host that reads it (below its model.read_dirs or write directory; for a URDF\n"
+      "  its meshes too), else by content: to one on another host, with --send, or for files\n"
+      "  elsewhere. By content a .dae or .zae goes as its bytes, a .urdf as the robot imported\n"
+      "  here (meshes from its folder and the package path, $CALIPER_PACKAGE_PATH then\n"
+      "  $ROS_PACKAGE_PATH) and converted to COLLADA (NAME.dae); its warnings are printed.\n");
   for (const std::string v : {"start", "pause", "stop"}) {
     const std::string summary = v == "start"   ? "run the simulation (at the real-time factor)"
                                 : v == "pause" ? "pause the simulation"
@@ -747,8 +765,9 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "  A recorder that misses the Model's push deadline (1 s; e.g. stopped) is dropped by\n"
       "  the Model: record then exits 1 with the Model's reason.\n",
       true);
-  add("save", "save FILE [--send] [--model NAME]", "export the scene with its current parameters as COLLADA",
-      Save,
+  add("save", "save FILE [--send] [--model NAME]",
+      "export the scene with its current parameters as COLLADA", Save,
+      "  Whatever was loaded (COLLADA or URDF), FILE is COLLADA with Caliper's technique.\n"
       "  FILE is written by the Model's process (sent as an absolute path) when it lies below\n"
       "  the Model's write directory (model.write_dir, the session's directory); otherwise (a\n"
       "  Model on another host, --send, files elsewhere) the export comes back by content and\n"

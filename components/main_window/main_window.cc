@@ -255,6 +255,10 @@ MainWindow::~MainWindow() {
   link_.reset();  // joins the worker
 }
 
+QString MainWindow::ModelFileFilter() {
+  return "Model files (*.dae *.zae *.urdf);;COLLADA (*.dae *.zae);;URDF (*.urdf);;All files (*)";
+}
+
 QString MainWindow::SettingsPath() {
   const QByteArray env = qgetenv("CALIPER_MAIN_SETTINGS");
   if (!env.isEmpty()) return QString::fromLocal8Bit(env);
@@ -449,7 +453,7 @@ void MainWindow::StartModel(QString path) {
   if (path.isEmpty()) path = last_model_;
   if (path.isEmpty())
     path = QFileDialog::getOpenFileName(this, "Model file for the new Model", QString(),
-                                        "COLLADA (*.dae);;All files (*)");
+                                        ModelFileFilter());
   if (path.isEmpty()) return;
   const QString program = BinPath("caliper-model");
   if (!QFileInfo(program).isExecutable()) {
@@ -515,8 +519,8 @@ void MainWindow::SelectedComponentAction(const std::string& verb) {
 }
 
 void MainWindow::OpenModelFile() {
-  const QString path = QFileDialog::getOpenFileName(this, "Open model", QString(),
-                                                    "COLLADA (*.dae);;All files (*)");
+  const QString path =
+      QFileDialog::getOpenFileName(this, "Open model", QString(), ModelFileFilter());
   if (path.isEmpty()) return;
   link_->LoadScene(path.toStdString());
   statusBar()->showMessage("loading " + path + " ...", kErrorShowMs);

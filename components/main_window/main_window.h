@@ -39,6 +39,9 @@ class MainWindow : public QMainWindow {
   /// The tree row of a channel id, or nullptr.
   QTreeWidgetItem* ItemOf(const std::string& id) const;
 
+  /// The file filter of the Open and Start-a-Model dialogs: every model file Caliper loads
+  /// (COLLADA .dae and .zae, URDF .urdf) first, then each format, then all files.
+  static QString ModelFileFilter();
   /// The per-user session file, or $CALIPER_MAIN_SETTINGS.
   static QString SettingsPath();
   /// Saves geometry, last model, simulation settings and open tools (closing does it too).

@@ -15,6 +15,7 @@
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
+#include "caliper/urdf/model_file.h"
 
 namespace caliper::main_window {
 
@@ -78,19 +79,30 @@ void ModelLink::LoadScene(const std::string& path) {
     std::vector<std::string> dirs;
     for (CORBA::ULong k = 0; k < files->read_dirs.length(); ++k)
       dirs.push_back(files->read_dirs[k].in());
-    if (core::ConfinedPaths(dirs, "", "", true).Allows(path, core::ConfinedPaths::Access::kRead)) {
+    const core::ConfinedPaths confined(dirs, "", "", true);
+    const auto kRead = core::ConfinedPaths::Access::kRead;
+    // a URDF goes by path only when its meshes lie there too (the Model refuses it otherwise)
+    bool by_path = confined.Allows(path, kRead);
+    if (by_path) {
+      try {
+        for (const auto& file : model_file::FilesRead(path))
+          by_path &= confined.Allows(file, kRead);
+      } catch (const collada::ImportError&) {
+        // not XML: the Model says so, naming the file
+      }
+    }
+    if (by_path) {
       i.model->load_scene(path.c_str());
     } else {
-      std::ifstream in(path, std::ios::binary);
-      if (!in) throw std::runtime_error("cannot read " + path);
-      const std::string bytes((std::istreambuf_iterator<char>(in)),
-                              std::istreambuf_iterator<char>());
+      // by content a Model takes COLLADA: a URDF is imported here and sent converted (NAME.dae)
+      const model_file::Content content = model_file::ContentToSend(path, nullptr);
+      const std::string& bytes = content.bytes;
       if (bytes.size() > static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20))
         throw std::runtime_error(path + " is larger than one CORBA message carries");
       M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
       data.length(static_cast<CORBA::ULong>(bytes.size()));
       std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
-      i.model->load_scene_data(std::filesystem::path(path).filename().c_str(), data);
+      i.model->load_scene_data(content.file_name.c_str(), data);
     }
     i.channels_listed = false;
   });

@@ -44,7 +44,7 @@ rtc::ReturnCode ModelComponent::OnInitialize() {
   std::string scene = runtime_.config().GetString("model.scene");
   // a scene a client chose (through a manager) is confined like load_scene's
   if (!scene.empty() && runtime_.config().GetBool("model.confine_scene"))
-    scene = files.read.Resolve(scene, core::ConfinedPaths::Access::kRead).string();
+    scene = files.ResolveScene(scene);
   if (!scene.empty()) core_->Load(scene);  // a bad file fails initialisation with its message
   return rtc::ReturnCode::kOk;
 }

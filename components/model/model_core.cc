@@ -15,6 +15,7 @@
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
 #include "caliper/logging/log.h"
+#include "caliper/urdf/model_file.h"
 
 namespace caliper::model {
 
@@ -132,7 +133,8 @@ void ModelCore::Load(const std::string& path) {
     RequireIdle();
   }
   std::vector<std::string> warnings;
-  sgal::Scene scene = collada::Import(path, &warnings);  // throws collada::ImportError
+  // COLLADA or URDF by the ending; throws collada::ImportError
+  sgal::Scene scene = model_file::Import(path, &warnings);
   for (const auto& w : warnings) logging::Get("model").warn("%s: %s", path.c_str(), w.c_str());
   LoadScene(scene, path);
 }
@@ -167,6 +169,13 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
   // the importer reads files (Collada-DOM opens .zae archives itself): a private copy, gone after
   const std::string base = std::filesystem::path(file_name).filename().string();
   const std::string ending = base.size() > 4 ? base.substr(base.size() - 4) : "";
+  // a URDF's meshes are other files, which do not travel with it
+  if (model_file::FormatOf(base) == model_file::Format::kUrdf) {
+    const std::string stem = std::filesystem::path(base).stem().string();
+    throw LoadError(file_name + ": a URDF cannot be sent by content (its meshes are other " +
+                    "files): send it by path, or convert it with `caliper-ctl inspect " + base +
+                    " --export " + stem + ".dae` and send that");
+  }
   if (ending != ".dae" && ending != ".zae")
     throw LoadError(file_name + ": a scene sent by content must be named *.dae or *.zae");
   if (bytes.empty()) throw LoadError(file_name + ": the scene sent is empty");

@@ -149,12 +149,14 @@ class ModelCore {
                      PhysicsFactory factory = nullptr);
   ~ModelCore();
 
-  /// Imports and builds a scene outside the lock, then swaps it in. On failure throws
-  /// std::runtime_error with the importer's or the engine's message and keeps the old scene.
+  /// Imports and builds a scene (COLLADA or URDF, model_file::Import) outside the lock, then
+  /// swaps it in. On failure throws std::runtime_error with the importer's or the engine's
+  /// message and keeps the old scene.
   void Load(const std::string& path);
   /// The same for a description built in memory (tests, generators).
   void LoadScene(const sgal::Scene& scene, const std::string& source);
   /// Loads a scene sent by content: `file_name` (its ending: .dae or .zae) names it in messages.
+  /// A .urdf is refused (its meshes would not come with it), saying how to send it instead.
   void LoadData(const std::string& file_name, const std::string& bytes);
   /// The scene with its current parameters as the bytes of a .dae file.
   std::string ExportBytes();

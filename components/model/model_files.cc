@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 
+#include "caliper/urdf/model_file.h"
+
 namespace caliper::model {
 
 std::vector<core::ConfigKey> ModelFiles::ConfigKeys() {
@@ -18,6 +20,21 @@ std::vector<core::ConfigKey> ModelFiles::ConfigKeys() {
        "model.scene too must lead below model.read_dirs (a manager sets it for the Models it "
        "starts: there a client chose the scene)"},
   };
+}
+
+std::string ModelFiles::ResolveScene(const std::string& path) const {
+  const std::string scene = read.Resolve(path, core::ConfinedPaths::Access::kRead).string();
+  // the meshes are checked as the scene is (links followed, `..` taken physically); the importer
+  // then reads them by the references in the file: whoever can change links in a read directory
+  // between the check and the read could still lead it elsewhere, a client over CORBA cannot
+  for (const std::string& file : model_file::FilesRead(scene)) {
+    try {
+      read.Resolve(file, core::ConfinedPaths::Access::kRead);
+    } catch (const core::PathRefused& e) {
+      throw core::PathRefused(scene + " reads another file, which is refused: " + e.what());
+    }
+  }
+  return scene;
 }
 
 ModelFiles ModelFiles::FromConfig(const core::Config& config) {

@@ -11,6 +11,8 @@
 //   model.confine_scene  model.scene too must lead below model.read_dirs (set by a manager for
 //                     the Models it starts, whose scene a client chose)
 // Relative paths start from the first read directory (load_scene) or the write directory.
+// A URDF's meshes (and its side file NAME.caliper.xml) must lie below model.read_dirs too: a
+// robot that names a mesh elsewhere is refused as a whole, before anything is read.
 
 #include <string>
 #include <vector>
@@ -23,6 +25,12 @@ namespace caliper::model {
 struct ModelFiles {
   core::ConfinedPaths read;   ///< model.read_dirs, then the write directory
   core::ConfinedPaths write;  ///< the write directory alone (none when unset)
+
+  /// The resolved path of a scene a client named (read.Resolve), once every other file that
+  /// importing it reads (a URDF's meshes and side file: model_file::FilesRead) lies below the
+  /// same directories. Throws core::PathRefused naming the scene and the file refused, or
+  /// collada::ImportError when the URDF is no well-formed XML.
+  std::string ResolveScene(const std::string& path) const;
 
   static std::vector<core::ConfigKey> ConfigKeys();
   /// The directories that `config` (and $CALIPER_FILES_DIR) give.

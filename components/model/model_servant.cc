@@ -6,7 +6,7 @@
 #include <set>
 #include <variant>
 
-
+#include "caliper/collada/importer.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
@@ -663,7 +663,10 @@ void ModelServant::load_scene(const char* path) {
   // only below the model search path: a client must not make the Model read any file
   std::string file;
   try {
-    file = files_.read.Resolve(path, core::ConfinedPaths::Access::kRead).string();
+    file = files_.ResolveScene(path);
+  } catch (const collada::ImportError& e) {
+    logging::Get("model").error("load %s failed: %s", path, e.what());
+    throw M::LoadFailed(e.what());  // a URDF that is not XML: not a refusal
   } catch (const std::exception& e) {
     logging::Get("model").warn("load_scene refused: %s", e.what());
     throw M::LoadFailed((std::string("load_scene: ") + e.what() +
