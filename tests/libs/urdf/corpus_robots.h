@@ -25,6 +25,8 @@
 // - panda_collision.urdf is panda.urdf with primitive collision shapes (capsules, spheres) and
 //   COLLADA visuals; same links, joints and masses.
 
+#include <ostream>
+
 namespace caliper::testing {
 
 struct CorpusRobot {
@@ -42,6 +44,9 @@ struct CorpusRobot {
   int joints() const { return moving() + fixed; }
   int merged_bodies() const { return moving() + 1; }  // the base and one per moving joint
 };
+
+// GoogleTest prints a parameter by its name rather than its bytes.
+inline void PrintTo(const CorpusRobot& robot, std::ostream* os) { *os << robot.name; }
 
 inline constexpr CorpusRobot kCorpusRobots[] = {
     {"UR5",

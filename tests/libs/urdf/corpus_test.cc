@@ -122,15 +122,19 @@ sgal::Scene PosedWithinLimits(sgal::Scene scene) {
 
 // The body speeds a robot falling from rest under gravity can reach: a point mass dropping twice
 // the robot's reach (the farthest body frame from the base) reaches sqrt(2 g 2 reach); light
-// links whipped by heavy ones go faster, so twice that, plus 1 m/s.
+// links whipped by heavy ones go faster (Panda's fingers reached 1.21 times that with links that
+// do not collide with each other), so 1.5 times that. Measured without self-collision: UR5 5.4,
+// Panda 7.7, Kinova 0.7, PR2 3.5, iiwa 4.6 m/s against bounds of 8.6, 9.6, 5.5, 10.5, 10.5 m/s.
 double SpeedBound(const sgal::Scene& scene, const Eigen::Vector3d& base) {
   double reach = 0;  // [m]
   for (const sgal::Body& body : scene.bodies) {
     reach = std::max(reach, (body.pose.position - base).norm());
   }
-  return 2 * std::sqrt(2 * 9.81 * 2 * reach) + 1;  // [m/s]
+  return 1.5 * std::sqrt(2 * 9.81 * 2 * reach);  // [m/s]
 }
 
+// The robot as imported, links colliding with every link but their parent and children, its base
+// static: no fault, no NaN, no body faster than SpeedBound, the base where it was.
 TEST_P(CorpusRobotTest, HangsFiveSecondsUnderGravity) {
   CALIPER_REQUIRE_CORPUS();
   const CorpusRobot& robot = GetParam();

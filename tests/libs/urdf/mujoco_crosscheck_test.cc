@@ -50,6 +50,8 @@ const Readable kReadable[] = {
     {"KukaIiwa", false}, {"R2D2", false},  {"PR2", true},
 };
 
+void PrintTo(const Readable& readable, std::ostream* os) { *os << readable.robot; }
+
 class MujocoReads : public ::testing::TestWithParam<Readable> {
  protected:
   const CorpusRobot& robot() const { return Robot(GetParam().robot); }
