@@ -97,6 +97,15 @@ struct TendonData {
   int saved_contacts = 0;
 };
 
+/// A coupling q_follower = ratio * q_leader + offset held by a stiff, critically damped
+/// spring-damper on the error, acting on both joints (the follower's load reaches the leader).
+struct CouplingData {
+  const sgal::Coupling* desc = nullptr;
+  int leader = -1, follower = -1;  // joints
+  double stiffness = 0;            // [N m/rad], [N/m] or mixed: per unit of error of the follower
+  double damping = 0;              // per unit of error speed
+};
+
 struct ActuatorData {
   const sgal::Actuator* desc = nullptr;
   std::unique_ptr<actuators::TendonActuator> model;
@@ -189,6 +198,10 @@ class BulletScene : public sgal::PhysicsScene {
   void ApplyTendonForces();
   void ApplyJointSprings();
   void ApplyJointFriction();
+  void BuildCouplings();
+  double JointInverseInertia(const JointData& j) const;
+  void ApplyCouplings();
+  void PushJoint(const JointData& j, double load);
   void CheckState();
   void BuildParameters();
   // the state at the start of a step (bodies, tendons, actuators), and putting it back
@@ -219,6 +232,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::unique_ptr<btRigidBody> fixed_body_;  // the world side of joints with one body
   std::vector<BodyData> bodies_;
   std::vector<JointData> joints_;
+  std::vector<CouplingData> couplings_;
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
   std::vector<Isometry3d> poses_;        // body frames this step [m]
@@ -306,6 +320,7 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
   for (size_t i = 0; i < scene_.bodies.size(); ++i) BuildBody(i);
   joints_.resize(scene_.constraints.size());
   for (size_t i = 0; i < scene_.constraints.size(); ++i) BuildConstraint(i);
+  BuildCouplings();
   BuildTendons();
   BuildParameters();
 }
@@ -657,6 +672,80 @@ void BulletScene::ApplyJointSprings() {
   }
 }
 
+double BulletScene::JointInverseInertia(const JointData& j) const {
+  // What the joint's coordinate sees of its own two bodies: body_a turning about the joint axis
+  // (parallel axes), body_b about its centre of mass (it may be free), or their masses for a
+  // slider. Whatever hangs on them through other joints only adds inertia.
+  const sgal::Constraint& c = *j.desc;
+  auto inverse = [&](int body, const sgal::Pose& frame, bool about_joint) -> double {
+    if (body < 0 || scene_.bodies[body].type != sgal::BodyType::kDynamic) return 0;
+    const sgal::Inertia& in = scene_.bodies[body].inertia;
+    if (c.kind == sgal::ConstraintKind::kSlider) return 1 / in.mass;
+    const Vector3d axis = frame.orientation.normalized() * Vector3d::UnitZ();
+    double inertia = axis.dot(in.tensor * axis);
+    if (about_joint) {
+      const Vector3d r = in.com - frame.position;
+      inertia += in.mass * (r - r.dot(axis) * axis).squaredNorm();
+    }
+    return 1 / inertia;
+  };
+  return inverse(j.body_a, c.frame_a, true) + inverse(j.body_b, c.frame_b, false);
+}
+
+void BulletScene::BuildCouplings() {
+  std::unordered_map<std::string, int> joint_index;
+  for (size_t k = 0; k < joints_.size(); ++k)
+    joint_index[joints_[k].desc->name] = static_cast<int>(k);
+  for (const auto& k : scene_.couplings) {
+    CouplingData data;
+    data.desc = &k;
+    data.leader = joint_index.at(k.leader);  // Validate checked the names and kinds
+    data.follower = joint_index.at(k.follower);
+    couplings_.push_back(data);
+  }
+}
+
+void BulletScene::PushJoint(const JointData& j, double load) {
+  // a torque (hinge) or force (slider) on body_a along the joint axis, its reaction on body_b
+  const bool hinge = j.desc->kind == sgal::ConstraintKind::kHinge;
+  auto push = [&](int body, double sign) {
+    if (body < 0 || scene_.bodies[body].type != sgal::BodyType::kDynamic) return;
+    btRigidBody& rb = *bodies_[body].rigid;
+    if (hinge)
+      rb.applyTorque(ToBt(j.axis * (sign * load), scale_ * scale_));
+    else
+      rb.applyCentralForce(ToBt(j.axis * (sign * load), scale_));
+  };
+  push(j.body_a, 1.0);
+  push(j.body_b, -1.0);
+}
+
+void BulletScene::ApplyCouplings() {
+  // The error e = q_f - (ratio q_l + offset) has the inertia m_e, 1/m_e = 1/M_f + ratio^2 / M_l
+  // (M: what each joint sees, see JointInverseInertia). A spring m_e w^2 with critical damping
+  // 2 m_e w closes it; explicit forces in Bullet's semi-implicit step stay stable for w dt up to
+  // about 0.8, and w dt = 0.2 leaves room for m_e being overestimated five-fold. Set each step:
+  // the time step may change. Hinge positions wrap at +-pi: a leader crossing it jumps.
+  const double w = 0.2 / dt_;
+  for (auto& k : couplings_) {
+    const JointData& leader = joints_[k.leader];
+    const JointData& follower = joints_[k.follower];
+    const double ratio = k.desc->ratio;
+    const double inverse =
+        JointInverseInertia(follower) + ratio * ratio * JointInverseInertia(leader);
+    if (!(inverse > 0)) continue;  // neither joint can move
+    const double m = 1 / inverse;
+    k.stiffness = m * w * w;
+    k.damping = 2 * m * w;
+    const double error = follower.position - (ratio * leader.position + k.desc->offset);
+    const double rate = follower.velocity - ratio * leader.velocity;
+    // the generalised force on q_f, and by the chain rule -ratio times it on q_l
+    const double load = -(k.stiffness * error + k.damping * rate);
+    PushJoint(follower, load);
+    PushJoint(leader, -ratio * load);
+  }
+}
+
 void BulletScene::ApplyJointFriction() {
   // Dry friction as PyBullet models it: a velocity motor aiming at rest whose impulse per step is
   // bounded by friction * dt, so the solver holds the joint while the load stays below the
@@ -836,6 +925,7 @@ void BulletScene::Step() {
     stage_ = {StepStage::kWorld, -1};
     ApplyJointSprings();
     ApplyJointFriction();
+    ApplyCouplings();
     world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
     CheckState();
     CacheBodyPoses();

@@ -136,6 +136,23 @@ std::vector<std::string> Validate(const Scene& s) {
         error(where + ": friction[" + std::to_string(i) + "] = " + std::to_string(c.friction[i]) +
               " (N or N m) must be finite and not negative");
   }
+  std::set<std::string> followers;
+  for (const auto& k : s.couplings) {
+    const std::string where = "coupling of '" + k.follower + "' to '" + k.leader + "'";
+    for (const std::string* joint : {&k.leader, &k.follower}) {
+      const auto c = std::find_if(s.constraints.begin(), s.constraints.end(),
+                                  [&](const Constraint& x) { return x.name == *joint; });
+      if (c == s.constraints.end())
+        error(where + ": no constraint (joint) '" + *joint + "'");
+      else if (c->kind != ConstraintKind::kHinge && c->kind != ConstraintKind::kSlider)
+        error(where + ": constraint '" + *joint + "' is not a hinge or slider");
+    }
+    if (k.leader == k.follower) error(where + ": a joint cannot follow itself");
+    if (!std::isfinite(k.ratio) || !std::isfinite(k.offset))
+      error(where + ": ratio and offset must be finite");
+    if (!followers.insert(k.follower).second)
+      error(where + ": joint '" + k.follower + "' already follows another coupling");
+  }
   for (const auto& o : s.obstacles) {
     if (!body_exists(o.body))
       error("obstacle '" + o.name + "': no body '" + o.body + "'");

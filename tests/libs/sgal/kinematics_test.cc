@@ -6,8 +6,8 @@
 
 #include <cmath>
 #include <map>
-#include <tuple>
 #include <string>
+#include <tuple>
 
 namespace caliper::sgal {
 namespace {

@@ -88,6 +88,31 @@ TEST(Validate, RejectsNegativeOrNonFiniteJointFriction) {
   EXPECT_TRUE(HasError(errors, "constraint 'hinge': friction[4] = nan"));
 }
 
+TEST(Validate, CouplingsJoinTwoKnownHingesOrSliders) {
+  Scene s = TwoBodies();
+  Constraint slider = s.constraints[0];
+  slider.name = "slider";
+  slider.kind = ConstraintKind::kSlider;
+  s.constraints.push_back(slider);
+  s.couplings.push_back({"hinge", "slider", 0.01, 0});
+  EXPECT_TRUE(Validate(s).empty());
+  s.couplings.push_back({"ghost", "hinge", 1, 0});
+  s.couplings.push_back({"slider", "slider", 1, NAN});
+  s.couplings.push_back({"hinge", "slider", 2, 0});
+  Constraint ball = s.constraints[0];
+  ball.name = "ball";
+  ball.kind = ConstraintKind::kBall;
+  s.constraints.push_back(ball);
+  s.couplings.push_back({"ball", "hinge", 1, 0});
+  const auto errors = Validate(s);
+  EXPECT_TRUE(HasError(errors, "coupling of 'hinge' to 'ghost': no constraint (joint) 'ghost'"));
+  EXPECT_TRUE(HasError(errors, "coupling of 'slider' to 'slider': a joint cannot follow itself"));
+  EXPECT_TRUE(
+      HasError(errors, "coupling of 'slider' to 'slider': ratio and offset must be finite"));
+  EXPECT_TRUE(HasError(errors, "coupling of 'slider' to 'hinge': joint 'slider' already follows"));
+  EXPECT_TRUE(HasError(errors, "coupling of 'hinge' to 'ball': constraint 'ball' is not a hinge"));
+}
+
 TEST(Validate, RejectsInertiaThatIsNotPositiveDefinite) {
   Scene s = TwoBodies();
   s.bodies[0].inertia.tensor = Eigen::Vector3d(1, 1, -1).asDiagonal();
