@@ -48,6 +48,7 @@ struct XmlFacts {
   std::vector<GeometryFacts> geometries;
   std::optional<bool> merge_fixed_joints;  // <caliper fixed_joints="merge|keep">
   std::optional<bool> floating_base;       // <caliper base="fixed|floating">
+  std::optional<bool> self_collision;      // <caliper self_collision="true|false">
   int caliper_line = 0;
 };
 
@@ -131,6 +132,9 @@ MassProperties Combine(const MassProperties& a, const MassProperties& b) {
   return out;
 }
 
+// The collision group of a robot's shapes when its links do not collide with each other.
+constexpr uint32_t kRobotGroup = 1u << 1;
+
 class Importer {
  public:
   Importer(std::string path, std::vector<std::string>* warnings, Options options)
@@ -140,6 +144,7 @@ class Importer {
     ReadFacts();
     if (facts_.merge_fixed_joints) options_.merge_fixed_joints = *facts_.merge_fixed_joints;
     if (facts_.floating_base) options_.floating_base = *facts_.floating_base;
+    if (facts_.self_collision) options_.self_collision = *facts_.self_collision;
     if (options_.package_path.empty()) options_.package_path = PackagePathFromEnvironment();
     CheckTree();
     model_ = Parse();
@@ -250,6 +255,11 @@ class Importer {
           facts_.floating_base = base == "floating";
         else if (!base.empty())
           Fail(where, "base=\"" + base + "\": fixed or floating");
+        const std::string self = AttributeOf(n, "self_collision");
+        if (self == "true" || self == "false")
+          facts_.self_collision = self == "true";
+        else if (!self.empty())
+          Fail(where, "self_collision=\"" + self + "\": true or false");
       }
     }
   }
@@ -435,6 +445,12 @@ class Importer {
                        : c.name;
       shape.geometry = std::move(*geometry);
       shape.pose = ToPose(c.origin);
+      if (!options_.self_collision) {
+        // the robot's own links pass through each other (their meshes often overlap where they
+        // join); everything else they meet
+        shape.group = kRobotGroup;
+        shape.mask = ~kRobotGroup;
+      }
       body.shapes.push_back(std::move(shape));
     }
     for (size_t i = 0; i < link.visual_array.size(); ++i) {
@@ -529,6 +545,11 @@ class Importer {
                                      Number(j.limits->upper));
       c.limits[0].lower = j.limits->lower;
       c.limits[0].upper = j.limits->upper;
+      if (!(j.limits->lower <= 0 && 0 <= j.limits->upper))
+        Warn(WhereJoint(j.name), "the link's frame is at joint position 0, outside the limits " +
+                                     Number(j.limits->lower) + " .. " + Number(j.limits->upper) +
+                                     (j.type == J::REVOLUTE ? " rad" : " m") +
+                                     ": the limit pushes it in when the simulation starts");
     }
     if (j.dynamics && c.kind != sgal::ConstraintKind::kFixed) {
       const int dof = c.kind == sgal::ConstraintKind::kGeneric6Dof ? 5 : 0;
@@ -663,9 +684,22 @@ class Importer {
         m.tensor =
             Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
       } else if (moving && !(m.mass > 0)) {
-        Fail(WhereLink(body.name), "mass " + Number(m.mass) +
-                                       " kg on a moving link (a joint other than fixed moves it): "
-                                       "a body that moves needs a positive mass");
+        const auto joint = model_->getLink(body.name)->parent_joint;
+        if (joint && joint->type == ::urdf::Joint::FIXED) {
+          // kept fixed joints (fixed_joints="keep"): a massless frame such as a tool flange
+          Warn(WhereLink(body.name), "mass 0 kg on a link held by the fixed joint '" + joint->name +
+                                         "', which is kept as a constraint; " +
+                                         Number(kDefaultMass) + " kg assumed");
+          m.mass = kDefaultMass;
+          m.com.setZero();
+          m.tensor =
+              Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
+        } else {
+          Fail(WhereLink(body.name),
+               "mass " + Number(m.mass) + " kg on a moving link (its joint '" +
+                   (joint ? joint->name : std::string("?")) +
+                   "' is not fixed): a body that moves needs a positive mass");
+        }
       }
       body.inertia.mass = m.mass;
       body.inertia.com = m.com;

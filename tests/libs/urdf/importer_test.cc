@@ -443,6 +443,46 @@ TEST(UrdfImport, ImpossibleInertiaIsRaisedWithAWarning) {
   EXPECT_LT((BodyOf(s, "arm").inertia.tensor - expected).norm(), 1e-12);
 }
 
+// A robot's links pass through each other by default (their meshes overlap where they join) and
+// meet everything else; with self_collision every pair but a link and its parent collides.
+TEST_F(KindsTest, LinksDoNotCollideWithEachOtherByDefault) {
+  const sgal::Shape& a = BodyOf(scene, "upper").shapes[0];
+  const sgal::Shape& b = BodyOf(scene, "base").shapes[0];
+  EXPECT_EQ(a.group & b.mask, 0u);
+  EXPECT_EQ(b.group & a.mask, 0u);
+  const sgal::Shape ground;  // a shape of the default group and mask, e.g. a floor added later
+  EXPECT_NE(a.group & ground.mask, 0u);
+  EXPECT_NE(ground.group & a.mask, 0u);
+  Options o = WithPackages();
+  o.self_collision = true;
+  std::vector<std::string> w;
+  const sgal::Scene s = Import(kData + "/kinds.urdf", &w, o);
+  const sgal::Shape& c = BodyOf(s, "upper").shapes[0];
+  const sgal::Shape& d = BodyOf(s, "fore").shapes[0];
+  EXPECT_NE(c.group & d.mask, 0u);
+  EXPECT_NE(d.group & c.mask, 0u);
+  EXPECT_FALSE(JointOf(s, "elbow").collide_connected);
+}
+
+TEST(UrdfImport, ZeroPositionOutsideTheLimitsWarns) {
+  const fs::path file =
+      fs::temp_directory_path() / ("caliper-limits-" + std::to_string(getpid()) + ".urdf");
+  std::ofstream(file) << R"(<robot name="r">
+  <link name="base"/>
+  <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="0.5" upper="2" effort="1" velocity="1"/></joint>
+</robot>)";
+  std::vector<std::string> warnings;
+  Import(file.string(), &warnings);
+  fs::remove(file);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(":4: joint 'j': the link's frame is at joint position 0, outside the "
+                             "limits 0.5 .. 2 rad"),
+            std::string::npos)
+      << warnings[0];
+}
+
 TEST(UrdfImport, FloatingBaseFromOptionsAndFromTheFile) {
   Options o = WithPackages();
   o.floating_base = true;

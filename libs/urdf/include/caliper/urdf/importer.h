@@ -20,8 +20,9 @@
 //   origin's rotation); principal moments that no rigid body has are raised with a warning;
 // - a link without <inertial> on a moving joint gets the default below, with a warning; one
 //   merged into its parent adds nothing;
-// - a link and its parent never collide with each other; <gazebo> and <transmission> are
-//   ignored; geometry of an unknown kind is skipped with a warning.
+// - the robot's links do not collide with each other unless Options::self_collision (then a
+//   link and its parent still do not); they collide with everything else. <gazebo> and
+//   <transmission> are ignored; geometry of an unknown kind is skipped with a warning.
 
 #include <string>
 #include <vector>
@@ -51,6 +52,10 @@ struct Options {
   bool merge_fixed_joints = true;
   /// The root link free (a mobile robot) instead of fixed to the world.
   bool floating_base = false;
+  /// Whether the robot's links collide with each other. Off (as in PyBullet and Gazebo) by
+  /// default: URDF collision meshes often overlap where links join, and the overlap would push
+  /// them apart at the first step. On, every pair collides but a link and its parent.
+  bool self_collision = false;
   /// Folders to find `package://NAME/...` in; empty: $CALIPER_PACKAGE_PATH, then
   /// $ROS_PACKAGE_PATH (each a ':'-separated list). A package is a folder whose package.xml says
   /// <name>NAME</name>, or a folder named NAME, in or directly below one of them.
