@@ -1,6 +1,7 @@
 #include "caliper/physics_bullet/bullet_scene.h"
 
 #include <btBulletDynamicsCommon.h>
+#include <LinearMath/btConvexHullComputer.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -275,8 +276,25 @@ std::unique_ptr<btCollisionShape> MakeShape(const sgal::Geometry& geometry, doub
           // convex hulls, and triangle meshes of moving bodies, collide as their convex hull
           if (!g.mesh || g.mesh->vertices.empty())
             throw std::invalid_argument(where + ": mesh without vertices");
+          btAlignedObjectArray<btVector3> points;
+          points.reserve(static_cast<int>(g.mesh->vertices.size()));
+          for (const auto& v : g.mesh->vertices) points.push_back(ToBt(v.template cast<double>(), s));
+          // Bullet adds a hull's collision margin outside it (0.04 engine units unless told:
+          // a hull rested 4 cm above a floor). The hull's corners moved inwards by the margin
+          // give back the mesh's own surface, rounded at the edges; and a CAD mesh's thousands of
+          // vertices inside the hull or on its flat faces, which every contact query would walk,
+          // are gone. A mesh whose hull has no volume (flat) keeps its points with a thin margin.
+          btConvexHullComputer computer;
+          const btScalar shrunk = computer.compute(&points[0].x(), sizeof(btVector3), points.size(),
+                                                   static_cast<btScalar>(0.04), static_cast<btScalar>(0.25));
+          btScalar margin = static_cast<btScalar>(1e-4 * s);
+          if (shrunk >= 0 && computer.vertices.size() >= 4) {
+            points = computer.vertices;
+            margin = std::max(shrunk, margin);
+          }
           auto hull = std::make_unique<btConvexHullShape>();
-          for (const auto& v : g.mesh->vertices) hull->addPoint(ToBt(v.template cast<double>(), s), false);
+          for (int i = 0; i < points.size(); ++i) hull->addPoint(points[i], false);
+          hull->setMargin(margin);
           hull->recalcLocalAabb();
           return hull;
         }

@@ -575,3 +575,58 @@ TEST(ObserverHub, ReportsOnlyTheBodiesThatMoved) {
 
 }  // namespace
 }  // namespace caliper::physics_bullet
+
+// A convex hull given with many points inside and on its faces (as CAD meshes are) rests on a
+// floor exactly as the hull of its corners does: the adapter keeps the corners only.
+namespace caliper::physics_bullet {
+namespace {
+
+double RestingHeight(std::shared_ptr<sgal::Mesh> mesh) {
+  sgal::Scene scene;
+  sgal::Body floor;
+  floor.name = "floor";
+  floor.type = sgal::BodyType::kStatic;
+  sgal::Shape plane;
+  plane.name = "floor";
+  plane.geometry = sgal::Plane{};
+  floor.shapes.push_back(plane);
+  scene.bodies.push_back(floor);
+  sgal::Body block;
+  block.name = "block";
+  block.pose.position = Eigen::Vector3d(0, 0, 0.2);
+  block.inertia.mass = 1;
+  block.inertia.tensor = Eigen::Matrix3d::Identity() * (1.0 / 6.0) * 0.01;  // 0.1 m cube
+  sgal::Shape hull;
+  hull.name = "hull";
+  hull.geometry = sgal::ConvexHull{mesh};
+  block.shapes.push_back(hull);
+  scene.bodies.push_back(block);
+  auto physics = MakeScene(scene);
+  for (int i = 0; i < 1000; ++i) physics->Step();
+  return physics->BodyStates()[1].pose.position.z();
+}
+
+TEST(BulletScene, AHullOfManyPointsCollidesAsTheHullOfItsCorners) {
+  auto corners = std::make_shared<sgal::Mesh>();
+  for (float x : {-0.05f, 0.05f})
+    for (float y : {-0.05f, 0.05f})
+      for (float z : {-0.05f, 0.05f}) corners->vertices.emplace_back(x, y, z);
+  auto dense = std::make_shared<sgal::Mesh>(*corners);
+  // 2000 points inside and on the faces of the same cube
+  uint32_t state = 12345;
+  auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 0.1f - 0.05f;
+  };
+  for (int i = 0; i < 2000; ++i) {
+    Eigen::Vector3f p(next(), next(), next());
+    if (i % 2 == 0) p[i % 3] = i % 4 == 0 ? 0.05f : -0.05f;  // on a face
+    dense->vertices.push_back(p);
+  }
+  const double expected = RestingHeight(corners);
+  EXPECT_NEAR(expected, 0.05, 5e-4);  // half the edge: no margin outside the hull
+  EXPECT_NEAR(RestingHeight(dense), expected, 1e-6);
+}
+
+}  // namespace
+}  // namespace caliper::physics_bullet
