@@ -100,6 +100,8 @@ void DofParts(const sgal::Constraint& c, int i, bool angular, const std::string&
                      Num(s.rest * scale) + " " + unit);
   if (s.damping != 0)
     parts->push_back("damping " + Num(s.damping) + (angular ? " N m s/rad" : " N s/m"));
+  if (c.friction[i] != 0)
+    parts->push_back("friction " + Num(c.friction[i]) + (angular ? " N m" : " N"));
 }
 
 void PrintBodies(const sgal::Scene& scene, std::ostream& out) {
