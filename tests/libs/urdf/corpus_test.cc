@@ -5,14 +5,19 @@
 #include "corpus.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "../collada/scene_compare.h"
+#include "caliper/collada/exporter.h"
+#include "caliper/collada/importer.h"
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/sgal/kinematics.h"
 #include "caliper/urdf/importer.h"
@@ -70,6 +75,23 @@ TEST_P(CorpusRobotTest, ImportsTheDeclaredBodiesJointsAndMass) {
 // Unmerged, a link on a fixed joint is a body of its own that moves with its parent: without
 // <inertial>, or with a zero mass (a massless frame such as a tool flange), it gets the default
 // mass and a warning naming it.
+// Import -> COLLADA export -> import gives the same scene: bodies, masses, collision shapes
+// (meshes vertex for vertex), visual counts, joints with limits, damping and friction, couplings.
+TEST_P(CorpusRobotTest, RoundTripThroughColladaGivesTheSameScene) {
+  CALIPER_REQUIRE_CORPUS();
+  const CorpusRobot& robot = GetParam();
+  const sgal::Scene first = ImportRobot(robot);
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() /
+      ("caliper-urdf-" + std::to_string(getpid()) + "-" + robot.name + ".dae");
+  collada::Export(first, out.string());
+  std::vector<std::string> warnings;
+  const sgal::Scene again = collada::Import(out.string(), &warnings);
+  std::filesystem::remove(out);
+  SceneComparison compare(1e-9);
+  EXPECT_EQ(compare.Compare(first, again), 0);
+}
+
 TEST_P(CorpusRobotTest, KeepsEveryLinkWhenFixedJointsAreNotMerged) {
   CALIPER_REQUIRE_CORPUS();
   const CorpusRobot& robot = GetParam();
@@ -89,7 +111,8 @@ TEST_P(CorpusRobotTest, KeepsEveryLinkWhenFixedJointsAreNotMerged) {
     ++zero_mass;
     bool warned = false;
     for (const auto& w : warnings)
-      warned |= w.find("link '" + std::string(link) + "': mass 0 kg on a link held by the fixed "
+      warned |= w.find("link '" + std::string(link) +
+                       "': mass 0 kg on a link held by the fixed "
                        "joint") != std::string::npos;
     EXPECT_TRUE(warned) << link;
   }
