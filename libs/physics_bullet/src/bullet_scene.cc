@@ -659,7 +659,10 @@ void BulletScene::UpdateJoints() {
     if (c.kind == sgal::ConstraintKind::kHinge) {
       // rotation of body_a's joint frame relative to body_b's (the parent's), about z
       const Eigen::Matrix3d rel = fb.linear().transpose() * fa.linear();
-      j.position = std::atan2(rel(1, 0), rel(0, 0));
+      // whole turns counted: the branch of the angle nearest the last position (a hinge turns
+      // far less than half a turn in a step), so that a continuous joint, a multi-turn limit
+      // (a UR5's +-2 pi) and a coupling's leader read on past +-pi instead of jumping
+      j.position += std::remainder(std::atan2(rel(1, 0), rel(0, 0)) - j.position, 2 * M_PI);
       j.velocity = axis.dot(spin(j.body_a) - spin(j.body_b));
     } else {
       j.position = axis.dot(fa.translation() - fb.translation());
@@ -743,7 +746,7 @@ void BulletScene::ApplyCouplings() {
   // (M: what each joint sees, see JointInverseInertia). A spring m_e w^2 with critical damping
   // 2 m_e w closes it; explicit forces in Bullet's semi-implicit step stay stable for w dt up to
   // about 0.8, and w dt = 0.2 leaves room for m_e being overestimated five-fold. Set each step:
-  // the time step may change. Hinge positions wrap at +-pi: a leader crossing it jumps.
+  // the time step may change. Hinge positions count whole turns (UpdateJoints).
   const double w = 0.2 / dt_;
   for (auto& k : couplings_) {
     const JointData& leader = joints_[k.leader];

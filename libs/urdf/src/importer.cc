@@ -49,7 +49,6 @@ struct XmlFacts {
   std::optional<bool> merge_fixed_joints;  // <caliper fixed_joints="merge|keep">
   std::optional<bool> floating_base;       // <caliper base="fixed|floating">
   std::optional<bool> self_collision;      // <caliper self_collision="true|false">
-  int caliper_line = 0;
 };
 
 const char* Chars(const xmlChar* s) { return reinterpret_cast<const char*>(s); }
@@ -146,6 +145,7 @@ class Importer {
     if (facts_.floating_base) options_.floating_base = *facts_.floating_base;
     if (facts_.self_collision) options_.self_collision = *facts_.self_collision;
     if (options_.package_path.empty()) options_.package_path = PackagePathFromEnvironment();
+    packages_.SetPath(options_.package_path);
     CheckTree();
     model_ = Parse();
     for (const auto& g : facts_.geometries) CheckGeometry(g);
@@ -171,10 +171,12 @@ class Importer {
     return At(it != facts_.link_lines.end() ? it->second : 0) + ": link '" + name + "'";
   }
   std::string WhereJoint(const std::string& name) const {
-    int line = 0;
+    return At(JointLine(name)) + ": joint '" + name + "'";
+  }
+  int JointLine(const std::string& name) const {
     for (const auto& j : facts_.joints)
-      if (j.name == name) line = j.line;
-    return At(line) + ": joint '" + name + "'";
+      if (j.name == name) return j.line;
+    return 0;
   }
   // `file:line` (the file alone when the line is not known)
   std::string At(int line) const { return path_ + (line > 0 ? ":" + std::to_string(line) : ""); }
@@ -243,25 +245,47 @@ class Importer {
           j.child = AttributeOf(c, "link");
         facts_.joints.push_back(j);
       } else if (Named(n, "caliper")) {
-        facts_.caliper_line = LineOf(n);
-        const std::string where = path_ + ":" + std::to_string(LineOf(n)) + ": <caliper>";
-        const std::string fixed = AttributeOf(n, "fixed_joints");
-        if (fixed == "merge" || fixed == "keep")
-          facts_.merge_fixed_joints = fixed == "merge";
-        else if (!fixed.empty())
-          Fail(where, "fixed_joints=\"" + fixed + "\": merge or keep");
-        const std::string base = AttributeOf(n, "base");
-        if (base == "fixed" || base == "floating")
-          facts_.floating_base = base == "floating";
-        else if (!base.empty())
-          Fail(where, "base=\"" + base + "\": fixed or floating");
-        const std::string self = AttributeOf(n, "self_collision");
-        if (self == "true" || self == "false")
-          facts_.self_collision = self == "true";
-        else if (!self.empty())
-          Fail(where, "self_collision=\"" + self + "\": true or false");
+        ReadCaliperAttributes(n, path_);
       }
     }
+    // the side file's <caliper> says the same things (a robot's URDF need not be edited)
+    std::error_code side_ec;
+    if (fs::is_regular_file(SidePath(), side_ec)) {
+      const std::string side = SidePath().string();
+      std::unique_ptr<xmlDoc, void (*)(xmlDocPtr)> side_doc(
+          xmlReadFile(
+              side.c_str(), nullptr,
+              XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING | XML_PARSE_BIG_LINES),
+          xmlFreeDoc);
+      // a malformed side file is reported with its line when the technique is read
+      const xmlNode* side_root = side_doc ? xmlDocGetRootElement(side_doc.get()) : nullptr;
+      if (side_root != nullptr && Named(side_root, "caliper"))
+        ReadCaliperAttributes(side_root, side);
+    }
+  }
+
+  fs::path SidePath() const {
+    return fs::path(path_).parent_path() / (fs::path(path_).stem().string() + ".caliper.xml");
+  }
+
+  // base, fixed_joints and self_collision of a <caliper> element; a second element that says
+  // otherwise than the first is an error
+  void ReadCaliperAttributes(const xmlNode* n, const std::string& file) {
+    const std::string where = file + ":" + std::to_string(LineOf(n)) + ": <caliper>";
+    auto read = [&](const char* attribute, const char* yes, const char* no,
+                    std::optional<bool>* into) {
+      const std::string v = AttributeOf(n, attribute);
+      if (v.empty()) return;
+      if (v != yes && v != no)
+        Fail(where, std::string(attribute) + "=\"" + v + "\": " + yes + " or " + no);
+      if (*into && **into != (v == yes))
+        Fail(where, std::string(attribute) + "=\"" + v + "\" where an earlier <caliper> says " +
+                        (**into ? yes : no));
+      *into = v == yes;
+    };
+    read("fixed_joints", "merge", "keep", &facts_.merge_fixed_joints);
+    read("base", "floating", "fixed", &facts_.floating_base);
+    read("self_collision", "true", "false", &facts_.self_collision);
   }
 
   // The shape of the tree, checked before urdfdom (which takes the last of two parents and
@@ -288,27 +312,40 @@ class Importer {
                                      "' (line " + std::to_string(j.line) +
                                      "); a URDF is a tree, where each link has one parent");
     }
-    // every link must reach a root by its parents; a walk longer than the links is a loop
+    // every link must reach a root by its parents; a walk that comes back to itself is a loop.
+    // Links known to reach a root end later walks (a deep chain stays linear).
     std::vector<std::string> roots;
+    std::set<std::string> reaches_root;
     for (const auto& [link, line] : facts_.link_lines) {
       if (parent_of.count(link) == 0) {
         roots.push_back(link);
-        continue;
-      }
-      std::vector<std::string> walk{link};
-      for (std::string at = link; parent_of.count(at) > 0;) {
-        at = parent_of[at]->parent;
-        const auto seen = std::find(walk.begin(), walk.end(), at);
-        if (seen != walk.end()) {
-          std::string loop;
-          for (auto k = seen; k != walk.end(); ++k)
-            loop += (loop.empty() ? "" : " <- ") + *k + " (joint '" + parent_of[*k]->name +
-                    "', line " + std::to_string(parent_of[*k]->line) + ")";
-          Fail(WhereLink(at), "the joints form a loop: " + loop + " <- " + at);
-        }
-        walk.push_back(at);
+        reaches_root.insert(link);
       }
     }
+    for (const auto& [link, line] : facts_.link_lines) {
+      std::vector<std::string> walk;
+      std::map<std::string, size_t> on_walk;
+      std::string at = link;
+      while (reaches_root.count(at) == 0) {
+        if (const auto seen = on_walk.find(at); seen != on_walk.end()) {
+          std::string loop;
+          for (size_t k = seen->second; k < walk.size(); ++k)
+            loop += (loop.empty() ? "" : " <- ") + walk[k] + " (joint '" +
+                    parent_of[walk[k]]->name + "', line " +
+                    std::to_string(parent_of[walk[k]]->line) + ")";
+          Fail(WhereLink(at), "the joints form a loop: " + loop + " <- " + at);
+        }
+        on_walk[at] = walk.size();
+        walk.push_back(at);
+        at = parent_of.at(at)->parent;
+      }
+      reaches_root.insert(walk.begin(), walk.end());
+    }
+    if (facts_.link_lines.count("world") > 0 && parent_of.count("world") > 0)
+      Fail(WhereLink("world"),
+           "is the child of joint '" + parent_of["world"]->name +
+               "': 'world' names the world (Gazebo's convention, and Caliper's data's "
+               "body=\"world\"), so only a root link may be called so; rename it");
     if (facts_.link_lines.empty())
       Fail(path_ + ":" + std::to_string(facts_.root_line) + ": robot", "has no links");
     if (roots.size() > 1) {
@@ -336,7 +373,14 @@ class Importer {
     if (!model) {
       std::string why;
       for (const auto& m : capture.messages) why += (why.empty() ? "" : "; ") + m;
-      Fail(path_, "liburdfdom cannot read it: " + (why.empty() ? "no reason given" : why));
+      // urdfdom names the element as "Joint [NAME]" or "Link [NAME]": give its line
+      std::string where = path_;
+      for (const auto& j : facts_.joints)
+        if (why.find("[" + j.name + "]") != std::string::npos) where = WhereJoint(j.name);
+      if (where == path_)
+        for (const auto& [link, line] : facts_.link_lines)
+          if (why.find("[" + link + "]") != std::string::npos) where = WhereLink(link);
+      Fail(where, "liburdfdom cannot read it: " + (why.empty() ? "no reason given" : why));
     }
     return model;
   }
@@ -363,17 +407,30 @@ class Importer {
                  pose * ToPose(joint->parent_to_joint_origin_transform));
   }
 
+  // Sizes no body has (zero, negative, not finite, beyond 1 km) stop the import: the engine would
+  // make them into a shape of no volume or of NaN.
+  void CheckSize(const std::string& link, const char* owner, const std::string& what,
+                 const Eigen::Vector3d& values) {
+    for (int i = 0; i < 3; ++i)
+      if (!(values[i] > 0) || !(values[i] <= 1e3))
+        Fail(WhereLink(link), std::string("<") + owner + "> " + what + " " + Numbers(values) +
+                                  ": sizes must be positive numbers of at most 1000 m");
+  }
+
   std::optional<sgal::Geometry> GeometryOf(const ::urdf::Geometry& g, const std::string& link,
                                            bool collision, Eigen::Vector4f* color) {
+    const char* owner = collision ? "collision" : "visual";
     switch (g.type) {
       case ::urdf::Geometry::BOX: {
         sgal::Box box;
         box.size = ToEigen(static_cast<const ::urdf::Box&>(g).dim);
+        CheckSize(link, owner, "box size", box.size);
         return box;
       }
       case ::urdf::Geometry::SPHERE: {
         sgal::Sphere s;
         s.radius = static_cast<const ::urdf::Sphere&>(g).radius;
+        CheckSize(link, owner, "sphere radius", Eigen::Vector3d::Constant(s.radius));
         return s;
       }
       case ::urdf::Geometry::CYLINDER: {
@@ -381,21 +438,26 @@ class Importer {
         sgal::Cylinder cyl;
         cyl.radius = c.radius;
         cyl.length = c.length;
+        CheckSize(link, owner, "cylinder radius, length, radius",
+                  Eigen::Vector3d(c.radius, c.length, c.radius));
         return cyl;
       }
       case ::urdf::Geometry::MESH: {
         const auto& m = static_cast<const ::urdf::Mesh&>(g);
+        const Eigen::Vector3d scale = ToEigen(m.scale);
+        // a mirroring (negative) scale is fine; zero flattens, huge overflows the mesh's floats
+        CheckSize(link, owner, "mesh scale (absolute)", scale.cwiseAbs());
         std::vector<std::string> tried;
-        const std::string file = ResolveMesh(m.filename, path_, options_.package_path, &tried);
+        const std::string file = packages_.Resolve(m.filename, path_, &tried);
         if (file.empty()) {
           std::string places;
           for (const auto& t : tried) places += "\n  " + t;
-          Fail(WhereLink(link), std::string(collision ? "collision" : "visual") + " mesh '" +
-                                    m.filename + "' not found; tried:" + places);
+          Fail(WhereLink(link),
+               std::string(owner) + " mesh '" + m.filename + "' not found; tried:" + places);
         }
         internal::MeshFile mesh;
         try {
-          mesh = meshes_.Load(file, ToEigen(m.scale));
+          mesh = meshes_.Load(file, scale);
         } catch (const std::exception& e) {
           Fail(WhereLink(link), "mesh " + file + ": " + e.what());
         }
@@ -408,15 +470,22 @@ class Importer {
   }
 
   void AddLink(const ::urdf::Link& link) {
-    if (IsWorld(link.name)) return;
+    if (IsWorld(link.name)) {
+      if (!link.visual_array.empty() || !link.collision_array.empty() || link.inertial)
+        Warn(WhereLink(link.name),
+             "the root link 'world' is the world itself: its " +
+                 std::to_string(link.visual_array.size()) + " visual(s) and " +
+                 std::to_string(link.collision_array.size()) +
+                 " collision(s) are not loaded (put them on a link fixed to it)");
+      return;
+    }
     sgal::Body body;
     body.name = link.name;
     body.pose = link_pose_.at(link.name);
     const bool root = link.name == model_->getRoot()->name;
     const auto parent = link.parent_joint;
     const bool on_world = parent && IsWorld(parent->parent_link_name);
-    if ((root && !options_.floating_base) ||
-        (on_world && parent->type == ::urdf::Joint::FIXED && options_.merge_fixed_joints))
+    if ((root && !options_.floating_base) || (on_world && parent->type == ::urdf::Joint::FIXED))
       body.type = sgal::BodyType::kStatic;
     MassProperties mp;
     if (link.inertial) {
@@ -481,6 +550,9 @@ class Importer {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(tensor);
     Eigen::Vector3d d = eigen.eigenvalues();
     const Eigen::Vector3d given = d;
+    if (d.minCoeff() < 0)
+      Fail(WhereLink(link),
+           "inertia with a negative principal moment (" + Numbers(d) + " kg m^2): no body has one");
     if (!(d.maxCoeff() > 0)) {
       d.setConstant(0.4 * std::max(mass, kDefaultMass) * kDefaultRadius * kDefaultRadius);
     } else {
@@ -545,6 +617,10 @@ class Importer {
                                      Number(j.limits->upper));
       c.limits[0].lower = j.limits->lower;
       c.limits[0].upper = j.limits->upper;
+      if (j.limits->lower == 0 && j.limits->upper == 0)
+        Warn(WhereJoint(j.name),
+             "<limit> with lower = upper = 0 (what URDF reads when both are "
+             "left out) locks the joint");
       if (!(j.limits->lower <= 0 && 0 <= j.limits->upper))
         Warn(WhereJoint(j.name), "the link's frame is at joint position 0, outside the limits " +
                                      Number(j.limits->lower) + " .. " + Number(j.limits->upper) +
@@ -579,6 +655,17 @@ class Importer {
     c.follower = j.name;
     c.ratio = j.mimic->multiplier;
     c.offset = j.mimic->offset;
+    // a chain of mimics must end at a joint that mimics none
+    std::vector<std::string> chain{j.name};
+    for (auto k = leader; k; k = k->mimic ? model_->getJoint(k->mimic->joint_name) : nullptr) {
+      if (std::find(chain.begin(), chain.end(), k->name) != chain.end()) {
+        std::string cycle;
+        for (const auto& n : chain) cycle += n + " (line " + std::to_string(JointLine(n)) + ") -> ";
+        Fail(WhereJoint(j.name), "the mimics form a cycle: " + cycle + k->name);
+      }
+      chain.push_back(k->name);
+      if (chain.size() > model_->joints_.size() + 1) break;
+    }
     scene_.couplings.push_back(c);
   }
 
@@ -586,8 +673,7 @@ class Importer {
 
   void ReadCaliperData() {
     collada::ImportTechniqueXml(path_, "caliper", &scene_, warnings_);
-    const fs::path side =
-        fs::path(path_).parent_path() / (fs::path(path_).stem().string() + ".caliper.xml");
+    const fs::path side = SidePath();
     std::error_code ec;
     if (fs::is_regular_file(side, ec)) {
       if (collada::ImportTechniqueXml(side.string(), "caliper", &scene_, warnings_) == 0)
@@ -696,9 +782,10 @@ class Importer {
               Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
         } else {
           Fail(WhereLink(body.name),
-               "mass " + Number(m.mass) + " kg on a moving link (its joint '" +
-                   (joint ? joint->name : std::string("?")) +
-                   "' is not fixed): a body that moves needs a positive mass");
+               "mass " + Number(m.mass) + " kg on a moving link (" +
+                   (joint ? "its joint '" + joint->name + "' is not fixed"
+                          : std::string("the root, free with a floating base")) +
+                   "): a body that moves needs a positive mass");
         }
       }
       body.inertia.mass = m.mass;
@@ -718,14 +805,13 @@ class Importer {
     for (const auto& p : problems) {
       // a finding starts "body 'NAME'" or "constraint 'NAME'": the link's or the joint's line
       int line = 0;
-      for (const std::string prefix : {"body '", "constraint '"}) {
+      for (const std::string prefix : {"body '", "constraint '", "coupling of '"}) {
         if (p.compare(0, prefix.size(), prefix) != 0) continue;
         const std::string name =
             p.substr(prefix.size(), p.find('\'', prefix.size()) - prefix.size());
         if (prefix[0] == 'b' && facts_.link_lines.count(name) > 0)
           line = facts_.link_lines.at(name);
-        for (const auto& j : facts_.joints)
-          if (prefix[0] == 'c' && j.name == name) line = j.line;
+        if (prefix[0] == 'c') line = JointLine(name);
       }
       message += (message.empty() ? "" : "\n") + At(line) + ": " + p;
     }
@@ -744,6 +830,7 @@ class Importer {
   std::set<std::string> has_inertial_;
   std::map<std::string, std::pair<std::string, sgal::Pose>> merged_into_;
   internal::MeshLoader meshes_;
+  internal::PackageFinder packages_;
 };
 
 }  // namespace

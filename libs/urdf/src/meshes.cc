@@ -44,20 +44,36 @@ std::string PackageName(const fs::path& manifest) {
   return b == std::string::npos ? "" : name.substr(b, e - b + 1);
 }
 
-// The folders that are package `name` in or directly below `dir`: `dir` itself or a subfolder
-// whose package.xml names it, or a subfolder called `name`.
+// The folders that are package `name` in or below `dir`, as ROS finds packages: `dir` itself or
+// a folder whose package.xml names it (not looking inside a package for another), and a folder
+// called `name` directly in `dir`. Bounded: a package path may name a large workspace.
 std::vector<fs::path> PackagesIn(const fs::path& dir, const std::string& name) {
   std::vector<fs::path> out;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return out;
-  if (PackageName(dir / "package.xml") == name) out.push_back(dir);
+  if (PackageName(dir / "package.xml") == name) return {dir};
   if (fs::is_directory(dir / name, ec)) out.push_back(dir / name);
-  // a bounded look at the subfolders: a package path may name a large workspace
+  constexpr int kMaxDepth = 6;
+  constexpr size_t kMaxEntries = 100000;
   size_t looked = 0;
-  for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end;
-       !ec && it != end && looked < 10000; it.increment(ec), ++looked) {
-    if (!it->is_directory(ec) || it->path().filename() == name) continue;
-    if (PackageName(it->path() / "package.xml") == name) out.push_back(it->path());
+  fs::recursive_directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end;
+  for (; !ec && it != end && looked < kMaxEntries; it.increment(ec), ++looked) {
+    std::error_code type_ec;
+    if (!it->is_directory(type_ec) || it.depth() >= kMaxDepth) {
+      if (it->is_directory(type_ec)) it.disable_recursion_pending();
+      continue;
+    }
+    const std::string leaf = it->path().filename().string();
+    if (!leaf.empty() && leaf[0] == '.') {  // .git and the like
+      it.disable_recursion_pending();
+      continue;
+    }
+    std::error_code manifest_ec;
+    if (!fs::is_regular_file(it->path() / "package.xml", manifest_ec)) continue;
+    // a package: not searched further inside
+    it.disable_recursion_pending();
+    if (PackageName(it->path() / "package.xml") == name && it->path() != dir / name)
+      out.push_back(it->path());
   }
   return out;
 }
@@ -85,6 +101,15 @@ std::vector<std::string> PackagePathFromEnvironment() {
 std::string ResolveMesh(const std::string& reference, const std::string& urdf_path,
                         const std::vector<std::string>& package_path,
                         std::vector<std::string>* tried) {
+  internal::PackageFinder finder;
+  finder.SetPath(package_path);
+  return finder.Resolve(reference, urdf_path, tried);
+}
+
+namespace internal {
+
+std::string PackageFinder::Resolve(const std::string& reference, const std::string& urdf_path,
+                                   std::vector<std::string>* tried) {
   std::vector<std::string> ignored;
   if (tried == nullptr) tried = &ignored;
   std::error_code ec;
@@ -104,10 +129,19 @@ std::string ResolveMesh(const std::string& reference, const std::string& urdf_pa
       tried->push_back("(not a package reference: package://NAME/PATH)");
       return "";
     }
-    for (const auto& dir : package_path)
-      for (const auto& package : PackagesIn(dir, name))
-        if (found(package / inside)) return (package / inside).string();
-    if (package_path.empty())
+    for (const auto& dir : path_) {
+      auto known = found_.find({dir, name});
+      if (known == found_.end()) {
+        std::vector<std::string> packages;
+        for (const auto& p : PackagesIn(dir, name)) packages.push_back(p.string());
+        known = found_.emplace(std::make_pair(dir, name), std::move(packages)).first;
+      }
+      if (known->second.empty())
+        tried->push_back("(no package '" + name + "' in or below " + dir + ")");
+      for (const auto& package : known->second)
+        if (found(fs::path(package) / inside)) return (fs::path(package) / inside).string();
+    }
+    if (path_.empty())
       tried->push_back("(no package path: $CALIPER_PACKAGE_PATH and $ROS_PACKAGE_PATH are empty)");
     // the folders above the URDF: a robot kept inside its own package resolves without a path
     bool above = false;
@@ -129,9 +163,11 @@ std::string ResolveMesh(const std::string& reference, const std::string& urdf_pa
   return found(p) ? p.string() : "";
 }
 
-namespace internal {
-
-MeshFile MeshLoader::Load(const std::string& file, const Eigen::Vector3d& scale) {
+MeshFile MeshLoader::Load(const std::string& given, const Eigen::Vector3d& scale) {
+  // one file by whatever path it was named (m/x.stl, ./m/x.stl, a link to it)
+  std::error_code ec;
+  fs::path canonical = fs::weakly_canonical(given, ec);
+  const std::string file = ec ? given : canonical.string();
   const auto key = std::make_tuple(file, scale.x(), scale.y(), scale.z());
   if (const auto it = scaled_.find(key); it != scaled_.end()) return it->second;
   auto raw = files_.find(file);
@@ -184,6 +220,8 @@ MeshFile MeshLoader::Load(const std::string& file, const Eigen::Vector3d& scale)
     for (auto& v : mesh->vertices) v = v.cwiseProduct(s);
     // normals go with the inverse transpose; a mirror turns the triangles inside out
     for (auto& n : mesh->normals) n = n.cwiseQuotient(s).normalized();
+    for (const auto& v : mesh->vertices)
+      if (!v.allFinite()) throw std::runtime_error("scaled, it holds a vertex beyond float range");
     if (s.prod() < 0)
       for (auto& t : mesh->triangles) std::swap(t[1], t[2]);
     result.mesh = std::move(mesh);

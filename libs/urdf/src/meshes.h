@@ -22,6 +22,20 @@ struct MeshFile {
   std::optional<Eigen::Vector4f> color;
 };
 
+/// Finds `package://` references' packages in a package path (urdf::ResolveMesh's rules), each
+/// folder of the path searched once per package name.
+class PackageFinder {
+ public:
+  void SetPath(std::vector<std::string> path) { path_ = std::move(path); }
+  /// As urdf::ResolveMesh with this finder's path.
+  std::string Resolve(const std::string& reference, const std::string& urdf_path,
+                      std::vector<std::string>* tried);
+
+ private:
+  std::vector<std::string> path_;
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> found_;
+};
+
 class MeshLoader {
  public:
   /// The mesh of `file` scaled by `scale` (per axis; a mirroring scale turns the triangles). Reads

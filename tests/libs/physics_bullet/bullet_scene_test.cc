@@ -630,3 +630,40 @@ TEST(BulletScene, AHullOfManyPointsCollidesAsTheHullOfItsCorners) {
 
 }  // namespace
 }  // namespace caliper::physics_bullet
+
+// A hinge's position counts whole turns: a wheel spinning at 10 rad/s for 1 s reads 10 rad, not
+// 10 - 4 pi, so continuous joints, multi-turn limits and coupled leaders read on past +-pi.
+namespace caliper::physics_bullet {
+namespace {
+
+TEST(BulletScene, HingePositionCountsWholeTurns) {
+  sgal::Scene scene;
+  scene.gravity.setZero();
+  sgal::Body base;
+  base.name = "base";
+  base.type = sgal::BodyType::kStatic;
+  scene.bodies.push_back(base);
+  sgal::Body wheel;
+  wheel.name = "wheel";
+  wheel.inertia.mass = 1;
+  wheel.inertia.tensor = Eigen::Matrix3d::Identity() * 0.01;
+  wheel.angular_velocity = Eigen::Vector3d(0, 0, 10);  // [rad/s]
+  scene.bodies.push_back(wheel);
+  sgal::Constraint axle;
+  axle.name = "axle";
+  axle.body_a = "wheel";
+  axle.body_b = "base";
+  scene.constraints.push_back(axle);
+  auto physics = MakeScene(scene);
+  double last = physics->GetParameter("axle.position");
+  for (int i = 0; i < 1000; ++i) {
+    physics->Step();
+    const double now = physics->GetParameter("axle.position");
+    ASSERT_GT(now, last) << "step " << i;  // never jumps back by a turn
+    last = now;
+  }
+  EXPECT_NEAR(last, 10.0, 1e-3);
+}
+
+}  // namespace
+}  // namespace caliper::physics_bullet

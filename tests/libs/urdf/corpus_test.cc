@@ -104,6 +104,12 @@ TEST_P(CorpusRobotTest, KeepsEveryLinkWhenFixedJointsAreNotMerged) {
   EXPECT_EQ(static_cast<int>(scene.bodies.size()), robot.links - world_link);
   // the joint from a "world" link makes the base static instead of a constraint
   EXPECT_EQ(Count(scene, sgal::ConstraintKind::kFixed), robot.fixed - world_link);
+  const sgal::Body* base = scene.FindBody(robot.base);
+  ASSERT_NE(base, nullptr) << robot.base;
+  EXPECT_EQ(base->type, sgal::BodyType::kStatic);
+  int static_bodies = 0;
+  for (const sgal::Body& body : scene.bodies) static_bodies += body.type == sgal::BodyType::kStatic;
+  EXPECT_EQ(static_bodies, 1);
   EXPECT_EQ(static_cast<int>(scene.constraints.size()), robot.joints() - world_link);
   int zero_mass = 0;
   for (const char* link : robot.zero_mass) {
@@ -152,7 +158,7 @@ double SpeedBound(const sgal::Scene& scene, const Eigen::Vector3d& base) {
   return 1.5 * std::sqrt(2 * 9.81 * 2 * reach);  // [m/s]
 }
 
-// The robot as imported, links colliding with every link but their parent and children, its base
+// The robot as imported (its links do not collide with each other, the default), its base
 // static: no fault, no NaN, no body faster than SpeedBound, the base where it was.
 TEST_P(CorpusRobotTest, HangsFiveSecondsUnderGravity) {
   CALIPER_REQUIRE_CORPUS();

@@ -183,7 +183,8 @@ TEST_F(KindsTest, FixedJointsMergeIntoTheParent) {
   const Eigen::Vector3d sensor_com(0, -0.01, 0.3);
   EXPECT_LT((fore.inertia.com - sensor_com / 2).norm(), 1e-15);
   const Eigen::Matrix3d own = Eigen::Vector3d(0.002, 0.002, 0.0005).asDiagonal();
-  const Eigen::Matrix3d sensor = Eigen::Matrix3d::Identity() * 0.0001;
+  // diag(1, 2, 3) 1e-4 kg m^2 in the sensor's frame, turned 90 deg about x into fore's
+  const Eigen::Matrix3d sensor = Eigen::Vector3d(1e-4, 3e-4, 2e-4).asDiagonal();
   auto shift = [](double m, const Eigen::Vector3d& d) -> Eigen::Matrix3d {
     return m * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
   };
@@ -197,12 +198,24 @@ TEST_F(KindsTest, FixedJointsMergeIntoTheParent) {
   EXPECT_EQ(fore.visuals.size(), 4u);  // 3 own, the tool's plate
   EXPECT_FALSE(AnyWarning(warnings, "'tool'")) << "a merged link without inertial needs none";
   // the tendon point given on the tool is now on fore, 0.3 m further along its z
-  ASSERT_EQ(scene.tendons.size(), 1u);
   const auto& path = scene.tendons[0].path;
   EXPECT_EQ(path[1].body, "fore");
   EXPECT_LT((path[1].position - Eigen::Vector3d(0, 0, 0.35)).norm(), 1e-15);
   EXPECT_EQ(path[0].body, "base");
   EXPECT_LT((path[0].position - Eigen::Vector3d(0, 0.1, 0.05)).norm(), 1e-15);
+  // the pulley on the sensor and the side point in the sensor's frame: z along fore's -y
+  ASSERT_EQ(scene.obstacles.size(), 1u);
+  EXPECT_EQ(scene.obstacles[0].body, "fore");
+  EXPECT_LT((scene.obstacles[0].pose.position - Eigen::Vector3d(0, -0.02, 0.3)).norm(), 1e-15);
+  EXPECT_LT((scene.obstacles[0].pose.orientation.toRotationMatrix() * Eigen::Vector3d::UnitZ() -
+             Eigen::Vector3d(0, -1, 0))
+                .norm(),
+            1e-15);
+  ASSERT_EQ(scene.tendons.size(), 2u);
+  const auto& wrap = scene.tendons[1].path[1];
+  ASSERT_EQ(wrap.kind, sgal::PathElement::Kind::kWrap);
+  ASSERT_TRUE(wrap.side.has_value());
+  EXPECT_LT((*wrap.side - Eigen::Vector3d(0, -0.02, 0.31)).norm(), 1e-15) << wrap.side->transpose();
   ASSERT_EQ(scene.actuators.size(), 1u);
   EXPECT_EQ(scene.actuators[0].kind, "ligament");
   EXPECT_DOUBLE_EQ(scene.actuators[0].parameters.at("stiffness"), 2000);  // 2 N/mm
@@ -481,6 +494,168 @@ TEST(UrdfImport, ZeroPositionOutsideTheLimitsWarns) {
                              "limits 0.5 .. 2 rad"),
             std::string::npos)
       << warnings[0];
+}
+
+// A small URDF written for one test, removed after it.
+class TempUrdf {
+ public:
+  TempUrdf(const std::string& name, const std::string& text)
+      : path_(fs::temp_directory_path() / ("caliper-" + name + "-" + std::to_string(getpid()))) {
+    fs::create_directories(path_);
+    std::ofstream(file()) << text;
+  }
+  ~TempUrdf() { fs::remove_all(path_); }
+  std::string file() const { return (path_ / "robot.urdf").string(); }
+  fs::path dir() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+const char* const kInertial =
+    R"(<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>)";
+
+std::string Robot(const std::string& body) { return "<robot name=\"r\">\n" + body + "\n</robot>"; }
+
+// I = R I' R^T with R the inertial origin's rotation (rpy: R = Rz(yaw) Ry(pitch) Rx(roll)), on a
+// turn about a skewed axis for which the transposed rotation (the classic bug) differs.
+TEST(UrdfImport, InertialRotationOnASkewedAxis) {
+  TempUrdf urdf("inertia", Robot(R"(<link name="base"/>
+  <link name="arm"><inertial><origin rpy="0.3 -0.4 0.5"/><mass value="1"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.003"/></inertial></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>)"));
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Import(urdf.file(), &warnings);
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  const Eigen::Matrix3d d = Eigen::Vector3d(0.001, 0.002, 0.003).asDiagonal();
+  const Eigen::Matrix3d expected = r * d * r.transpose();
+  const Eigen::Matrix3d& got = BodyOf(s, "arm").inertia.tensor;
+  EXPECT_LT((got - expected).norm(), 1e-15) << got;
+  ASSERT_GT((r.transpose() * d * r - expected).norm(), 1e-4) << "the test would not see R^T I R";
+  EXPECT_GT(std::abs(got(0, 1)), 1e-5);
+}
+
+TEST(UrdfImport, KeptFixedJointToTheWorldMakesAStaticBody) {
+  Options o;
+  o.merge_fixed_joints = false;
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Import(kData + "/side.urdf", &warnings, o);
+  EXPECT_EQ(BodyOf(s, "frame").type, sgal::BodyType::kStatic);
+  EXPECT_EQ(BodyOf(s, "rod").type, sgal::BodyType::kDynamic);
+}
+
+TEST(UrdfImport, SizesNoBodyHasAreErrors) {
+  for (const std::string geometry :
+       {R"(<box size="-1 1 1"/>)", R"(<sphere radius="0"/>)",
+        R"(<cylinder radius="0.1" length="-1"/>)", R"(<mesh filename="x.stl" scale="0 1 1"/>)",
+        R"(<mesh filename="x.stl" scale="1e40 1 1"/>)"}) {
+    TempUrdf urdf("sizes", Robot(std::string(R"(<link name="base"><visual><geometry>)") + geometry +
+                                 "</geometry></visual></link>"));
+    const std::string message = ImportError(urdf.file());
+    EXPECT_NE(message.find("robot.urdf:2: link 'base': <visual> "), std::string::npos) << message;
+    EXPECT_NE(message.find("sizes must be positive numbers"), std::string::npos) << message;
+  }
+}
+
+TEST(UrdfImport, NegativeInertiaIsAnError) {
+  TempUrdf urdf("negative", Robot(R"(<link name="base"/>
+  <link name="arm"><inertial><mass value="1"/><inertia ixx="-0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>)"));
+  const std::string message = ImportError(urdf.file());
+  EXPECT_NE(message.find(":3: link 'arm': inertia with a negative principal moment"),
+            std::string::npos)
+      << message;
+}
+
+TEST(UrdfImport, MimicCycleIsAnError) {
+  TempUrdf urdf("mimic", Robot(std::string(R"(<link name="base"/>
+  <link name="a">)") + kInertial +
+                               R"(</link>
+  <link name="b">)" + kInertial +
+                               R"(</link>
+  <joint name="ja" type="continuous"><parent link="base"/><child link="a"/><mimic joint="jb"/></joint>
+  <joint name="jb" type="continuous"><parent link="base"/><child link="b"/><mimic joint="ja"/></joint>)"));
+  const std::string message = ImportError(urdf.file());
+  EXPECT_NE(message.find("the mimics form a cycle: "), std::string::npos) << message;
+  EXPECT_NE(message.find("(line 5)"), std::string::npos) << message;
+}
+
+TEST(UrdfImport, WorldIsOnlyTheRoot) {
+  TempUrdf child("world", Robot(std::string(R"(<link name="base"/>
+  <link name="world">)") + kInertial +
+                                R"(</link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="world"/></joint>)"));
+  const std::string message = ImportError(child.file());
+  EXPECT_NE(message.find(":3: link 'world': is the child of joint 'j'"), std::string::npos)
+      << message;
+  // what a world root carries is not loaded, and the warning says so
+  TempUrdf root(
+      "worldroot",
+      Robot(
+          R"(<link name="world"><collision><geometry><box size="10 10 0.1"/></geometry></collision></link>
+  <link name="base"/>
+  <joint name="j" type="fixed"><parent link="world"/><child link="base"/></joint>)"));
+  std::vector<std::string> warnings;
+  Import(root.file(), &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(":2: link 'world': the root link 'world' is the world itself: its 0 "
+                             "visual(s) and 1 collision(s) are not loaded"),
+            std::string::npos)
+      << warnings[0];
+}
+
+TEST(UrdfImport, UrdfdomErrorsGetTheElementsLine) {
+  // a revolute joint without <limit>: urdfdom refuses it, naming the joint
+  TempUrdf urdf("nolimit", Robot(std::string(R"(<link name="base"/>
+  <link name="arm">)") + kInertial +
+                                 R"(</link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/></joint>)"));
+  const std::string message = ImportError(urdf.file());
+  EXPECT_NE(message.find("robot.urdf:4: joint 'hinge': liburdfdom cannot read it: "),
+            std::string::npos)
+      << message;
+}
+
+// Packages are found below a folder of the package path, as ROS finds them in a workspace
+// (src/REPO/PKG/package.xml); a package not found names every folder searched.
+TEST(UrdfMeshPaths, PackagesBelowTheFoldersOfThePathAndWhereItLooked) {
+  TempUrdf ws(
+      "ws",
+      Robot(
+          R"(<link name="base"><visual><geometry><mesh filename="package://deep_pkg/m/x.stl"/></geometry></visual></link>)"));
+  const fs::path pkg = ws.dir() / "src" / "repo" / "deep_pkg";
+  fs::create_directories(pkg / "m");
+  std::ofstream(pkg / "package.xml") << "<package><name>deep_pkg</name></package>";
+  fs::copy_file(kPackages + "/caliper_test_meshes/meshes/tetra_ascii.stl", pkg / "m" / "x.stl");
+  Options o;
+  o.package_path = {(ws.dir() / "src").string()};
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Import(ws.file(), &warnings, o);
+  EXPECT_EQ(BodyOf(s, "base").visuals.size(), 1u);
+  o.package_path = {kPackages};
+  const std::string message = ImportError(ws.file(), o);
+  EXPECT_NE(message.find("(no package 'deep_pkg' in or below " + kPackages + ")"),
+            std::string::npos)
+      << message;
+}
+
+TEST(UrdfImport, SideFileChoosesHowTheUrdfIsRead) {
+  TempUrdf urdf("sideopts", Robot(std::string(R"(<link name="base">)") + kInertial + R"(</link>
+  <link name="cap">)" + kInertial +
+                                  R"(</link>
+  <joint name="j" type="fixed"><parent link="base"/><child link="cap"/></joint>)"));
+  std::ofstream(urdf.dir() / "robot.caliper.xml")
+      << R"(<caliper base="floating" fixed_joints="keep"/>)";
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Import(urdf.file(), &warnings);
+  EXPECT_EQ(BodyOf(s, "base").type, sgal::BodyType::kDynamic);
+  EXPECT_EQ(JointOf(s, "j").kind, sgal::ConstraintKind::kFixed);
+  std::ofstream(urdf.dir() / "robot.caliper.xml") << R"(<caliper fixed_joints="bogus"/>)";
+  EXPECT_NE(ImportError(urdf.file()).find("robot.caliper.xml:1: <caliper>: fixed_joints=\"bogus\""),
+            std::string::npos);
 }
 
 TEST(UrdfImport, FloatingBaseFromOptionsAndFromTheFile) {
