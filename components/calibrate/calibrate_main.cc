@@ -99,7 +99,10 @@ Options Parse(int argc, char** argv) {
 
 // The parameters' values in the scene as it is (asked of a Model).
 std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
-  const std::string bytes = ctl::ReadScene(spec.experiments.front().scene);
+  // a URDF is imported here and sent converted: its import warnings are said here, once
+  std::vector<std::string> warnings;
+  const std::string bytes = ctl::ReadScene(spec.experiments.front().scene, &warnings);
+  for (const auto& w : warnings) std::cerr << "caliper-calibrate: warning: " << w << "\n";
   std::vector<double> values;
   pool.WithModel([&](M::Model_ptr model) {
     try {
