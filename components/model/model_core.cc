@@ -14,6 +14,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
+#include "caliper/core/scratch_directory.h"
 #include "caliper/logging/log.h"
 #include "caliper/urdf/model_file.h"
 
@@ -139,31 +140,6 @@ void ModelCore::Load(const std::string& path) {
   LoadScene(scene, path);
 }
 
-namespace {
-
-// A private directory, removed with everything in it when the object goes.
-class ScratchDirectory {
- public:
-  ScratchDirectory() {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") +
-                          "/caliper-scene-XXXXXX";
-    if (mkdtemp(pattern.data()) == nullptr)
-      throw std::runtime_error("cannot make a scratch directory in " + pattern + ": " +
-                               std::strerror(errno));
-    path_ = pattern;
-  }
-  ~ScratchDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-}  // namespace
 
 sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::string& bytes) const {
   // the importer reads files (Collada-DOM opens .zae archives itself): a private copy, gone after
@@ -179,7 +155,7 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
   if (ending != ".dae" && ending != ".zae")
     throw LoadError(file_name + ": a scene sent by content must be named *.dae or *.zae");
   if (bytes.empty()) throw LoadError(file_name + ": the scene sent is empty");
-  ScratchDirectory scratch;
+  core::ScratchDirectory scratch("caliper-scene");
   // a plain name for the copy: the importer refuses names it would read as URIs ('#', '%')
   const std::string path = scratch.path() + "/scene" + ending;
   {
@@ -225,7 +201,7 @@ void ModelCore::LoadData(const std::string& file_name, const std::string& bytes)
 }
 
 std::string ModelCore::ExportBytes() {
-  ScratchDirectory scratch;
+  core::ScratchDirectory scratch("caliper-scene");
   const std::string path = scratch.path() + "/scene.dae";
   Save(path);
   std::ifstream in(path, std::ios::binary);

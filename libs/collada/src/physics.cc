@@ -24,6 +24,15 @@ const Eigen::Quaterniond kZToY(Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::Unit
 // The names of the degrees of freedom of a generic constraint, in sgal's order.
 const char* const kDofNames[6] = {"x", "y", "z", "rx", "ry", "rz"};
 
+// The degree of freedom an element's dof attribute names (0-5 or x, y, z, rx, ry, rz; 0 when
+// absent); fails naming the element for another.
+int DofSlot(const Context& ctx, const Element& e) {
+  const std::string dof = e.Attribute("dof", "0");
+  for (int i = 0; i < 6; ++i)
+    if (dof == kDofNames[i] || dof == std::to_string(i)) return i;
+  ctx.Fail(&e, "unknown degree of freedom '" + dof + "' (0-5 or x, y, z, rx, ry, rz)");
+}
+
 std::string Strip(const std::string& url) {
   return !url.empty() && url[0] == '#' ? url.substr(1) : url;
 }
@@ -755,21 +764,11 @@ bool ReadConstraintExtra(Context& ctx, const Element& owner, sgal::Constraint* c
       } else if (n == "name") {
         // read with the constraint's name
       } else if (n == "spring") {
-        const std::string dof = e->Attribute("dof", "0");
-        int slot = -1;
-        for (int i = 0; i < 6; ++i)
-          if (dof == kDofNames[i] || dof == std::to_string(i)) slot = i;
-        if (slot < 0)
-          ctx.Fail(e.get(), "unknown degree of freedom '" + dof + "' (0-5 or x, y, z, rx, ry, rz)");
+        const int slot = DofSlot(ctx, *e);
         const auto v = ctx.Numbers(*e, 3);
         c->springs[slot] = sgal::JointSpring{v[0], v[1], v[2]};
       } else if (n == "friction") {
-        const std::string dof = e->Attribute("dof", "0");
-        int slot = -1;
-        for (int i = 0; i < 6; ++i)
-          if (dof == kDofNames[i] || dof == std::to_string(i)) slot = i;
-        if (slot < 0)
-          ctx.Fail(e.get(), "unknown degree of freedom '" + dof + "' (0-5 or x, y, z, rx, ry, rz)");
+        const int slot = DofSlot(ctx, *e);
         const double friction = ctx.Numbers(*e, 1)[0];
         if (!(friction >= 0) || !std::isfinite(friction))
           ctx.Fail(e.get(), "joint friction " + e->Trimmed() +

@@ -120,6 +120,15 @@ Eigen::Matrix3d Shift(double mass, const Eigen::Vector3d& d) {
   return mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
 }
 
+// What a link gets that needs a mass and has none: kDefaultMass as a solid sphere of
+// kDefaultRadius about the link's origin.
+MassProperties DefaultMass() {
+  MassProperties m;
+  m.mass = kDefaultMass;
+  m.tensor = Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
+  return m;
+}
+
 // Two bodies' mass properties as one (both in the same frame).
 MassProperties Combine(const MassProperties& a, const MassProperties& b) {
   MassProperties out;
@@ -765,10 +774,7 @@ class Importer {
         Warn(WhereLink(body.name), "no <inertial> on a moving link; " + Number(kDefaultMass) +
                                        " kg assumed, as a solid sphere of radius " +
                                        Number(kDefaultRadius) + " m about the link's origin");
-        m.mass = kDefaultMass;
-        m.com.setZero();
-        m.tensor =
-            Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
+        m = DefaultMass();
       } else if (moving && !(m.mass > 0)) {
         const auto joint = model_->getLink(body.name)->parent_joint;
         if (joint && joint->type == ::urdf::Joint::FIXED) {
@@ -776,10 +782,7 @@ class Importer {
           Warn(WhereLink(body.name), "mass 0 kg on a link held by the fixed joint '" + joint->name +
                                          "', which is kept as a constraint; " +
                                          Number(kDefaultMass) + " kg assumed");
-          m.mass = kDefaultMass;
-          m.com.setZero();
-          m.tensor =
-              Eigen::Matrix3d::Identity() * 0.4 * kDefaultMass * kDefaultRadius * kDefaultRadius;
+          m = DefaultMass();
         } else {
           Fail(WhereLink(body.name),
                "mass " + Number(m.mass) + " kg on a moving link (" +

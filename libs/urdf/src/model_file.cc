@@ -13,9 +13,11 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "caliper/collada/exporter.h"
+#include "caliper/core/scratch_directory.h"
 #include "caliper/urdf/importer.h"
 
 namespace caliper::model_file {
@@ -61,30 +63,6 @@ std::string ReadBytes(const std::string& path) {
   if (in.bad()) throw collada::ImportError(path + " cannot be read: " + std::strerror(errno));
   return bytes;
 }
-
-// A private directory, removed with everything in it when the object goes.
-class ScratchDirectory {
- public:
-  ScratchDirectory() {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern =
-        std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/caliper-urdf-XXXXXX";
-    if (mkdtemp(pattern.data()) == nullptr)
-      throw collada::ExportError("cannot make a temporary directory " + pattern + ": " +
-                                 std::strerror(errno));
-    path_ = pattern;
-  }
-  ~ScratchDirectory() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  ScratchDirectory(const ScratchDirectory&) = delete;
-  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 }  // namespace
 
@@ -153,8 +131,13 @@ Content ContentToSend(const std::string& path, std::vector<std::string>* warning
     case Format::kUrdf: {
       const sgal::Scene scene = urdf::Import(path, warnings);
       const std::string name = fs::path(path).stem().string() + ".dae";
-      ScratchDirectory scratch;
-      const std::string file = scratch.path() + "/scene.dae";
+      std::optional<core::ScratchDirectory> scratch;
+      try {
+        scratch.emplace("caliper-urdf");
+      } catch (const std::runtime_error& e) {
+        throw collada::ExportError(e.what());
+      }
+      const std::string file = scratch->path() + "/scene.dae";
       collada::Export(scene, file);
       return {name, ReadBytes(file)};
     }
