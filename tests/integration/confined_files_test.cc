@@ -14,8 +14,8 @@
 
 #include "caliper/model.hh"
 #include "caliper/rtc/client_orb.h"
-#include "caliper/rtc/naming.h"
 #include "corpus.h"
+#include "support/corba.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -26,10 +26,6 @@ namespace M = ::Caliper::Simulation;
 namespace D = ::Caliper::Daq;
 
 using std::chrono::seconds;
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 std::string Source(const std::string& relative) {
   const char* dir = std::getenv("CALIPER_SOURCE_DIR");
@@ -63,19 +59,9 @@ class ConfinedFilesTest : public ::testing::Test {
                                   "log.spool_dir=" + root_ + "/spool"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     model_ = std::make_unique<Process>(argv, root_ + "/model.out");
-    ASSERT_TRUE(WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root =
-                rtc::ResolveRoot(rtc::ClientOrb("confined_files_test"), naming_->address());
-            ref_ = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(ref_) && !ref_->_non_existent();
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20)))
-        << model_->Output();
+    ref_ = WaitForModel(rtc::ClientOrb("confined_files_test"), naming_->address(), "model0",
+                        seconds(20));
+    ASSERT_FALSE(CORBA::is_nil(ref_)) << model_->Output();
   }
 
   void StartConfinedModel() {
@@ -83,14 +69,8 @@ class ConfinedFilesTest : public ::testing::Test {
                 "model.write_dir=" + root_ + "/session"});
   }
 
-  /// LoadFailed's reason for load_scene(path) ("" when it loaded).
   std::string LoadRefusal(const std::string& path) {
-    try {
-      ref_->load_scene(path.c_str());
-      return "";
-    } catch (const M::LoadFailed& e) {
-      return e.reason.in();
-    }
+    return caliper::testing::LoadRefusal(ref_, path);
   }
 
   /// InvalidParameter's reason for save_scene(path) ("" when it saved).
@@ -103,10 +83,7 @@ class ConfinedFilesTest : public ::testing::Test {
     }
   }
 
-  std::string Scene() {
-    M::SimulationStatus_var s = ref_->status();
-    return s->scene.in();
-  }
+  std::string Scene() { return LoadedScene(ref_); }
 
   CommandResult Ctl(const std::vector<std::string>& args) {
     return caliper::testing::Ctl(naming_->address(), args);

@@ -15,7 +15,7 @@
 
 #include "caliper/model.hh"
 #include "caliper/rtc/client_orb.h"
-#include "caliper/rtc/naming.h"
+#include "support/corba.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -59,38 +59,19 @@ class UrdfModelTest : public ::testing::Test {
                                  "model.read_dirs=" + root_ + "/models", "-o",
                                  "model.write_dir=" + root_ + "/session"},
         root_ + "/model.out");
-    ASSERT_TRUE(WaitFor(
-        [&] {
-          try {
-            CosNaming::NamingContext_var root =
-                rtc::ResolveRoot(rtc::ClientOrb("urdf_model_test"), naming_->address());
-            ref_ = M::Model::_narrow(rtc::FindComponent(root, "model0").object);
-            return !CORBA::is_nil(ref_) && !ref_->_non_existent();
-          } catch (...) {
-            return false;
-          }
-        },
-        seconds(20)))
-        << model_->Output();
+    ref_ =
+        WaitForModel(rtc::ClientOrb("urdf_model_test"), naming_->address(), "model0", seconds(20));
+    ASSERT_FALSE(CORBA::is_nil(ref_)) << model_->Output();
   }
 
   CommandResult Ctl(const std::vector<std::string>& args) {
     return caliper::testing::Ctl(naming_->address(), args);
   }
 
-  std::string Scene() {
-    M::SimulationStatus_var s = ref_->status();
-    return s->scene.in();
-  }
+  std::string Scene() { return LoadedScene(ref_); }
 
-  /// LoadFailed's reason for load_scene(path) ("" when it loaded).
   std::string LoadRefusal(const std::string& path) {
-    try {
-      ref_->load_scene(path.c_str());
-      return "";
-    } catch (const M::LoadFailed& e) {
-      return e.reason.in();
-    }
+    return caliper::testing::LoadRefusal(ref_, path);
   }
 
   /// Steps `n` and says whether all ran without a fault.

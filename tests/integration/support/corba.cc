@@ -97,6 +97,37 @@ CORBA::Object_ptr Activate(CORBA::ORB_ptr orb, PortableServer::ServantBase* serv
   return q;
 }
 
+M::Model_ptr WaitForModel(CORBA::ORB_ptr orb, const std::string& naming_address,
+                          const std::string& name, std::chrono::milliseconds timeout) {
+  M::Model_var model;
+  const bool answered = WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, naming_address);
+          model = M::Model::_narrow(rtc::FindComponent(root, name).object);
+          return !CORBA::is_nil(model) && !model->_non_existent();
+        } catch (...) {
+          return false;
+        }
+      },
+      timeout);
+  return answered ? model._retn() : M::Model::_nil();
+}
+
+std::string LoadRefusal(M::Model_ptr model, const std::string& path) {
+  try {
+    model->load_scene(path.c_str());
+    return "";
+  } catch (const M::LoadFailed& e) {
+    return e.reason.in();
+  }
+}
+
+std::string LoadedScene(M::Model_ptr model) {
+  M::SimulationStatus_var s = model->status();
+  return s->scene.in();
+}
+
 void ModelProcessTest::SetUp() {
   orb_();
   naming_ = std::make_unique<NamingService>(dir_.path());

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <omniORB4/CORBA.h>
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +43,19 @@ CORBA::Object_ptr Activate(CORBA::ORB_ptr orb, PortableServer::ServantBase* serv
 /// A query of every record up to priority 700 of `instance` ("" = any) whose message matches
 /// `regex` ("" = any), at any time, unlimited.
 ::Caliper::Logging::RecordFilter RecordsOf(const std::string& instance, const std::string& regex);
+
+/// The Model bound as `name` in the naming service at `naming_address`, reached through `orb`,
+/// as soon as it answers (not _non_existent); nil when it is not bound or does not answer within
+/// `timeout` (the naming service and the Model start on their own time, so every failure until
+/// then counts as "not yet").
+M::Model_ptr WaitForModel(CORBA::ORB_ptr orb, const std::string& naming_address,
+                          const std::string& name, std::chrono::milliseconds timeout);
+
+/// The reason of the LoadFailed `model`->load_scene(`path`) raises; "" when it loads.
+std::string LoadRefusal(M::Model_ptr model, const std::string& path);
+
+/// The scene `model` has loaded, as its status says ("" when none).
+std::string LoadedScene(M::Model_ptr model);
 
 /// A fixture running caliper-model with the shipped pendulum_tendon.dae (its execution context
 /// active: 200 Hz, real time; no log service) bound as model0 in a private naming service, reached

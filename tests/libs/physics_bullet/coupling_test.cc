@@ -9,6 +9,7 @@
 
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/sgal/kinematics.h"
+#include "test_scenes.h"
 
 namespace caliper::physics_bullet {
 namespace {
@@ -33,12 +34,7 @@ constexpr Arm kFollower{0.5, 0.15, 1e-3};
 /// Two arms on a static base, hinged about the world y axis 0.3 m apart, level at zero
 /// (gravity turns both towards positive angles); the follower coupled to the leader.
 sgal::Scene Pair(bool follower_slides = false) {
-  sgal::Scene s;
-  s.name = "pair";
-  sgal::Body base;
-  base.name = "base";
-  base.type = sgal::BodyType::kStatic;
-  s.bodies.push_back(base);
+  sgal::Scene s = testing::SceneOnStaticBase("pair");
   const Eigen::Quaterniond z_to_y(Eigen::AngleAxisd(-M_PI / 2, Vector3d::UnitX()));
   auto add = [&](const std::string& name, const Arm& arm, const Vector3d& pivot) {
     sgal::Body b;
@@ -48,14 +44,8 @@ sgal::Scene Pair(bool follower_slides = false) {
     b.inertia.com = Vector3d(arm.length, 0, 0);
     b.inertia.tensor = Vector3d(arm.iyy / 2, arm.iyy, arm.iyy).asDiagonal();
     s.bodies.push_back(b);
-    sgal::Constraint c;
-    c.name = name + "_joint";
-    c.body_a = name;
-    c.body_b = "base";
-    c.frame_a.orientation = z_to_y;
-    c.frame_b.position = pivot;
-    c.frame_b.orientation = z_to_y;
-    s.constraints.push_back(c);
+    s.constraints.push_back(
+        testing::Joint(name + "_joint", sgal::ConstraintKind::kHinge, name, "base", z_to_y, pivot));
   };
   add("leader", kLeader, Vector3d::Zero());
   add("follower", kFollower, Vector3d(0, 0.3, 0));

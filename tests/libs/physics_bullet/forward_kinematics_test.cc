@@ -11,6 +11,7 @@
 
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/sgal/kinematics.h"
+#include "test_scenes.h"
 
 namespace caliper::physics_bullet {
 namespace {
@@ -32,46 +33,22 @@ sgal::Body Link(const std::string& name, const Vector3d& position, double mass,
 /// link1's x on a spring; link3 hinged to link2 about an axis tilted from y, so that the chain
 /// leaves the xz plane. Body frames at their joints, x along each link.
 sgal::Scene Chain() {
-  sgal::Scene s;
-  s.name = "chain";
-  sgal::Body base;
-  base.name = "base";
-  base.type = sgal::BodyType::kStatic;
-  s.bodies.push_back(base);
+  sgal::Scene s = testing::SceneOnStaticBase("chain");
   s.bodies.push_back(Link("link1", Vector3d::Zero(), 1.0, Vector3d(1e-3, 8e-3, 8e-3)));
   s.bodies.push_back(Link("link2", Vector3d(0.3, 0, 0), 0.6, Vector3d(5e-4, 3e-3, 3e-3)));
   s.bodies.push_back(Link("link3", Vector3d(0.5, 0, 0), 0.4, Vector3d(3e-4, 2e-3, 2e-3)));
   const Eigen::Quaterniond z_to_y(Eigen::AngleAxisd(-M_PI / 2, Vector3d::UnitX()));
-  sgal::Constraint shoulder;
-  shoulder.name = "shoulder";
-  shoulder.kind = sgal::ConstraintKind::kHinge;
-  shoulder.body_a = "link1";
-  shoulder.body_b = "base";
-  shoulder.frame_a.orientation = z_to_y;
-  shoulder.frame_b.orientation = z_to_y;
-  s.constraints.push_back(shoulder);
-  sgal::Constraint rail;
-  rail.name = "rail";
-  rail.kind = sgal::ConstraintKind::kSlider;
-  rail.body_a = "link2";
-  rail.body_b = "link1";
+  s.constraints.push_back(
+      testing::Joint("shoulder", sgal::ConstraintKind::kHinge, "link1", "base", z_to_y));
   const Eigen::Quaterniond z_to_x(Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitY()));
-  rail.frame_a.orientation = z_to_x;
-  rail.frame_b.position = Vector3d(0.3, 0, 0);
-  rail.frame_b.orientation = z_to_x;
+  sgal::Constraint rail = testing::Joint("rail", sgal::ConstraintKind::kSlider, "link2", "link1",
+                                         z_to_x, Vector3d(0.3, 0, 0));
   rail.springs[0] = {300.0, 2.0, 0.0};  // [N/m], [N s/m], [m]
   s.constraints.push_back(rail);
-  sgal::Constraint elbow;
-  elbow.name = "elbow";
-  elbow.kind = sgal::ConstraintKind::kHinge;
-  elbow.body_a = "link3";
-  elbow.body_b = "link2";
   const Eigen::Quaterniond tilted(Eigen::AngleAxisd(-M_PI / 2, Vector3d::UnitX()) *
                                   Eigen::AngleAxisd(0.4, Vector3d::UnitY()));
-  elbow.frame_a.orientation = tilted;
-  elbow.frame_b.position = Vector3d(0.2, 0, 0);
-  elbow.frame_b.orientation = tilted;
-  s.constraints.push_back(elbow);
+  s.constraints.push_back(testing::Joint("elbow", sgal::ConstraintKind::kHinge, "link3", "link2",
+                                         tilted, Vector3d(0.2, 0, 0)));
   return s;
 }
 

@@ -62,6 +62,46 @@ std::string ImportError(const std::string& file, const Options& options = {}) {
   return "";
 }
 
+// A small URDF written for one test, removed after it.
+class TempUrdf {
+ public:
+  TempUrdf(const std::string& name, const std::string& text)
+      : path_(fs::temp_directory_path() / ("caliper-" + name + "-" + std::to_string(getpid()))) {
+    fs::create_directories(path_);
+    std::ofstream(file()) << text;
+  }
+  ~TempUrdf() { fs::remove_all(path_); }
+  std::string file() const { return (path_ / "robot.urdf").string(); }
+  fs::path dir() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+const char* const kInertial =
+    R"(<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>)";
+
+std::string Robot(const std::string& body) { return "<robot name=\"r\">\n" + body + "\n</robot>"; }
+
+// A link `name` of 1 kg with kInertial, on one line.
+std::string InertialLink(const std::string& name) {
+  return "<link name=\"" + name + "\">" + kInertial + "</link>";
+}
+
+// ImportError of `text` written as robot.urdf in a folder of its own named after `name`.
+std::string ImportErrorOf(const std::string& name, const std::string& text) {
+  TempUrdf urdf(name, text);
+  return ImportError(urdf.file());
+}
+
+// The warnings of importing `text` written as robot.urdf in a folder of its own named after `name`.
+std::vector<std::string> ImportWarningsOf(const std::string& name, const std::string& text) {
+  TempUrdf urdf(name, text);
+  std::vector<std::string> warnings;
+  Import(urdf.file(), &warnings);
+  return warnings;
+}
+
 // World pose of body_a's joint frame when the joint is at q, from the constraint's frames.
 Eigen::Isometry3d ChildAt(const sgal::Scene& s, const sgal::Constraint& c, double q) {
   const Eigen::Isometry3d parent =
@@ -435,18 +475,15 @@ TEST(UrdfImport, MissingMeshListsEveryPlaceTried) {
 }
 
 TEST(UrdfImport, ImpossibleInertiaIsRaisedWithAWarning) {
-  const fs::path file =
-      fs::temp_directory_path() / ("caliper-inertia-" + std::to_string(getpid()) + ".urdf");
-  std::ofstream(file) << R"(<robot name="r">
+  TempUrdf urdf("raised", R"(<robot name="r">
   <link name="base"/>
   <link name="arm">
     <inertial><mass value="1"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.01"/></inertial>
   </link>
   <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
-</robot>)";
+</robot>)");
   std::vector<std::string> warnings;
-  const sgal::Scene s = Import(file.string(), &warnings);
-  fs::remove(file);
+  const sgal::Scene s = Import(urdf.file(), &warnings);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find(":3: link 'arm': principal moments of inertia 0.001 0.001 0.01 kg m^2 "
                              "are not those of a rigid body; raised to 0.005 0.005 0.01"),
@@ -478,44 +515,18 @@ TEST_F(KindsTest, LinksDoNotCollideWithEachOtherByDefault) {
 }
 
 TEST(UrdfImport, ZeroPositionOutsideTheLimitsWarns) {
-  const fs::path file =
-      fs::temp_directory_path() / ("caliper-limits-" + std::to_string(getpid()) + ".urdf");
-  std::ofstream(file) << R"(<robot name="r">
+  const std::vector<std::string> warnings = ImportWarningsOf("limits", R"(<robot name="r">
   <link name="base"/>
   <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
     <limit lower="0.5" upper="2" effort="1" velocity="1"/></joint>
-</robot>)";
-  std::vector<std::string> warnings;
-  Import(file.string(), &warnings);
-  fs::remove(file);
+</robot>)");
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find(":4: joint 'j': the link's frame is at joint position 0, outside the "
                              "limits 0.5 .. 2 rad"),
             std::string::npos)
       << warnings[0];
 }
-
-// A small URDF written for one test, removed after it.
-class TempUrdf {
- public:
-  TempUrdf(const std::string& name, const std::string& text)
-      : path_(fs::temp_directory_path() / ("caliper-" + name + "-" + std::to_string(getpid()))) {
-    fs::create_directories(path_);
-    std::ofstream(file()) << text;
-  }
-  ~TempUrdf() { fs::remove_all(path_); }
-  std::string file() const { return (path_ / "robot.urdf").string(); }
-  fs::path dir() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-const char* const kInertial =
-    R"(<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>)";
-
-std::string Robot(const std::string& body) { return "<robot name=\"r\">\n" + body + "\n</robot>"; }
 
 // I = R I' R^T with R the inertial origin's rotation (rpy: R = Rz(yaw) Ry(pitch) Rx(roll)), on a
 // turn about a skewed axis for which the transposed rotation (the classic bug) differs.
@@ -552,54 +563,46 @@ TEST(UrdfImport, SizesNoBodyHasAreErrors) {
        {R"(<box size="-1 1 1"/>)", R"(<sphere radius="0"/>)",
         R"(<cylinder radius="0.1" length="-1"/>)", R"(<mesh filename="x.stl" scale="0 1 1"/>)",
         R"(<mesh filename="x.stl" scale="1e40 1 1"/>)"}) {
-    TempUrdf urdf("sizes", Robot(std::string(R"(<link name="base"><visual><geometry>)") + geometry +
-                                 "</geometry></visual></link>"));
-    const std::string message = ImportError(urdf.file());
+    const std::string message =
+        ImportErrorOf("sizes", Robot(std::string(R"(<link name="base"><visual><geometry>)") +
+                                     geometry + "</geometry></visual></link>"));
     EXPECT_NE(message.find("robot.urdf:2: link 'base': <visual> "), std::string::npos) << message;
     EXPECT_NE(message.find("sizes must be positive numbers"), std::string::npos) << message;
   }
 }
 
 TEST(UrdfImport, NegativeInertiaIsAnError) {
-  TempUrdf urdf("negative", Robot(R"(<link name="base"/>
+  const std::string message = ImportErrorOf("negative", Robot(R"(<link name="base"/>
   <link name="arm"><inertial><mass value="1"/><inertia ixx="-0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>)"));
-  const std::string message = ImportError(urdf.file());
   EXPECT_NE(message.find(":3: link 'arm': inertia with a negative principal moment"),
             std::string::npos)
       << message;
 }
 
 TEST(UrdfImport, MimicCycleIsAnError) {
-  TempUrdf urdf("mimic", Robot(std::string(R"(<link name="base"/>
-  <link name="a">)") + kInertial +
-                               R"(</link>
-  <link name="b">)" + kInertial +
-                               R"(</link>
+  const std::string message = ImportErrorOf("mimic", Robot(R"(<link name="base"/>
+  )" + InertialLink("a") + R"(
+  )" + InertialLink("b") + R"(
   <joint name="ja" type="continuous"><parent link="base"/><child link="a"/><mimic joint="jb"/></joint>
   <joint name="jb" type="continuous"><parent link="base"/><child link="b"/><mimic joint="ja"/></joint>)"));
-  const std::string message = ImportError(urdf.file());
   EXPECT_NE(message.find("the mimics form a cycle: "), std::string::npos) << message;
   EXPECT_NE(message.find("(line 5)"), std::string::npos) << message;
 }
 
 TEST(UrdfImport, WorldIsOnlyTheRoot) {
-  TempUrdf child("world", Robot(std::string(R"(<link name="base"/>
-  <link name="world">)") + kInertial +
-                                R"(</link>
+  const std::string message = ImportErrorOf("world", Robot(R"(<link name="base"/>
+  )" + InertialLink("world") + R"(
   <joint name="j" type="continuous"><parent link="base"/><child link="world"/></joint>)"));
-  const std::string message = ImportError(child.file());
   EXPECT_NE(message.find(":3: link 'world': is the child of joint 'j'"), std::string::npos)
       << message;
   // what a world root carries is not loaded, and the warning says so
-  TempUrdf root(
+  const std::vector<std::string> warnings = ImportWarningsOf(
       "worldroot",
       Robot(
           R"(<link name="world"><collision><geometry><box size="10 10 0.1"/></geometry></collision></link>
   <link name="base"/>
   <joint name="j" type="fixed"><parent link="world"/><child link="base"/></joint>)"));
-  std::vector<std::string> warnings;
-  Import(root.file(), &warnings);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find(":2: link 'world': the root link 'world' is the world itself: its 0 "
                              "visual(s) and 1 collision(s) are not loaded"),
@@ -609,11 +612,9 @@ TEST(UrdfImport, WorldIsOnlyTheRoot) {
 
 TEST(UrdfImport, UrdfdomErrorsGetTheElementsLine) {
   // a revolute joint without <limit>: urdfdom refuses it, naming the joint
-  TempUrdf urdf("nolimit", Robot(std::string(R"(<link name="base"/>
-  <link name="arm">)") + kInertial +
-                                 R"(</link>
+  const std::string message = ImportErrorOf("nolimit", Robot(R"(<link name="base"/>
+  )" + InertialLink("arm") + R"(
   <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/></joint>)"));
-  const std::string message = ImportError(urdf.file());
   EXPECT_NE(message.find("robot.urdf:4: joint 'hinge': liburdfdom cannot read it: "),
             std::string::npos)
       << message;
@@ -643,9 +644,7 @@ TEST(UrdfMeshPaths, PackagesBelowTheFoldersOfThePathAndWhereItLooked) {
 }
 
 TEST(UrdfImport, SideFileChoosesHowTheUrdfIsRead) {
-  TempUrdf urdf("sideopts", Robot(std::string(R"(<link name="base">)") + kInertial + R"(</link>
-  <link name="cap">)" + kInertial +
-                                  R"(</link>
+  TempUrdf urdf("sideopts", Robot(InertialLink("base") + "\n  " + InertialLink("cap") + R"(
   <joint name="j" type="fixed"><parent link="base"/><child link="cap"/></joint>)"));
   std::ofstream(urdf.dir() / "robot.caliper.xml")
       << R"(<caliper base="floating" fixed_joints="keep"/>)";
@@ -665,16 +664,13 @@ TEST(UrdfImport, FloatingBaseFromOptionsAndFromTheFile) {
   EXPECT_EQ(BodyOf(Import(kData + "/kinds.urdf", &warnings, o), "base").type,
             sgal::BodyType::kDynamic);
   // <caliper base="floating" fixed_joints="keep"> in the file says the same
-  const fs::path file =
-      fs::temp_directory_path() / ("caliper-base-" + std::to_string(getpid()) + ".urdf");
-  std::ofstream(file) << R"(<robot name="r">
+  TempUrdf urdf("base", R"(<robot name="r">
   <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <link name="cap"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <joint name="j" type="fixed"><parent link="base"/><child link="cap"/></joint>
   <caliper base="floating" fixed_joints="keep"/>
-</robot>)";
-  const sgal::Scene s = Import(file.string(), &warnings);
-  fs::remove(file);
+</robot>)");
+  const sgal::Scene s = Import(urdf.file(), &warnings);
   EXPECT_EQ(BodyOf(s, "base").type, sgal::BodyType::kDynamic);
   EXPECT_EQ(JointOf(s, "j").kind, sgal::ConstraintKind::kFixed);
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <stdexcept>
 
@@ -106,6 +107,23 @@ mjModel* LoadCopy(const std::string& urdf_path, const std::vector<std::string>& 
   return model;
 }
 
+// urdfdom's joint type as a URDF file spells it.
+std::string JointTypeName(int type) {
+  static const std::map<int, std::string> kNames = {
+      {urdf::Joint::REVOLUTE, "revolute"},   {urdf::Joint::CONTINUOUS, "continuous"},
+      {urdf::Joint::PRISMATIC, "prismatic"}, {urdf::Joint::FIXED, "fixed"},
+      {urdf::Joint::FLOATING, "floating"},   {urdf::Joint::PLANAR, "planar"}};
+  const auto it = kNames.find(type);
+  return it == kNames.end() ? "unknown" : it->second;
+}
+
+// The names of `model`'s objects of `type` with ids `first` to `end` - 1.
+std::vector<std::string> Names(const mjModel* model, mjtObj type, int first, int end) {
+  std::vector<std::string> names;
+  for (int i = first; i < end; ++i) names.push_back(mj_id2name(model, type, i));
+  return names;
+}
+
 }  // namespace
 
 std::vector<UrdfJoint> ReadUrdfJoints(const std::string& urdf_path) {
@@ -122,29 +140,7 @@ std::vector<UrdfJoint> ReadUrdfJoints(const std::string& urdf_path) {
     joint.name = j->name;
     joint.parent = j->parent_link_name;
     joint.child = j->child_link_name;
-    switch (j->type) {
-      case urdf::Joint::REVOLUTE:
-        joint.type = "revolute";
-        break;
-      case urdf::Joint::CONTINUOUS:
-        joint.type = "continuous";
-        break;
-      case urdf::Joint::PRISMATIC:
-        joint.type = "prismatic";
-        break;
-      case urdf::Joint::FIXED:
-        joint.type = "fixed";
-        break;
-      case urdf::Joint::FLOATING:
-        joint.type = "floating";
-        break;
-      case urdf::Joint::PLANAR:
-        joint.type = "planar";
-        break;
-      default:
-        joint.type = "unknown";
-        break;
-    }
+    joint.type = JointTypeName(j->type);
     if (j->type == urdf::Joint::CONTINUOUS) {
       joint.lower = -M_PI;
       joint.upper = M_PI;
@@ -216,16 +212,13 @@ double MujocoUrdf::total_mass() const {
   return mass;
 }
 
+// body 0 is MuJoCo's world
 std::vector<std::string> MujocoUrdf::body_names() const {
-  std::vector<std::string> names;
-  for (int i = 1; i < model_->nbody; ++i) names.push_back(mj_id2name(model_, mjOBJ_BODY, i));
-  return names;
+  return Names(model_, mjOBJ_BODY, 1, model_->nbody);
 }
 
 std::vector<std::string> MujocoUrdf::joint_names() const {
-  std::vector<std::string> names;
-  for (int i = 0; i < model_->njnt; ++i) names.push_back(mj_id2name(model_, mjOBJ_JOINT, i));
-  return names;
+  return Names(model_, mjOBJ_JOINT, 0, model_->njnt);
 }
 
 double MujocoUrdf::body_mass(const std::string& body) const {
