@@ -76,3 +76,18 @@ function(caliper_test name)
     LABELS "${ARG_LABELS}"
     ENVIRONMENT "CALIPER_BIN_DIR=${CMAKE_BINARY_DIR}/bin;CALIPER_CONFIG_DIR=${CMAKE_SOURCE_DIR}/config;CALIPER_SOURCE_DIR=${CMAKE_SOURCE_DIR};CALIPER_CORPUS_DEFAULT=${CMAKE_SOURCE_DIR}/../shared/corpus")
 endfunction()
+
+# caliper_find_mujoco(VAR): finds MuJoCo 2.2.2 (libmujoco-dev, the benchmarks' and cross-checks'
+# reference) in the calling directory and sets VAR to TRUE when mujoco::mujoco can be linked.
+# Debian's mujoco target names an include directory that does not exist: dropped here.
+function(caliper_find_mujoco var)
+  find_package(mujoco CONFIG QUIET)
+  if(NOT mujoco_FOUND)
+    set(${var} FALSE PARENT_SCOPE)
+    return()
+  endif()
+  get_target_property(_mj_inc mujoco::mujoco INTERFACE_INCLUDE_DIRECTORIES)
+  list(FILTER _mj_inc EXCLUDE REGEX "qhull")
+  set_target_properties(mujoco::mujoco PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_mj_inc}")
+  set(${var} TRUE PARENT_SCOPE)
+endfunction()
