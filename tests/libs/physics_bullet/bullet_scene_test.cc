@@ -667,3 +667,58 @@ TEST(BulletScene, HingePositionCountsWholeTurns) {
 
 }  // namespace
 }  // namespace caliper::physics_bullet
+
+// Limits of a hinge beyond +-pi, as URDF arms have them: a span of a full turn or more has no
+// stops (Bullet keeps its stops within one turn); a span of less than a turn that lies beyond pi
+// holds the joint inside it, on the side of the circle where it lies.
+namespace caliper::physics_bullet {
+namespace {
+
+// A wheel on a hinge about z spun at 10 rad/s without gravity for 1 s: the lowest and highest
+// positions it reached [rad] (a stop throws it back: Bullet's limits bounce).
+std::pair<double, double> SpunWheel(double lower, double upper) {
+  sgal::Scene scene;
+  scene.gravity.setZero();
+  sgal::Body base;
+  base.name = "base";
+  base.type = sgal::BodyType::kStatic;
+  scene.bodies.push_back(base);
+  sgal::Body wheel;
+  wheel.name = "wheel";
+  wheel.inertia.mass = 1;
+  wheel.inertia.tensor = Eigen::Matrix3d::Identity() * 0.01;
+  wheel.angular_velocity = Eigen::Vector3d(0, 0, 10);  // [rad/s]
+  scene.bodies.push_back(wheel);
+  sgal::Constraint axle;
+  axle.name = "axle";
+  axle.body_a = "wheel";
+  axle.body_b = "base";
+  axle.limits[0].lower = lower;
+  axle.limits[0].upper = upper;
+  scene.constraints.push_back(axle);
+  auto physics = MakeScene(scene);
+  std::pair<double, double> range(0, 0);
+  for (int i = 0; i < 1000; ++i) {
+    physics->Step();
+    const double q = physics->GetParameter("axle.position");
+    range = {std::min(range.first, q), std::max(range.second, q)};
+  }
+  return range;
+}
+
+TEST(BulletScene, HingeLimitsBeyondHalfATurn) {
+  // -2 pi .. 2 pi (a UR5's): free, the wheel turns on to 10 rad
+  EXPECT_NEAR(SpunWheel(-2 * M_PI, 2 * M_PI).second, 10.0, 1e-2);
+  // -0.5 .. 2.5 rad: held between the stops
+  auto [low, high] = SpunWheel(-0.5, 2.5);
+  EXPECT_NEAR(high, 2.5, 0.05);
+  EXPECT_GT(low, -0.55);
+  // -4.0 .. 2.0: a span of less than a turn reaching past -pi; spinning up, the wheel stops at
+  // 2.0 (thrown back, it reaches -0.39 rad in the second left)
+  std::tie(low, high) = SpunWheel(-4.0, 2.0);
+  EXPECT_NEAR(high, 2.0, 0.05);
+  EXPECT_GT(low, -4.05);
+}
+
+}  // namespace
+}  // namespace caliper::physics_bullet
