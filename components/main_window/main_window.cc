@@ -538,6 +538,10 @@ QTreeWidgetItem* MainWindow::ItemOf(const std::string& id) const {
 void MainWindow::Refresh() {
   const Snapshot s = link_->snapshot();
   RefreshComponents(s);
+  if (s.notice_serial != notice_serial_) {
+    notice_serial_ = s.notice_serial;
+    ShowError(QString::fromStdString(s.last_notice));
+  }
   if (s.error_serial != error_serial_) {
     error_serial_ = s.error_serial;
     ShowError(QString::fromStdString(s.last_error));

@@ -118,6 +118,7 @@ class MainWindow : public QMainWindow {
   std::map<std::string, QTreeWidgetItem*> items_;   // channel id -> its row
   std::uint64_t channels_version_ = 0;
   std::uint64_t error_serial_ = 0;
+  std::uint64_t notice_serial_ = 0;
   bool updating_ = false;                           // the tree is being filled, not edited
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -72,7 +73,7 @@ void ModelLink::Queue(std::string what, std::function<void(Impl&)> call, bool ne
 
 void ModelLink::LoadScene(const std::string& path) {
   const int long_ms = options_.long_call_timeout_ms;
-  Queue("load " + path, [path, long_ms](Impl& i) {
+  Queue("load " + path, [this, path, long_ms](Impl& i) {
     omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
     // the Model reads only below its search path: other files go by content
     M::FileAccess_var files = i.model->file_access();
@@ -95,7 +96,19 @@ void ModelLink::LoadScene(const std::string& path) {
       i.model->load_scene(path.c_str());
     } else {
       // by content a Model takes COLLADA: a URDF is imported here and sent converted (NAME.dae)
-      const model_file::Content content = model_file::ContentToSend(path, nullptr);
+      std::vector<std::string> warnings;
+      const model_file::Content content = model_file::ContentToSend(path, &warnings);
+      if (!warnings.empty()) {
+        // the Model imports the converted COLLADA without a word: the URDF's warnings are said
+        // here, in the status bar and on the terminal
+        std::string notice = content.file_name + " (converted from " + path + "): " +
+                             std::to_string(warnings.size()) + " import warning" +
+                             (warnings.size() == 1 ? "" : "s") + ": " + warnings.front();
+        for (const auto& w : warnings) std::fprintf(stderr, "caliper-main: warning: %s\n", w.c_str());
+        std::lock_guard<std::mutex> lock(mutex_);
+        snapshot_.last_notice = std::move(notice);
+        ++snapshot_.notice_serial;
+      }
       const std::string& bytes = content.bytes;
       if (bytes.size() > static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20))
         throw std::runtime_error(path + " is larger than one CORBA message carries");

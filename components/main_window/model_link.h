@@ -58,6 +58,8 @@ struct Snapshot {
   std::map<std::string, double> values;    ///< latest values of the watched scalar ids
   std::string last_error;                  ///< the latest failed command's message
   std::uint64_t error_serial = 0;          ///< counts failed commands
+  std::string last_notice;                 ///< what a finished command has to say (warnings)
+  std::uint64_t notice_serial = 0;         ///< counts notices
   std::uint64_t commands_done = 0;         ///< counts finished commands (failed or not)
   bool naming_reachable = false;           ///< the naming service answered the last listing
   std::uint64_t components_version = 0;    ///< counts the listings of `components`

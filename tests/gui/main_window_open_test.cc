@@ -6,12 +6,14 @@
 
 #include <QApplication>
 #include <QFileDialog>
+#include <QStatusBar>
 #include <QLineEdit>
 #include <QPushButton>
 #include <QTimer>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <string>
@@ -129,6 +131,23 @@ TEST_F(MainWindowOpenTest, AUrdfChosenInTheDialogLoadsByPathOrConverted) {
   ASSERT_TRUE(OpenThroughDialog(copy, [](QFileDialog&) {}));
   EXPECT_TRUE(WaitInGui([&] { return Scene() == "arm2.dae (sent by content)"; }, seconds(10)))
       << Scene();
+
+  // a URDF with something to warn about, converted: the warning is said in the status bar (the
+  // Model, given COLLADA, has none to log)
+  const std::string bare = elsewhere_.path() + "/bare.urdf";
+  std::ofstream(bare) << R"(<robot name="bare"><link name="base"/><link name="arm"/>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint></robot>)";
+  ASSERT_TRUE(OpenThroughDialog(bare, [](QFileDialog&) {}));
+  std::string shown;
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        shown = window_->statusBar()->currentMessage().toStdString();
+        return shown.find("bare.dae (converted from " + bare + "): 1 import warning: ") !=
+                   std::string::npos &&
+               shown.find("link 'arm': no <inertial> on a moving link") != std::string::npos;
+      },
+      seconds(10)))
+      << shown;
 }
 
 }  // namespace
