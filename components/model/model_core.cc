@@ -359,13 +359,8 @@ void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded) {
   loaded->sampler = channels.sampler;
   for (const auto& id : channels.skipped)
     logging::Get("model").warn("channel %s not registered: the id is taken", id.c_str());
-  if (had_scene)
-    for (const auto& [name, value] : loaded_->commands)
-      if (std::any_of(loaded->description->actuators.begin(), loaded->description->actuators.end(),
-                      [&](const sgal::Actuator& a) { return a.name == name; })) {
-        loaded->physics->SetCommand(name, value);
-        loaded->commands[name] = value;
-      }
+  // every command starts at zero in the new physics, as after MuJoCo's reset: a stop, reset or
+  // load that left a motor driving would move the arm the user just rewound
   loaded_ = std::move(loaded);
   ++generation_;
   pending_commands_.clear();

@@ -16,6 +16,7 @@
 #include <new>
 #include <string>
 #include <thread>
+#include <vector>
 
 
 namespace caliper::model {
@@ -116,6 +117,51 @@ TEST(ModelCore, StopEndsAStepRequestAndRewinds) {
   EXPECT_LT(request.get(), 4000000000u);
   EXPECT_EQ(core.status().state, RunState::kStopped);
   EXPECT_EQ(core.status().steps, 0u);
+}
+
+// Stop, reset and load rewind the commands too (as MuJoCo's reset zeroes its controls); pause
+// keeps them. "Not driven" is checked against a Model that never had a command.
+TEST(ModelCore, StopResetAndLoadZeroEveryCommandAndPauseKeepsThem) {
+  const char* const kPosition = "pendulum_tendon.pendulum.position";
+  ModelCore idle;
+  idle.Load(Model("pendulum_tendon.dae"));
+  ASSERT_EQ(idle.StepNow(300), 300u);
+  const std::vector<double> undriven = idle.Sample({kPosition}).at(0).values;
+
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const std::string motor = core.Actuators().at(0).name;
+  auto drive = [&] {
+    core.SetCommands({{motor, 6.0}});
+    ASSERT_EQ(core.StepNow(300), 300u);
+    ASSERT_EQ(core.ActuatorStates().at(0).command, 6.0);
+    ASSERT_NE(core.Sample({kPosition}).at(0).values, undriven) << "the command moved nothing";
+  };
+  auto expect_not_driven = [&](const char* after) {
+    EXPECT_EQ(core.ActuatorStates().at(0).command, 0.0) << "after " << after;
+    ASSERT_EQ(core.StepNow(300), 300u);
+    EXPECT_EQ(core.ActuatorStates().at(0).command, 0.0) << "after " << after;
+    EXPECT_EQ(core.Sample({kPosition}).at(0).values, undriven) << "after " << after;
+  };
+
+  drive();
+  core.SetRealTimeFactor(0);
+  core.Start();
+  core.Pause();
+  EXPECT_EQ(core.ActuatorStates().at(0).command, 6.0) << "pause kept the command";
+  core.Stop();
+  EXPECT_EQ(core.status().state, RunState::kStopped);
+  expect_not_driven("stop");
+
+  core.Stop();
+  drive();
+  core.Reset();
+  expect_not_driven("reset");
+
+  core.Stop();
+  drive();
+  core.Load(Model("pendulum_tendon.dae"));
+  expect_not_driven("load");
 }
 
 struct FaultCase {
