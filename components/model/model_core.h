@@ -171,8 +171,8 @@ class ModelCore {
 
   void Start();
   void Pause();
-  void Stop();   // pause and rewind
-  void Reset();  // rewind, keep the run state
+  void Stop();   // pause and rewind (every actuator command back to 0)
+  void Reset();  // rewind (every actuator command back to 0), keep the run state
   /// Runs n steps now and returns how many ran: n, or fewer when a stop or pause ended it early
   /// or the physics faulted. It lets other calls in between slices of kSlice: reads are answered,
   /// commands and parameter writes queue for the next step, stop and pause end it; another step,
