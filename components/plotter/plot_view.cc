@@ -10,6 +10,8 @@
 #include <qwt_symbol.h>
 #include <qwt_text.h>
 
+#include <QEvent>
+#include <QFontMetrics>
 #include <QPen>
 #include <algorithm>
 #include <cmath>
@@ -214,6 +216,17 @@ void PlotView::Draw(const SampleStore& store, double t0, double t1, bool fit_val
     if (hi - lo <= 1e-12 + 1e-9 * level) margin = std::max(0.1 * level, 1e-3);
     if (Divisible(lo - margin, hi + margin)) setAxisScale(QwtPlot::yLeft, lo - margin, hi + margin);
   }
+}
+
+bool PlotView::eventFilter(QObject* watched, QEvent* event) {
+  if (watched == canvas() && event->type() == QEvent::Resize) {
+    // Qwt's default of 8 major steps stacks the value labels on top of each other in a small tile:
+    // give each label two lines of the axis font, between 2 steps and Qwt's 8
+    const int line_px = QFontMetrics(axisWidget(QwtPlot::yLeft)->font()).height();
+    const int steps = std::clamp(canvas()->height() / std::max(1, 2 * line_px), 2, 8);
+    if (axisMaxMajor(QwtPlot::yLeft) != steps) setAxisMaxMajor(QwtPlot::yLeft, steps);
+  }
+  return QwtPlot::eventFilter(watched, event);
 }
 
 void PlotView::ResetZoomBase() { zoomer_->setZoomBase(false); }

@@ -70,6 +70,10 @@ class PlotView : public QwtPlot {
   /// Called with the new time interval when the user zooms or pans this plot.
   std::function<void(double t0, double t1)> on_user_time_range;
 
+ protected:
+  /// Keeps the value axis to as many major ticks as its labels fit in the canvas height.
+  bool eventFilter(QObject* watched, QEvent* event) override;
+
  private:
   struct Curve;
   void Restyle(Curve& c);
