@@ -593,6 +593,10 @@ int Record(Client& client, std::vector<std::string>& args) {
   auto last_progress = Clock::now() - std::chrono::seconds(1);
   auto last_check = Clock::now();
   std::string shown, lost, interrupted, ended;
+  // why no samples come, shown after the progress: a Model that is not running sends none, and
+  // a recording with a duration would otherwise wait without a word until someone starts it
+  std::string idle_note;
+  uint64_t samples_at_check = 0;
   D::SubscriptionStatus counts{};  // the Model's, as last read
   auto read_counts = [&] {
     try {
@@ -615,7 +619,7 @@ int Record(Client& client, std::vector<std::string>& args) {
     const auto t = Clock::now();
     if (t - last_progress >= std::chrono::milliseconds(250)) {
       std::lock_guard<std::mutex> lock(consumer->mutex);
-      const std::string text = Progress(recording, start, duration);
+      const std::string text = Progress(recording, start, duration) + idle_note;
       if (text != shown) std::cerr << "\r" << text << std::flush;
       shown = text;
       last_progress = t;
@@ -630,6 +634,26 @@ int Record(Client& client, std::vector<std::string>& args) {
         break;
       }
       if (!ended.empty()) break;
+      uint64_t samples = 0;
+      {
+        std::lock_guard<std::mutex> lock(consumer->mutex);
+        samples = recording.samples();
+      }
+      // a step request samples while the state is not RUNNING: only a Model that sent nothing
+      // for a second counts as idle
+      idle_note.clear();
+      if (samples == samples_at_check) {
+        try {
+          M::SimulationStatus_var now_status = m.model->status();
+          if (now_status->state != M::RUNNING)
+            idle_note = " - " + name + " is " + rtc::Name(now_status->state) +
+                        ": waiting until it runs (caliper-ctl start) or steps";
+        } catch (const CORBA::SystemException& e) {
+          lost = Client::Unreachable(m.path, e);
+          break;
+        }
+      }
+      samples_at_check = samples;
       last_check = t;
     }
   }
@@ -652,7 +676,11 @@ int Record(Client& client, std::vector<std::string>& args) {
   file.close();
 
   std::lock_guard<std::mutex> lock(consumer->mutex);
-  std::cerr << "\r" << Progress(recording, start, duration) << "\n";
+  const std::string last = Progress(recording, start, duration);
+  // blanks over the rest of a longer line shown before (one with the idle note)
+  std::cerr << "\r" << last
+            << std::string(shown.size() > last.size() ? shown.size() - last.size() : 0, ' ')
+            << "\n";
   if (!interrupted.empty()) std::cerr << interrupted << "\n";
   std::cout << "wrote " << recording.samples() << " samples";
   if (recording.samples() > 0)

@@ -281,5 +281,31 @@ TEST_F(LosslessRecordingTest, AStoppedRecorderHoldsTheModelAtMostThePushDeadline
       << record.Output();
 }
 
+// A recording waiting on a Model that no longer runs says so instead of waiting without a word.
+TEST_F(LosslessRecordingTest, CtlRecordOnAPausedModelSaysItWaitsForIt) {
+  const CommandResult start = Ctl(naming_->address(), {"start"});
+  ASSERT_EQ(start.exit_code, 0) << start.err;
+  const std::string csv = dir_.path() + "/record.csv";
+  Process record({Bin("caliper-ctl"), "--nameservice", naming_->address(), "record", kTension,
+                  "--csv", csv, "--duration", "1000"},
+                 dir_.path() + "/record.out");
+  ASSERT_TRUE(WaitFor([&] { return Contains(record.Output(), "lossless:"); }, seconds(10)))
+      << record.Output();
+  EXPECT_FALSE(Contains(record.Output(), "PAUSED")) << record.Output();
+  const CommandResult pause = Ctl(naming_->address(), {"pause"});
+  ASSERT_EQ(pause.exit_code, 0) << pause.err;
+  // checked once a second, after a second without samples
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        return Contains(record.Output(),
+                        "model0 is PAUSED: waiting until it runs (caliper-ctl start) or steps");
+      },
+      seconds(5)))
+      << record.Output();
+  record.Signal(SIGTERM);
+  EXPECT_EQ(record.Wait(seconds(10)), 0) << record.Output();
+  EXPECT_TRUE(Contains(record.Output(), "terminated (SIGTERM)")) << record.Output();
+}
+
 }  // namespace
 }  // namespace caliper::testing
