@@ -251,6 +251,7 @@ class ExtensionReader {
         if (a.parameters.count(name) > 0)
           ctx_.Fail(c.get(), "parameter '" + name + "' is given twice");
         a.parameters[name] = ctx_.Number(c.get(), 0) * UnitFactor(*c, *spec);
+        WarnUnitlessLength(*c, a, *spec);
       } else if (n == "option") {
         a.options[Required(*c, "name")] = c->Trimmed();
       } else {
@@ -270,6 +271,26 @@ class ExtensionReader {
     }
     ctx_.actuator_source[a.name] = &e;
     ctx_.scene.actuators.push_back(std::move(a));
+  }
+
+  // A length parameter without a unit attribute is read in its kind's unit (metres), not in the
+  // document's <unit>: in a millimetre file `spool_radius 5` means 5 m, which is rarely meant.
+  void WarnUnitlessLength(const Element& param, const sgal::Actuator& a,
+                          const actuators::ParameterSpec& spec) {
+    if (param.FindAttribute("unit") != nullptr || ctx_.meter == 1) return;
+    Unit declared;
+    std::string bad;
+    if (!ParseUnit(spec.unit, &declared, &bad) ||
+        declared.dimension != std::array<int, 5>{1, 0, 0, 0, 0})
+      return;
+    const int line = ctx_.doc.LineOf(param);
+    ctx_.Warn(&param, "actuator '" + a.name + "': length parameter '" + spec.name +
+                          "' has no unit (" +
+                          (line > 0 ? "line " + std::to_string(line) : "line not known") +
+                          ") and is read as " + FormatNumber(a.parameters.at(spec.name)) + " " +
+                          spec.unit + ", although this file's <unit meter=\"" +
+                          FormatNumber(ctx_.meter) + "\"> scales its geometry; write unit=\"" +
+                          spec.unit + "\" (or the unit meant) on it");
   }
 
   // The factor from a <param>'s unit attribute to the unit its kind declares.

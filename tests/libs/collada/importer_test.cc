@@ -578,6 +578,26 @@ TEST(ColladaImportTest, WarnsAboutAnUnknownElementOfTheTechniqueWithItsLine) {
   EXPECT_NE(warnings[0].find("line 107"), std::string::npos) << warnings[0];
 }
 
+TEST(ColladaImportTest, WarnsAboutALengthWithoutUnitInAMillimetreFile) {
+  // <unit meter="0.001">, and `rest_length 5` without a unit: read as 5 m, said with its line
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Load(Data("unitless_length_in_mm_file.dae"), &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("unitless_length_in_mm_file.dae:106:"), std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find("actuator 'spring': length parameter 'rest_length' has no unit "
+                             "(line 106) and is read as 5 m"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find("<unit meter=\"0.001\">"), std::string::npos) << warnings[0];
+  ASSERT_EQ(s.actuators.size(), 1u);
+  EXPECT_EQ(s.actuators[0].parameters.at("rest_length"), 5.0);
+  // the same parameter with a unit, or in a metre file, is not warned about
+  warnings.clear();
+  Load(Data("extension_unknown_element.dae"), &warnings);
+  for (const auto& w : warnings) EXPECT_EQ(w.find("has no unit"), std::string::npos) << w;
+}
+
 TEST(ColladaImportTest, ReadsNumbersTheSameUnderACommaDecimalLocale) {
   // the Main Window and the tools are Qt processes: under LANG=de_DE.UTF-8 their C locale reads
   // "1.2" as 1 (strtod, and Collada-DOM's own sscanf for float_array)
