@@ -143,11 +143,24 @@ void PrintConstraints(const sgal::Scene& scene, std::ostream& out) {
                                       " to " + BodyName(c.body_b)};
     switch (c.kind) {
       case sgal::ConstraintKind::kHinge:
-        DofParts(c, 0, true, "", &parts);
+      case sgal::ConstraintKind::kSlider: {
+        // the joint turns about (slides along) frame_b's z axis; the world direction is the one
+        // at the description pose (a body_b of "" is the world itself)
+        // rounding leftovers of a quarter turn (2e-16) shown as 0
+        auto clean = [](Eigen::Vector3d v) {
+          for (int i = 0; i < 3; ++i)
+            if (std::abs(v[i]) < 1e-12) v[i] = 0;
+          return v;
+        };
+        const Eigen::Vector3d raw = c.frame_b.orientation * Eigen::Vector3d::UnitZ();
+        const sgal::Body* b = c.body_b.empty() ? nullptr : scene.FindBody(c.body_b);
+        const Eigen::Vector3d world = clean(b ? Eigen::Vector3d(b->pose.orientation * raw) : raw);
+        const Eigen::Vector3d local = clean(raw);
+        parts.push_back("axis " + Vec(local) + " in " + BodyName(c.body_b) + ", " + Vec(world) +
+                        " in world");
+        DofParts(c, 0, c.kind == sgal::ConstraintKind::kHinge, "", &parts);
         break;
-      case sgal::ConstraintKind::kSlider:
-        DofParts(c, 0, false, "", &parts);
-        break;
+      }
       case sgal::ConstraintKind::kGeneric6Dof:
         for (int i = 0; i < 6; ++i) DofParts(c, i, i >= 3, kDofs[i], &parts);
         break;

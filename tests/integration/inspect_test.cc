@@ -54,6 +54,8 @@ TEST(Inspect, ListsWhatAShippedModelHoldsWithoutASession) {
   EXPECT_TRUE(Contains(r.out, "stiffness 3000 N/m")) << r.out;
   EXPECT_TRUE(Contains(r.out, "max_isometric_force 150 N")) << r.out;
   EXPECT_TRUE(Contains(r.out, "limits 0 .. 145 deg")) << r.out;
+  // hinge axes: frame_b's z in body_b's frame and in world at the description pose
+  EXPECT_TRUE(Contains(r.out, "axis (0, -1, 0) in upper_arm, (0, -1, 0) in world")) << r.out;
   EXPECT_TRUE(Contains(r.out, "wrap elbow_pulley")) << r.out;
   EXPECT_TRUE(Contains(r.out, "warnings (0)")) << r.out;
   EXPECT_EQ(r.err, "");
