@@ -636,7 +636,9 @@ TEST(BulletScene, AHullOfManyPointsCollidesAsTheHullOfItsCorners) {
 namespace caliper::physics_bullet {
 namespace {
 
-TEST(BulletScene, HingePositionCountsWholeTurns) {
+// A wheel on a hinge "axle" about z, spinning at 10 rad/s, no gravity; limits lower .. upper
+// [rad] (free when lower > upper).
+sgal::Scene SpinningWheel(double lower = 1, double upper = -1) {
   sgal::Scene scene;
   scene.gravity.setZero();
   sgal::Body base;
@@ -653,8 +655,14 @@ TEST(BulletScene, HingePositionCountsWholeTurns) {
   axle.name = "axle";
   axle.body_a = "wheel";
   axle.body_b = "base";
+  axle.limits[0].lower = lower;
+  axle.limits[0].upper = upper;
   scene.constraints.push_back(axle);
-  auto physics = MakeScene(scene);
+  return scene;
+}
+
+TEST(BulletScene, HingePositionCountsWholeTurns) {
+  auto physics = MakeScene(SpinningWheel());
   double last = physics->GetParameter("axle.position");
   for (int i = 0; i < 1000; ++i) {
     physics->Step();
@@ -677,26 +685,7 @@ namespace {
 // A wheel on a hinge about z spun at 10 rad/s without gravity for 1 s: the lowest and highest
 // positions it reached [rad] (a stop throws it back: Bullet's limits bounce).
 std::pair<double, double> SpunWheel(double lower, double upper) {
-  sgal::Scene scene;
-  scene.gravity.setZero();
-  sgal::Body base;
-  base.name = "base";
-  base.type = sgal::BodyType::kStatic;
-  scene.bodies.push_back(base);
-  sgal::Body wheel;
-  wheel.name = "wheel";
-  wheel.inertia.mass = 1;
-  wheel.inertia.tensor = Eigen::Matrix3d::Identity() * 0.01;
-  wheel.angular_velocity = Eigen::Vector3d(0, 0, 10);  // [rad/s]
-  scene.bodies.push_back(wheel);
-  sgal::Constraint axle;
-  axle.name = "axle";
-  axle.body_a = "wheel";
-  axle.body_b = "base";
-  axle.limits[0].lower = lower;
-  axle.limits[0].upper = upper;
-  scene.constraints.push_back(axle);
-  auto physics = MakeScene(scene);
+  auto physics = MakeScene(SpinningWheel(lower, upper));
   std::pair<double, double> range(0, 0);
   for (int i = 0; i < 1000; ++i) {
     physics->Step();
