@@ -678,18 +678,7 @@ void BulletScene::ApplyJointSprings() {
     if (c.kind != sgal::ConstraintKind::kHinge && c.kind != sgal::ConstraintKind::kSlider) continue;
     const sgal::JointSpring& sp = c.springs[0];
     if (sp.stiffness == 0 && sp.damping == 0) continue;
-    const double load = -(sp.stiffness * (j.position - sp.rest) + sp.damping * j.velocity);
-    const Vector3d axis = j.axis;
-    auto push = [&](int body, double sign) {
-      if (body < 0 || scene_.bodies[body].type != sgal::BodyType::kDynamic) return;
-      btRigidBody& rb = *bodies_[body].rigid;
-      if (c.kind == sgal::ConstraintKind::kHinge)
-        rb.applyTorque(ToBt(axis * (sign * load), scale_ * scale_));
-      else
-        rb.applyCentralForce(ToBt(axis * (sign * load), scale_));
-    };
-    push(j.body_a, 1.0);
-    push(j.body_b, -1.0);
+    PushJoint(j, -(sp.stiffness * (j.position - sp.rest) + sp.damping * j.velocity));
   }
 }
 
