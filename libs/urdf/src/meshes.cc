@@ -44,15 +44,18 @@ std::string PackageName(const fs::path& manifest) {
   return b == std::string::npos ? "" : name.substr(b, e - b + 1);
 }
 
-// The folders that are package `name` in or below `dir`, as ROS finds packages: `dir` itself or
-// a folder whose package.xml names it (not looking inside a package for another), and a folder
-// called `name` directly in `dir`. Bounded: a package path may name a large workspace.
-std::vector<fs::path> PackagesIn(const fs::path& dir, const std::string& name) {
-  std::vector<fs::path> out;
+// Every package in or below `dir` by its name, as ROS finds packages: a folder whose package.xml
+// names it (not looking inside a package for another). Walked once per folder of the package
+// path, whatever number of packages a URDF names; bounded, as a package path may name a large
+// workspace.
+std::multimap<std::string, std::string> PackagesIn(const fs::path& dir) {
+  std::multimap<std::string, std::string> out;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return out;
-  if (PackageName(dir / "package.xml") == name) return {dir};
-  if (fs::is_directory(dir / name, ec)) out.push_back(dir / name);
+  if (const std::string own = PackageName(dir / "package.xml"); !own.empty()) {
+    out.emplace(own, dir.string());
+    return out;
+  }
   constexpr int kMaxDepth = 6;
   constexpr size_t kMaxEntries = 100000;
   size_t looked = 0;
@@ -70,10 +73,9 @@ std::vector<fs::path> PackagesIn(const fs::path& dir, const std::string& name) {
     }
     std::error_code manifest_ec;
     if (!fs::is_regular_file(it->path() / "package.xml", manifest_ec)) continue;
-    // a package: not searched further inside
-    it.disable_recursion_pending();
-    if (PackageName(it->path() / "package.xml") == name && it->path() != dir / name)
-      out.push_back(it->path());
+    it.disable_recursion_pending();  // a package: not searched further inside
+    if (const std::string name = PackageName(it->path() / "package.xml"); !name.empty())
+      out.emplace(name, it->path().string());
   }
   return out;
 }
@@ -130,16 +132,17 @@ std::string PackageFinder::Resolve(const std::string& reference, const std::stri
       return "";
     }
     for (const auto& dir : path_) {
-      auto known = found_.find({dir, name});
-      if (known == found_.end()) {
-        std::vector<std::string> packages;
-        for (const auto& p : PackagesIn(dir, name)) packages.push_back(p.string());
-        known = found_.emplace(std::make_pair(dir, name), std::move(packages)).first;
-      }
-      if (known->second.empty())
-        tried->push_back("(no package '" + name + "' in or below " + dir + ")");
-      for (const auto& package : known->second)
-        if (found(fs::path(package) / inside)) return (fs::path(package) / inside).string();
+      auto known = index_.find(dir);
+      if (known == index_.end()) known = index_.emplace(dir, PackagesIn(dir)).first;
+      // a folder called NAME directly in the folder of the path, then those package.xml names
+      std::vector<fs::path> packages;
+      if (fs::is_directory(fs::path(dir) / name, ec)) packages.push_back(fs::path(dir) / name);
+      const auto [first, last] = known->second.equal_range(name);
+      for (auto p = first; p != last; ++p)
+        if (fs::path(p->second) != fs::path(dir) / name) packages.push_back(p->second);
+      if (packages.empty()) tried->push_back("(no package '" + name + "' in or below " + dir + ")");
+      for (const auto& package : packages)
+        if (found(package / inside)) return (package / inside).string();
     }
     if (path_.empty())
       tried->push_back("(no package path: $CALIPER_PACKAGE_PATH and $ROS_PACKAGE_PATH are empty)");

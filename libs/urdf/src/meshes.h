@@ -23,7 +23,7 @@ struct MeshFile {
 };
 
 /// Finds `package://` references' packages in a package path (urdf::ResolveMesh's rules), each
-/// folder of the path searched once per package name.
+/// folder of the path walked once per import, however many packages the URDF names.
 class PackageFinder {
  public:
   void SetPath(std::vector<std::string> path) { path_ = std::move(path); }
@@ -33,7 +33,8 @@ class PackageFinder {
 
  private:
   std::vector<std::string> path_;
-  std::map<std::pair<std::string, std::string>, std::vector<std::string>> found_;
+  // each folder of the path walked once: package name -> its folders
+  std::map<std::string, std::multimap<std::string, std::string>> index_;
 };
 
 class MeshLoader {
