@@ -41,6 +41,10 @@ class FailingScene : public sgal::PhysicsScene {
   int ParameterIndex(const std::string& id) const override { return inner_->ParameterIndex(id); }
   double GetParameter(int index) const override { return inner_->GetParameter(index); }
   void SetParameter(const std::string& id, double v) override { inner_->SetParameter(id, v); }
+  sgal::DynamicState SaveDynamicState() const override { return inner_->SaveDynamicState(); }
+  void RestoreDynamicState(const sgal::DynamicState& s) override { inner_->RestoreDynamicState(s); }
+  void SetPull(const sgal::Pull& pull) override { inner_->SetPull(pull); }
+  void ClearPull() override { inner_->ClearPull(); }
 
  private:
   std::unique_ptr<sgal::PhysicsScene> inner_;

@@ -238,6 +238,9 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   std::unique_lock<std::mutex> lock(mutex_);
   if (loaded_) loaded_->commands.clear();
   BuildLocked(std::move(loaded));
+  undo_.clear();
+  redo_.clear();
+  last_edit_.clear();
   state_ = RunState::kPaused;
   last_error_.clear();
   result.load_wall_s = std::chrono::duration<double>(Clock::now() - load_begin).count();
@@ -346,12 +349,20 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
   last_error_.clear();
+  undo_.clear();
+  redo_.clear();
+  last_edit_.clear();
+  selection_ = {"", "", 0, selection_.revision + 1};
   logging::Get("model").notice("loaded %s: %zu bodies, %zu tendons, %zu actuators", source.c_str(),
                                scene.bodies.size(), scene.tendons.size(), scene.actuators.size());
 }
 
-void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded) {
+void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded, bool edit) {
   const bool had_scene = loaded_ != nullptr;
+  if (!edit) {
+    ++restarts_;
+    pull_.reset();
+  }
   // the old scene's channels go first (they refer to its physics); subscriptions stay and
   // re-resolve their ids at the next step
   registry_.Clear();
@@ -363,7 +374,7 @@ void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded) {
   // load that left a motor driving would move the arm the user just rewound
   loaded_ = std::move(loaded);
   ++generation_;
-  pending_commands_.clear();
+  if (!edit) pending_commands_.clear();
   if (had_scene)
     for (auto* l : listeners_) l->OnCleared();
   for (auto* l : listeners_) l->OnScene(loaded_->description, generation_);
@@ -448,7 +459,7 @@ uint64_t ModelCore::StepNow(uint64_t n) {
     ModelCore* core;
     ~EndRequest() { core->step_request_ = 0; }  // the lock is held again when it ends
   } end_request{this};
-  const uint64_t generation = generation_;
+  const uint64_t generation = restarts_;
   rate_wall_ = Clock::now();
   rate_sim_ = loaded_->physics->time();
   auto slice_end = rate_wall_ + kSlice;
@@ -456,7 +467,7 @@ uint64_t ModelCore::StepNow(uint64_t n) {
   while (step_done_ < n) {
     // a lossless consumer is let catch up; a stop, pause or shutdown meanwhile ends the request
     if (AwaitConsumersLocked(lock) &&
-        (generation_ != generation || !end_request_.empty() || cancel_)) {
+        (restarts_ != generation || !end_request_.empty() || cancel_)) {
       ended = cancel_ ? "the Model is shutting down" : end_request_;
       break;
     }
@@ -467,7 +478,7 @@ uint64_t ModelCore::StepNow(uint64_t n) {
       MeasureRateLocked(0.5);
       HandOverLocked(lock);
       // a stop rewound (a new generation), a pause asked to end, or the Model is going
-      if (generation_ != generation || !end_request_.empty() || cancel_) {
+      if (restarts_ != generation || !end_request_.empty() || cancel_) {
         ended = cancel_ ? "the Model is shutting down" : end_request_;
         break;
       }
@@ -475,7 +486,7 @@ uint64_t ModelCore::StepNow(uint64_t n) {
     }
   }
   const uint64_t ran = step_done_;
-  if (generation_ == generation && state_ != RunState::kFaulted) {
+  if (restarts_ == generation && state_ != RunState::kFaulted) {
     state_ = RunState::kPaused;
     // writes that came during the request and found no step after them take effect now, as
     // they do when nothing steps
@@ -899,7 +910,7 @@ bool ModelCore::AwaitConsumersLocked(std::unique_lock<std::mutex>& lock) {
   if (lossless_ == 0) return false;
   // what ends the wait besides room: a stop, pause, load or shutdown meanwhile
   const RunState state = state_;
-  const uint64_t generation = generation_;
+  const uint64_t generation = restarts_;
   bool released = false;
   uint64_t waiting_for = 0;  // the subscription waited for now (0: none yet)
   Clock::time_point since;
@@ -947,7 +958,7 @@ bool ModelCore::AwaitConsumersLocked(std::unique_lock<std::mutex>& lock) {
     const auto it = feeds_.find(blocked);
     if (it != feeds_.end())
       it->second.waited_s += std::chrono::duration<double>(Clock::now() - now).count();
-    if (state_ != state || generation_ != generation || !end_request_.empty() || cancel_)
+    if (state_ != state || restarts_ != generation || !end_request_.empty() || cancel_)
       return true;
   }
 }
@@ -992,6 +1003,196 @@ void ModelCore::RemoveListener(CoreListener* listener) {
 std::string ModelCore::model_name() const {
   const auto lock = Lock();
   return loaded_ ? loaded_->name : "";
+}
+
+}  // namespace caliper::model
+
+namespace caliper::model {
+
+void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
+                                const std::string& what) {
+  // the scene as loaded (what a rewind returns to) and the engine's copy (tuned parameters)
+  auto base = std::make_shared<sgal::Scene>(*loaded_->description);
+  sgal::Scene current = loaded_->physics->description();
+  apply(*base);
+  apply(current);
+  for (const sgal::Scene* s : {static_cast<const sgal::Scene*>(base.get()),
+                               static_cast<const sgal::Scene*>(&current)}) {
+    const auto problems = sgal::Validate(*s);
+    if (!problems.empty()) {
+      std::string reason = what + ": the scene would not be sound:";
+      for (const auto& p : problems) reason += "\n  " + p;
+      throw sgal::EditError(reason);
+    }
+  }
+  std::unique_ptr<sgal::PhysicsScene> physics;
+  try {
+    physics = MakePhysics(current);
+  } catch (const std::exception& e) {
+    throw sgal::EditError(what + ": the engine refuses the edited scene: " + e.what());
+  }
+  // the dynamic state, matched by name: bodies and constraints are never added by an edit;
+  // actuators are, and removed (a new one starts from its own rest state)
+  const sgal::DynamicState old_state = loaded_->physics->SaveDynamicState();
+  const sgal::Scene& old_scene = loaded_->physics->description();
+  sgal::DynamicState state = old_state;
+  state.actuators.assign(current.actuators.size(), {});
+  state.commands.assign(current.actuators.size(), 0.0);
+  for (size_t k = 0; k < current.actuators.size(); ++k)
+    for (size_t j = 0; j < old_scene.actuators.size(); ++j)
+      if (old_scene.actuators[j].name == current.actuators[k].name &&
+          old_scene.actuators[j].kind == current.actuators[k].kind) {
+        state.actuators[k] = old_state.actuators[j];
+        state.commands[k] = old_state.commands[j];
+      }
+  try {
+    physics->RestoreDynamicState(state);
+    if (pull_) physics->SetPull(*pull_);
+  } catch (const std::exception& e) {
+    throw sgal::EditError(what + ": the state does not carry over: " + e.what());
+  }
+  auto loaded = std::make_unique<Loaded>();
+  loaded->description = base;
+  loaded->source = loaded_->source;
+  loaded->name = loaded_->name;
+  loaded->physics = std::move(physics);
+  for (const auto& [name, value] : loaded_->commands)
+    for (const auto& a : current.actuators)
+      if (a.name == name) loaded->commands[name] = value;
+  BuildLocked(std::move(loaded), /*edit=*/true);
+  ++edit_revision_;
+  last_edit_ = what;
+  // a selection of what the edit removed is gone
+  if ((selection_.kind == "tendon" || selection_.kind == "path_point") &&
+      base->FindTendon(selection_.name) == nullptr)
+    selection_ = {"", "", 0, selection_.revision + 1};
+  if (selection_.kind == "obstacle" && base->FindObstacle(selection_.name) == nullptr)
+    selection_ = {"", "", 0, selection_.revision + 1};
+  logging::Get("model").notice("scene edit: %s (t = %.3f s)", what.c_str(),
+                               loaded_->physics->time());
+}
+
+ModelCore::EditStatus ModelCore::EditStatusLocked() const {
+  EditStatus s;
+  s.revision = edit_revision_;
+  s.last = last_edit_;
+  if (!undo_.empty()) s.undo = undo_.back().label;
+  if (!redo_.empty()) s.redo = redo_.back().label;
+  return s;
+}
+
+ModelCore::EditStatus ModelCore::Edit(
+    const std::function<sgal::SceneEdit(const sgal::Scene&)>& make) {
+  const auto lock = Lock();
+  Require(true);
+  RequireNoExperiment();
+  sgal::SceneEdit edit = make(*loaded_->description);
+  ApplyEditLocked(edit.apply, edit.label);
+  undo_.push_back(std::move(edit));
+  if (undo_.size() > 200) undo_.erase(undo_.begin());  // a bounded history
+  redo_.clear();
+  return EditStatusLocked();
+}
+
+ModelCore::EditStatus ModelCore::Undo() {
+  const auto lock = Lock();
+  Require(true);
+  RequireNoExperiment();
+  if (undo_.empty()) throw sgal::EditError("nothing to undo");
+  ApplyEditLocked(undo_.back().revert, "undo " + undo_.back().label);
+  redo_.push_back(std::move(undo_.back()));
+  undo_.pop_back();
+  return EditStatusLocked();
+}
+
+ModelCore::EditStatus ModelCore::Redo() {
+  const auto lock = Lock();
+  Require(true);
+  RequireNoExperiment();
+  if (redo_.empty()) throw sgal::EditError("nothing to redo");
+  ApplyEditLocked(redo_.back().apply, "redo " + redo_.back().label);
+  undo_.push_back(std::move(redo_.back()));
+  redo_.pop_back();
+  return EditStatusLocked();
+}
+
+ModelCore::EditStatus ModelCore::edit_status() const {
+  const auto lock = Lock();
+  return EditStatusLocked();
+}
+
+void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
+                     const Eigen::Vector3d& target, double stiffness_n_per_m) {
+  const auto lock = Lock();
+  Require(true);
+  RequireNoExperiment();
+  const sgal::Scene& scene = loaded_->physics->description();
+  const int index = scene.BodyIndex(body);
+  if (index < 0) throw sgal::EditError("pull: no body '" + body + "'");
+  if (scene.bodies[index].type != sgal::BodyType::kDynamic)
+    throw sgal::EditError("pull: body '" + body + "' does not move");
+  if (!(stiffness_n_per_m >= 0) || !std::isfinite(stiffness_n_per_m))
+    throw sgal::EditError("pull: stiffness must be >= 0 N/m (0: the default)");
+  const double mass = scene.bodies[index].inertia.mass;
+  const double omega = 2 * M_PI * 2.0;  // the default spring moves the body at about 2 Hz
+  sgal::Pull pull;
+  pull.body = index;
+  pull.point = point;
+  pull.target = target;
+  pull.stiffness = stiffness_n_per_m > 0 ? stiffness_n_per_m : mass * omega * omega;
+  pull.damping = 2 * std::sqrt(pull.stiffness * mass);  // critical for the body alone
+  try {
+    loaded_->physics->SetPull(pull);
+  } catch (const std::exception& e) {
+    throw sgal::EditError(std::string("pull: ") + e.what());
+  }
+  if (!pull_ || pull_->body != index)
+    logging::Get("model").info("pull on %s at %.3f %.3f %.3f m (body frame), %.1f N/m",
+                               body.c_str(), point.x(), point.y(), point.z(), pull.stiffness);
+  pull_ = pull;
+}
+
+void ModelCore::ReleasePull() {
+  const auto lock = Lock();
+  if (!loaded_) return;
+  if (pull_) logging::Get("model").info("pull released");
+  pull_.reset();
+  loaded_->physics->ClearPull();
+}
+
+void ModelCore::Select(const std::string& kind, const std::string& name, uint32_t index) {
+  const auto lock = Lock();
+  if (!kind.empty()) {
+    Require(true);
+    const sgal::Scene& s = *loaded_->description;
+    bool found = false;
+    if (kind == "body") {
+      found = s.FindBody(name) != nullptr;
+    } else if (kind == "tendon") {
+      found = s.FindTendon(name) != nullptr;
+    } else if (kind == "path_point") {
+      const sgal::Tendon* t = s.FindTendon(name);
+      found = t != nullptr && index < t->path.size();
+    } else if (kind == "obstacle") {
+      found = s.FindObstacle(name) != nullptr;
+    } else if (kind == "constraint") {
+      found = std::any_of(s.constraints.begin(), s.constraints.end(),
+                          [&](const sgal::Constraint& c) { return c.name == name; });
+    } else {
+      throw sgal::EditError("select: unknown kind '" + kind +
+                            "' (body, tendon, path_point, obstacle, constraint, or '' for none)");
+    }
+    if (!found)
+      throw sgal::EditError("select: the scene has no " + kind + " '" + name + "'" +
+                            (kind == "path_point" ? " with element " + std::to_string(index) : ""));
+  }
+  selection_ = {kind, kind.empty() ? "" : name, kind == "path_point" ? index : 0,
+                selection_.revision + 1};
+}
+
+ModelCore::Selection ModelCore::selection() const {
+  const auto lock = Lock();
+  return selection_;
 }
 
 }  // namespace caliper::model

@@ -11,10 +11,12 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "caliper/sgal/edits.h"
 #include "caliper/daq/daq_scene.h"
 #include "caliper/daq/recorder.h"
 #include "caliper/daq/registry.h"
@@ -192,6 +194,34 @@ class ModelCore {
   /// One step if RUNNING (lock-step with an external execution context).
   void Tick();
 
+  // scene editing (idl/caliper/editing.idl has the meaning)
+  struct EditStatus {
+    uint64_t revision = 0;
+    std::string last, undo, redo;
+  };
+  /// Makes an edit against the scene as loaded (plus earlier edits) and applies it to that scene
+  /// and to the running engine's copy (its tuned parameters stay), checking both with
+  /// sgal::Validate and the engine's build; the dynamic state carries over. Throws
+  /// sgal::EditError (refused, nothing changed) or NotAvailable (no scene, an experiment runs).
+  EditStatus Edit(const std::function<sgal::SceneEdit(const sgal::Scene&)>& make);
+  EditStatus Undo();
+  EditStatus Redo();
+  EditStatus edit_status() const;
+  /// A spring on a moving body's point (body frame) towards a world target from the next step;
+  /// stiffness 0 takes the body's mass times (2 pi 2 Hz)^2. Damping is critical for the mass.
+  void Pull(const std::string& body, const Eigen::Vector3d& point, const Eigen::Vector3d& target,
+            double stiffness_n_per_m);
+  void ReleasePull();
+  struct Selection {
+    std::string kind, name;
+    uint32_t index = 0;
+    uint64_t revision = 0;
+  };
+  /// What a GUI picked (kind body, tendon, path_point, obstacle, constraint, or "" for nothing);
+  /// throws sgal::EditError for an unknown kind or a name the scene lacks.
+  void Select(const std::string& kind, const std::string& name, uint32_t index);
+  Selection selection() const;
+
   // scene and actuators
   std::shared_ptr<const sgal::Scene> description() const;  // nullptr when empty
   void Save(const std::string& path);
@@ -249,7 +279,11 @@ class ModelCore {
 
  private:
   struct Loaded;
-  void BuildLocked(std::unique_ptr<Loaded> loaded);
+  /// `edit`: the same scene edited (history, commands and step requests go on).
+  void BuildLocked(std::unique_ptr<Loaded> loaded, bool edit = false);
+  /// Applies `apply` (an edit's apply or revert) to the scene and the engine's copy; see Edit.
+  void ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply, const std::string& what);
+  EditStatus EditStatusLocked() const;
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();
@@ -296,7 +330,13 @@ class ModelCore {
   daq::Registry registry_;
   daq::Recorder recorder_{registry_};
   std::unique_ptr<Loaded> loaded_;
-  uint64_t generation_ = 0;
+  uint64_t generation_ = 0;  // of the scene observers see: every load, rewind and edit
+  uint64_t restarts_ = 0;    // loads and rewinds (a step request ends on one, not on an edit)
+  std::vector<sgal::SceneEdit> undo_, redo_;  // of the loaded scene; cleared by a load
+  uint64_t edit_revision_ = 0;
+  std::string last_edit_;
+  Selection selection_;
+  std::optional<sgal::Pull> pull_;  // carried over edits; ended by a rewind or load
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
   std::atomic<bool> cancel_{false};     // ends the running experiment (shutting down)

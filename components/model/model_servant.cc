@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <set>
 #include <variant>
 
+#include "caliper/actuators/actuator.h"
 #include "caliper/collada/importer.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
@@ -154,6 +156,9 @@ auto Guard(F&& f) -> decltype(f()) {
     throw Unavailable(BoundedReason(e.what()).c_str());
   } catch (const LimitExceeded& e) {
     throw D::LimitExceeded(BoundedReason(e.what()).c_str(), e.limit());
+  } catch (const sgal::EditError& e) {
+    // only the editing operations make these; they declare EditRefused
+    throw M::EditRefused(BoundedReason(e.what()).c_str());
   } catch (const CORBA::UserException&) {
     throw;
   } catch (const std::exception& e) {
@@ -248,11 +253,20 @@ S::Description* ToIdl(const sgal::Scene& scene) {
     d->tendons[i].name = t.name.c_str();
     d->tendons[i].radius = t.radius;
     CORBA::ULong n = 0;
-    for (const auto& e : t.path)
+    d->tendons[i].path.length(static_cast<CORBA::ULong>(t.path.size()));
+    for (CORBA::ULong k = 0; k < t.path.size(); ++k) {
+      const auto& e = t.path[k];
+      S::PathPoint& p = d->tendons[i].path[k];
+      p.body = e.body.c_str();
+      p.x = e.position.x();
+      p.y = e.position.y();
+      p.z = e.position.z();
+      p.obstacle = e.kind == sgal::PathElement::Kind::kWrap ? e.obstacle.c_str() : "";
       if (e.kind == sgal::PathElement::Kind::kWrap) {
         d->tendons[i].obstacles.length(n + 1);
         d->tendons[i].obstacles[n++] = e.obstacle.c_str();
       }
+    }
   }
   return d;
 }
@@ -1019,6 +1033,232 @@ CORBA::ULongLong ModelServant::add_observer(S::SceneObserver_ptr observer) {
 
 void ModelServant::remove_observer(CORBA::ULongLong id) {
   pool_.Remove(PushPool::Kind::kObserver, id);
+}
+
+// ------------------------------------------------------------------------ scene editing
+
+namespace {
+
+sgal::PathElement FromIdl(const S::PathPoint& p) {
+  sgal::PathElement e;
+  if (std::strlen(p.obstacle.in()) > 0) {
+    e.kind = sgal::PathElement::Kind::kWrap;
+    e.obstacle = p.obstacle.in();
+  } else {
+    e.body = p.body.in();
+    e.position = {p.x, p.y, p.z};
+  }
+  return e;
+}
+
+sgal::Pose FromFrame(const S::Frame& f) {
+  sgal::Pose p;
+  p.position = {f.px, f.py, f.pz};
+  p.orientation = Eigen::Quaterniond(f.qw, f.qx, f.qy, f.qz);
+  return p;
+}
+
+M::EditStatus* ToIdl(const ModelCore::EditStatus& s) {
+  auto* out = new M::EditStatus;
+  out->revision = s.revision;
+  out->last = s.last.c_str();
+  out->undo = s.undo.c_str();
+  out->redo = s.redo.c_str();
+  return out;
+}
+
+}  // namespace
+
+M::EditStatus* ModelServant::move_path_point(const char* tendon, CORBA::ULong index,
+                                             const S::PathPoint& point) {
+  return Guard([&] {
+    const sgal::PathElement to = FromIdl(point);
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) {
+      return sgal::MovePathPoint(s, tendon, index, to);
+    }));
+  });
+}
+
+M::EditStatus* ModelServant::insert_path_point(const char* tendon, CORBA::ULong index,
+                                               const S::PathPoint& point) {
+  return Guard([&] {
+    const sgal::PathElement element = FromIdl(point);
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) {
+      return sgal::InsertPathPoint(s, tendon, index, element);
+    }));
+  });
+}
+
+M::EditStatus* ModelServant::remove_path_point(const char* tendon, CORBA::ULong index) {
+  return Guard([&] {
+    return ToIdl(core_.Edit(
+        [&](const sgal::Scene& s) { return sgal::RemovePathPoint(s, tendon, index); }));
+  });
+}
+
+M::EditStatus* ModelServant::add_tendon(const char* tendon, const S::PathPoint& from,
+                                        const S::PathPoint& to, CORBA::Double radius_m,
+                                        const char* actuator, const char* kind) {
+  return Guard([&] {
+    sgal::Tendon t;
+    t.name = tendon;
+    t.radius = radius_m;
+    t.path = {FromIdl(from), FromIdl(to)};
+    const std::vector<std::string> kinds = actuators::Kinds();
+    if (std::find(kinds.begin(), kinds.end(), std::string(kind)) == kinds.end()) {
+      std::string known;
+      for (const auto& k : kinds) known += (known.empty() ? "" : ", ") + k;
+      throw sgal::EditError("add_tendon: no actuator kind '" + std::string(kind) + "' (" + known +
+                            ")");
+    }
+    sgal::Actuator a;
+    a.name = actuator;
+    a.kind = kind;
+    std::string missing;
+    for (const auto& p : actuators::KindParameters(kind)) {
+      if (p.required) missing += (missing.empty() ? "" : ", ") + p.name;
+      a.parameters[p.name] = p.default_value;
+    }
+    if (!missing.empty())
+      throw sgal::EditError("add_tendon: a " + std::string(kind) + " needs " + missing +
+                            ", which have no default: declare it in the model file");
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) { return sgal::AddTendon(s, t, a); }));
+  });
+}
+
+M::EditStatus* ModelServant::remove_tendon(const char* tendon) {
+  return Guard([&] {
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) { return sgal::RemoveTendon(s, tendon); }));
+  });
+}
+
+M::EditStatus* ModelServant::set_obstacle(const S::Obstacle& obstacle) {
+  return Guard([&] {
+    sgal::WrapObstacle o;
+    o.name = obstacle.name.in();
+    o.body = obstacle.body.in();
+    const std::string kind = obstacle.kind.in();
+    if (kind != "sphere" && kind != "cylinder")
+      throw sgal::EditError("obstacle '" + o.name + "': kind '" + kind +
+                            "' is not sphere or cylinder");
+    o.kind = kind == "sphere" ? sgal::ObstacleKind::kSphere : sgal::ObstacleKind::kCylinder;
+    o.pose = FromFrame(obstacle.pose);
+    o.radius = obstacle.radius;
+    o.length = obstacle.length;
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) { return sgal::SetObstacle(s, o); }));
+  });
+}
+
+M::EditStatus* ModelServant::remove_obstacle(const char* obstacle) {
+  return Guard([&] {
+    return ToIdl(
+        core_.Edit([&](const sgal::Scene& s) { return sgal::RemoveObstacle(s, obstacle); }));
+  });
+}
+
+M::EditStatus* ModelServant::set_shape_dims(const char* body, CORBA::ULong index,
+                                            const S::DoubleSeq& dims) {
+  return Guard([&] {
+    if (dims.length() > 16) throw sgal::EditError("set_shape_dims: at most 4 dimensions");
+    std::vector<double> values(dims.get_buffer(), dims.get_buffer() + dims.length());
+    return ToIdl(core_.Edit(
+        [&](const sgal::Scene& s) { return sgal::SetShapeDims(s, body, index, values); }));
+  });
+}
+
+M::EditStatus* ModelServant::set_mass(const char* body, CORBA::Double mass_kg) {
+  return Guard([&] {
+    return ToIdl(core_.Edit([&](const sgal::Scene& s) { return sgal::SetMass(s, body, mass_kg); }));
+  });
+}
+
+M::EditStatus* ModelServant::undo() {
+  return Guard([&] { return ToIdl(core_.Undo()); });
+}
+
+M::EditStatus* ModelServant::redo() {
+  return Guard([&] { return ToIdl(core_.Redo()); });
+}
+
+M::EditStatus* ModelServant::edit_status() { return ToIdl(core_.edit_status()); }
+
+S::VisualSeq* ModelServant::body_shapes(const char* body) {
+  return Guard([&] {
+    const auto scene = core_.description();
+    if (!scene) throw NotAvailable("no scene is loaded (load one first)");
+    const sgal::Body* b = scene->FindBody(body);
+    if (b == nullptr) throw sgal::EditError("no body '" + std::string(body) + "'");
+    auto* out = new S::VisualSeq;
+    out->length(static_cast<CORBA::ULong>(b->shapes.size()));
+    std::map<const sgal::Mesh*, CORBA::Long> meshes;  // meshes are not sent: index only
+    for (CORBA::ULong k = 0; k < b->shapes.size(); ++k) {
+      (*out)[k].name = b->shapes[k].name.c_str();
+      (*out)[k].geometry = ToGeometry(b->shapes[k].geometry, &meshes);
+      (*out)[k].pose = ToFrame(b->shapes[k].pose);
+      (*out)[k].r = (*out)[k].g = (*out)[k].b = 0.7f;
+      (*out)[k].a = 1;
+    }
+    return out;
+  });
+}
+
+M::ActuatorKindSeq* ModelServant::actuator_kinds() {
+  auto* out = new M::ActuatorKindSeq;
+  const std::vector<std::string> kinds = actuators::Kinds();
+  out->length(static_cast<CORBA::ULong>(kinds.size()));
+  for (CORBA::ULong i = 0; i < kinds.size(); ++i) {
+    M::ActuatorKind& k = (*out)[i];
+    k.kind = kinds[i].c_str();
+    const auto& specs = actuators::KindParameters(kinds[i]);
+    k.parameters.length(static_cast<CORBA::ULong>(specs.size()));
+    k.defaults.length(static_cast<CORBA::ULong>(specs.size()));
+    k.units.length(static_cast<CORBA::ULong>(specs.size()));
+    sgal::Actuator probe;
+    probe.name = "probe";
+    probe.kind = kinds[i];
+    for (CORBA::ULong p = 0; p < specs.size(); ++p) {
+      k.parameters[p] = specs[p].name.c_str();
+      k.defaults[p] = specs[p].default_value;
+      k.units[p] = specs[p].unit.c_str();
+      probe.parameters[specs[p].name] = specs[p].default_value;
+    }
+    try {
+      k.command_unit = actuators::Make(probe)->command_unit().c_str();
+    } catch (const std::exception&) {
+      k.command_unit = "";  // a kind that needs parameters without defaults
+    }
+  }
+  return out;
+}
+
+void ModelServant::pull(const char* body, const M::Vector3& point, const M::Vector3& target,
+                        CORBA::Double stiffness_n_per_m) {
+  Guard([&] {
+    core_.Pull(body, {point.x, point.y, point.z}, {target.x, target.y, target.z},
+               stiffness_n_per_m);
+  });
+}
+
+void ModelServant::release_pull() {
+  Guard([&] { core_.ReleasePull(); });
+}
+
+void ModelServant::select(const char* kind, const char* name, CORBA::ULong index) {
+  try {
+    core_.Select(kind, name, index);
+  } catch (const std::exception& e) {
+    throw M::EditRefused(rtc::BoundedReason(e.what()).c_str());
+  }
+}
+
+M::Selection* ModelServant::current_selection() {
+  const ModelCore::Selection s = core_.selection();
+  auto* out = new M::Selection;
+  out->kind = s.kind.c_str();
+  out->name = s.name.c_str();
+  out->index = s.index;
+  out->revision = s.revision;
+  return out;
 }
 
 }  // namespace caliper::model

@@ -226,6 +226,34 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   // ObserverRegistry
   CORBA::ULongLong add_observer(Caliper::Scene::SceneObserver_ptr observer) override;
   void remove_observer(CORBA::ULongLong id) override;
+  // SceneEditing
+  Caliper::Simulation::EditStatus* move_path_point(const char* tendon, CORBA::ULong index,
+                                                   const Caliper::Scene::PathPoint& point) override;
+  Caliper::Simulation::EditStatus* insert_path_point(
+      const char* tendon, CORBA::ULong index, const Caliper::Scene::PathPoint& point) override;
+  Caliper::Simulation::EditStatus* remove_path_point(const char* tendon,
+                                                     CORBA::ULong index) override;
+  Caliper::Simulation::EditStatus* add_tendon(const char* tendon,
+                                              const Caliper::Scene::PathPoint& from,
+                                              const Caliper::Scene::PathPoint& to,
+                                              CORBA::Double radius_m, const char* actuator,
+                                              const char* kind) override;
+  Caliper::Simulation::EditStatus* remove_tendon(const char* tendon) override;
+  Caliper::Simulation::EditStatus* set_obstacle(const Caliper::Scene::Obstacle& obstacle) override;
+  Caliper::Simulation::EditStatus* remove_obstacle(const char* obstacle) override;
+  Caliper::Simulation::EditStatus* set_shape_dims(const char* body, CORBA::ULong index,
+                                                  const Caliper::Scene::DoubleSeq& dims) override;
+  Caliper::Simulation::EditStatus* set_mass(const char* body, CORBA::Double mass_kg) override;
+  Caliper::Simulation::EditStatus* undo() override;
+  Caliper::Simulation::EditStatus* redo() override;
+  Caliper::Simulation::EditStatus* edit_status() override;
+  Caliper::Scene::VisualSeq* body_shapes(const char* body) override;
+  Caliper::Simulation::ActuatorKindSeq* actuator_kinds() override;
+  void pull(const char* body, const Caliper::Simulation::Vector3& point,
+            const Caliper::Simulation::Vector3& target, CORBA::Double stiffness_n_per_m) override;
+  void release_pull() override;
+  void select(const char* kind, const char* name, CORBA::ULong index) override;
+  Caliper::Simulation::Selection* current_selection() override;
 
  private:
   /// subscribe and subscribe_lossless.

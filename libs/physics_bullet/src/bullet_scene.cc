@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <exception>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <typeinfo>
@@ -187,6 +188,10 @@ class BulletScene : public sgal::PhysicsScene {
   int ParameterIndex(const std::string& id) const override;
   double GetParameter(int index) const override;
   void SetParameter(const std::string& id, double value) override;
+  sgal::DynamicState SaveDynamicState() const override;
+  void RestoreDynamicState(const sgal::DynamicState& state) override;
+  void SetPull(const sgal::Pull& pull) override;
+  void ClearPull() override { pull_.reset(); }
 
  private:
   void BuildBody(size_t index);
@@ -199,6 +204,7 @@ class BulletScene : public sgal::PhysicsScene {
   void ApplyTendonForces();
   void ApplyJointSprings();
   void ApplyJointFriction();
+  void ApplyPull();
   void BuildCouplings();
   double JointInverseInertia(const JointData& j) const;
   void ApplyCouplings();
@@ -224,6 +230,7 @@ class BulletScene : public sgal::PhysicsScene {
   double dt_;
   double time_ = 0;
   uint64_t steps_ = 0;
+  std::optional<sgal::Pull> pull_;  // the GUI's spring on a body, while it lasts
 
   std::unique_ptr<btDefaultCollisionConfiguration> configuration_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
@@ -936,6 +943,7 @@ void BulletScene::Step() {
     ApplyJointSprings();
     ApplyJointFriction();
     ApplyCouplings();
+    ApplyPull();
     world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
     CheckState();
     CacheBodyPoses();
@@ -945,6 +953,96 @@ void BulletScene::Step() {
   }
   time_ += dt_;
   ++steps_;
+}
+
+void BulletScene::ApplyPull() {
+  if (!pull_) return;
+  const int i = pull_->body;
+  const Vector3d at = poses_[i] * pull_->point;
+  const Vector3d v = velocities_[i] + spins_[i].cross(at - coms_[i]);
+  const Vector3d force = pull_->stiffness * (pull_->target - at) - pull_->damping * v;
+  bodies_[i].rigid->applyForce(ToBt(force, scale_), ToBt(at - coms_[i], scale_));
+}
+
+void BulletScene::SetPull(const sgal::Pull& pull) {
+  if (pull.body < 0 || pull.body >= static_cast<int>(bodies_.size()) ||
+      scene_.bodies[pull.body].type != sgal::BodyType::kDynamic)
+    throw std::out_of_range("pull: body index " + std::to_string(pull.body) +
+                            " is not a moving body");
+  if (!pull.point.allFinite() || !pull.target.allFinite() || !std::isfinite(pull.stiffness) ||
+      !std::isfinite(pull.damping) || pull.stiffness < 0 || pull.damping < 0)
+    throw std::invalid_argument("pull on '" + scene_.bodies[pull.body].name +
+                                "': point, target, stiffness and damping must be finite, the "
+                                "last two >= 0");
+  pull_ = pull;
+}
+
+sgal::DynamicState BulletScene::SaveDynamicState() const {
+  sgal::DynamicState s;
+  s.time = time_;
+  s.steps = steps_;
+  s.bodies = BodyStates();
+  for (const auto& j : joints_) s.joint_positions.push_back(j.position);
+  for (const auto& a : actuators_) {
+    std::vector<double> state(a.model->StateSize());
+    a.model->SaveState(state.data());
+    s.actuators.push_back(std::move(state));
+    s.commands.push_back(a.model->command());
+  }
+  return s;
+}
+
+void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
+  auto refuse = [](const std::string& what) {
+    throw std::invalid_argument("restoring the dynamic state: " + what);
+  };
+  if (s.bodies.size() != bodies_.size())
+    refuse(std::to_string(s.bodies.size()) + " bodies for a scene of " +
+           std::to_string(bodies_.size()));
+  if (s.joint_positions.size() != joints_.size())
+    refuse(std::to_string(s.joint_positions.size()) + " joint positions for a scene of " +
+           std::to_string(joints_.size()) + " constraints");
+  if (s.actuators.size() != actuators_.size() || s.commands.size() != actuators_.size())
+    refuse(std::to_string(s.actuators.size()) + " actuator states for a scene of " +
+           std::to_string(actuators_.size()) + " actuators");
+  for (size_t k = 0; k < actuators_.size(); ++k)
+    if (!s.actuators[k].empty() && s.actuators[k].size() != actuators_[k].model->StateSize())
+      refuse("actuator '" + actuators_[k].desc->name + "' has " +
+             std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
+             std::to_string(s.actuators[k].size()));
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    btRigidBody& rb = *bodies_[i].rigid;
+    const sgal::BodyState& b = s.bodies[i];
+    // the body frame's pose and velocity to the centre of mass's, as Bullet keeps them
+    const Isometry3d com = b.pose.ToIsometry() * bodies_[i].com_in_body;
+    const Vector3d v_com =
+        b.linear_velocity + b.angular_velocity.cross(com.translation() - b.pose.position);
+    const Eigen::Quaterniond q(com.linear());
+    btTransform t;
+    t.setOrigin(ToBt(com.translation(), scale_));
+    t.setRotation(btQuaternion(q.x(), q.y(), q.z(), q.w()));
+    if (scene_.bodies[i].type == sgal::BodyType::kDynamic) {
+      rb.setLinearVelocity(ToBt(v_com, scale_));
+      rb.setAngularVelocity(ToBt(b.angular_velocity));
+    }
+    rb.setCenterOfMassTransform(t);
+    if (rb.getMotionState() == nullptr) rb.setInterpolationWorldTransform(t);
+    rb.clearForces();
+  }
+  time_ = s.time;
+  steps_ = s.steps;
+  for (size_t j = 0; j < joints_.size(); ++j) joints_[j].position = s.joint_positions[j];
+  CacheBodyPoses();
+  UpdateJoints();  // counted turns continue from the positions carried over
+  RefreshWorldShapes();
+  EvaluateTendons();
+  for (size_t k = 0; k < actuators_.size(); ++k) {
+    ActuatorData& a = actuators_[k];
+    if (!s.actuators[k].empty()) a.model->RestoreState(s.actuators[k].data());
+    a.model->SetCommand(s.commands[k]);
+  }
+  // the path's speed comes from the next step's length: no jump from the length before an edit
+  for (auto& t : tendons_) t.previous_length = t.geometry.length;
 }
 
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {

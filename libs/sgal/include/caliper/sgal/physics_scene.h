@@ -47,6 +47,28 @@ struct ParameterInfo {
   bool is_static = false;  // a model parameter (true) or a state that changes every step (false)
 };
 
+/// What changes from step to step, to carry a running simulation over into an edited copy of its
+/// scene (or to restore it later): bodies, joints' counted positions, actuators' internal states
+/// and commands, time.
+struct DynamicState {
+  double time = 0;  // [s]
+  uint64_t steps = 0;
+  std::vector<BodyState> bodies;               // description().bodies order
+  std::vector<double> joint_positions;         // description().constraints order [rad] or [m]
+  std::vector<std::vector<double>> actuators;  // description().actuators order: their states
+  std::vector<double> commands;                // description().actuators order
+};
+
+/// A spring pulling a point of a body towards a target (the GUI's Ctrl+drag), with damping on the
+/// point's velocity: force = stiffness (target - point) - damping velocity.
+struct Pull {
+  int body = -1;                                      // index into description().bodies
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // in the body frame [m]
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  // world [m]
+  double stiffness = 0;                               // [N/m]
+  double damping = 0;                                 // [N s/m]
+};
+
 class PhysicsScene {
  public:
   virtual ~PhysicsScene() = default;
@@ -83,6 +105,16 @@ class PhysicsScene {
   /// actuator's max_substep below time_step / 10^4 or a time step that needs more sub-steps:
   /// the message gives the reason and the bound).
   virtual void SetParameter(const std::string& id, double value) = 0;
+
+  virtual DynamicState SaveDynamicState() const = 0;
+  /// Puts the scene in `state`, which must have this scene's numbers of bodies, constraints and
+  /// actuators and each actuator's state size (else std::invalid_argument saying which); an
+  /// actuator whose state is empty keeps its own (one that a scene edit just added).
+  virtual void RestoreDynamicState(const DynamicState& state) = 0;
+  /// From the next step on, applies the pull until ClearPull(); std::out_of_range for a body
+  /// index that is not a moving body, std::invalid_argument for non-finite numbers.
+  virtual void SetPull(const Pull& pull) = 0;
+  virtual void ClearPull() = 0;
 };
 
 /// Receives the bodies whose pose changed beyond a tolerance since it was last told.
