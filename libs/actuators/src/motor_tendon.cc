@@ -13,6 +13,7 @@
 #include "caliper/actuators/actuator.h"
 #include "caliper/actuators/dc_motor.h"
 #include "caliper/actuators/elastic.h"
+#include "caliper/logging/log.h"
 
 namespace caliper::actuators {
 
@@ -166,6 +167,7 @@ class DcMotorTendon : public TendonActuator {
     line_length_ = path_length - length;
     elastic_length_ = length;
     tension_ = elastic_->Peek(length, 0, 0);
+    if (line_length_ < 0) WarnNegativeLine();
   }
 
   double Step(double path_length, double path_speed, double dt) override {
@@ -322,6 +324,28 @@ class DcMotorTendon : public TendonActuator {
   }
 
   double voltage() const { return duty_input_ ? command_ * supply_voltage_ : command_; }
+
+  // Reset keeps the element just taut at the pretension, whatever the path: a relaxed element
+  // longer than the path leaves a negative line, which a file author rarely means (a rest_length
+  // in the wrong unit, or a route shorter than drawn), so the load says so in millimetres
+  void WarnNegativeLine() const {
+    constexpr double kMm = 1000;  // [mm/m]
+    std::string rest;
+    if (HasElastic("rest_length"))
+      rest = "rest_length " + Number(elastic_->Get("rest_length") * kMm) + " mm";
+    if (pretension_ > 0)
+      rest += (rest.empty() ? "" : ", ") + std::string("relaxed length ") +
+              Number(elastic_length_ * kMm) + " mm at pretension " + Number(pretension_) + " N";
+    logging::Get("actuators")
+        .warn(
+            "%sits elastic element (%s) is longer than its tendon path at load (%s mm): the "
+            "kite line starts at %s mm, i.e. %s mm of the element counts as already wound on "
+            "the spool; it is just taut at %s N and pulls as soon as the spool winds in (an "
+            "element shorter than %s mm when relaxed gives a line of positive length)",
+            prefix_.c_str(), rest.c_str(), Number(path_length_ * kMm).c_str(),
+            Number(line_length_ * kMm).c_str(), Number(-line_length_ * kMm).c_str(),
+            Number(pretension_).c_str(), Number(path_length_ * kMm).c_str());
+  }
 
   std::string prefix_;
   DcMotor motor_;
