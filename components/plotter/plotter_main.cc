@@ -38,7 +38,8 @@ options:
   --session FILE        the GUI session file shared with the Main Window (INI): the window's
                         geometry (plotter/geometry, unless --geometry) and the last layout
                         (plotter/layout, unless --layout or --ids) are restored from it and
-                        written back when the window moves, is resized or closes; a layout
+                        written back when the window moves, is resized or closes (the layout
+                        also as soon as it is applied and whenever it changes); a layout
                         there that does not parse is kept as plotter/layout.rejected
   -h, --help            this text
   -platform NAME, -style NAME, ...  Qt's own options
@@ -136,6 +137,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     caliper::plotter::PlotterWindow window(std::move(link));
+    // the session file first: the layout applied below goes into it at once, so that a plotter
+    // that never closes (killed, its X server gone) does not leave an earlier session's layout
+    window.SetSessionFile(session);
     // the layout: --layout and --ids, else the session's (kept aside when it does not parse,
     // before anything writes the session)
     if (have_layout) {
@@ -145,7 +149,6 @@ int main(int argc, char** argv) {
       if (!window.RestoreSessionLayout(session, &error) && !error.isEmpty())
         std::cerr << "caliper-plotter: " << error.toStdString() << "\n";
     }
-    window.SetSessionFile(session);
     auto* tool = new caliper::gui_session::ToolWindow(&window, "plotter", session);
     tool->Restore(geometry);
     window.show();

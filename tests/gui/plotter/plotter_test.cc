@@ -10,6 +10,8 @@
 // for --help, bad options, Qt's options and the session file (a layout there that does not parse
 // is kept aside). Widgets run on QT_QPA_PLATFORM=offscreen.
 #include <gtest/gtest.h>
+#include <qwt_plot_curve.h>
+#include <qwt_symbol.h>
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -41,9 +43,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
-
-#include <qwt_plot_curve.h>
-#include <qwt_symbol.h>
 
 #include "caliper/model.hh"
 #include "caliper/rtc/naming.h"
@@ -646,6 +645,33 @@ TEST_F(PlotterTest, TheProgramTakesItsOptionsAndKeepsItsSession) {
   QSettings after(QString::fromStdString(session), QSettings::IniFormat);
   EXPECT_EQ(after.value("plotter/layout.rejected").toString(), rejected);
   EXPECT_NE(after.value("plotter/layout").toString(), rejected) << "the window's layout is written";
+}
+
+// The layout shown is in the session file from the start, not only once the window closes: a
+// plotter that never closes (SIGKILL here; a lost X server or a crash alike) does not leave the
+// layout of an earlier session behind for the next one.
+TEST_F(PlotterTest, WritesTheLayoutItShowsAtOnceSoAKilledPlotterLeavesIt) {
+  const std::string session = dir_.path() + "/killed.ini";
+  QSettings(QString::fromStdString(session), QSettings::IniFormat)
+      .setValue("plotter/layout", "version = 1\n[plot]\ncurve = earlier.session\n");
+  Process p({Bin("caliper-plotter"), "-platform", "offscreen", "--nameservice", naming_->address(),
+             "--session", session, "--ids", "demo.elbow.position"},
+            dir_.path() + "/killed.out");
+  Layout stored;
+  QString error;
+  const auto deadline = std::chrono::steady_clock::now() + seconds(10);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (PlotterWindow::SessionLayout(QString::fromStdString(session), &stored, &error) &&
+        stored.Keys() == std::vector<std::string>{"demo.elbow.position"})
+      break;
+    std::this_thread::sleep_for(milliseconds(50));
+  }
+  p.Signal(SIGKILL);
+  p.Wait(seconds(10));
+  ASSERT_TRUE(PlotterWindow::SessionLayout(QString::fromStdString(session), &stored, &error))
+      << error.toStdString() << ReadFile(session);
+  EXPECT_EQ(stored.Keys(), std::vector<std::string>{"demo.elbow.position"})
+      << "the earlier session's layout stayed: " << ReadFile(session);
 }
 
 TEST_F(PlotterTest, KeepsARejectedSessionLayoutAsideAndSaysWhy) {
