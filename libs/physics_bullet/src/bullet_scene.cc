@@ -1039,10 +1039,16 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   for (size_t k = 0; k < actuators_.size(); ++k) {
     ActuatorData& a = actuators_[k];
     if (!s.actuators[k].empty()) a.model->RestoreState(s.actuators[k].data());
-    a.model->SetCommand(s.commands[k]);
+    // passive elements take no command (and refuse one): only what differs is set
+    if (s.commands[k] != a.model->command()) a.model->SetCommand(s.commands[k]);
   }
-  // the path's speed comes from the next step's length: no jump from the length before an edit
-  for (auto& t : tendons_) t.previous_length = t.geometry.length;
+  // the path's speed comes from the next step's length: no jump from the length before an edit;
+  // the tension reads what the actuators carried over hold
+  for (auto& t : tendons_) {
+    t.previous_length = t.geometry.length;
+    t.tension = 0;
+    for (int index : t.actuators) t.tension += actuators_[index].model->tension();
+  }
 }
 
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {
