@@ -31,12 +31,14 @@
 #include <memory>
 
 #include "caliper/gui_session/tool_window.h"
+#include "selection_panel.h"
 
 namespace caliper::main_window {
 
 namespace {
 
 constexpr int kIdRole = Qt::UserRole;
+constexpr int kGroupRole = Qt::UserRole + 2;  // a group row's dotted prefix
 constexpr int kErrorShowMs = 8000;
 
 QPushButton* Button(const QString& text, const char* name, QWidget* parent) {
@@ -149,6 +151,8 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   tree_->setColumnCount(3);
   tree_->setHeaderLabels({"Parameter", "Value", "Unit"});
   tree_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  // a tendon's selection shows its actuators' rows too
+  tree_->setSelectionMode(QAbstractItemView::ExtendedSelection);
   tree_->header()->setSectionResizeMode(0, QHeaderView::Stretch);
   tree_->setColumnWidth(1, 160);
   tree_->header()->setStretchLastSection(false);
@@ -180,6 +184,39 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   panel_layout->addLayout(actions);
   dock->setWidget(panel);
   addDockWidget(Qt::BottomDockWidgetArea, dock);
+
+  // the selection shared with the renderer, and its edits
+  auto* selection_dock = new QDockWidget("Selection", this);
+  selection_dock->setObjectName("selection_dock");
+  selection_panel_ = new SelectionPanel(*link_, selection_dock);
+  selection_panel_->set_message_handler(
+      [this](const QString& text) { statusBar()->showMessage(text, kErrorShowMs); });
+  selection_dock->setWidget(selection_panel_);
+  addDockWidget(Qt::RightDockWidgetArea, selection_dock);
+
+  QMenu* edit = menuBar()->addMenu("&Edit");
+  undo_ = edit->addAction("&Undo");
+  undo_->setObjectName("undo");
+  undo_->setShortcuts(QKeySequence::Undo);
+  undo_->setEnabled(false);
+  redo_ = edit->addAction("&Redo");
+  redo_->setObjectName("redo");
+  redo_->setShortcuts({QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")});
+  redo_->setEnabled(false);
+  connect(undo_, &QAction::triggered, this, [this] {
+    link_->Undo();
+    statusBar()->showMessage("undoing ...", 3000);
+  });
+  connect(redo_, &QAction::triggered, this, [this] {
+    link_->Redo();
+    statusBar()->showMessage("redoing ...", 3000);
+  });
+  edit->addSeparator();
+  QAction* add_tendon = edit->addAction("Add &tendon...");
+  add_tendon->setObjectName("add_tendon_action");
+  connect(add_tendon, &QAction::triggered, this, [this] { selection_panel_->OpenAddTendon(); });
+  edit->addSeparator();
+  edit->addAction(selection_dock->toggleViewAction());
 
   // menus: tools as their own processes, and the panels
   QMenu* tools = menuBar()->addMenu("&Tools");
@@ -227,6 +264,8 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   });
   connect(tree_, &QTreeWidget::itemChanged, this,
           [this](QTreeWidgetItem* item, int column) { OnItemChanged(item, column); });
+  connect(tree_, &QTreeWidget::currentItemChanged, this,
+          [this](QTreeWidgetItem* item, QTreeWidgetItem*) { OnCurrentItemChanged(item); });
 
   timer_ = new QTimer(this);
   connect(timer_, &QTimer::timeout, this, [this] { Refresh(); });
@@ -535,6 +574,132 @@ QTreeWidgetItem* MainWindow::ItemOf(const std::string& id) const {
   return it == items_.end() ? nullptr : it->second;
 }
 
+QTreeWidgetItem* MainWindow::GroupOf(const std::string& prefix) const {
+  const auto it = groups_.find(prefix);
+  return it == groups_.end() ? nullptr : it->second;
+}
+
+void MainWindow::RefreshEditActions(const Snapshot& s) {
+  const bool on = s.connected && s.editing;
+  const QString undo = on ? QString::fromStdString(s.edit.undo) : QString();
+  const QString redo = on ? QString::fromStdString(s.edit.redo) : QString();
+  // "Undo set the mass of forearm to 1.3 kg": the Model's words for the edit
+  undo_->setText(undo.isEmpty() ? QString("&Undo") : "&Undo " + undo);
+  redo_->setText(redo.isEmpty() ? QString("&Redo") : "&Redo " + redo);
+  undo_->setEnabled(!undo.isEmpty());
+  redo_->setEnabled(!redo.isEmpty());
+}
+
+std::pair<std::string, std::string> MainWindow::EntityOf(const QTreeWidgetItem* item) const {
+  if (item == nullptr || scene_name_.empty()) return {};
+  const std::string prefix = item->data(0, kGroupRole).toString().toStdString();
+  const std::string head = scene_name_ + ".";
+  if (prefix.compare(0, head.size(), head) != 0) return {};
+  std::string rest = prefix.substr(head.size());
+  const SceneInfo& scene = link_->snapshot().scene;
+  // a tendon's states live under <tendon>.tendon (tendons often share their actuator's name)
+  const std::string suffix = ".tendon";
+  if (rest.size() > suffix.size() &&
+      rest.compare(rest.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+      scene.FindTendon(rest.substr(0, rest.size() - suffix.size())) != nullptr)
+    return {"tendon", rest.substr(0, rest.size() - suffix.size())};
+  if (scene.FindBody(rest) != nullptr) return {"body", rest};
+  for (const auto& a : scene.actuators)
+    if (a.name == rest && scene.FindTendon(a.tendon) != nullptr) return {"tendon", a.tendon};
+  if (scene.FindTendon(rest) != nullptr) return {"tendon", rest};
+  for (const auto& c : scene.constraints)
+    if (c == rest) return {"constraint", rest};
+  return {};
+}
+
+void MainWindow::OnCurrentItemChanged(QTreeWidgetItem* item) {
+  if (following_ || updating_ || item == nullptr) return;
+  const auto [kind, name] = EntityOf(item);
+  if (kind.empty()) return;
+  link_->Select(kind, name);  // the renderer highlights it; the panel follows the Model
+}
+
+void MainWindow::FollowSelection(const Snapshot& s) {
+  const SelectionInfo& sel = s.selection;
+  const SceneInfo& scene = s.scene;
+  const std::string head = scene.name + ".";
+  auto group = [&](const std::string& name) { return GroupOf(head + name); };
+  QTreeWidgetItem* current = nullptr;
+  std::vector<QTreeWidgetItem*> also;  // rows shown selected beside the current one
+  QString text;
+  const QString name = QString::fromStdString(sel.name);
+  auto tendon_rows = [&](const std::string& tendon) {
+    current = group(tendon + ".tendon");
+    QStringList actuators;
+    for (const auto& a : scene.actuators) {
+      if (a.tendon != tendon) continue;
+      actuators << QString::fromStdString(a.name);
+      if (QTreeWidgetItem* row = group(a.name)) also.push_back(row);
+    }
+    if (current == nullptr && !also.empty()) current = also.front();
+    return actuators.isEmpty() ? QString("no actuator") : "actuators " + actuators.join(", ");
+  };
+  if (sel.kind == "body") {
+    current = group(sel.name);
+    const BodyInfo* b = scene.FindBody(sel.name);
+    text = "selected body " + name + (b != nullptr && !b->moving ? " (static)" : "");
+  } else if (sel.kind == "tendon") {
+    text = "selected tendon " + name + " (" + tendon_rows(sel.name) + ")";
+  } else if (sel.kind == "path_point") {
+    const TendonInfo* t = scene.FindTendon(sel.name);
+    const QString where = t != nullptr && sel.index < t->path.size()
+                              ? QString::fromStdString(PathElementName(*t, sel.index))
+                              : QString("point %1 of %2").arg(sel.index).arg(name);
+    QString at;
+    if (t != nullptr && sel.index < t->path.size() && t->path[sel.index].obstacle.empty()) {
+      const PathPointInfo& p = t->path[sel.index];
+      at = QString(" at (%1, %2, %3) mm in %4")
+               .arg(p.x_m * 1000, 0, 'g', 6)
+               .arg(p.y_m * 1000, 0, 'g', 6)
+               .arg(p.z_m * 1000, 0, 'g', 6)
+               .arg(p.body.empty() ? QString("the world") : QString::fromStdString(p.body));
+    }
+    text = "selected " + where + at + " (" + tendon_rows(sel.name) + ")";
+  } else if (sel.kind == "obstacle") {
+    // an obstacle has no parameters: its body's row is shown
+    const ObstacleInfo* o = scene.FindObstacle(sel.name);
+    if (o != nullptr) current = group(o->body);
+    text = "selected obstacle " + name +
+           (o != nullptr ? QString(" (%1 on %2, radius %3 mm)")
+                               .arg(QString::fromStdString(o->kind),
+                                    o->body.empty() ? QString("the world")
+                                                    : QString::fromStdString(o->body))
+                               .arg(o->radius_m * 1000, 0, 'g', 6)
+                         : QString());
+  } else if (sel.kind == "constraint") {
+    current = group(sel.name);
+    text = "selected constraint " + name;
+  } else {
+    text = "nothing selected";
+  }
+  if (selection_shown_) statusBar()->showMessage(text, kErrorShowMs);
+  selection_shown_ = true;
+
+  // the row the user chose for this entity stays; otherwise the tree jumps to the entity's rows
+  const auto chosen = EntityOf(tree_->currentItem());
+  const std::string kind = sel.kind == "path_point" ? "tendon" : sel.kind;
+  if (!sel.kind.empty() && chosen.first == kind && chosen.second == sel.name) return;
+  following_ = true;
+  tree_->clearSelection();
+  for (QTreeWidgetItem* row : also) {
+    row->setSelected(true);
+    row->setExpanded(true);
+  }
+  if (current != nullptr) {
+    for (QTreeWidgetItem* p = current->parent(); p != nullptr; p = p->parent())
+      p->setExpanded(true);
+    current->setExpanded(true);
+    tree_->setCurrentItem(current, 0, QItemSelectionModel::Select);
+    tree_->scrollToItem(current);
+  }
+  following_ = false;
+}
+
 void MainWindow::Refresh() {
   const Snapshot s = link_->snapshot();
   RefreshComponents(s);
@@ -555,6 +720,7 @@ void MainWindow::Refresh() {
                      static_cast<QWidget*>(step_), static_cast<QWidget*>(stop_),
                      static_cast<QWidget*>(reset_), static_cast<QWidget*>(open_)})
     w->setEnabled(s.connected);
+  RefreshEditActions(s);
   if (!s.connected) {
     const QString why = QString::fromStdString(s.connection_message);
     no_model_->setText(why);
@@ -586,7 +752,19 @@ void MainWindow::Refresh() {
   if (s.channels_version != channels_version_) {
     channels_version_ = s.channels_version;
     BuildTree(s);
+    selection_shown_ = false;  // the new rows follow the selection again, quietly
   }
+
+  scene_name_ = s.scene.name;
+  if (s.scene_version != scene_version_ || s.selection.revision != selection_revision_ ||
+      !selection_shown_) {
+    const bool moved = s.selection.revision != selection_revision_;
+    scene_version_ = s.scene_version;
+    selection_revision_ = s.selection.revision;
+    selection_panel_->Rebuild(s);
+    if (moved || !selection_shown_) FollowSelection(s);
+  }
+  selection_panel_->UpdateValues(s);
 
   // live values of the scalars in expanded groups; those are the ones watched next
   updating_ = true;
@@ -602,6 +780,8 @@ void MainWindow::Refresh() {
       item->setText(1, Number(v->second));
   }
   updating_ = false;
+  for (const std::string& id : selection_panel_->watched())
+    if (std::find(visible.begin(), visible.end(), id) == visible.end()) visible.push_back(id);
   link_->Watch(std::move(visible));
 }
 
@@ -609,7 +789,8 @@ void MainWindow::BuildTree(const Snapshot& s) {
   updating_ = true;
   tree_->clear();
   items_.clear();
-  std::map<std::string, QTreeWidgetItem*> groups;  // dotted prefix -> its row
+  groups_.clear();
+  std::map<std::string, QTreeWidgetItem*>& groups = groups_;
   for (const Channel& c : s.channels) {
     QTreeWidgetItem* parent = nullptr;
     std::string prefix;
@@ -621,7 +802,9 @@ void MainWindow::BuildTree(const Snapshot& s) {
       if (g == nullptr) {
         g = parent == nullptr ? new QTreeWidgetItem(tree_) : new QTreeWidgetItem(parent);
         g->setText(0, QString::fromStdString(part));
-        g->setFlags(Qt::ItemIsEnabled);
+        g->setData(0, kGroupRole, QString::fromStdString(prefix));
+        // selectable: choosing a body's or tendon's row selects it on the Model
+        g->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable);
       }
       parent = g;
       start = dot + 1;

@@ -7,9 +7,11 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "model_link.h"
 
+class QAction;
 class QCloseEvent;
 class QDoubleSpinBox;
 class QProcess;
@@ -23,6 +25,8 @@ class QTreeWidget;
 class QTreeWidgetItem;
 
 namespace caliper::main_window {
+
+class SelectionPanel;
 
 class MainWindow : public QMainWindow {
  public:
@@ -38,6 +42,9 @@ class MainWindow : public QMainWindow {
   void Refresh();
   /// The tree row of a channel id, or nullptr.
   QTreeWidgetItem* ItemOf(const std::string& id) const;
+  /// The tree row grouping the ids that start with `prefix` + "." (e.g. ecce_arm.forearm), or
+  /// nullptr.
+  QTreeWidgetItem* GroupOf(const std::string& prefix) const;
 
   /// The file filter of the Open and Start-a-Model dialogs: every model file Caliper loads
   /// (COLLADA .dae and .zae, URDF .urdf) first, then each format, then all files.
@@ -76,6 +83,14 @@ class MainWindow : public QMainWindow {
 
  private:
   void BuildTree(const Snapshot& s);
+  /// Edit menu: Undo and Redo named after what they would do, enabled when there is something.
+  void RefreshEditActions(const Snapshot& s);
+  /// The tree and the status bar follow the Model's selection.
+  void FollowSelection(const Snapshot& s);
+  /// The entity (kind, name) a tree group stands for: a body, a tendon (its node, or an
+  /// actuator's), a constraint; empty when none.
+  std::pair<std::string, std::string> EntityOf(const QTreeWidgetItem* item) const;
+  void OnCurrentItemChanged(QTreeWidgetItem* item);
   void OnItemChanged(QTreeWidgetItem* item, int column);
   void OpenModelFile();
   void ShowError(const QString& message);
@@ -115,6 +130,15 @@ class MainWindow : public QMainWindow {
   bool settings_applied_ = false;                  // saved simulation settings sent to the Model
   double saved_time_step_ = 0;
   double saved_real_time_factor_ = -1;
+  QAction* undo_ = nullptr;
+  QAction* redo_ = nullptr;
+  SelectionPanel* selection_panel_ = nullptr;
+  std::uint64_t scene_version_ = 0;
+  std::uint64_t selection_revision_ = 0;
+  bool selection_shown_ = false;                    // the Model's selection was followed once
+  bool following_ = false;                          // the tree follows the Model's selection
+  std::string scene_name_;                          // the first part of the parameter ids
+  std::map<std::string, QTreeWidgetItem*> groups_;  // dotted prefix -> its group row
   std::map<std::string, QTreeWidgetItem*> items_;   // channel id -> its row
   std::uint64_t channels_version_ = 0;
   std::uint64_t error_serial_ = 0;

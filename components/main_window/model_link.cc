@@ -35,6 +35,9 @@ struct ModelLink::Impl {
   Clock::time_point last_lookup{};
   Clock::time_point last_listing{};
   CosNaming::NamingContext_var root;  // nil until resolved; dropped on failure
+  bool scene_read = false;        // SceneInfo read for `edit_scene` at `edit_revision`
+  std::string edit_scene;
+  std::uint64_t edit_revision = 0;
 
   CosNaming::NamingContext_ptr Root(const std::string& nameservice) {
     if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
@@ -148,6 +151,208 @@ void ModelLink::Set(const std::string& id, double value) {
   });
 }
 
+const BodyInfo* SceneInfo::FindBody(const std::string& n) const {
+  for (const auto& b : bodies)
+    if (b.name == n) return &b;
+  return nullptr;
+}
+const ObstacleInfo* SceneInfo::FindObstacle(const std::string& n) const {
+  for (const auto& o : obstacles)
+    if (o.name == n) return &o;
+  return nullptr;
+}
+const TendonInfo* SceneInfo::FindTendon(const std::string& n) const {
+  for (const auto& t : tendons)
+    if (t.name == n) return &t;
+  return nullptr;
+}
+
+namespace {
+
+EditInfo FromIdl(const M::EditStatus& s) {
+  return EditInfo{s.revision, s.last.in(), s.undo.in(), s.redo.in()};
+}
+
+S::PathPoint ToIdl(const PathPointInfo& p) {
+  S::PathPoint out;
+  out.body = p.body.c_str();
+  out.x = p.x_m;
+  out.y = p.y_m;
+  out.z = p.z_m;
+  out.obstacle = p.obstacle.c_str();
+  return out;
+}
+
+std::string KindName(S::ShapeKind kind) {
+  switch (kind) {
+    case S::BOX: return "box";
+    case S::SPHERE: return "sphere";
+    case S::CAPSULE: return "capsule";
+    case S::CYLINDER: return "cylinder";
+    case S::CONE: return "cone";
+    case S::PLANE: return "plane";
+    case S::CONVEX_HULL: return "convex_hull";
+    case S::TRIANGLE_MESH: return "triangle_mesh";
+  }
+  return "?";
+}
+
+}  // namespace
+
+void ModelLink::QueueEdit(std::string what, std::function<EditInfo(Impl&)> call) {
+  Queue(what, [this, call](Impl& i) {
+    const EditInfo info = call(i);
+    i.scene_read = false;  // the next poll reads the edited scene
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.editing = true;
+    snapshot_.edit = info;
+  });
+}
+
+void ModelLink::Undo() {
+  QueueEdit("undo", [](Impl& i) { return FromIdl(M::EditStatus_var(i.model->undo()).in()); });
+}
+void ModelLink::Redo() {
+  QueueEdit("redo", [](Impl& i) { return FromIdl(M::EditStatus_var(i.model->redo()).in()); });
+}
+void ModelLink::Select(const std::string& kind, const std::string& name, unsigned index) {
+  Queue("select " + (kind.empty() ? std::string("nothing") : kind + " " + name),
+        [kind, name, index](Impl& i) { i.model->select(kind.c_str(), name.c_str(), index); });
+}
+void ModelLink::SetMass(const std::string& body, double mass_kg) {
+  QueueEdit("set the mass of " + body, [body, mass_kg](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->set_mass(body.c_str(), mass_kg)).in());
+  });
+}
+void ModelLink::SetShapeDims(const std::string& body, unsigned index, std::vector<double> dims_m) {
+  QueueEdit("set shape " + std::to_string(index) + " of " + body, [body, index, dims_m](Impl& i) {
+    S::DoubleSeq dims;
+    dims.length(static_cast<CORBA::ULong>(dims_m.size()));
+    for (CORBA::ULong k = 0; k < dims.length(); ++k) dims[k] = dims_m[k];
+    return FromIdl(M::EditStatus_var(i.model->set_shape_dims(body.c_str(), index, dims)).in());
+  });
+}
+void ModelLink::SetObstacle(const ObstacleInfo& o) {
+  QueueEdit("set obstacle " + o.name, [o](Impl& i) {
+    S::Obstacle out;
+    out.name = o.name.c_str();
+    out.body = o.body.c_str();
+    out.kind = o.kind.c_str();
+    out.pose.px = o.position_m[0];
+    out.pose.py = o.position_m[1];
+    out.pose.pz = o.position_m[2];
+    out.pose.qw = o.orientation[0];
+    out.pose.qx = o.orientation[1];
+    out.pose.qy = o.orientation[2];
+    out.pose.qz = o.orientation[3];
+    out.radius = o.radius_m;
+    out.length = o.length_m;
+    return FromIdl(M::EditStatus_var(i.model->set_obstacle(out)).in());
+  });
+}
+void ModelLink::RemoveObstacle(const std::string& obstacle) {
+  QueueEdit("remove obstacle " + obstacle, [obstacle](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->remove_obstacle(obstacle.c_str())).in());
+  });
+}
+void ModelLink::MovePathPoint(const std::string& tendon, unsigned index,
+                              const PathPointInfo& point) {
+  QueueEdit("move point " + std::to_string(index) + " of " + tendon, [tendon, index, point](Impl& i) {
+    return FromIdl(
+        M::EditStatus_var(i.model->move_path_point(tendon.c_str(), index, ToIdl(point))).in());
+  });
+}
+void ModelLink::RemovePathPoint(const std::string& tendon, unsigned index) {
+  QueueEdit("remove point " + std::to_string(index) + " of " + tendon, [tendon, index](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->remove_path_point(tendon.c_str(), index)).in());
+  });
+}
+void ModelLink::RemoveTendon(const std::string& tendon) {
+  QueueEdit("remove tendon " + tendon, [tendon](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->remove_tendon(tendon.c_str())).in());
+  });
+}
+void ModelLink::AddTendon(const std::string& tendon, const PathPointInfo& from,
+                          const PathPointInfo& to, double radius_m, const std::string& actuator,
+                          const std::string& kind) {
+  QueueEdit("add tendon " + tendon, [=](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->add_tendon(tendon.c_str(), ToIdl(from), ToIdl(to),
+                                                         radius_m, actuator.c_str(),
+                                                         kind.c_str()))
+                       .in());
+  });
+}
+
+void ModelLink::ReadScene() {
+  Impl& i = *impl_;
+  SceneInfo scene;
+  S::Description_var d = i.model->scene_description();
+  scene.name = d->name.in();
+  for (CORBA::ULong k = 0; k < d->bodies.length(); ++k) {
+    BodyInfo body;
+    body.name = d->bodies[k].name.in();
+    body.moving = d->bodies[k].moving;
+    S::VisualSeq_var shapes = i.model->body_shapes(body.name.c_str());
+    for (CORBA::ULong j = 0; j < shapes->length(); ++j) {
+      const S::Visual& v = shapes[j];
+      ShapeInfo shape{v.name.in(), KindName(v.geometry.kind), {}};
+      for (CORBA::ULong n = 0; n < v.geometry.dims.length(); ++n)
+        shape.dims.push_back(v.geometry.dims[n]);
+      body.shapes.push_back(std::move(shape));
+    }
+    scene.bodies.push_back(std::move(body));
+  }
+  for (CORBA::ULong k = 0; k < d->obstacles.length(); ++k) {
+    const S::Obstacle& o = d->obstacles[k];
+    ObstacleInfo info;
+    info.name = o.name.in();
+    info.body = o.body.in();
+    info.kind = o.kind.in();
+    info.position_m[0] = o.pose.px;
+    info.position_m[1] = o.pose.py;
+    info.position_m[2] = o.pose.pz;
+    info.orientation[0] = o.pose.qw;
+    info.orientation[1] = o.pose.qx;
+    info.orientation[2] = o.pose.qy;
+    info.orientation[3] = o.pose.qz;
+    info.radius_m = o.radius;
+    info.length_m = o.length;
+    scene.obstacles.push_back(std::move(info));
+  }
+  for (CORBA::ULong k = 0; k < d->tendons.length(); ++k) {
+    const S::Tendon& t = d->tendons[k];
+    TendonInfo info{t.name.in(), t.radius, {}};
+    for (CORBA::ULong j = 0; j < t.path.length(); ++j) {
+      const S::PathPoint& p = t.path[j];
+      info.path.push_back(PathPointInfo{p.body.in(), p.x, p.y, p.z, p.obstacle.in()});
+    }
+    scene.tendons.push_back(std::move(info));
+  }
+  for (CORBA::ULong k = 0; k < d->constraints.length(); ++k)
+    scene.constraints.push_back(d->constraints[k].name.in());
+  M::ActuatorInfoSeq_var actuators = i.model->actuators();
+  for (CORBA::ULong k = 0; k < actuators->length(); ++k)
+    scene.actuators.push_back(
+        ActuatorInfo{actuators[k].name.in(), actuators[k].kind.in(), actuators[k].tendon.in()});
+
+  std::vector<ActuatorKindInfo> kinds;
+  M::ActuatorKindSeq_var got = i.model->actuator_kinds();
+  for (CORBA::ULong k = 0; k < got->length(); ++k) {
+    ActuatorKindInfo info;
+    info.kind = got[k].kind.in();
+    for (CORBA::ULong j = 0; j < got[k].parameters.length(); ++j) {
+      info.parameters.push_back(got[k].parameters[j].in());
+      info.defaults.push_back(j < got[k].defaults.length() ? got[k].defaults[j] : 0.0);
+      info.units.push_back(j < got[k].units.length() ? got[k].units[j].in() : "");
+    }
+    kinds.push_back(std::move(info));
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_.scene = std::move(scene);
+  snapshot_.actuator_kinds = std::move(kinds);
+  ++snapshot_.scene_version;
+}
+
 void ModelLink::ComponentAction(const std::string& instance, const std::string& verb) {
   const std::string ns = options_.nameservice;
   Queue(verb + " " + instance, [instance, verb, ns](Impl& i) {
@@ -223,6 +428,7 @@ void ModelLink::Run() {
   auto lost = [&](const std::string& why) {
     i.model = M::Model::_nil();
     i.channels_listed = false;
+    i.scene_read = false;
     std::lock_guard<std::mutex> lock(mutex_);
     snapshot_.connected = false;
     snapshot_.connection_message = "no Model reachable: " + why;
@@ -267,6 +473,8 @@ void ModelLink::Run() {
         } catch (const D::NotAvailable& e) {
           error = what + ": " + e.reason.in();
         } catch (const M::LoadFailed& e) {
+          error = what + ": " + e.reason.in();
+        } catch (const M::EditRefused& e) {
           error = what + ": " + e.reason.in();
         } catch (const CORBA::SystemException& e) {
           error = what + ": " + rtc::Describe(e);
@@ -353,7 +561,33 @@ void ModelLink::Run() {
         }
       }
 
+      // the edit history and the selection, shared with the renderer and other clients; the
+      // scene is read again after each edit (from any client) and with each new scene
+      M::EditStatus_var edit = i.model->edit_status();
+      M::Selection_var selection = i.model->current_selection();
+      if (status.state == "EMPTY") {
+        i.scene_read = false;
+      } else if (!i.scene_read || edit->revision != i.edit_revision ||
+                 status.scene != i.edit_scene) {
+        // an edit may add or remove parameters (a tendon's actuator): list them again
+        if (i.scene_read && edit->revision != i.edit_revision) i.channels_listed = false;
+        try {
+          ReadScene();
+          i.scene_read = true;
+          i.edit_scene = status.scene;
+          i.edit_revision = edit->revision;
+        } catch (const M::NotAvailable&) {
+          // no scene (a load in progress): read it at the next poll
+        } catch (const M::EditRefused&) {
+          // a body went away between the description and its shapes: read it again
+        }
+      }
+
       std::lock_guard<std::mutex> lock(mutex_);
+      snapshot_.editing = true;
+      snapshot_.edit = FromIdl(edit.in());
+      snapshot_.selection = SelectionInfo{selection->kind.in(), selection->name.in(),
+                                          selection->index, selection->revision};
       snapshot_.connected = true;
       snapshot_.connection_message.clear();
       snapshot_.status = status;

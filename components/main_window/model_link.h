@@ -48,6 +48,87 @@ struct ComponentInfo {
   std::string state;     ///< CREATED, INACTIVE, ACTIVE, ERROR or UNREACHABLE
 };
 
+/// One element of a tendon's declared path (Scene::PathPoint without CORBA).
+struct PathPointInfo {
+  std::string body;      ///< the body it is fixed in ("" = the world)
+  double x_m = 0;        ///< position in the body's frame [m]
+  double y_m = 0;
+  double z_m = 0;
+  std::string obstacle;  ///< non-empty: a wrap around this obstacle (no position)
+};
+
+/// A collision shape of a body, in the order set_shape_dims indexes them.
+struct ShapeInfo {
+  std::string name;
+  std::string kind;               ///< box, sphere, capsule, cylinder, cone, plane, convex_hull, ...
+  std::vector<double> dims;       ///< as Scene::ShapeGeometry's dims of its kind [m]
+};
+
+struct BodyInfo {
+  std::string name;
+  bool moving = false;
+  std::vector<ShapeInfo> shapes;
+};
+
+struct ObstacleInfo {
+  std::string name;
+  std::string body;
+  std::string kind;               ///< sphere or cylinder
+  double position_m[3] = {0, 0, 0};         ///< in the body's frame [m]
+  double orientation[4] = {1, 0, 0, 0};     ///< unit quaternion w x y z, kept by an edit
+  double radius_m = 0;
+  double length_m = 0;
+};
+
+struct TendonInfo {
+  std::string name;
+  double radius_m = 0;
+  std::vector<PathPointInfo> path;
+};
+
+struct ActuatorInfo {
+  std::string name;
+  std::string kind;
+  std::string tendon;  ///< the tendon it acts along
+};
+
+/// A registered actuator kind with its parameters' defaults (SI units).
+struct ActuatorKindInfo {
+  std::string kind;
+  std::vector<std::string> parameters;
+  std::vector<double> defaults;
+  std::vector<std::string> units;
+};
+
+/// What the editing panels show of the loaded scene, read again after every edit.
+struct SceneInfo {
+  std::string name;  ///< the scene's name: the first part of its parameter ids
+  std::vector<BodyInfo> bodies;
+  std::vector<ObstacleInfo> obstacles;
+  std::vector<TendonInfo> tendons;
+  std::vector<ActuatorInfo> actuators;
+  std::vector<std::string> constraints;
+  const BodyInfo* FindBody(const std::string& n) const;
+  const ObstacleInfo* FindObstacle(const std::string& n) const;
+  const TendonInfo* FindTendon(const std::string& n) const;
+};
+
+/// The Model's edit history (SceneEditing::EditStatus).
+struct EditInfo {
+  std::uint64_t revision = 0;  ///< grows by one with every edit, undo and redo
+  std::string last;            ///< what the last edit, undo or redo did
+  std::string undo;            ///< what undo would revert ("" = nothing)
+  std::string redo;            ///< what redo would apply again ("" = nothing)
+};
+
+/// What a GUI selected on the Model (SceneEditing::Selection).
+struct SelectionInfo {
+  std::string kind;            ///< body, tendon, path_point, obstacle, constraint or "" (none)
+  std::string name;
+  unsigned index = 0;          ///< the path element of a path_point
+  std::uint64_t revision = 0;  ///< grows by one with every select()
+};
+
 /// What the GUI reads: a copy of everything the worker last learnt.
 struct Snapshot {
   bool connected = false;
@@ -64,6 +145,12 @@ struct Snapshot {
   bool naming_reachable = false;           ///< the naming service answered the last listing
   std::uint64_t components_version = 0;    ///< counts the listings of `components`
   std::vector<ComponentInfo> components;   ///< everything bound in the naming service
+  bool editing = false;                    ///< the Model answered edit_status()
+  EditInfo edit;                           ///< the Model's edit history
+  SelectionInfo selection;                 ///< the Model's shared selection
+  std::uint64_t scene_version = 0;         ///< changes whenever `scene` is read anew
+  SceneInfo scene;                         ///< the loaded scene, as edited
+  std::vector<ActuatorKindInfo> actuator_kinds;
 };
 
 /// The worker and its command queue. Every method returns at once.
@@ -99,6 +186,20 @@ class ModelLink {
   void Set(const std::string& id, double value);
   /// The scalar ids whose values are polled (e.g. the visible rows).
   void Watch(std::vector<std::string> ids);
+  /// Scene editing (SceneEditing on the Model); a refused edit's reason becomes last_error.
+  void Undo();
+  void Redo();
+  void Select(const std::string& kind, const std::string& name, unsigned index = 0);
+  void SetMass(const std::string& body, double mass_kg);
+  void SetShapeDims(const std::string& body, unsigned index, std::vector<double> dims_m);
+  void SetObstacle(const ObstacleInfo& obstacle);
+  void RemoveObstacle(const std::string& obstacle);
+  void MovePathPoint(const std::string& tendon, unsigned index, const PathPointInfo& point);
+  void RemovePathPoint(const std::string& tendon, unsigned index);
+  void RemoveTendon(const std::string& tendon);
+  void AddTendon(const std::string& tendon, const PathPointInfo& from, const PathPointInfo& to,
+                 double radius_m, const std::string& actuator, const std::string& kind);
+
   /// A lifecycle transition of a component in the naming service: `verb` is activate,
   /// deactivate, reset or exit. Needs no Model.
   void ComponentAction(const std::string& instance, const std::string& verb);
@@ -114,6 +215,10 @@ class ModelLink {
     bool needs_model = true;
   };
   void Queue(std::string what, std::function<void(Impl&)> call, bool needs_model = true);
+  /// An edit: `call` returns the Model's EditStatus, which the snapshot takes at once.
+  void QueueEdit(std::string what, std::function<EditInfo(Impl&)> call);
+  /// Reads the scene, its actuators and the bodies' shapes; on the worker thread only.
+  void ReadScene();
   void ListComponents();
   void Run();
 
