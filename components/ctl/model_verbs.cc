@@ -142,6 +142,8 @@ auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
     throw Failure(m.name + ": " + e.reason.in());
   } catch (const M::LoadFailed& e) {
     throw Failure(e.reason.in());
+  } catch (const M::EditRefused& e) {
+    throw Failure(m.name + ": edit refused: " + e.reason.in());
   } catch (const CORBA::UserException& e) {
     throw Failure(m.path + ": " + rtc::Describe(e));
   } catch (const CORBA::SystemException& e) {
@@ -716,6 +718,196 @@ int Record(Client& client, std::vector<std::string>& args) {
   return 0;
 }
 
+// ------------------------------------------------------------------------ edit
+
+void PrintEditStatus(const M::EditStatus& s) {
+  std::cout << "revision " << s.revision << "\n";
+  if (std::strlen(s.last.in()) > 0) std::cout << "last: " << s.last.in() << "\n";
+  std::cout << "undo: " << (std::strlen(s.undo.in()) > 0 ? s.undo.in() : "(nothing)") << "\n";
+  std::cout << "redo: " << (std::strlen(s.redo.in()) > 0 ? s.redo.in() : "(nothing)") << "\n";
+}
+
+S::PathPoint PointArgs(const std::vector<std::string>& args, size_t at) {
+  if (args.size() < at + 4) throw UsageError("expected BODY X Y Z (metres in the body's frame)");
+  S::PathPoint p;
+  p.body = (args[at] == "world" ? "" : args[at]).c_str();
+  p.x = ParseNumber(args[at + 1], "X [m]");
+  p.y = ParseNumber(args[at + 2], "Y [m]");
+  p.z = ParseNumber(args[at + 3], "Z [m]");
+  p.obstacle = "";
+  return p;
+}
+
+CORBA::ULong IndexArg(const std::string& text) {
+  const double v = ParseNumber(text, "INDEX");
+  if (!(v >= 0) || v != std::floor(v) || v > 1e6)
+    throw UsageError("INDEX must be a path element number (0 = the first attachment)");
+  return static_cast<CORBA::ULong>(v);
+}
+
+void NeedArgs(const std::vector<std::string>& args, size_t n, const std::string& usage) {
+  if (args.size() != n) throw UsageError("expected: edit " + usage);
+}
+
+int Edit(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  std::string stiffness_text = "0";
+  TakeOption(args, "--stiffness", &stiffness_text);
+  RejectOptions(args);
+  ModelRef m = Connect(client, name);
+  if (args.empty()) {
+    M::EditStatus_var s = Call(m, [&] { return m.model->edit_status(); });
+    PrintEditStatus(s.in());
+    M::Selection_var sel = Call(m, [&] { return m.model->current_selection(); });
+    std::cout << "selected: "
+              << (std::strlen(sel->kind.in()) == 0
+                      ? std::string("(nothing)")
+                      : std::string(sel->kind.in()) + " " + sel->name.in() +
+                            (std::string(sel->kind.in()) == "path_point"
+                                 ? " element " + std::to_string(sel->index)
+                                 : ""))
+              << "\n";
+    return 0;
+  }
+  const std::string what = args[0];
+  std::vector<std::string> a(args.begin() + 1, args.end());
+  M::EditStatus_var s;
+  if (what == "path") {
+    NeedArgs(a, 1, "path TENDON");
+    S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
+    for (CORBA::ULong i = 0; i < d->tendons.length(); ++i) {
+      if (a[0] != d->tendons[i].name.in()) continue;
+      const S::PathPointSeq& path = d->tendons[i].path;
+      std::cout << "ELEMENT  BODY / OBSTACLE        X [mm]      Y [mm]      Z [mm]\n";
+      for (CORBA::ULong k = 0; k < path.length(); ++k) {
+        const bool wrap = std::strlen(path[k].obstacle.in()) > 0;
+        std::cout << std::left << std::setw(9) << k << std::setw(22)
+                  << (wrap ? "wrap " + std::string(path[k].obstacle.in())
+                           : std::strlen(path[k].body.in()) ? std::string(path[k].body.in())
+                                                            : std::string("world"));
+        if (!wrap)
+          std::cout << std::right << std::setw(10) << Num(path[k].x * 1000, 4) << std::setw(12)
+                    << Num(path[k].y * 1000, 4) << std::setw(12) << Num(path[k].z * 1000, 4)
+                    << std::left;
+        std::cout << "\n";
+      }
+      return 0;
+    }
+    throw Failure(m.name + ": no tendon '" + a[0] + "'");
+  } else if (what == "kinds") {
+    NeedArgs(a, 0, "kinds");
+    M::ActuatorKindSeq_var kinds = Call(m, [&] { return m.model->actuator_kinds(); });
+    for (CORBA::ULong i = 0; i < kinds->length(); ++i) {
+      std::cout << kinds[i].kind.in()
+                << (std::strlen(kinds[i].command_unit.in()) ? " (command in " +
+                                                                   std::string(kinds[i].command_unit.in()) + ")"
+                                                             : std::string(" (passive)"))
+                << "\n";
+      for (CORBA::ULong p = 0; p < kinds[i].parameters.length(); ++p)
+        std::cout << "  " << kinds[i].parameters[p].in() << " = " << Num(kinds[i].defaults[p])
+                  << " " << kinds[i].units[p].in() << "\n";
+    }
+    return 0;
+  } else if (what == "move" || what == "insert") {
+    if (a.size() == 4 && what == "insert" && a[2] == "--wrap") a.erase(a.begin() + 2);
+    if (what == "insert" && a.size() == 3) {
+      // insert TENDON INDEX OBSTACLE: a wrap
+      S::PathPoint p;
+      p.body = "";
+      p.x = p.y = p.z = 0;
+      p.obstacle = a[2].c_str();
+      s = Call(m, [&] { return m.model->insert_path_point(a[0].c_str(), IndexArg(a[1]), p); });
+    } else {
+      NeedArgs(a, 6, what + " TENDON INDEX BODY X Y Z");
+      const S::PathPoint p = PointArgs(a, 2);
+      s = Call(m, [&] {
+        return what == "move" ? m.model->move_path_point(a[0].c_str(), IndexArg(a[1]), p)
+                              : m.model->insert_path_point(a[0].c_str(), IndexArg(a[1]), p);
+      });
+    }
+  } else if (what == "remove-point") {
+    NeedArgs(a, 2, "remove-point TENDON INDEX");
+    s = Call(m, [&] { return m.model->remove_path_point(a[0].c_str(), IndexArg(a[1])); });
+  } else if (what == "add-tendon") {
+    if (a.size() != 10 && a.size() != 11)
+      throw UsageError(
+          "expected: edit add-tendon TENDON BODY_A X Y Z BODY_B X Y Z KIND [ACTUATOR]");
+    const S::PathPoint from = PointArgs(a, 1), to = PointArgs(a, 5);
+    const std::string actuator = a.size() == 11 ? a[10] : a[0];
+    s = Call(m, [&] {
+      return m.model->add_tendon(a[0].c_str(), from, to, 0.0015, actuator.c_str(), a[9].c_str());
+    });
+  } else if (what == "remove-tendon") {
+    NeedArgs(a, 1, "remove-tendon TENDON");
+    s = Call(m, [&] { return m.model->remove_tendon(a[0].c_str()); });
+  } else if (what == "obstacle") {
+    if (a.size() != 7 && a.size() != 8)
+      throw UsageError("expected: edit obstacle NAME BODY sphere|cylinder X Y Z RADIUS [LENGTH]");
+    S::Obstacle o;
+    o.name = a[0].c_str();
+    o.body = (a[1] == "world" ? "" : a[1]).c_str();
+    o.kind = a[2].c_str();
+    o.pose = {ParseNumber(a[3], "X [m]"), ParseNumber(a[4], "Y [m]"), ParseNumber(a[5], "Z [m]"),
+              1, 0, 0, 0};
+    o.radius = ParseNumber(a[6], "RADIUS [m]");
+    o.length = a.size() == 8 ? ParseNumber(a[7], "LENGTH [m]") : 0.0;
+    s = Call(m, [&] { return m.model->set_obstacle(o); });
+  } else if (what == "remove-obstacle") {
+    NeedArgs(a, 1, "remove-obstacle NAME");
+    s = Call(m, [&] { return m.model->remove_obstacle(a[0].c_str()); });
+  } else if (what == "shape") {
+    if (a.size() < 3) throw UsageError("expected: edit shape BODY INDEX DIM... (metres)");
+    S::DoubleSeq dims;
+    dims.length(static_cast<CORBA::ULong>(a.size() - 2));
+    for (size_t i = 2; i < a.size(); ++i)
+      dims[static_cast<CORBA::ULong>(i - 2)] = ParseNumber(a[i], "DIM [m]");
+    s = Call(m, [&] { return m.model->set_shape_dims(a[0].c_str(), IndexArg(a[1]), dims); });
+  } else if (what == "shapes") {
+    NeedArgs(a, 1, "shapes BODY");
+    S::VisualSeq_var shapes = Call(m, [&] { return m.model->body_shapes(a[0].c_str()); });
+    static const char* const kKinds[] = {"box",  "sphere", "capsule",     "cylinder",
+                                         "cone", "plane",  "convex_hull", "triangle_mesh"};
+    for (CORBA::ULong i = 0; i < shapes->length(); ++i) {
+      std::cout << i << " " << kKinds[shapes[i].geometry.kind] << " " << shapes[i].name.in();
+      for (CORBA::ULong k = 0; k < shapes[i].geometry.dims.length(); ++k)
+        std::cout << " " << Num(shapes[i].geometry.dims[k]);
+      std::cout << (shapes[i].geometry.dims.length() ? " m" : "") << "\n";
+    }
+    return 0;
+  } else if (what == "mass") {
+    NeedArgs(a, 2, "mass BODY KG");
+    s = Call(m, [&] { return m.model->set_mass(a[0].c_str(), ParseNumber(a[1], "KG")); });
+  } else if (what == "undo" || what == "redo") {
+    NeedArgs(a, 0, what);
+    s = Call(m, [&] { return what == "undo" ? m.model->undo() : m.model->redo(); });
+  } else if (what == "pull") {
+    NeedArgs(a, 4, "pull BODY X Y Z [--stiffness N_PER_M] (target, world metres)");
+    M::Vector3 point{0, 0, 0};
+    M::Vector3 target{ParseNumber(a[1], "X [m]"), ParseNumber(a[2], "Y [m]"),
+                      ParseNumber(a[3], "Z [m]")};
+    const double k = ParseNumber(stiffness_text, "--stiffness [N/m]");
+    Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
+    std::cout << "pulling " << a[0] << "'s origin toward " << a[1] << " " << a[2] << " " << a[3]
+              << " m (until `edit release`)\n";
+    return 0;
+  } else if (what == "release") {
+    NeedArgs(a, 0, "release");
+    Call(m, [&] { m.model->release_pull(); });
+    std::cout << "pull released\n";
+    return 0;
+  } else if (what == "select") {
+    if (a.empty() || a.size() > 3) throw UsageError("expected: edit select KIND NAME [INDEX] or none");
+    if (a[0] == "none") a = {"", "", "0"};
+    if (a.size() == 2) a.push_back("0");
+    Call(m, [&] { m.model->select(a[0].c_str(), a[1].c_str(), IndexArg(a[2])); });
+    return 0;
+  } else {
+    throw UsageError("unknown edit '" + what + "' (see caliper-ctl help edit)");
+  }
+  PrintEditStatus(s.in());
+  return 0;
+}
+
 }  // namespace
 
 void AddModelVerbs(std::map<std::string, Verb>* verbs) {
@@ -793,6 +985,30 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "  A recorder that misses the Model's push deadline (1 s; e.g. stopped) is dropped by\n"
       "  the Model: record then exits 1 with the Model's reason.\n",
       true);
+  add("edit", "edit [WHAT ARGS...] [--model NAME]",
+      "edit the running scene: tendon routes, obstacles, shapes, masses; undo, redo; pull",
+      Edit,
+      "  Without WHAT: the edit history (what undo and redo would do) and the GUI's selection.\n"
+      "  Positions are metres in the named body's frame (`world` for the world); each edit is\n"
+      "  checked as an imported file is and refused with the reason, and applies at the next\n"
+      "  step boundary, the simulation going on from where it is. `save` writes the result.\n"
+      "    path TENDON                        its elements: index, body or wrap, position [mm]\n"
+      "    move TENDON INDEX BODY X Y Z       move an attachment or via point\n"
+      "    insert TENDON INDEX BODY X Y Z     a via point before element INDEX\n"
+      "    insert TENDON INDEX OBSTACLE       a wrap around OBSTACLE before element INDEX\n"
+      "    remove-point TENDON INDEX          remove a via point or wrap\n"
+      "    add-tendon TENDON BODY_A X Y Z BODY_B X Y Z KIND [ACTUATOR]\n"
+      "                                       a tendon with an actuator of KIND at its defaults\n"
+      "    remove-tendon TENDON               with its actuators\n"
+      "    kinds                              actuator kinds with their parameters' defaults\n"
+      "    obstacle NAME BODY sphere|cylinder X Y Z RADIUS [LENGTH]   add, or move and resize\n"
+      "    remove-obstacle NAME               one no tendon wraps around\n"
+      "    shapes BODY / shape BODY INDEX DIM...   list / set a collision shape's dimensions\n"
+      "    mass BODY KG                       the inertia scales with the mass\n"
+      "    undo / redo\n"
+      "    pull BODY X Y Z [--stiffness K]    spring the body's origin toward a world point\n"
+      "    release                            end the pull\n"
+      "    select KIND NAME [INDEX] / select none   what the GUI shows as selected\n");
   add("save", "save FILE [--send] [--model NAME]",
       "export the scene with its current parameters as COLLADA", Save,
       "  Whatever was loaded (COLLADA or URDF), FILE is COLLADA with Caliper's technique.\n"

@@ -1060,6 +1060,14 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
     for (const auto& a : current.actuators)
       if (a.name == name) loaded->commands[name] = value;
   BuildLocked(std::move(loaded), /*edit=*/true);
+  // a fault left the engine at the start of the failing step: the edit (often the undo of what
+  // made it explode) may step on from there
+  if (state_ == RunState::kFaulted) {
+    state_ = RunState::kPaused;
+    logging::Get("model").notice("the edit clears the fault (%s): paused at t = %.3f s",
+                                 last_error_.c_str(), loaded_->physics->time());
+    last_error_.clear();
+  }
   ++edit_revision_;
   last_edit_ = what;
   // a selection of what the edit removed is gone
