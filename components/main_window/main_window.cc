@@ -9,24 +9,25 @@
 #include <QDir>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
-#include <QFileInfo>
-#include <QMenu>
-#include <QMenuBar>
-#include <QProcess>
-#include <QSettings>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QGuiApplication>
-#include <QScreen>
-#include <QWindow>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
+#include <QMenu>
+#include <QMenuBar>
+#include <QProcess>
 #include <QPushButton>
+#include <QScreen>
+#include <QScrollArea>
+#include <QSettings>
 #include <QSpinBox>
 #include <QStatusBar>
 #include <QTimer>
 #include <QTreeWidget>
 #include <QVBoxLayout>
+#include <QWindow>
 #include <algorithm>
 #include <memory>
 
@@ -191,7 +192,11 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   selection_panel_ = new SelectionPanel(*link_, selection_dock);
   selection_panel_->set_message_handler(
       [this](const QString& text) { statusBar()->showMessage(text, kErrorShowMs); });
-  selection_dock->setWidget(selection_panel_);
+  // scrolled: the panel's forms never widen the window beyond its session's geometry
+  auto* selection_scroll = new QScrollArea(selection_dock);
+  selection_scroll->setWidgetResizable(true);
+  selection_scroll->setWidget(selection_panel_);
+  selection_dock->setWidget(selection_scroll);
   addDockWidget(Qt::RightDockWidgetArea, selection_dock);
 
   QMenu* edit = menuBar()->addMenu("&Edit");
@@ -665,12 +670,12 @@ void MainWindow::FollowSelection(const Snapshot& s) {
     const ObstacleInfo* o = scene.FindObstacle(sel.name);
     if (o != nullptr) current = group(o->body);
     text = "selected obstacle " + name +
-           (o != nullptr ? QString(" (%1 on %2, radius %3 mm)")
-                               .arg(QString::fromStdString(o->kind),
-                                    o->body.empty() ? QString("the world")
-                                                    : QString::fromStdString(o->body))
-                               .arg(o->radius_m * 1000, 0, 'g', 6)
-                         : QString());
+           (o != nullptr
+                ? QString(" (%1 on %2, radius %3 mm)")
+                      .arg(QString::fromStdString(o->kind),
+                           o->body.empty() ? QString("the world") : QString::fromStdString(o->body))
+                      .arg(o->radius_m * 1000, 0, 'g', 6)
+                : QString());
   } else if (sel.kind == "constraint") {
     current = group(sel.name);
     text = "selected constraint " + name;

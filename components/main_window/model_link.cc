@@ -35,7 +35,7 @@ struct ModelLink::Impl {
   Clock::time_point last_lookup{};
   Clock::time_point last_listing{};
   CosNaming::NamingContext_var root;  // nil until resolved; dropped on failure
-  bool scene_read = false;        // SceneInfo read for `edit_scene` at `edit_revision`
+  bool scene_read = false;            // SceneInfo read for `edit_scene` at `edit_revision`
   std::string edit_scene;
   std::uint64_t edit_revision = 0;
 
@@ -185,14 +185,22 @@ S::PathPoint ToIdl(const PathPointInfo& p) {
 
 std::string KindName(S::ShapeKind kind) {
   switch (kind) {
-    case S::BOX: return "box";
-    case S::SPHERE: return "sphere";
-    case S::CAPSULE: return "capsule";
-    case S::CYLINDER: return "cylinder";
-    case S::CONE: return "cone";
-    case S::PLANE: return "plane";
-    case S::CONVEX_HULL: return "convex_hull";
-    case S::TRIANGLE_MESH: return "triangle_mesh";
+    case S::BOX:
+      return "box";
+    case S::SPHERE:
+      return "sphere";
+    case S::CAPSULE:
+      return "capsule";
+    case S::CYLINDER:
+      return "cylinder";
+    case S::CONE:
+      return "cone";
+    case S::PLANE:
+      return "plane";
+    case S::CONVEX_HULL:
+      return "convex_hull";
+    case S::TRIANGLE_MESH:
+      return "triangle_mesh";
   }
   return "?";
 }
@@ -201,8 +209,8 @@ std::string KindName(S::ShapeKind kind) {
 
 void ModelLink::QueueEdit(std::string what, std::function<EditInfo(Impl&)> call) {
   Queue(what, [this, call](Impl& i) {
+    // the next poll sees the revision move and reads the edited scene and its parameters
     const EditInfo info = call(i);
-    i.scene_read = false;  // the next poll reads the edited scene
     std::lock_guard<std::mutex> lock(mutex_);
     snapshot_.editing = true;
     snapshot_.edit = info;
@@ -257,10 +265,11 @@ void ModelLink::RemoveObstacle(const std::string& obstacle) {
 }
 void ModelLink::MovePathPoint(const std::string& tendon, unsigned index,
                               const PathPointInfo& point) {
-  QueueEdit("move point " + std::to_string(index) + " of " + tendon, [tendon, index, point](Impl& i) {
-    return FromIdl(
-        M::EditStatus_var(i.model->move_path_point(tendon.c_str(), index, ToIdl(point))).in());
-  });
+  QueueEdit(
+      "move point " + std::to_string(index) + " of " + tendon, [tendon, index, point](Impl& i) {
+        return FromIdl(
+            M::EditStatus_var(i.model->move_path_point(tendon.c_str(), index, ToIdl(point))).in());
+      });
 }
 void ModelLink::RemovePathPoint(const std::string& tendon, unsigned index) {
   QueueEdit("remove point " + std::to_string(index) + " of " + tendon, [tendon, index](Impl& i) {
@@ -277,8 +286,7 @@ void ModelLink::AddTendon(const std::string& tendon, const PathPointInfo& from,
                           const std::string& kind) {
   QueueEdit("add tendon " + tendon, [=](Impl& i) {
     return FromIdl(M::EditStatus_var(i.model->add_tendon(tendon.c_str(), ToIdl(from), ToIdl(to),
-                                                         radius_m, actuator.c_str(),
-                                                         kind.c_str()))
+                                                         radius_m, actuator.c_str(), kind.c_str()))
                        .in());
   });
 }

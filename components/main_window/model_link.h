@@ -50,8 +50,8 @@ struct ComponentInfo {
 
 /// One element of a tendon's declared path (Scene::PathPoint without CORBA).
 struct PathPointInfo {
-  std::string body;      ///< the body it is fixed in ("" = the world)
-  double x_m = 0;        ///< position in the body's frame [m]
+  std::string body;  ///< the body it is fixed in ("" = the world)
+  double x_m = 0;    ///< position in the body's frame [m]
   double y_m = 0;
   double z_m = 0;
   std::string obstacle;  ///< non-empty: a wrap around this obstacle (no position)
@@ -60,8 +60,8 @@ struct PathPointInfo {
 /// A collision shape of a body, in the order set_shape_dims indexes them.
 struct ShapeInfo {
   std::string name;
-  std::string kind;               ///< box, sphere, capsule, cylinder, cone, plane, convex_hull, ...
-  std::vector<double> dims;       ///< as Scene::ShapeGeometry's dims of its kind [m]
+  std::string kind;          ///< box, sphere, capsule, cylinder, cone, plane, convex_hull, ...
+  std::vector<double> dims;  ///< as Scene::ShapeGeometry's dims of its kind [m]
 };
 
 struct BodyInfo {
@@ -73,9 +73,9 @@ struct BodyInfo {
 struct ObstacleInfo {
   std::string name;
   std::string body;
-  std::string kind;               ///< sphere or cylinder
-  double position_m[3] = {0, 0, 0};         ///< in the body's frame [m]
-  double orientation[4] = {1, 0, 0, 0};     ///< unit quaternion w x y z, kept by an edit
+  std::string kind;                      ///< sphere or cylinder
+  double position_m[3] = {0, 0, 0};      ///< in the body's frame [m]
+  double orientation[4] = {1, 0, 0, 0};  ///< unit quaternion w x y z, kept by an edit
   double radius_m = 0;
   double length_m = 0;
 };
@@ -123,7 +123,7 @@ struct EditInfo {
 
 /// What a GUI selected on the Model (SceneEditing::Selection).
 struct SelectionInfo {
-  std::string kind;            ///< body, tendon, path_point, obstacle, constraint or "" (none)
+  std::string kind;  ///< body, tendon, path_point, obstacle, constraint or "" (none)
   std::string name;
   unsigned index = 0;          ///< the path element of a path_point
   std::uint64_t revision = 0;  ///< grows by one with every select()

@@ -45,8 +45,10 @@ QString ElementText(const PathPointInfo& p) {
 std::string PathElementName(const TendonInfo& tendon, unsigned index) {
   const bool end = index == 0 || index + 1 == tendon.path.size();
   const bool wrap = index < tendon.path.size() && !tendon.path[index].obstacle.empty();
-  return std::string(wrap ? "wrap " : end ? "attachment " : "via point ") + std::to_string(index) +
-         " of " + tendon.name;
+  return std::string(wrap  ? "wrap "
+                     : end ? "attachment "
+                           : "via point ") +
+         std::to_string(index) + " of " + tendon.name;
 }
 
 // ------------------------------------------------------------------------ Add tendon dialog
@@ -139,9 +141,7 @@ AddTendonDialog::AddTendonDialog(const SceneInfo& scene, const std::vector<Actua
 }
 
 std::string AddTendonDialog::tendon() const { return tendon_->text().trimmed().toStdString(); }
-std::string AddTendonDialog::actuator() const {
-  return actuator_->text().trimmed().toStdString();
-}
+std::string AddTendonDialog::actuator() const { return actuator_->text().trimmed().toStdString(); }
 std::string AddTendonDialog::kind() const { return kind_->currentData().toString().toStdString(); }
 double AddTendonDialog::radius_m() const { return radius_mm_->value() / kMmPerM; }
 
@@ -183,8 +183,8 @@ void SelectionPanel::Say(const QString& text) {
   if (message_) message_(text);
 }
 
-QDoubleSpinBox* SelectionPanel::Spin(const QString& name, double value, double scale,
-                                     int decimals, const QString& suffix) {
+QDoubleSpinBox* SelectionPanel::Spin(const QString& name, double value, double scale, int decimals,
+                                     const QString& suffix) {
   auto* spin = new QDoubleSpinBox(form_);
   spin->setObjectName(name);
   spin->setDecimals(decimals);
@@ -206,8 +206,7 @@ void SelectionPanel::Rebuild(const Snapshot& s) {
   selection_ = s.selection;
   // a fresh form for the selection: the widgets of the last one go
   delete form_layout_;
-  for (QWidget* w : form_->findChildren<QWidget*>(QString(), Qt::FindDirectChildrenOnly))
-    delete w;
+  for (QWidget* w : form_->findChildren<QWidget*>(QString(), Qt::FindDirectChildrenOnly)) delete w;
   form_layout_ = new QVBoxLayout(form_);
   form_layout_->setContentsMargins(0, 0, 0, 0);
   mass_ = nullptr;
@@ -241,12 +240,16 @@ void SelectionPanel::Rebuild(const Snapshot& s) {
     form_layout_->addWidget(new QLabel("its parameters are in the tree", form_));
     return;
   }
-  title_->setText(sel.kind.empty() ? QString("Nothing selected")
-                                   : QString("%1 %2: not in the scene (any more)")
-                                         .arg(Q(sel.kind), Q(sel.name)));
-  if (sel.kind.empty())
-    form_layout_->addWidget(
-        new QLabel("Pick in the Scene Renderer or select a body or tendon in the tree.", form_));
+  title_->setText(
+      sel.kind.empty()
+          ? QString("Nothing selected")
+          : QString("%1 %2: not in the scene (any more)").arg(Q(sel.kind), Q(sel.name)));
+  if (sel.kind.empty()) {
+    auto* hint =
+        new QLabel("Pick in the Scene Renderer or select a body or tendon in the tree.", form_);
+    hint->setWordWrap(true);
+    form_layout_->addWidget(hint);
+  }
 }
 
 void SelectionPanel::BuildBody(const BodyInfo& body) {
@@ -314,9 +317,9 @@ void SelectionPanel::BuildObstacle(const ObstacleInfo& obstacle) {
   for (int a = 0; a < 3; ++a) {
     position[a] =
         Spin(QString("obstacle_%1").arg(kAxes[a]), obstacle.position_m[a], kMmPerM, 2, " mm");
-    form->addRow(QString("%1 in %2").arg(kAxes[a], obstacle.body.empty() ? "world"
-                                                                          : Q(obstacle.body)),
-                 position[a]);
+    form->addRow(
+        QString("%1 in %2").arg(kAxes[a], obstacle.body.empty() ? "world" : Q(obstacle.body)),
+        position[a]);
   }
   form_layout_->addLayout(form);
   auto* row = new QHBoxLayout;
@@ -351,9 +354,9 @@ void SelectionPanel::BuildTendon(const TendonInfo& tendon, const Snapshot& s) {
   QStringList actuators;
   for (const auto& a : s.scene.actuators)
     if (a.tendon == tendon.name) actuators << QString("%1 (%2)").arg(Q(a.name), Q(a.kind));
-  auto* label = new QLabel(path + "\nactuators: " +
-                               (actuators.isEmpty() ? QString("none") : actuators.join(", ")),
-                           form_);
+  auto* label = new QLabel(
+      path + "\nactuators: " + (actuators.isEmpty() ? QString("none") : actuators.join(", ")),
+      form_);
   label->setObjectName("tendon_path");
   label->setWordWrap(true);
   form_layout_->addWidget(label);

@@ -74,11 +74,11 @@ class SelectionPanel : public QWidget {
   ModelLink& link_;
   std::function<void(const QString&)> message_;
   QLabel* title_ = nullptr;
-  QWidget* form_ = nullptr;        // rebuilt for each selection
+  QWidget* form_ = nullptr;  // rebuilt for each selection
   QVBoxLayout* form_layout_ = nullptr;
   QDoubleSpinBox* mass_ = nullptr;
-  std::string mass_id_;            // <scene>.<body>.mass, "" when no body is shown
-  double shown_mass_ = -1;         // the Model's mass last put in mass_ [kg]
+  std::string mass_id_;     // <scene>.<body>.mass, "" when no body is shown
+  double shown_mass_ = -1;  // the Model's mass last put in mass_ [kg]
   SceneInfo scene_;
   std::vector<ActuatorKindInfo> kinds_;
   SelectionInfo selection_;
