@@ -128,6 +128,7 @@ Outcome Try(F&& call) {
   CALIPER_USER_EXCEPTION(M::NotAvailable)
   CALIPER_USER_EXCEPTION(M::LoadFailed)
   CALIPER_USER_EXCEPTION(M::RunFailed)
+  CALIPER_USER_EXCEPTION(M::EditRefused)
   CALIPER_USER_EXCEPTION(D::UnknownId)
   CALIPER_USER_EXCEPTION(D::InvalidParameter)
   CALIPER_USER_EXCEPTION(D::NotAvailable)
@@ -627,6 +628,123 @@ TEST_F(HostileModelTest, SceneSubscriptionsObserversAndExperimentsRefuseHostileV
   }
   EXPECT_LT(RssKb(model_->process().pid()) - rss_after_first, kRoundGrowthKb);
   ASSERT_EQ(Try([&] { M::Recording_var(ref_->run_experiment(valid)); }).kind, Outcome::kOk);
+}
+
+TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
+  rss_growth_kb_ = 96 * MiB;  // 10 MB names, a million dims
+  const double kHuge = std::numeric_limits<double>::max();
+  auto point = [](const std::string& body, double x, double y, double z, const std::string& o = "") {
+    S::PathPoint p;
+    p.body = body.c_str();
+    p.x = x;
+    p.y = y;
+    p.z = z;
+    p.obstacle = o.c_str();
+    return p;
+  };
+  auto path_length = [&] {
+    S::Description_var d = ref_->scene_description();
+    return d->tendons[0].path.length();
+  };
+  const CORBA::ULong path = path_length();
+  // names: empty, unknown, 10 MB; indices at the ends of the range; non-finite and huge positions
+  for (const std::string& name : {std::string(), std::string("nosuch"), kTenMegabytes}) {
+    EXPECT_REFUSED(M::EditStatus_var(ref_->move_path_point(name.c_str(), 1, point("frame", 0, 0, 0))), "");
+    if (!name.empty()) {  // "" is the world for a point and nothing for a selection
+      EXPECT_REFUSED(M::EditStatus_var(ref_->move_path_point("line", 1, point(name, 0, 0, 0))), "");
+      EXPECT_REFUSED(M::EditStatus_var(ref_->insert_path_point("line", 1, point("", 0, 0, 0, name))), "");
+      EXPECT_REFUSED(ref_->select(name.c_str(), "pendulum", 0), "");
+    }
+    EXPECT_REFUSED(M::EditStatus_var(ref_->remove_tendon(name.c_str())), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->remove_obstacle(name.c_str())), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass(name.c_str(), 1)), "");
+    EXPECT_REFUSED(S::VisualSeq_var(ref_->body_shapes(name.c_str())), "");
+    EXPECT_REFUSED(ref_->select("body", name.c_str(), 0), "");
+    EXPECT_REFUSED(ref_->pull(name.c_str(), {0, 0, 0}, {0, 0, 0}, 0), "");
+  }
+  for (const CORBA::ULong index : {CORBA::ULong(0xffffffffu), path, CORBA::ULong(1u << 31)}) {
+    EXPECT_REFUSED(M::EditStatus_var(ref_->move_path_point("line", index, point("frame", 0, 0, 0))), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->insert_path_point("line", index, point("frame", 0, 0, 0))), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->remove_path_point("line", index)), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->set_shape_dims("pendulum", index, S::DoubleSeq())), "");
+  }
+  for (const double bad : kNonFinite) {
+    EXPECT_REFUSED(M::EditStatus_var(ref_->move_path_point("line", 1, point("frame", bad, 0, 0))), "");
+    EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass("pendulum", bad)), "");
+    EXPECT_REFUSED(ref_->pull("pendulum", {bad, 0, 0}, {0, 0, 0}, 0), "");
+    EXPECT_REFUSED(ref_->pull("pendulum", {0, 0, 0}, {0, 0, 0}, bad), "");
+  }
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass("pendulum", -1)), "mass");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass("frame", 1)), "does not move");
+  S::DoubleSeq dims;
+  dims.length(kMillion);
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_shape_dims("pendulum", 0, dims)), "");
+  dims.length(3);
+  dims[0] = dims[1] = dims[2] = kHuge;
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_shape_dims("pendulum", 0, dims)), "");
+  // obstacles: bad kinds, radii, poses
+  S::Obstacle o;
+  o.name = "knob";
+  o.body = "pendulum";
+  o.kind = "cube";
+  o.pose = {0, 0, 0, 1, 0, 0, 0};
+  o.radius = 0.01;
+  o.length = 0.02;
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_obstacle(o)), "sphere or cylinder");
+  o.kind = "sphere";
+  for (const double bad : {0.0, -1.0, kHuge, kNaN}) {
+    o.radius = bad;
+    EXPECT_REFUSED(M::EditStatus_var(ref_->set_obstacle(o)), "radius");
+  }
+  o.radius = 0.01;
+  o.pose = {0, 0, 0, 0, 0, 0, 0};  // not a rotation
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_obstacle(o)), "unit quaternion");
+  // tendons: existing names, unknown kinds, huge radii
+  EXPECT_REFUSED(M::EditStatus_var(ref_->add_tendon("line", point("frame", 0, 0, 0),
+                                                    point("pendulum", 0, 0, 0), 0.001, "m2",
+                                                    "dc_motor_tendon")), "exists");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->add_tendon("t2", point("frame", 0, 0, 0),
+                                                    point("pendulum", 0, 0, 0), 0.001, "m2",
+                                                    kTenMegabytes.c_str())), "no actuator kind");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->add_tendon("t2", point("frame", 0, 0, 0),
+                                                    point("pendulum", 0, 0, 0), kHuge, "m2",
+                                                    "dc_motor_tendon")), "radius");
+  // history: nothing to undo or redo
+  EXPECT_REFUSED(M::EditStatus_var(ref_->undo()), "nothing to undo");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->redo()), "nothing to redo");
+  M::EditStatus_var status = ref_->edit_status();
+  EXPECT_EQ(status->revision, 0u) << "a refused edit counted";
+  EXPECT_EQ(path_length(), path);
+  EXPECT_ANSWERED(M::ActuatorKindSeq_var(ref_->actuator_kinds()));
+  EXPECT_ANSWERED(ref_->release_pull());
+
+  // a thousand sound edits from four clients at once while stepping, then as many undos: all
+  // answered, the path as it was
+  std::vector<std::thread> clients;
+  std::atomic<int> answered{0};
+  for (int c = 0; c < 4; ++c)
+    clients.emplace_back([&, c] {
+      for (int i = 0; i < 250; ++i) {
+        try {
+          if (c == 0 && i % 10 == 0) ref_->step(5);
+          M::EditStatus_var s = ref_->move_path_point("line", 1, point("frame", 0.3, 0, 1.0 + 1e-4 * i));
+          ++answered;
+        } catch (const CORBA::UserException&) {
+          ++answered;  // a step from another client running: NotAvailable
+        } catch (const CORBA::Exception&) {
+        }
+      }
+    });
+  for (auto& t : clients) t.join();
+  EXPECT_EQ(answered.load(), 1000);
+  for (int i = 0; i < 1000; ++i) {
+    try {
+      M::EditStatus_var s = ref_->undo();
+    } catch (const M::EditRefused&) {
+      break;  // the history holds the last 200
+    }
+  }
+  EXPECT_ANSWERED(ref_->step(10));
 }
 
 TEST_F(HostileModelTest, LifecycleAndExecutionContextRefuseHostileArguments) {
