@@ -101,8 +101,22 @@ R::SceneDescription FromIdl(const S::Description& scene) {
     obstacle.length = in.length;
     out.obstacles.push_back(std::move(obstacle));
   }
-  for (CORBA::ULong t = 0; t < scene.tendons.length(); ++t)
-    out.tendons.push_back({scene.tendons[t].name.in(), scene.tendons[t].radius});
+  for (CORBA::ULong t = 0; t < scene.tendons.length(); ++t) {
+    const S::Tendon& in = scene.tendons[t];
+    R::Tendon tendon;
+    tendon.name = in.name.in();
+    tendon.radius = in.radius;
+    for (CORBA::ULong e = 0; e < in.path.length(); ++e) {
+      R::PathPoint point;
+      point.body = in.path[e].body.in();
+      point.p[0] = in.path[e].x;
+      point.p[1] = in.path[e].y;
+      point.p[2] = in.path[e].z;
+      point.obstacle = in.path[e].obstacle.in();
+      tendon.path.push_back(std::move(point));
+    }
+    out.tendons.push_back(std::move(tendon));
+  }
   return out;
 }
 

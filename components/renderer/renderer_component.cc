@@ -26,8 +26,11 @@ std::vector<core::ConfigKey> RendererComponent::ConfigKeys() {
   };
 }
 
-RendererComponent::RendererComponent(rtc::Runtime& runtime, SceneMailbox& mailbox)
-    : runtime_(runtime), mailbox_(mailbox) {}
+RendererComponent::RendererComponent(rtc::Runtime& runtime, SceneMailbox& mailbox,
+                                     ModelReference& model)
+    : runtime_(runtime), mailbox_(mailbox), shared_model_(model) {}
+
+RendererComponent::~RendererComponent() { shared_model_.Set(M::Model::_nil()); }
 
 rtc::ReturnCode RendererComponent::OnInitialize() {
   const auto& c = runtime_.config();
@@ -89,12 +92,14 @@ void RendererComponent::CheckRegistration() {
                  static_cast<unsigned long long>(id));
     observer_id_ = id;
     model_ = found._retn();
+    shared_model_.Set(model_.in());
     reported_missing_ = false;
   } catch (const CORBA::Exception& e) {
     if (!CORBA::is_nil(model_) || !reported_missing_)
       log.info("Model '%s' unreachable: %s", name.c_str(), rtc::Describe(e).c_str());
     reported_missing_ = true;
     model_ = M::Model::_nil();
+    shared_model_.Set(M::Model::_nil());
   }
 }
 
@@ -106,6 +111,7 @@ void RendererComponent::Unregister() {
     // the Model is gone: nothing to unregister from
   }
   model_ = M::Model::_nil();
+  shared_model_.Set(M::Model::_nil());
 }
 
 }  // namespace caliper::renderer

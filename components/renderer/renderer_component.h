@@ -19,13 +19,17 @@
 
 #include "caliper/model.hh"
 #include "caliper/rtc/runtime.h"
+#include "model_edit_client.h"
 #include "scene_mailbox.h"
 
 namespace caliper::renderer {
 
 class RendererComponent : public rtc::Component {
  public:
-  RendererComponent(rtc::Runtime& runtime, SceneMailbox& mailbox);
+  /// `model` receives the Model found (nil while there is none) for the GUI's scene editing.
+  RendererComponent(rtc::Runtime& runtime, SceneMailbox& mailbox, ModelReference& model);
+  /// Lets go of the shared reference while the ORB still runs.
+  ~RendererComponent() override;
   rtc::ReturnCode OnInitialize() override;
   rtc::ReturnCode OnActivated() override;
   rtc::ReturnCode OnExecute() override;
@@ -39,6 +43,7 @@ class RendererComponent : public rtc::Component {
 
   rtc::Runtime& runtime_;
   SceneMailbox& mailbox_;
+  ModelReference& shared_model_;
   Caliper::Scene::SceneObserver_var observer_;
   Caliper::Simulation::Model_var model_;
   CORBA::ULongLong observer_id_ = 0;

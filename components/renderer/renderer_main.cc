@@ -12,15 +12,14 @@
 #include <QApplication>
 #include <QBuffer>
 #include <QByteArray>
-
 #include <QTimer>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <future>
+#include <iostream>
 #include <memory>
 #include <stdexcept>
-#include <iostream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,9 +29,11 @@
 #include "caliper/gui_session/tool_window.h"
 #include "caliper/logging/log.h"
 #include "caliper/render_coin/offscreen_renderer.h"
+#include "caliper/render_coin/scene_editor.h"
 #include "caliper/render_coin/scene_graph.h"
 #include "caliper/render_coin/viewer.h"
 #include "caliper/rtc/rtobject_servant.h"
+#include "model_edit_client.h"
 #include "renderer_component.h"
 #include "renderer_servant.h"
 
@@ -79,14 +80,18 @@ bool ParseOptions(int argc, char** argv, Options* out) {
   return true;
 }
 
-// moves what arrived into the scene graph; true when something changed
+// moves what arrived into the scene graph; true when something changed. Only a different scene
+// is framed again: an edit sends the same scene (name and bodies) changed, and the camera stays.
 bool Apply(renderer::SceneMailbox& mailbox, render_coin::SceneGraph& graph, bool* framed) {
+  static std::string shown;  // SceneIdentity() of the scene last built (one graph per process)
   renderer::PendingUpdate pending = mailbox.Take();
   if (pending.empty()) return false;
   if (pending.cleared) graph.Clear();
   if (pending.scene) {
+    const std::string identity = renderer::SceneIdentity(*pending.scene);
     graph.Build(*pending.scene);
-    *framed = false;
+    if (identity != shown) *framed = false;
+    shown = identity;
   }
   graph.SetBodyPoses(pending.body_indices, pending.body_poses);
   if (!pending.tendons.empty()) graph.SetTendons(pending.tendons);
@@ -190,6 +195,7 @@ int main(int argc, char** argv) {
   if (options.screenshot.empty()) top_level = render_coin::InitializeViewer(argc, argv, "caliper-renderer");
   render_coin::SceneGraph graph;
   renderer::SceneMailbox mailbox;
+  renderer::ModelReference model_ref;  // set by the component's thread, called by the GUI's
   bool framed = false;
   GuiControl control(mailbox, graph, &framed);
   // runs a function on the GUI thread and waits; a call the GUI drops (it ended) or never gets to
@@ -234,7 +240,9 @@ int main(int argc, char** argv) {
     int rest_argc = static_cast<int>(options.rest.size()) - 1;
     rtc_exit = rtc::RunComponent(
         rest_argc, options.rest.data(), type,
-        [&](rtc::Runtime& rt) { return std::make_unique<renderer::RendererComponent>(rt, mailbox); },
+        [&](rtc::Runtime& rt) {
+          return std::make_unique<renderer::RendererComponent>(rt, mailbox, model_ref);
+        },
         [&](rtc::Runtime& rt, rtc::Component&) -> PortableServer::Servant {
           return new renderer::RendererServant(rt, control, gui_call);
         });
@@ -243,7 +251,12 @@ int main(int argc, char** argv) {
   auto request_exit = [] { kill(getpid(), SIGTERM); };
 
   std::unique_ptr<render_coin::Viewer> viewer;
-  if (top_level != nullptr) viewer = std::make_unique<render_coin::Viewer>(top_level, graph);
+  renderer::ModelEditClient edit_client(model_ref);
+  std::unique_ptr<render_coin::SceneEditor> editor;
+  if (top_level != nullptr) {
+    viewer = std::make_unique<render_coin::Viewer>(top_level, graph);
+    editor = std::make_unique<render_coin::SceneEditor>(graph, *viewer, &edit_client);
+  }
   control.set_viewer(viewer.get());
 
   // at most max_fps: apply what arrived; the viewer redraws when the graph changed

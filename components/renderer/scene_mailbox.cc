@@ -2,6 +2,12 @@
 
 namespace caliper::renderer {
 
+std::string SceneIdentity(const render_coin::SceneDescription& scene) {
+  std::string id = scene.name;
+  for (const render_coin::Body& body : scene.bodies) id += '\n' + body.name;
+  return id;
+}
+
 void SceneMailbox::SetSettings(const ViewSettings& settings) {
   std::lock_guard<std::mutex> lock(mutex_);
   settings_ = settings;

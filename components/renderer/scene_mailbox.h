@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "caliper/render_coin/scene_description.h"
@@ -33,6 +34,10 @@ struct ViewSettings {
   int height = 768;
   bool show_constraint_axes = false;  // as configured; show_constraint_axes() overrides it
 };
+
+/// What tells one scene from another for framing: its name and its bodies' names. An edited
+/// scene (tendons, obstacles, shapes changed) keeps it, so the view does not jump.
+std::string SceneIdentity(const render_coin::SceneDescription& scene);
 
 /// Thread-safe; any number of producers, one consumer.
 class SceneMailbox {

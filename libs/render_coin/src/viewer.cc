@@ -35,6 +35,15 @@ void Viewer::Render() { impl_->viewer->render(); }
 
 QWidget* Viewer::widget() const { return impl_->viewer->getWidget(); }
 
+QWidget* Viewer::gl_widget() const { return impl_->viewer->getGLWidget(); }
+
+QSize Viewer::view_size() const {
+  const SbVec2s size = impl_->viewer->getViewportRegion().getWindowSize();
+  return QSize(size[0], size[1]);
+}
+
+void Viewer::ScheduleRedraw() { impl_->viewer->scheduleRedraw(); }
+
 void Viewer::Show(QWidget* top_level) { SoQt::show(top_level); }
 
 }  // namespace caliper::render_coin

@@ -65,9 +65,29 @@ struct Constraint {
   Pose frame_b;        // in body_b's frame
 };
 
+/// One declared element of a tendon's path: a point fixed in a body, or a wrap around an obstacle.
+struct PathPoint {
+  std::string body;         // the body the point is fixed in ("" = the world)
+  double p[3] = {0, 0, 0};  // in the body's frame [m]
+  std::string obstacle;     // non-empty: a wrap around this obstacle (body and p unused)
+};
+
 struct Tendon {
   std::string name;
-  double radius = 0;  // [m]
+  double radius = 0;            // [m]
+  std::vector<PathPoint> path;  // attachments, via points and wraps, in order
+};
+
+/// Something a user can pick: kind "body", "tendon", "path_point", "obstacle" or "" (nothing);
+/// `index` is the path element of a path_point.
+struct Entity {
+  std::string kind;
+  std::string name;
+  uint32_t index = 0;
+  bool operator==(const Entity& o) const {
+    return kind == o.kind && name == o.name && index == o.index;
+  }
+  bool operator!=(const Entity& o) const { return !(*this == o); }
 };
 
 struct SceneDescription {

@@ -21,6 +21,17 @@ namespace caliper::render_coin {
 /// Initializes Coin's database once (idempotent); enough for building graphs without a display.
 void InitializeCoin();
 
+/// `local` (in the frame `pose`) in the world [m].
+void ToWorld(const Pose& pose, const double local[3], double world[3]);
+/// `world` in the frame `pose` [m].
+void ToLocal(const Pose& pose, const double world[3], double local[3]);
+
+/// What a ray through a pixel met: a pickable entity and the point where it met it [m, world].
+struct Hit {
+  Entity entity;
+  double point[3] = {0, 0, 0};
+};
+
 class SceneGraph {
  public:
   /// Calls InitializeCoin(). The graph starts empty (grid and axes only).
@@ -69,6 +80,44 @@ class SceneGraph {
   /// adjusts them only when it draws; offscreen renders call this).
   void FitClippingPlanes();
   CameraPose camera_pose() const;
+
+  /// The description last built (empty after Clear()).
+  const SceneDescription& scene() const;
+  /// The state last received of tendon `index`; nullptr before any.
+  const TendonState* tendon_state(size_t index) const;
+  /// Index of the body `name` in scene().bodies; -1 when there is none.
+  int body_index(const std::string& name) const;
+  /// Current world pose of body `name`; the identity for "" (the world). False when unknown.
+  bool BodyPose(const std::string& name, Pose* pose) const;
+
+  /// The entities under pixel (x, y) (from the top left) of a width x height view, nearest first
+  /// (the same entity may appear more than once). Bodies, tendons, path points (markers drawn
+  /// at the declared attachments and via points) and obstacles are pickable; the grid is not.
+  std::vector<Hit> Pick(double x, double y, int width, int height) const;
+  /// The ray through pixel (x, y) of a width x height view: origin and unit direction [world].
+  void Ray(double x, double y, int width, int height, double origin[3], double direction[3]) const;
+  /// The camera's unit viewing direction [world].
+  std::array<double, 3> view_direction() const;
+
+  /// Highlights one entity (kind "" for none); kept across Build() while it exists.
+  void SetHighlight(const Entity& entity);
+  const Entity& highlight() const;
+  /// Draws the marker of path element `index` of `tendon` at `local` (its body's frame [m]),
+  /// nullptr: at its declared place.
+  void SetPathPointMarker(const std::string& tendon, uint32_t index, const double* local);
+  /// Where the marker of that path element is drawn (its body's frame [m]); false if none.
+  bool PathPointMarker(const std::string& tendon, uint32_t index, double local[3]) const;
+  /// Draws obstacle `name` at `pose` (its body's frame), nullptr: at its declared pose.
+  void SetObstacleMarker(const std::string& name, const Pose* pose);
+  /// A line from `local` on body `body` (it moves with the body) to `target` [m, world];
+  /// body < 0 hides it.
+  void SetPullLine(int body, const double local[3], const double target[3]);
+  bool pull_line_visible() const;
+  /// A line of text at the top left of the view (what is selected, why an edit was refused).
+  void SetStatus(const std::string& text);
+  std::string status_text() const;
+  /// Markers of path points (attachments and via points; wraps have none) in the scene.
+  size_t path_point_count() const;
 
   /// What viewers show: the camera, the content and the legend (owned by this graph).
   SoSeparator* root() const;

@@ -1,6 +1,7 @@
 #pragma once
 // An interactive SoQt examiner viewer on a SceneGraph (rotate, pan, zoom with the mouse).
 
+#include <QSize>
 #include <QWidget>
 #include <memory>
 
@@ -20,6 +21,12 @@ class Viewer {
   /// Draws now (under Xvfb the first frame waits for this).
   void Render();
   QWidget* widget() const;
+  /// The GL area itself: where the mouse events arrive (an event filter on it sees them first).
+  QWidget* gl_widget() const;
+  /// The GL area's size [px].
+  QSize view_size() const;
+  /// Asks for a redraw at the next turn of the event loop.
+  void ScheduleRedraw();
   /// Shows SoQt's top-level window.
   static void Show(QWidget* top_level);
 
