@@ -197,7 +197,11 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   selection_scroll->setWidgetResizable(true);
   selection_scroll->setWidget(selection_panel_);
   selection_dock->setWidget(selection_scroll);
-  addDockWidget(Qt::RightDockWidgetArea, selection_dock);
+  // a tab beside the components: a narrow arranged window keeps its tree wide; a new
+  // selection brings the tab up
+  addDockWidget(Qt::BottomDockWidgetArea, selection_dock);
+  tabifyDockWidget(dock, selection_dock);
+  selection_dock_ = selection_dock;
 
   QMenu* edit = menuBar()->addMenu("&Edit");
   undo_ = edit->addAction("&Undo");
@@ -700,7 +704,7 @@ void MainWindow::FollowSelection(const Snapshot& s) {
       p->setExpanded(true);
     current->setExpanded(true);
     tree_->setCurrentItem(current, 0, QItemSelectionModel::Select);
-    tree_->scrollToItem(current);
+    tree_->scrollToItem(current, QAbstractItemView::PositionAtTop);  // its parameters below
   }
   following_ = false;
 }
@@ -767,6 +771,7 @@ void MainWindow::Refresh() {
     scene_version_ = s.scene_version;
     selection_revision_ = s.selection.revision;
     selection_panel_->Rebuild(s);
+    if (moved && !s.selection.kind.empty()) selection_dock_->raise();
     if (moved || !selection_shown_) FollowSelection(s);
   }
   selection_panel_->UpdateValues(s);

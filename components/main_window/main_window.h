@@ -13,6 +13,7 @@
 
 class QAction;
 class QCloseEvent;
+class QDockWidget;
 class QDoubleSpinBox;
 class QProcess;
 class QRect;
@@ -133,6 +134,7 @@ class MainWindow : public QMainWindow {
   QAction* undo_ = nullptr;
   QAction* redo_ = nullptr;
   SelectionPanel* selection_panel_ = nullptr;
+  QDockWidget* selection_dock_ = nullptr;
   std::uint64_t scene_version_ = 0;
   std::uint64_t selection_revision_ = 0;
   bool selection_shown_ = false;                    // the Model's selection was followed once
