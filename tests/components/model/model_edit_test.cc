@@ -163,26 +163,22 @@ TEST_F(ModelEdit, RefusedEditsSayWhyAndChangeNothing) {
   }, "wraps around it");
   expect_refused([](const sgal::Scene& s) { return sgal::SetShapeDims(s, "forearm", 0, {0.1}); },
                  "dimensions");
-  expect_refused([](const sgal::Scene& s) {
-    sgal::Tendon t;
-    t.name = "elbow_flexor";
-    t.path = {Point("torso", 0, 0, 0), Point("forearm", 0, 0, 0)};
-    sgal::Actuator a;
-    a.name = "x";
-    a.kind = "ligament";
-    return sgal::AddTendon(s, t, a);
-  }, "exists");
+  // a tendon from the torso to the forearm with a ligament along it
+  const auto add_ligament = [](const std::string& tendon, const std::string& parameter) {
+    return [tendon, parameter](const sgal::Scene& s) {
+      sgal::Tendon t;
+      t.name = tendon;
+      t.path = {Point("torso", 0, 0, 0), Point("forearm", 0, 0, 0)};
+      sgal::Actuator a;
+      a.name = "new_actuator";
+      a.kind = "ligament";
+      a.parameters[parameter] = 1;
+      return sgal::AddTendon(s, t, a);
+    };
+  };
+  expect_refused(add_ligament("elbow_flexor", "stiffness"), "exists");
   // an actuator the engine cannot build (a parameter its kind does not know) is the engine's refusal
-  expect_refused([](const sgal::Scene& s) {
-    sgal::Tendon t;
-    t.name = "new_tendon";
-    t.path = {Point("torso", 0, 0, 0), Point("forearm", 0, 0, 0)};
-    sgal::Actuator a;
-    a.name = "new_actuator";
-    a.kind = "ligament";
-    a.parameters["no_such_parameter"] = 1;
-    return sgal::AddTendon(s, t, a);
-  }, "engine refuses");
+  expect_refused(add_ligament("new_tendon", "no_such_parameter"), "engine refuses");
   EXPECT_EQ(scene()->tendons.size(), before.tendons.size());
   EXPECT_EQ(TendonOf(*scene(), "elbow_flexor").path[0].position,
             TendonOf(before, "elbow_flexor").path[0].position);

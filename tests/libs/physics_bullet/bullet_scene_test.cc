@@ -238,13 +238,14 @@ sgal::Tendon TendonTo(const std::string& name, const Vector3d& anchor, const std
 /// The pendulum pulled by a DC motor with a Zener element, a muscle with an elastic tendon, a
 /// ligament and the test kind that fails on purpose ("faulty", a DC motor too): on a tendon of
 /// its own after all the others, or sharing the first motor's tendon after it.
-sgal::Scene PulledPendulum(bool share_tendon) {
-  sgal::Scene s = Pendulum(0.4, 0.0);
+/// A pendulum starting at `angle` held by a DC motor (zener tendon), an elastic-tendon muscle and a
+/// ligament, each on its own tendon.
+sgal::Scene ThreePullers(double angle) {
+  sgal::Scene s = Pendulum(0.4, angle);
   const std::string bob = s.bodies[0].name;
   s.tendons.push_back(TendonTo("t_motor", Vector3d(0.35, 0, -0.3), bob));
   s.tendons.push_back(TendonTo("t_muscle", Vector3d(-0.35, 0, -0.3), bob));
   s.tendons.push_back(TendonTo("t_ligament", Vector3d(0, 0, -0.8), bob));
-  if (!share_tendon) s.tendons.push_back(TendonTo("t_faulty", Vector3d(0.35, 0, -0.5), bob));
   s.actuators.push_back(
       {"motor", "dc_motor_tendon", "t_motor", {{"pretension", 2}}, {{"elastic", "zener"}}});
   s.actuators.push_back({"muscle",
@@ -256,6 +257,13 @@ sgal::Scene PulledPendulum(bool share_tendon) {
                          {{"tendon", "elastic"}}});
   s.actuators.push_back(
       {"ligament", "ligament", "t_ligament", {{"stiffness", 300}, {"rest_length", 0.39}}, {}});
+  return s;
+}
+
+sgal::Scene PulledPendulum(bool share_tendon) {
+  sgal::Scene s = ThreePullers(0.0);
+  if (!share_tendon)
+    s.tendons.push_back(TendonTo("t_faulty", Vector3d(0.35, 0, -0.5), s.bodies[0].name));
   s.actuators.push_back({"faulty",
                          "test_faulty_motor",
                          share_tendon ? "t_motor" : "t_faulty",
@@ -719,22 +727,7 @@ namespace {
 // mid-run and restored into a scene built afresh goes on as the scene it came from (the scene
 // editor carries running simulations over this way).
 TEST(BulletSceneDynamicState, RestoredIntoAFreshSceneItGoesOnAsTheOriginal) {
-  sgal::Scene s = Pendulum(0.4, 0.3);
-  const std::string bob = s.bodies[0].name;
-  s.tendons.push_back(TendonTo("t_motor", Vector3d(0.35, 0, -0.3), bob));
-  s.tendons.push_back(TendonTo("t_muscle", Vector3d(-0.35, 0, -0.3), bob));
-  s.tendons.push_back(TendonTo("t_ligament", Vector3d(0, 0, -0.8), bob));
-  s.actuators.push_back(
-      {"motor", "dc_motor_tendon", "t_motor", {{"pretension", 2}}, {{"elastic", "zener"}}});
-  s.actuators.push_back({"muscle",
-                         "hill_muscle",
-                         "t_muscle",
-                         {{"optimal_fiber_length", 0.1},
-                          {"tendon_slack_length", 0.25},
-                          {"max_isometric_force", 30}},
-                         {{"tendon", "elastic"}}});
-  s.actuators.push_back(
-      {"ligament", "ligament", "t_ligament", {{"stiffness", 300}, {"rest_length", 0.39}}, {}});
+  const sgal::Scene s = ThreePullers(0.3);
   auto original = MakeScene(s);
   original->SetCommand("motor", 0.5);
   original->SetCommand("muscle", 0.4);
