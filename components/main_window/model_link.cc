@@ -571,15 +571,26 @@ void ModelLink::Run() {
 
       // the edit history and the selection, shared with the renderer and other clients; the
       // scene is read again after each edit (from any client) and with each new scene
-      M::EditStatus_var edit = i.model->edit_status();
-      M::Selection_var selection = i.model->current_selection();
-      if (status.state == "EMPTY") {
+      M::EditStatus_var edit;
+      M::Selection_var selection;
+      bool editing = false;
+      try {
+        edit = i.model->edit_status();
+        selection = i.model->current_selection();
+        editing = true;
+      } catch (const CORBA::BAD_OPERATION&) {
+        // a Model built before scene editing: everything else still works
+      }
+      if (!editing || status.state == "EMPTY") {
         i.scene_read = false;
       } else if (!i.scene_read || edit->revision != i.edit_revision ||
                  status.scene != i.edit_scene) {
         // an edit may add or remove parameters (a tendon's actuator): list them again
         if (i.scene_read && edit->revision != i.edit_revision) i.channels_listed = false;
         try {
+          // a scene with large meshes takes longer than a short call to describe
+          omniORB::setClientThreadCallTimeout(
+              static_cast<CORBA::ULong>(options_.long_call_timeout_ms));
           ReadScene();
           i.scene_read = true;
           i.edit_scene = status.scene;
@@ -589,13 +600,16 @@ void ModelLink::Run() {
         } catch (const M::EditRefused&) {
           // a body went away between the description and its shapes: read it again
         }
+        omniORB::setClientThreadCallTimeout(short_ms);
       }
 
       std::lock_guard<std::mutex> lock(mutex_);
-      snapshot_.editing = true;
-      snapshot_.edit = FromIdl(edit.in());
-      snapshot_.selection = SelectionInfo{selection->kind.in(), selection->name.in(),
-                                          selection->index, selection->revision};
+      snapshot_.editing = editing;
+      if (editing) {
+        snapshot_.edit = FromIdl(edit.in());
+        snapshot_.selection = SelectionInfo{selection->kind.in(), selection->name.in(),
+                                            selection->index, selection->revision};
+      }
       snapshot_.connected = true;
       snapshot_.connection_message.clear();
       snapshot_.status = status;
