@@ -383,6 +383,73 @@ TEST_F(RendererEdit, ARefusedEditSaysWhyAndLeavesTheSceneAsItWas) {
   editor_->set_client(&client_);
 }
 
+TEST_F(RendererEdit, TheContextMenuEditsReachTheModel) {
+  // a via point a quarter of the way from the biceps' via point to its shoulder end: in the
+  // upper arm (the nearer end's body; no body lies under it there)
+  const auto a = MarkerWorld("biceps_line", 0), b = MarkerWorld("biceps_line", 1);
+  const std::array<double, 3> on_tendon = {b[0] + (a[0] - b[0]) / 4, b[1] + (a[1] - b[1]) / 4,
+                                           b[2] + (a[2] - b[2]) / 4};
+  const QPoint at = Project(on_tendon);
+  ASSERT_EQ(editor_->ContextActions(at),
+            (std::vector<std::string>{"Insert via point here", "Remove tendon"}));
+  ASSERT_TRUE(editor_->RunContextAction(at, "Insert via point here")) << editor_->last_error();
+  ASSERT_EQ(PathLength("biceps_line"), 4u);
+  const S::PathPoint inserted = DeclaredPoint("biceps_line", 1);
+  EXPECT_EQ(std::string(inserted.body.in()), "upper_arm");
+  R::Pose upper_arm = PoseNow("upper_arm");
+  double expected[3];
+  R::ToLocal(upper_arm, on_tendon.data(), expected);
+  const double pixel = MetresPerPixel(on_tendon[1] - FrontCamera().position[1]);
+  EXPECT_NEAR(inserted.x, expected[0], 2 * pixel);
+  EXPECT_NEAR(inserted.z, expected[2], 2 * pixel);
+  EXPECT_NEAR(DeclaredPoint("biceps_line", 2).x, 0.045, 1e-9);  // the old via point, one on
+
+  // an obstacle on the upper arm's front face, then grown by a fifth
+  ASSERT_TRUE(PumpUntil([&] { return graph_.scene().tendons[0].path.size() == 4; }, seconds(5)));
+  const QPoint face = Project(BodyWorld("upper_arm", {-0.01, -0.035, 0.08}));
+  ASSERT_TRUE(editor_->RunContextAction(face, "Add obstacle here")) << editor_->last_error();
+  auto obstacle = [&]() -> S::Obstacle {
+    S::Description_var scene = model_->scene_description();
+    for (CORBA::ULong o = 0; o < scene->obstacles.length(); ++o)
+      if (std::string(scene->obstacles[o].name.in()) == "obstacle1") return scene->obstacles[o];
+    return S::Obstacle();
+  };
+  S::Obstacle added = obstacle();
+  EXPECT_EQ(std::string(added.body.in()), "upper_arm");
+  EXPECT_EQ(std::string(added.kind.in()), "sphere");
+  EXPECT_NEAR(added.radius, 0.02, 1e-12);
+  EXPECT_NEAR(added.pose.px, -0.01, 2 * pixel);
+  EXPECT_NEAR(added.pose.py, -0.035, 0.002);
+  EXPECT_NEAR(added.pose.pz, 0.08, 2 * pixel);
+  ASSERT_TRUE(PumpUntil([&] { return graph_.scene().obstacles.size() == 3; }, seconds(5)));
+  ASSERT_EQ(editor_->ContextActions(face),
+            (std::vector<std::string>{"Grow 20%", "Shrink 20%", "Remove obstacle"}));
+  ASSERT_TRUE(editor_->RunContextAction(face, "Grow 20%")) << editor_->last_error();
+  EXPECT_NEAR(obstacle().radius, 0.024, 1e-12);
+
+  // a new tendon from the forearm's front to the hand's, with the first actuator kind offered
+  QStringList offered;
+  editor_->set_kind_chooser([&](const QStringList& kinds, QString* chosen) {
+    offered = kinds;
+    *chosen = kinds.front();
+    return true;
+  });
+  const QPoint forearm = Project(BodyWorld("forearm", {-0.01, -0.03, 0.0}));
+  const QPoint hand = Project(BodyWorld("hand", {0.0, -0.015, 0.0}));
+  ASSERT_TRUE(editor_->RunContextAction(forearm, "Start tendon here")) << editor_->last_error();
+  ASSERT_TRUE(editor_->RunContextAction(hand, "End tendon here")) << editor_->last_error();
+  ASSERT_FALSE(offered.isEmpty());
+  S::Description_var scene = model_->scene_description();
+  ASSERT_EQ(scene->tendons.length(), 6u);
+  const S::Tendon& added_tendon = scene->tendons[5];
+  EXPECT_EQ(std::string(added_tendon.name.in()), "tendon1");
+  ASSERT_EQ(added_tendon.path.length(), 2u);
+  EXPECT_EQ(std::string(added_tendon.path[0].body.in()), "forearm");
+  EXPECT_EQ(std::string(added_tendon.path[1].body.in()), "hand");
+  M::EditStatus_var status = model_->edit_status();
+  EXPECT_EQ(status->revision, 4u);
+}
+
 TEST_F(RendererEdit, CtrlDragPullsAHangingLinkTowardsTheCursor) {
   constexpr CORBA::ULong kSteps = 600;  // 0.3 s at 0.5 ms
   const std::array<double, 3> grab = BodyWorld("hand", {0, -0.015, 0});

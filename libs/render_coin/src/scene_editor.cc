@@ -18,6 +18,7 @@ namespace {
 constexpr int kClickSlop = 4;                // [px] a press and release closer than this click
 constexpr double kNewObstacleRadius = 0.02;  // [m], "Add obstacle here"
 constexpr double kNewTendonRadius = 0.0015;  // [m], "End tendon here"
+constexpr double kOnBody = 0.03;             // [m] a tendon this near a body's surface lies on it
 constexpr double kGrow = 1.2;                // "Grow 20%"
 constexpr double kShrink = 0.8;              // "Shrink 20%"
 
@@ -373,11 +374,13 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
         segment = i;
       }
     }
-    // the body under the cursor, else the body of the segment's nearer end
+    // the body under the cursor where the tendon lies on it (not one far behind), else the
+    // body of the segment's nearer end
     std::string body;
     bool found = false;
     for (const Hit& h : hits) {
-      if (h.entity.kind != "body") continue;
+      if (h.entity.kind != "body" || DistanceToSegment(h.point, hit.point, hit.point) > kOnBody)
+        continue;
       body = h.entity.name;
       found = true;
       break;
