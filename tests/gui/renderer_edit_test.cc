@@ -4,6 +4,7 @@
 // where known points project through a camera the test sets (a pinhole model of its own).
 #include <gtest/gtest.h>
 
+#include <QImage>
 #include <QTest>
 #include <QVBoxLayout>
 #include <QWidget>
@@ -12,12 +13,15 @@
 #include <cstdlib>
 #include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "caliper/model.hh"
 #include "caliper/render_coin/scene_editor.h"
 #include "caliper/render_coin/scene_graph.h"
 #include "caliper/render_coin/viewer.h"
+#include "caliper/renderer.hh"
+#include "caliper/rtc/naming.h"
 #include "model_edit_client.h"
 #include "observer_servant.h"
 #include "scene_mailbox.h"
@@ -486,6 +490,83 @@ TEST_F(RendererEdit, CtrlDragPullsAHangingLinkTowardsTheCursor) {
   EXPECT_TRUE(
       WaitFor([&] { return model_process_->Output().find("pull released") != std::string::npos; },
               seconds(5)));
+}
+
+// the renderer as its own process: an edit arrives as a new scene, and the camera stays put
+TEST(RendererProcess, AnEditedSceneKeepsTheCameraWhereItWas) {
+  namespace V = ::Caliper::Viewer;
+  if (const std::string why = NoDisplay("the renderer needs X with GLX"); !why.empty())
+    GTEST_SKIP() << why;
+  TempDir dir;
+  NamingService naming(dir.path());
+  auto model_process = StartModelProcess(
+      naming.address(),
+      std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/tests/data/collada/caliper_arm.dae",
+      dir.path(), dir.path() + "/model.out");
+  M::Model_var model = WaitForModel(naming.address());
+  ASSERT_FALSE(CORBA::is_nil(model)) << model_process->Output();
+  Process viewer(
+      {Bin("caliper-renderer"), "-o", "renderer.check_interval=0.2", "--nameservice",
+       naming.address(), "-o", "log.service=none", "-o", "log.spool_dir=" + dir.path() + "/spool"},
+      dir.path() + "/viewer.out");
+  V::Renderer_var renderer;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        try {
+          CosNaming::NamingContext_var root = rtc::ResolveRoot(Orb(), naming.address());
+          renderer = V::Renderer::_narrow(rtc::FindComponent(root, "renderer0").object);
+          return !CORBA::is_nil(renderer) && !renderer->_non_existent();
+        } catch (...) {
+          return false;
+        }
+      },
+      seconds(20)))
+      << viewer.Output();
+  // close in front of the upper arm (Inventor looks along its -z: turned 90 degrees about x)
+  const S::Frame pose{0, -0.6, 0.85, std::sqrt(0.5), std::sqrt(0.5), 0, 0};
+  QImage before;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        try {
+          renderer->set_camera(pose, kHeightAngle);
+          V::Png_var png = renderer->screenshot_png(320, 240);
+          return before.loadFromData(png->get_buffer(), static_cast<int>(png->length()), "PNG");
+        } catch (const V::NotAvailable&) {
+          return false;  // no scene yet
+        }
+      },
+      seconds(20)))
+      << viewer.Output();
+  std::this_thread::sleep_for(milliseconds(300));  // a few frames: a pending framing would show
+
+  S::PathPoint point;
+  point.body = "upper_arm";
+  point.x = 0.06;
+  point.y = 0;
+  point.z = -0.02;
+  model->move_path_point("biceps_line", 1, point);
+  auto scenes = [&] {
+    const std::string out = viewer.Output();
+    size_t n = 0;
+    for (size_t at = out.find("scene 'caliper_arm'"); at != std::string::npos;
+         at = out.find("scene 'caliper_arm'", at + 1))
+      ++n;
+    return n;
+  };
+  ASSERT_TRUE(WaitFor([&] { return scenes() >= 2; }, seconds(5))) << viewer.Output();
+  std::this_thread::sleep_for(milliseconds(300));
+  V::Png_var png = renderer->screenshot_png(320, 240);
+  QImage after;
+  ASSERT_TRUE(after.loadFromData(png->get_buffer(), static_cast<int>(png->length()), "PNG"));
+  ASSERT_EQ(after.size(), before.size());
+  int differing = 0;
+  for (int y = 0; y < after.height(); ++y)
+    for (int x = 0; x < after.width(); ++x)
+      if (after.pixel(x, y) != before.pixel(x, y)) ++differing;
+  RecordProperty("pixels_changed_by_the_edit", differing);
+  // the moved via point and its tendon change a few hundred pixels; a view framed anew all of them
+  EXPECT_GT(differing, 0) << "the edit is drawn";
+  EXPECT_LT(differing, after.width() * after.height() / 20) << viewer.Output();
 }
 
 TEST(SceneIdentity, AnEditedSceneKeepsItsIdentityAnotherSceneDoesNot) {
