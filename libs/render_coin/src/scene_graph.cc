@@ -448,7 +448,10 @@ SceneGraph::SceneGraph() : impl_(std::make_unique<Impl>()) {
   pull->addChild(pull_end);
   m.pull_switch->addChild(pull);
   m.pull_switch->whichChild = SO_SWITCH_NONE;
-  world->addChild(m.pull_switch);
+  // drawn over the bodies: the grabbed point is on a surface, often half inside it
+  auto* on_top = new SoAnnotation;
+  on_top->addChild(m.pull_switch);
+  world->addChild(on_top);
   m.root->addChild(world);
 
   // the legend in normalized screen coordinates, drawn over everything
