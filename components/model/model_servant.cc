@@ -198,6 +198,7 @@ S::Description* ToIdl(const sgal::Scene& scene) {
     out.name = b.name.c_str();
     out.pose = ToFrame(b.pose);
     out.moving = b.type != sgal::BodyType::kStatic;
+    out.mass = b.type == sgal::BodyType::kDynamic ? b.inertia.mass : 0.0;
     // what to draw: the visuals, or the collision shapes of a body that has none
     std::vector<sgal::Visual> visuals = b.visuals;
     if (visuals.empty())

@@ -1,5 +1,6 @@
 #include "observer_servant.h"
 
+#include <cmath>
 #include <exception>
 
 #include "caliper/logging/log.h"
@@ -56,6 +57,7 @@ R::SceneDescription FromIdl(const S::Description& scene) {
     body.name = in.name.in();
     body.pose = FromIdl(in.pose);
     body.moving = in.moving;
+    body.mass = std::isfinite(in.mass) ? in.mass : 0.0;
     for (CORBA::ULong v = 0; v < in.visuals.length(); ++v) {
       const S::Visual& iv = in.visuals[v];
       R::Visual visual;

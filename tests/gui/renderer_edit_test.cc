@@ -285,7 +285,7 @@ TEST_F(RendererEdit, AClickSelectsWhatIsUnderTheCursorAndTellsTheModel) {
   s = model_->current_selection();
   EXPECT_EQ(std::string(s->kind.in()), "body");
   EXPECT_EQ(std::string(s->name.in()), "upper_arm");
-  EXPECT_EQ(editor_->description().rfind("body upper_arm (moving) at ", 0), 0u)
+  EXPECT_EQ(editor_->description().rfind("body upper_arm (moving, 2 kg) at ", 0), 0u)
       << editor_->description();
 
   // the biceps between its shoulder attachment and its via point: tension and length

@@ -128,8 +128,9 @@ std::string SceneEditor::Describe(const Entity& e) const {
     if (index < 0) return "body " + e.name;
     const Body& body = scene.bodies[static_cast<size_t>(index)];
     const Pose pose = graph_.body_pose(static_cast<size_t>(index));
-    return "body " + e.name + (body.moving ? " (moving)" : " (fixed)") + " at " +
-           Millimetres(pose.p);
+    std::snprintf(text, sizeof text, " (moving, %.3g kg)", body.mass);
+    return "body " + e.name + (body.moving ? std::string(text) : std::string(" (fixed)")) +
+           " at " + Millimetres(pose.p);
   }
   if (e.kind == "tendon") {
     for (size_t i = 0; i < scene.tendons.size(); ++i) {

@@ -42,6 +42,7 @@ struct Body {
   std::string name;
   Pose pose;  // world frame
   bool moving = true;
+  double mass = 0;  // [kg] (0 for a body that does not move)
   std::vector<Visual> visuals;
 };
 
