@@ -1051,6 +1051,7 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
   } catch (const std::exception& e) {
     throw sgal::EditError(what + ": the state does not carry over: " + e.what());
   }
+  const std::shared_ptr<const sgal::Scene> old_base = loaded_->description;
   auto loaded = std::make_unique<Loaded>();
   loaded->description = base;
   loaded->source = loaded_->source;
@@ -1070,10 +1071,28 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
   }
   ++edit_revision_;
   last_edit_ = what;
-  // a selection of what the edit removed is gone
+  // a selection of what the edit removed is gone; a selected path element that an insert or a
+  // removal before it shifted keeps pointing at the same element
   if ((selection_.kind == "tendon" || selection_.kind == "path_point") &&
       base->FindTendon(selection_.name) == nullptr)
     selection_ = {"", "", 0, selection_.revision + 1};
+  if (selection_.kind == "path_point") {
+    const auto& now = base->FindTendon(selection_.name)->path;
+    const sgal::Tendon* was = old_base->FindTendon(selection_.name);
+    if (was != nullptr && was->path.size() != now.size() && selection_.index < was->path.size()) {
+      const sgal::PathElement& e = was->path[selection_.index];
+      const auto same = [&](const sgal::PathElement& x) {
+        return x.kind == e.kind && x.body == e.body && x.position == e.position &&
+               x.obstacle == e.obstacle;
+      };
+      const auto found = std::find_if(now.begin(), now.end(), same);
+      if (found == now.end())
+        selection_ = {"", "", 0, selection_.revision + 1};
+      else if (static_cast<uint32_t>(found - now.begin()) != selection_.index)
+        selection_ = {"path_point", selection_.name, static_cast<uint32_t>(found - now.begin()),
+                      selection_.revision + 1};
+    }
+  }
   if (selection_.kind == "obstacle" && base->FindObstacle(selection_.name) == nullptr)
     selection_ = {"", "", 0, selection_.revision + 1};
   logging::Get("model").notice("scene edit: %s (t = %.3f s)", what.c_str(),

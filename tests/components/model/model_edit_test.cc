@@ -324,6 +324,21 @@ TEST_F(ModelEdit, SelectionIsCheckedAndCounted) {
   EXPECT_THROW(core_.Select("wheel", "x", 0), sgal::EditError);
   core_.Select("", "", 0);
   EXPECT_EQ(core_.selection().kind, "");
+  // a via point inserted before the selected element: the selection follows the element; its
+  // removal ends the selection
+  core_.Select("path_point", "elbow_flexor", 1);
+  core_.Edit([&](const sgal::Scene& sc) {
+    return sgal::InsertPathPoint(sc, "elbow_flexor", 1, Point("upper_arm", 0.01, 0, -0.1));
+  });
+  EXPECT_EQ(core_.selection().index, 2u);
+  core_.Edit([&](const sgal::Scene& sc) { return sgal::RemovePathPoint(sc, "elbow_flexor", 1); });
+  EXPECT_EQ(core_.selection().index, 1u);
+  core_.Edit([&](const sgal::Scene& sc) {
+    return sgal::InsertPathPoint(sc, "elbow_flexor", 1, Point("upper_arm", 0.01, 0, -0.1));
+  });
+  core_.Select("path_point", "elbow_flexor", 1);
+  core_.Edit([&](const sgal::Scene& sc) { return sgal::RemovePathPoint(sc, "elbow_flexor", 1); });
+  EXPECT_EQ(core_.selection().kind, "");
   // removing the selected tendon clears the selection
   core_.Select("tendon", "wrist_flexor", 0);
   core_.Edit([&](const sgal::Scene& sc) { return sgal::RemoveTendon(sc, "wrist_flexor"); });
