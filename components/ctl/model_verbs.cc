@@ -902,7 +902,7 @@ int Edit(Client& client, std::vector<std::string>& args) {
     Call(m, [&] { m.model->select(a[0].c_str(), a[1].c_str(), IndexArg(a[2])); });
     return 0;
   } else {
-    throw UsageError("unknown edit '" + what + "' (see caliper-ctl help edit)");
+    throw UsageError("unknown edit '" + what + "' (see caliper-ctl edit --help)");
   }
   PrintEditStatus(s.in());
   return 0;
