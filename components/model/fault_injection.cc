@@ -45,6 +45,7 @@ class FailingScene : public sgal::PhysicsScene {
   void RestoreDynamicState(const sgal::DynamicState& s) override { inner_->RestoreDynamicState(s); }
   void SetPull(const sgal::Pull& pull) override { inner_->SetPull(pull); }
   void ClearPull() override { inner_->ClearPull(); }
+  void ResetCaches() override { inner_->ResetCaches(); }
 
  private:
   std::unique_ptr<sgal::PhysicsScene> inner_;

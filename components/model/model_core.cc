@@ -1036,6 +1036,7 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
   const sgal::DynamicState old_state = loaded_->physics->SaveDynamicState();
   const sgal::Scene& old_scene = loaded_->physics->description();
   sgal::DynamicState state = old_state;
+  state.engine.clear();  // the engine's own numbers belong to the scene before the edit
   state.actuators.assign(current.actuators.size(), {});
   state.commands.assign(current.actuators.size(), 0.0);
   for (size_t k = 0; k < current.actuators.size(); ++k)

@@ -192,6 +192,7 @@ class BulletScene : public sgal::PhysicsScene {
   void RestoreDynamicState(const sgal::DynamicState& state) override;
   void SetPull(const sgal::Pull& pull) override;
   void ClearPull() override { pull_.reset(); }
+  void ResetCaches() override;
 
  private:
   void BuildBody(size_t index);
@@ -977,12 +978,58 @@ void BulletScene::SetPull(const sgal::Pull& pull) {
   pull_ = pull;
 }
 
+namespace {
+
+// the engine's floats, kept exactly in doubles
+void PutTransform(const btTransform& t, std::vector<double>* out) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out->push_back(t.getBasis()[r][c]);
+  for (int k = 0; k < 3; ++k) out->push_back(t.getOrigin()[k]);
+}
+
+void PutVector(const btVector3& v, std::vector<double>* out) {
+  for (int k = 0; k < 3; ++k) out->push_back(v[k]);
+}
+
+btTransform TakeTransform(const double*& in) {
+  btMatrix3x3 basis;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) basis[r][c] = static_cast<btScalar>(*in++);
+  btVector3 origin(0, 0, 0);
+  for (int k = 0; k < 3; ++k) origin[k] = static_cast<btScalar>(*in++);
+  return btTransform(basis, origin);
+}
+
+btVector3 TakeVector(const double*& in) {
+  btVector3 v(0, 0, 0);
+  for (int k = 0; k < 3; ++k) v[k] = static_cast<btScalar>(*in++);
+  return v;
+}
+
+constexpr size_t kBodyEngineValues = 2 * 12 + 4 * 3;  // two transforms, four velocities
+
+}  // namespace
+
 sgal::DynamicState BulletScene::SaveDynamicState() const {
   sgal::DynamicState s;
   s.time = time_;
   s.steps = steps_;
   s.bodies = BodyStates();
   for (const auto& j : joints_) s.joint_positions.push_back(j.position);
+  for (const auto& b : bodies_) {
+    const btRigidBody& rb = *b.rigid;
+    PutTransform(rb.getCenterOfMassTransform(), &s.engine);
+    PutTransform(rb.getInterpolationWorldTransform(), &s.engine);
+    PutVector(rb.getLinearVelocity(), &s.engine);
+    PutVector(rb.getAngularVelocity(), &s.engine);
+    PutVector(rb.getInterpolationLinearVelocity(), &s.engine);
+    PutVector(rb.getInterpolationAngularVelocity(), &s.engine);
+  }
+  for (const auto& t : tendons_) {
+    s.engine.push_back(t.previous_length);
+    s.engine.push_back(static_cast<double>(t.path.wrap_sides().size()));
+    for (int side : t.path.wrap_sides()) s.engine.push_back(side);
+  }
   for (const auto& a : actuators_) {
     std::vector<double> state(a.model->StateSize());
     a.model->SaveState(state.data());
@@ -990,6 +1037,26 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
     s.commands.push_back(a.model->command());
   }
   return s;
+}
+
+
+void BulletScene::ResetCaches() {
+  // every body and constraint out (their contact manifolds go with their pairs), a new broad
+  // phase, then all back in the order the constructor adds them, at their present poses
+  std::vector<std::pair<int, int>> filters;
+  for (auto& j : joints_) world_->removeConstraint(j.constraint.get());
+  for (auto& b : bodies_) {
+    const btBroadphaseProxy* proxy = b.rigid->getBroadphaseHandle();
+    filters.emplace_back(proxy ? proxy->m_collisionFilterGroup : 0,
+                         proxy ? proxy->m_collisionFilterMask : 0);
+    world_->removeRigidBody(b.rigid.get());
+  }
+  auto fresh = std::make_unique<btDbvtBroadphase>();
+  world_->setBroadphase(fresh.get());
+  broadphase_ = std::move(fresh);
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    world_->addRigidBody(bodies_[i].rigid.get(), filters[i].first, filters[i].second);
+  for (auto& j : joints_) world_->addConstraint(j.constraint.get(), !j.desc->collide_connected);
 }
 
 void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
@@ -1010,8 +1077,28 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
       refuse("actuator '" + actuators_[k].desc->name + "' has " +
              std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
              std::to_string(s.actuators[k].size()));
+  const bool exact = !s.engine.empty();
+  if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 2 * tendons_.size())
+    refuse("the engine state has " + std::to_string(s.engine.size()) + " values, too few for " +
+           std::to_string(bodies_.size()) + " bodies");
+  const double* in = s.engine.data();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     btRigidBody& rb = *bodies_[i].rigid;
+    if (exact) {
+      // the engine's own numbers: the same bits as when saved
+      const btTransform t = TakeTransform(in);
+      const btTransform interpolation = TakeTransform(in);
+      const btVector3 v = TakeVector(in), w = TakeVector(in);
+      const btVector3 iv = TakeVector(in), iw = TakeVector(in);
+      rb.setCenterOfMassTransform(t);
+      rb.setLinearVelocity(v);
+      rb.setAngularVelocity(w);
+      rb.setInterpolationWorldTransform(interpolation);
+      rb.setInterpolationLinearVelocity(iv);
+      rb.setInterpolationAngularVelocity(iw);
+      rb.clearForces();
+      continue;
+    }
     const sgal::BodyState& b = s.bodies[i];
     // the body frame's pose and velocity to the centre of mass's, as Bullet keeps them
     const Isometry3d com = b.pose.ToIsometry() * bodies_[i].com_in_body;
@@ -1048,6 +1135,18 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     t.previous_length = t.geometry.length;
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
+  }
+  if (exact) {
+    const double* end = s.engine.data() + s.engine.size();
+    for (auto& t : tendons_) {
+      if (end - in < 2) refuse("the engine state ends before the tendons'");
+      t.previous_length = *in++;
+      const size_t n = static_cast<size_t>(*in++);
+      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
+      std::vector<int> sides(in, in + n);
+      in += n;
+      t.path.set_wrap_sides(std::move(sides));
+    }
   }
 }
 

@@ -60,6 +60,9 @@ class TendonPath {
  public:
   /// Path through the elements (points, with wraps between two points).
   PathGeometry Evaluate(const std::vector<WorldElement>& elements);
+  /// The side each wrap took at the last evaluation (the state carried from step to step).
+  const std::vector<int>& wrap_sides() const { return wrap_side_; }
+  void set_wrap_sides(std::vector<int> sides) { wrap_side_ = std::move(sides); }
 
  private:
   std::vector<int> wrap_side_;  // per wrap element: 0 not wrapping, +1 / -1 side taken

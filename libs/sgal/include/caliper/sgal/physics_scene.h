@@ -57,6 +57,10 @@ struct DynamicState {
   std::vector<double> joint_positions;         // description().constraints order [rad] or [m]
   std::vector<std::vector<double>> actuators;  // description().actuators order: their states
   std::vector<double> commands;                // description().actuators order
+  /// The engine's own state, bit for bit (its numbers in its precision, tendon wrap sides); a
+  /// restore into a scene built from the same description uses it and ignores `bodies`. Empty
+  /// (a scene edit changed the description): the restore goes by `bodies`.
+  std::vector<double> engine;
 };
 
 /// A spring pulling a point of a body towards a target (the GUI's Ctrl+drag), with damping on the
@@ -115,6 +119,11 @@ class PhysicsScene {
   /// index that is not a moving body, std::invalid_argument for non-finite numbers.
   virtual void SetPull(const Pull& pull) = 0;
   virtual void ClearPull() = 0;
+  /// Drops what the engine keeps between steps beyond the dynamic state (contact caches and
+  /// their warm-start impulses, the order its broad phase found pairs in), leaving it as a scene
+  /// built afresh, restored with the same exact state and reset the same way is: from there both
+  /// step bit for bit alike (recording keyframes do this).
+  virtual void ResetCaches() = 0;
 };
 
 /// Receives the bodies whose pose changed beyond a tolerance since it was last told.
