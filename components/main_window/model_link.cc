@@ -208,7 +208,11 @@ std::string KindName(S::ShapeKind kind) {
 }  // namespace
 
 void ModelLink::QueueEdit(std::string what, std::function<EditInfo(Impl&)> call) {
-  Queue(what, [this, call](Impl& i) {
+  const int long_ms = options_.long_call_timeout_ms;
+  Queue(what, [this, call, long_ms](Impl& i) {
+    // an edit rebuilds the engine: on a big scene that takes longer than a short call, and a
+    // timeout would report failed an edit the Model applied
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
     // the next poll sees the revision move and reads the edited scene and its parameters
     const EditInfo info = call(i);
     std::lock_guard<std::mutex> lock(mutex_);

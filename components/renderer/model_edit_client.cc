@@ -1,5 +1,6 @@
 #include "model_edit_client.h"
 
+#include <algorithm>
 #include <functional>
 
 #include "caliper/rtc/naming.h"
@@ -62,10 +63,12 @@ M::Model_ptr ModelReference::Get() const {
   return M::Model::_duplicate(model_.in());
 }
 
-M::Model_ptr ModelEditClient::Model() const {
+M::Model_ptr ModelEditClient::Model() const { return Model(timeout_ms_); }
+
+M::Model_ptr ModelEditClient::Model(unsigned long timeout_ms) const {
   M::Model_var model = model_.Get();
   if (CORBA::is_nil(model)) throw R::EditError("no Model found yet (renderer.model)");
-  omniORB::setClientCallTimeout(model.in(), static_cast<CORBA::ULong>(timeout_ms_));
+  omniORB::setClientCallTimeout(model.in(), static_cast<CORBA::ULong>(timeout_ms));
   return model._retn();
 }
 
@@ -144,6 +147,19 @@ void ModelEditClient::Pull(const std::string& body, const double point[3], const
 void ModelEditClient::ReleasePull() {
   M::Model_var m = Model();
   Call("release the pull", [&] { m->release_pull(); });
+}
+
+bool ModelEditClient::CurrentSelection(R::Entity* entity, uint64_t* revision) {
+  // a poll: a Model that does not answer within a second is asked again at the next one
+  M::Model_var m = Model(std::min(timeout_ms_, 1000ul));
+  Call("read the selection", [&] {
+    M::Selection_var s = m->current_selection();
+    entity->kind = s->kind.in();
+    entity->name = s->name.in();
+    entity->index = s->index;
+    *revision = s->revision;
+  });
+  return true;
 }
 
 }  // namespace caliper::renderer

@@ -1,7 +1,8 @@
 #pragma once
 // The scene editor's EditClient over the Model's CORBA reference (Caliper::Simulation::
 // SceneEditing, idl/caliper/editing.idl). The component's thread finds the Model and keeps the
-// reference up to date in a ModelReference; the GUI thread calls the Model through it.
+// reference up to date in a ModelReference; the scene editor's worker thread calls the Model
+// through it (never the GUI thread).
 
 #include <mutex>
 
@@ -46,10 +47,13 @@ class ModelEditClient : public render_coin::EditClient {
   void Pull(const std::string& body, const double point[3], const double target[3],
             double stiffness_n_per_m) override;
   void ReleasePull() override;
+  /// Reads the Model's shared selection with a short timeout (it is polled).
+  bool CurrentSelection(render_coin::Entity* entity, uint64_t* revision) override;
 
  private:
   // the Model with this client's call timeout; throws EditError when there is none
   Caliper::Simulation::Model_ptr Model() const;
+  Caliper::Simulation::Model_ptr Model(unsigned long timeout_ms) const;
 
   const ModelReference& model_;
   unsigned long timeout_ms_;

@@ -4,13 +4,16 @@
 // where known points project through a camera the test sets (a pinhole model of its own).
 #include <gtest/gtest.h>
 
+#include <QApplication>
 #include <QImage>
+#include <QMouseEvent>
 #include <QTest>
 #include <QVBoxLayout>
 #include <QWidget>
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <mutex>
 #include <regex>
 #include <string>
 #include <thread>
@@ -185,6 +188,11 @@ class RendererEdit : public ::testing::Test {
 
   QWidget* gl() { return viewer_->gl_widget(); }
 
+  // the editor calls the Model on its worker: waits (bounded) for every answer queued so far
+  bool Answered() {
+    return WaitInGui([&] { return editor_->pending_answers() == 0; }, seconds(10));
+  }
+
   // the pixel (from the top left) where `world` projects through FrontCamera(): x right, z up
   QPoint Project(const std::array<double, 3>& world) const {
     const R::CameraPose c = FrontCamera();
@@ -269,6 +277,7 @@ TEST_F(RendererEdit, AClickSelectsWhatIsUnderTheCursorAndTellsTheModel) {
   // the biceps' via point: 45 mm beside the upper arm, in its frame
   const QPoint via = Project(MarkerWorld("biceps_line", 1));
   QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier, via);
+  ASSERT_TRUE(Answered());
   M::Selection_var s = model_->current_selection();
   EXPECT_EQ(std::string(s->kind.in()), "path_point");
   EXPECT_EQ(std::string(s->name.in()), "biceps_line");
@@ -282,6 +291,7 @@ TEST_F(RendererEdit, AClickSelectsWhatIsUnderTheCursorAndTellsTheModel) {
   // the upper arm's front face, off the tendons
   QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier,
                     Project(BodyWorld("upper_arm", {-0.01, -0.035, 0.08})));
+  ASSERT_TRUE(Answered());
   s = model_->current_selection();
   EXPECT_EQ(std::string(s->kind.in()), "body");
   EXPECT_EQ(std::string(s->name.in()), "upper_arm");
@@ -292,6 +302,7 @@ TEST_F(RendererEdit, AClickSelectsWhatIsUnderTheCursorAndTellsTheModel) {
   const auto a = MarkerWorld("biceps_line", 0), b = MarkerWorld("biceps_line", 1);
   QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier,
                     Project({(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}));
+  ASSERT_TRUE(Answered());
   s = model_->current_selection();
   EXPECT_EQ(std::string(s->kind.in()), "tendon");
   EXPECT_EQ(std::string(s->name.in()), "biceps_line");
@@ -303,6 +314,7 @@ TEST_F(RendererEdit, AClickSelectsWhatIsUnderTheCursorAndTellsTheModel) {
   // empty space selects nothing
   const CORBA::ULongLong revision = M::Selection_var(model_->current_selection())->revision;
   QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier, QPoint(20, 20));
+  ASSERT_TRUE(Answered());
   s = model_->current_selection();
   EXPECT_EQ(std::string(s->kind.in()), "");
   EXPECT_EQ(graph_.highlight(), R::Entity());
@@ -322,6 +334,7 @@ TEST_F(RendererEdit, DraggingTheSelectedViaPointMovesItInTheModel) {
   EXPECT_GT(MarkerWorld("biceps_line", 1)[0], before[0] + 0.02);
   EXPECT_NEAR(DeclaredPoint("biceps_line", 1).x, 0.045, 1e-9);
   QTest::mouseRelease(gl(), Qt::LeftButton, Qt::NoModifier, at + QPoint(20, -10));
+  ASSERT_TRUE(Answered());
   EXPECT_EQ(editor_->last_error(), "");
 
   // the plane through the grabbed point (on the marker's front, 6 mm before its centre)
@@ -362,7 +375,8 @@ TEST_F(RendererEdit, ARefusedEditSaysWhyAndLeavesTheSceneAsItWas) {
   const QPoint end = Project(MarkerWorld("biceps_line", 2));
   const std::vector<std::string> offered = editor_->ContextActions(end);
   ASSERT_EQ(offered, std::vector<std::string>{"Remove via point"});
-  EXPECT_FALSE(editor_->RunContextAction(end, "Remove via point"));
+  EXPECT_TRUE(editor_->RunContextAction(end, "Remove via point"));  // sent; the answer follows
+  ASSERT_TRUE(Answered());
   EXPECT_NE(editor_->last_error().find("is an end of the tendon"), std::string::npos)
       << editor_->last_error();
   EXPECT_NE(graph_.status_text().find("refused: "), std::string::npos) << graph_.status_text();
@@ -375,10 +389,12 @@ TEST_F(RendererEdit, ARefusedEditSaysWhyAndLeavesTheSceneAsItWas) {
   editor_->set_client(&refusing);
   const QPoint via = Project(MarkerWorld("biceps_line", 1));
   QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier, via);
+  ASSERT_TRUE(Answered());
   ASSERT_EQ(editor_->selection(), (R::Entity{"path_point", "biceps_line", 1}));
   QTest::mousePress(gl(), Qt::LeftButton, Qt::NoModifier, via);
   QTest::mouseMove(gl(), via + QPoint(30, 0));
   QTest::mouseRelease(gl(), Qt::LeftButton, Qt::NoModifier, via + QPoint(30, 0));
+  ASSERT_TRUE(Answered());
   EXPECT_EQ(refusing.moves, 1);
   EXPECT_EQ(editor_->last_error(), "refused for the test");
   double local[3];
@@ -397,6 +413,8 @@ TEST_F(RendererEdit, TheContextMenuEditsReachTheModel) {
   ASSERT_EQ(editor_->ContextActions(at),
             (std::vector<std::string>{"Insert via point here", "Remove tendon"}));
   ASSERT_TRUE(editor_->RunContextAction(at, "Insert via point here")) << editor_->last_error();
+  ASSERT_TRUE(Answered());
+  ASSERT_EQ(editor_->last_error(), "");
   ASSERT_EQ(PathLength("biceps_line"), 4u);
   const S::PathPoint inserted = DeclaredPoint("biceps_line", 1);
   EXPECT_EQ(std::string(inserted.body.in()), "upper_arm");
@@ -412,6 +430,8 @@ TEST_F(RendererEdit, TheContextMenuEditsReachTheModel) {
   ASSERT_TRUE(PumpUntil([&] { return graph_.scene().tendons[0].path.size() == 4; }, seconds(5)));
   const QPoint face = Project(BodyWorld("upper_arm", {-0.01, -0.035, 0.08}));
   ASSERT_TRUE(editor_->RunContextAction(face, "Add obstacle here")) << editor_->last_error();
+  ASSERT_TRUE(Answered());
+  ASSERT_EQ(editor_->last_error(), "");
   auto obstacle = [&]() -> S::Obstacle {
     S::Description_var scene = model_->scene_description();
     for (CORBA::ULong o = 0; o < scene->obstacles.length(); ++o)
@@ -429,6 +449,8 @@ TEST_F(RendererEdit, TheContextMenuEditsReachTheModel) {
   ASSERT_EQ(editor_->ContextActions(face),
             (std::vector<std::string>{"Grow 20%", "Shrink 20%", "Remove obstacle"}));
   ASSERT_TRUE(editor_->RunContextAction(face, "Grow 20%")) << editor_->last_error();
+  ASSERT_TRUE(Answered());
+  ASSERT_EQ(editor_->last_error(), "");
   EXPECT_NEAR(obstacle().radius, 0.024, 1e-12);
 
   // a new tendon from the forearm's front to the hand's, with the first actuator kind offered
@@ -442,6 +464,8 @@ TEST_F(RendererEdit, TheContextMenuEditsReachTheModel) {
   const QPoint hand = Project(BodyWorld("hand", {0.0, -0.015, 0.0}));
   ASSERT_TRUE(editor_->RunContextAction(forearm, "Start tendon here")) << editor_->last_error();
   ASSERT_TRUE(editor_->RunContextAction(hand, "End tendon here")) << editor_->last_error();
+  ASSERT_TRUE(Answered());
+  ASSERT_EQ(editor_->last_error(), "");
   ASSERT_FALSE(offered.isEmpty());
   S::Description_var scene = model_->scene_description();
   ASSERT_EQ(scene->tendons.length(), 6u);
@@ -478,6 +502,7 @@ TEST_F(RendererEdit, CtrlDragPullsAHangingLinkTowardsTheCursor) {
   const double pulled_x = PoseNow("hand").p[0];
   QTest::mouseRelease(gl(), Qt::LeftButton, Qt::ControlModifier, at + QPoint(100, 0));
   EXPECT_FALSE(graph_.pull_line_visible());
+  ASSERT_TRUE(Answered());
   EXPECT_EQ(editor_->last_error(), "");
 
   RecordProperty("hand_x_free_mm", std::to_string(1000 * free_x));
@@ -490,6 +515,117 @@ TEST_F(RendererEdit, CtrlDragPullsAHangingLinkTowardsTheCursor) {
   EXPECT_TRUE(
       WaitFor([&] { return model_process_->Output().find("pull released") != std::string::npos; },
               seconds(5)));
+}
+
+// an EditClient that answers slowly and records the pulls it is sent (called on the worker)
+class SlowClient : public RefusingClient {
+ public:
+  void Select(const R::Entity&) override { std::this_thread::sleep_for(milliseconds(1500)); }
+  void Pull(const std::string&, const double*, const double* target, double) override {
+    std::this_thread::sleep_for(milliseconds(150));
+    std::lock_guard<std::mutex> lock(mutex);
+    targets.push_back({target[0], target[1], target[2]});
+  }
+  size_t Pulls() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return targets.size();
+  }
+  std::array<double, 3> Last() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return targets.back();
+  }
+  std::mutex mutex;
+  std::vector<std::array<double, 3>> targets;
+};
+
+TEST_F(RendererEdit, ASlowModelDoesNotFreezeTheView) {
+  SlowClient slow;
+  editor_->set_client(&slow);
+  const QPoint via = Project(MarkerWorld("biceps_line", 1));
+  const auto before = std::chrono::steady_clock::now();
+  QTest::mouseClick(gl(), Qt::LeftButton, Qt::NoModifier, via);
+  const auto click_ms =
+      std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - before).count();
+  RecordProperty("click_with_a_1500_ms_model_ms", std::to_string(click_ms));
+  // the highlight is at once; the Model's answer is still on its way
+  EXPECT_LT(click_ms, 500);
+  EXPECT_EQ(graph_.highlight(), (R::Entity{"path_point", "biceps_line", 1}));
+  EXPECT_EQ(editor_->pending_answers(), 1);
+  ASSERT_TRUE(Answered());
+  editor_->set_client(&client_);
+}
+
+TEST_F(RendererEdit, PullsCoalesceAndAreRenewedWhileTheButtonIsHeld) {
+  SlowClient slow;
+  editor_->set_client(&slow);
+  editor_->set_pull_interval(milliseconds(0));
+  const QPoint at = Project(BodyWorld("hand", {0, -0.015, 0}));
+  QTest::mousePress(gl(), Qt::LeftButton, Qt::ControlModifier, at);
+  ASSERT_TRUE(graph_.pull_line_visible());
+  // 30 moves faster than the Model answers: never a backlog, the last target is sent
+  // (straight to the GL area: the X server would merge motion events on the way)
+  for (int i = 1; i <= 30; ++i) {
+    QMouseEvent move(QEvent::MouseMove, at + QPoint(2 * i, 0), Qt::NoButton, Qt::LeftButton,
+                     Qt::ControlModifier);
+    QApplication::sendEvent(gl(), &move);
+  }
+  ASSERT_TRUE(WaitInGui([&] { return editor_->pending_answers() == 0; }, seconds(5)));
+  const size_t after_moves = slow.Pulls();
+  RecordProperty("pulls_sent_for_30_moves", std::to_string(after_moves));
+  EXPECT_GE(after_moves, 1u);
+  EXPECT_LE(after_moves, 3u);
+  // the mouse rests: the target is sent again at least every 0.5 s (the Model's lease is 2 s)
+  const std::array<double, 3> last = slow.Last();
+  QTest::qWait(1300);
+  ASSERT_TRUE(WaitInGui([&] { return editor_->pending_answers() == 0; }, seconds(5)));
+  EXPECT_GE(slow.Pulls(), after_moves + 2);
+  EXPECT_EQ(slow.Last(), last);
+  QTest::mouseRelease(gl(), Qt::LeftButton, Qt::ControlModifier, at + QPoint(60, 0));
+  ASSERT_TRUE(Answered());
+  const size_t released = slow.Pulls();
+  QTest::qWait(700);
+  EXPECT_EQ(slow.Pulls(), released) << "no renewal after the release";
+  editor_->set_client(&client_);
+}
+
+TEST_F(RendererEdit, TheViewFollowsTheModelsSharedSelection) {
+  // a pick elsewhere (the Main Window, caliper-ctl edit select) highlights here
+  model_->select("tendon", "triceps_line", 0);
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return graph_.highlight() == R::Entity{"tendon", "triceps_line", 0};
+      },
+      seconds(3)));
+  EXPECT_EQ(editor_->selection(), (R::Entity{"tendon", "triceps_line", 0}));
+  EXPECT_EQ(graph_.status_text().rfind("tendon triceps_line", 0), 0u) << graph_.status_text();
+
+  // an insert before the selected via point: the Model re-points its selection, so does the view
+  model_->select("path_point", "biceps_line", 1);
+  ASSERT_TRUE(WaitInGui(
+      [&] {
+        return graph_.highlight() == R::Entity{"path_point", "biceps_line", 1};
+      },
+      seconds(3)));
+  S::PathPoint extra;
+  extra.body = "upper_arm";
+  extra.x = 0.04;
+  extra.y = 0;
+  extra.z = 0.1;
+  model_->insert_path_point("biceps_line", 1, extra);
+  ASSERT_TRUE(PumpUntil(
+      [&] {
+        return graph_.highlight() == R::Entity{"path_point", "biceps_line", 2} &&
+               graph_.scene().tendons[0].path.size() == 4;
+      },
+      seconds(5)))
+      << graph_.highlight().kind << " " << graph_.highlight().index;
+  // Delete removes what the Model has selected: the old via point, not the inserted one
+  QTest::keyClick(gl(), Qt::Key_Delete);
+  ASSERT_TRUE(Answered());
+  EXPECT_EQ(editor_->last_error(), "");
+  ASSERT_EQ(PathLength("biceps_line"), 3u);
+  EXPECT_NEAR(DeclaredPoint("biceps_line", 1).x, 0.04, 1e-9);
+  EXPECT_NEAR(DeclaredPoint("biceps_line", 1).z, 0.1, 1e-9);
 }
 
 // the renderer as its own process: an edit arrives as a new scene, and the camera stays put

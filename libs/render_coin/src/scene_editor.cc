@@ -1,5 +1,6 @@
 #include "caliper/render_coin/scene_editor.h"
 
+#include <QCursor>
 #include <QEvent>
 #include <QInputDialog>
 #include <QKeyEvent>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 namespace caliper::render_coin {
 
@@ -62,18 +64,171 @@ bool DefaultKindChooser(const QStringList& kinds, QString* chosen) {
 }  // namespace
 
 SceneEditor::SceneEditor(SceneGraph& graph, Viewer& viewer, EditClient* client)
-    : graph_(graph), viewer_(viewer), client_(client), choose_kind_(DefaultKindChooser) {
+    : graph_(graph),
+      viewer_(viewer),
+      client_(client),
+      choose_kind_(DefaultKindChooser),
+      poll_client_(client) {
   viewer_.gl_widget()->installEventFilter(this);
+  // the Model ends a pull it has not heard of for 2 s: renew it while the button is held
+  pull_renewal_.setInterval(500);
+  connect(&pull_renewal_, &QTimer::timeout, this, [this] {
+    if (mode_ == Mode::kPull) QueuePull();
+  });
+  worker_ = std::thread([this] { WorkerLoop(); });
 }
 
 SceneEditor::~SceneEditor() {
-  if (mode_ == Mode::kPull && client_ != nullptr) {
-    try {
-      client_->ReleasePull();
-    } catch (const std::exception&) {
-      // the Model is gone: nothing pulls any more
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // what is still queued has nobody to answer to; a pull in progress must not outlive us
+    jobs_.clear();
+    if (mode_ == Mode::kPull && client_ != nullptr) {
+      Job release;
+      release.client = client_;
+      release.call = [](EditClient& c) { c.ReleasePull(); };
+      jobs_.push_back(std::move(release));
+    }
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+}
+
+void SceneEditor::set_client(EditClient* client) {
+  client_ = client;
+  std::lock_guard<std::mutex> lock(mutex_);
+  poll_client_ = client;
+  model_selection_known_ = false;
+}
+
+void SceneEditor::set_pull_renewal(std::chrono::milliseconds interval) {
+  pull_renewal_.setInterval(static_cast<int>(interval.count()));
+}
+
+void SceneEditor::set_selection_poll(std::chrono::milliseconds interval) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    poll_interval_ = interval;
+  }
+  wake_.notify_all();
+}
+
+void SceneEditor::Queue(Job job) {
+  ++pending_answers_;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    jobs_.push_back(std::move(job));
+  }
+  wake_.notify_all();
+}
+
+void SceneEditor::QueuePull() {
+  pull_pending_ = false;
+  last_pull_ = std::chrono::steady_clock::now();
+  if (client_ == nullptr) return;
+  {
+    // a pull still waiting for the worker takes the new target: only the latest is sent
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!jobs_.empty() && jobs_.back().pull && jobs_.back().client == client_ &&
+        jobs_.back().body == pull_body_) {
+      for (int i = 0; i < 3; ++i) jobs_.back().target[i] = pull_target_[i];
+      return;
     }
   }
+  Job job;
+  job.client = client_;
+  job.pull = true;
+  job.body = pull_body_;
+  for (int i = 0; i < 3; ++i) {
+    job.local[i] = pull_local_[i];
+    job.target[i] = pull_target_[i];
+  }
+  const std::string body = pull_body_;
+  job.answer = [this, body](const std::string& error) {
+    if (error.empty()) {
+      ++pulls_sent_;
+      if (mode_ == Mode::kPull) last_error_.clear();
+      return;
+    }
+    if (mode_ == Mode::kPull && pull_body_ == body) {
+      mode_ = Mode::kIdle;
+      pull_renewal_.stop();
+      graph_.SetPullLine(-1, nullptr, nullptr);
+    }
+    Refused("pull on " + body, error, viewer_.gl_widget()->mapFromGlobal(QCursor::pos()));
+  };
+  Queue(std::move(job));
+}
+
+void SceneEditor::WorkerLoop() {
+  auto next_poll = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait_until(lock, next_poll, [&] {
+      return stopping_ || !jobs_.empty() || std::chrono::steady_clock::now() >= next_poll;
+    });
+    if (!jobs_.empty()) {
+      Job job = std::move(jobs_.front());
+      jobs_.pop_front();
+      lock.unlock();
+      std::string error;
+      try {
+        if (job.pull)
+          job.client->Pull(job.body, job.local, job.target, 0);
+        else
+          job.call(*job.client);
+      } catch (const std::exception& e) {
+        error = e.what();
+        if (error.empty()) error = "unknown error";
+      }
+      if (job.answer)
+        QMetaObject::invokeMethod(
+            this,
+            [this, answer = std::move(job.answer), error] {
+              --pending_answers_;
+              answer(error);
+            },
+            Qt::QueuedConnection);
+      lock.lock();
+      continue;
+    }
+    if (stopping_) return;
+    if (std::chrono::steady_clock::now() < next_poll) continue;
+    next_poll = std::chrono::steady_clock::now() + poll_interval_;
+    EditClient* client = poll_client_;
+    if (client == nullptr) continue;
+    lock.unlock();
+    Entity entity;
+    uint64_t revision = 0;
+    bool known = false;
+    try {
+      known = client->CurrentSelection(&entity, &revision);
+    } catch (const std::exception&) {
+      // no Model (yet) or one that does not answer: the next poll asks again
+    }
+    if (known)
+      QMetaObject::invokeMethod(
+          this, [this, entity, revision] { ModelSelected(entity, revision); },
+          Qt::QueuedConnection);
+    lock.lock();
+  }
+}
+
+void SceneEditor::ModelSelected(const Entity& entity, uint64_t revision) {
+  // read before a select of ours reached the Model: it would undo the click for a moment
+  if (selects_in_flight_ > 0) return;
+  const bool changed = !model_selection_known_ || revision != model_selection_revision_;
+  model_selection_known_ = true;
+  model_selection_revision_ = revision;
+  // a drag in progress keeps what it drags until it is dropped
+  if (!changed || entity == selection_ || mode_ == Mode::kDragPoint || mode_ == Mode::kDragObstacle)
+    return;
+  selection_ = entity;
+  graph_.SetHighlight(entity);
+  description_ = Describe(entity);
+  graph_.SetStatus(description_);
+  Redraw();
 }
 
 std::vector<Hit> SceneEditor::PickAt(QPoint at) const {
@@ -129,8 +284,8 @@ std::string SceneEditor::Describe(const Entity& e) const {
     const Body& body = scene.bodies[static_cast<size_t>(index)];
     const Pose pose = graph_.body_pose(static_cast<size_t>(index));
     std::snprintf(text, sizeof text, " (moving, %.3g kg)", body.mass);
-    return "body " + e.name + (body.moving ? std::string(text) : std::string(" (fixed)")) +
-           " at " + Millimetres(pose.p);
+    return "body " + e.name + (body.moving ? std::string(text) : std::string(" (fixed)")) + " at " +
+           Millimetres(pose.p);
   }
   if (e.kind == "tendon") {
     for (size_t i = 0; i < scene.tendons.size(); ++i) {
@@ -183,13 +338,16 @@ void SceneEditor::Select(const Entity& entity, QPoint at) {
   else
     QToolTip::showText(widget->mapToGlobal(at), QString::fromStdString(description_), widget);
   if (client_ != nullptr) {
-    try {
-      client_->Select(entity);
-      last_error_.clear();
-    } catch (const std::exception& e) {
-      last_error_ = e.what();
-      graph_.SetStatus(description_ + "  (the Model: " + last_error_ + ")");
-    }
+    ++selects_in_flight_;
+    Job job;
+    job.client = client_;
+    job.call = [entity](EditClient& c) { c.Select(entity); };
+    job.answer = [this](const std::string& error) {
+      --selects_in_flight_;
+      last_error_ = error;
+      if (!error.empty()) graph_.SetStatus(description_ + "  (the Model: " + error + ")");
+    };
+    Queue(std::move(job));
   }
   Redraw();
 }
@@ -206,19 +364,30 @@ void SceneEditor::Refused(const std::string& what, const std::string& reason, QP
   Redraw();
 }
 
-bool SceneEditor::Send(const std::string& what, QPoint at, const std::function<void()>& edit) {
+bool SceneEditor::Send(const std::string& what, QPoint at, std::function<void(EditClient&)> edit) {
   if (client_ == nullptr) {
     Refused(what, "no Model to edit", at);
     return false;
   }
-  try {
-    edit();
-  } catch (const std::exception& e) {
-    Refused(what, e.what(), at);
-    return false;
-  }
-  last_error_.clear();
-  graph_.SetStatus(what);
+  Job job;
+  job.client = client_;
+  job.call = std::move(edit);
+  const Entity sent_for = selection_;
+  job.answer = [this, what, at, sent_for](const std::string& error) {
+    if (!error.empty()) {
+      // the element dragged goes back even when the selection moved on meanwhile
+      if (sent_for.kind == "path_point")
+        graph_.SetPathPointMarker(sent_for.name, sent_for.index, nullptr);
+      if (sent_for.kind == "obstacle") graph_.SetObstacleMarker(sent_for.name, nullptr);
+      Refused(what, error, at);
+      return;
+    }
+    last_error_.clear();
+    graph_.SetStatus(what);
+    Redraw();
+  };
+  Queue(std::move(job));
+  graph_.SetStatus(what + " (sent)");
   Redraw();
   return true;
 }
@@ -259,7 +428,7 @@ void SceneEditor::FinishDrag(QPoint at) {
     const std::string tendon = selection_.name;
     const uint32_t index = selection_.index;
     Send("move point " + std::to_string(index) + " of " + tendon + " to " + Millimetres(moved.p),
-         at, [&] { client_->MovePathPoint(tendon, index, moved); });
+         at, [=](EditClient& c) { c.MovePathPoint(tendon, index, moved); });
   } else {
     const Obstacle* o = FindObstacle(selection_.name);
     if (o == nullptr) return;
@@ -270,7 +439,7 @@ void SceneEditor::FinishDrag(QPoint at) {
     for (int i = 0; i < 3; ++i) world[i] += grab_offset_[i];
     ToLocal(body, world, moved.pose.p);
     Send("move obstacle " + moved.name + " to " + Millimetres(moved.pose.p), at,
-         [&] { client_->SetObstacle(moved); });
+         [=](EditClient& c) { c.SetObstacle(moved); });
   }
 }
 
@@ -283,32 +452,12 @@ void SceneEditor::PullTo(QPoint at, bool force) {
     // send the latest target when the interval is over, even if the mouse stops here
     if (!pull_pending_)
       QTimer::singleShot(pull_interval_, this, [this] {
-        if (mode_ != Mode::kPull || !pull_pending_ || client_ == nullptr) return;
-        try {
-          client_->Pull(pull_body_, pull_local_, pull_target_, 0);
-          ++pulls_sent_;
-        } catch (const std::exception& e) {
-          last_error_ = e.what();
-          graph_.SetStatus("pull refused: " + last_error_);
-        }
-        last_pull_ = std::chrono::steady_clock::now();
-        pull_pending_ = false;
+        if (mode_ == Mode::kPull && pull_pending_) QueuePull();
       });
     pull_pending_ = true;
     return;
   }
-  pull_pending_ = false;
-  last_pull_ = now;
-  if (client_ == nullptr) return;
-  try {
-    client_->Pull(pull_body_, pull_local_, pull_target_, 0);
-    ++pulls_sent_;
-    last_error_.clear();
-  } catch (const std::exception& e) {
-    mode_ = Mode::kIdle;
-    graph_.SetPullLine(-1, nullptr, nullptr);
-    Refused("pull on " + pull_body_, e.what(), at);
-  }
+  QueuePull();
 }
 
 std::vector<std::string> SceneEditor::ContextActions(QPoint at) {
@@ -332,12 +481,12 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
   const Hit& hit = hits.front();
   const Entity& e = hit.entity;
   if (action == kRemoveTendon)
-    return Send("remove tendon " + e.name, at, [&] { client_->RemoveTendon(e.name); });
+    return Send("remove tendon " + e.name, at, [=](EditClient& c) { c.RemoveTendon(e.name); });
   if (action == kRemoveVia)
     return Send("remove point " + std::to_string(e.index) + " of " + e.name, at,
-                [&] { client_->RemovePathPoint(e.name, e.index); });
+                [=](EditClient& c) { c.RemovePathPoint(e.name, e.index); });
   if (action == kRemoveObstacle)
-    return Send("remove obstacle " + e.name, at, [&] { client_->RemoveObstacle(e.name); });
+    return Send("remove obstacle " + e.name, at, [=](EditClient& c) { c.RemoveObstacle(e.name); });
   if (action == kGrowObstacle || action == kShrinkObstacle) {
     const Obstacle* o = FindObstacle(e.name);
     if (o == nullptr) return false;
@@ -345,7 +494,7 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
     const double factor = action == kGrowObstacle ? kGrow : kShrink;
     resized.radius *= factor;
     resized.length *= factor;
-    return Send(action + " " + e.name, at, [&] { client_->SetObstacle(resized); });
+    return Send(action + " " + e.name, at, [=](EditClient& c) { c.SetObstacle(resized); });
   }
   if (action == kInsertVia) {
     const Tendon* t = FindTendon(e.name);
@@ -400,7 +549,7 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
     ToLocal(pose, hit.point, point.p);
     const uint32_t index = static_cast<uint32_t>(segment + 1);
     return Send("insert a via point into " + e.name + " on " + body + " at " + Millimetres(point.p),
-                at, [&] { client_->InsertPathPoint(e.name, index, point); });
+                at, [=](EditClient& c) { c.InsertPathPoint(e.name, index, point); });
   }
   // the rest act on a body at the picked point
   Pose pose;
@@ -415,7 +564,8 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
     o.kind = "sphere";
     for (int i = 0; i < 3; ++i) o.pose.p[i] = here.p[i];
     o.radius = kNewObstacleRadius;
-    return Send("add obstacle " + o.name + " on " + e.name, at, [&] { client_->SetObstacle(o); });
+    return Send("add obstacle " + o.name + " on " + e.name, at,
+                [=](EditClient& c) { c.SetObstacle(o); });
   }
   if (action == kStartTendon) {
     tendon_started_ = true;
@@ -432,24 +582,34 @@ bool SceneEditor::RunContextAction(QPoint at, const std::string& action) {
       Refused("add tendon", "no Model to edit", at);
       return false;
     }
-    QStringList kinds;
-    try {
-      for (const ActuatorKindInfo& k : client_->ActuatorKinds())
-        kinds << QString::fromStdString(k.kind);
-    } catch (const std::exception& ex) {
-      Refused("add tendon", ex.what(), at);
-      return false;
-    }
-    QString kind;
-    if (kinds.isEmpty() || !choose_kind_(kinds, &kind)) {
-      graph_.SetStatus("add tendon cancelled");
-      return false;
-    }
-    const std::string name = FreeName("tendon", true);
-    const std::string actuator = "actuator" + name.substr(6);
-    return Send("add tendon " + name + " (" + kind.toStdString() + ")", at, [&] {
-      client_->AddTendon(name, tendon_start_, here, kNewTendonRadius, actuator, kind.toStdString());
-    });
+    // the kinds come from the Model (on the worker); the choice and the edit follow the answer
+    auto kinds = std::make_shared<std::vector<ActuatorKindInfo>>();
+    Job job;
+    job.client = client_;
+    job.call = [kinds](EditClient& c) { *kinds = c.ActuatorKinds(); };
+    const PathPoint from = tendon_start_;
+    job.answer = [this, kinds, from, here, at](const std::string& error) {
+      if (!error.empty()) {
+        Refused("add tendon", error, at);
+        return;
+      }
+      QStringList names;
+      for (const ActuatorKindInfo& k : *kinds) names << QString::fromStdString(k.kind);
+      QString kind;
+      if (names.isEmpty() || !choose_kind_(names, &kind)) {
+        graph_.SetStatus("add tendon cancelled");
+        return;
+      }
+      const std::string name = FreeName("tendon", true);
+      const std::string actuator = "actuator" + name.substr(6);
+      const std::string chosen = kind.toStdString();
+      Send("add tendon " + name + " (" + chosen + ")", at, [=](EditClient& c) {
+        c.AddTendon(name, from, here, kNewTendonRadius, actuator, chosen);
+      });
+    };
+    Queue(std::move(job));
+    graph_.SetStatus("add tendon: asking the Model for the actuator kinds");
+    return true;
   }
   return false;
 }
@@ -482,6 +642,8 @@ bool SceneEditor::eventFilter(QObject* watched, QEvent* event) {
           mode_ = Mode::kPull;
           pull_pending_ = false;
           last_pull_ = {};
+          for (int i = 0; i < 3; ++i) pull_target_[i] = h.point[i];
+          pull_renewal_.start();
           graph_.SetPullLine(index, pull_local_, h.point);
           graph_.SetStatus("pulling " + pull_body_);
           Redraw();
@@ -551,18 +713,21 @@ bool SceneEditor::eventFilter(QObject* watched, QEvent* event) {
           FinishDrag(e->pos());
           mode_ = Mode::kIdle;
           return true;
-        case Mode::kPull:
+        case Mode::kPull: {
+          pull_renewal_.stop();
           graph_.SetPullLine(-1, nullptr, nullptr);
           graph_.SetStatus("");
           Redraw();
-          if (client_ != nullptr) {
-            try {
-              client_->ReleasePull();
-            } catch (const std::exception& ex) {
-              last_error_ = ex.what();
-            }
-          }
+          if (client_ == nullptr) return true;
+          Job job;
+          job.client = client_;
+          job.call = [](EditClient& c) { c.ReleasePull(); };
+          job.answer = [this](const std::string& error) {
+            if (!error.empty()) last_error_ = error;
+          };
+          Queue(std::move(job));
           return true;
+        }
         case Mode::kIdle:
           return false;
       }
@@ -580,11 +745,11 @@ bool SceneEditor::eventFilter(QObject* watched, QEvent* event) {
       const Entity s = selection_;
       if (s.kind == "path_point")
         Send("remove point " + std::to_string(s.index) + " of " + s.name, at,
-             [&] { client_->RemovePathPoint(s.name, s.index); });
+             [=](EditClient& c) { c.RemovePathPoint(s.name, s.index); });
       else if (s.kind == "tendon")
-        Send("remove tendon " + s.name, at, [&] { client_->RemoveTendon(s.name); });
+        Send("remove tendon " + s.name, at, [=](EditClient& c) { c.RemoveTendon(s.name); });
       else if (s.kind == "obstacle")
-        Send("remove obstacle " + s.name, at, [&] { client_->RemoveObstacle(s.name); });
+        Send("remove obstacle " + s.name, at, [=](EditClient& c) { c.RemoveObstacle(s.name); });
       else
         return false;
       return true;
