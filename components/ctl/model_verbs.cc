@@ -751,8 +751,9 @@ void NeedArgs(const std::vector<std::string>& args, size_t n, const std::string&
 
 int Edit(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
-  std::string stiffness_text = "0";
+  std::string stiffness_text = "0", hold_text = "0";
   TakeOption(args, "--stiffness", &stiffness_text);
+  TakeOption(args, "--for", &hold_text);
   RejectOptions(args);
   ModelRef m = Connect(client, name);
   if (args.empty()) {
@@ -778,7 +779,8 @@ int Edit(Client& client, std::vector<std::string>& args) {
     for (CORBA::ULong i = 0; i < d->tendons.length(); ++i) {
       if (a[0] != d->tendons[i].name.in()) continue;
       const S::PathPointSeq& path = d->tendons[i].path;
-      std::cout << "ELEMENT  BODY / OBSTACLE        X [mm]      Y [mm]      Z [mm]\n";
+      // millimetres to read; the edits take metres, as every length of the IDL
+      std::cout << "ELEMENT  BODY / OBSTACLE        X [mm]      Y [mm]      Z [mm]   (edits take m)\n";
       for (CORBA::ULong k = 0; k < path.length(); ++k) {
         const bool wrap = std::strlen(path[k].obstacle.in()) > 0;
         std::cout << std::left << std::setw(9) << k << std::setw(22)
@@ -849,6 +851,15 @@ int Edit(Client& client, std::vector<std::string>& args) {
     o.kind = a[2].c_str();
     o.pose = {ParseNumber(a[3], "X [m]"), ParseNumber(a[4], "Y [m]"), ParseNumber(a[5], "Z [m]"),
               1, 0, 0, 0};
+    // an obstacle moved and resized keeps its orientation (a cylinder's axis)
+    S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
+    for (CORBA::ULong i = 0; i < d->obstacles.length(); ++i)
+      if (a[0] == d->obstacles[i].name.in()) {
+        o.pose.qw = d->obstacles[i].pose.qw;
+        o.pose.qx = d->obstacles[i].pose.qx;
+        o.pose.qy = d->obstacles[i].pose.qy;
+        o.pose.qz = d->obstacles[i].pose.qz;
+      }
     o.radius = ParseNumber(a[6], "RADIUS [m]");
     o.length = a.size() == 8 ? ParseNumber(a[7], "LENGTH [m]") : 0.0;
     s = Call(m, [&] { return m.model->set_obstacle(o); });
@@ -886,14 +897,27 @@ int Edit(Client& client, std::vector<std::string>& args) {
     M::Vector3 target{ParseNumber(a[1], "X [m]"), ParseNumber(a[2], "Y [m]"),
                       ParseNumber(a[3], "Z [m]")};
     const double k = ParseNumber(stiffness_text, "--stiffness [N/m]");
+    const double hold = ParseNumber(hold_text, "--for [s]");
+    if (!(hold >= 0)) throw UsageError("--for needs seconds >= 0 (0: until Ctrl-C)");
+    // the Model ends a pull that is not renewed within 2 s (a client gone mid-drag): renew it
+    // every half second while this runs, and release it at the end
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
     Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
-    std::cout << "pulling " << a[0] << "'s origin toward " << a[1] << " " << a[2] << " " << a[3]
-              << " m (until `edit release`)\n";
-    return 0;
-  } else if (what == "release") {
-    NeedArgs(a, 0, "release");
+    std::cerr << "pulling " << a[0] << "'s origin toward " << a[1] << " " << a[2] << " " << a[3]
+              << " m " << (hold > 0 ? "for " + Num(hold) + " s" : std::string("until Ctrl-C"))
+              << "\n";
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(hold);
+    while (hold == 0 || std::chrono::steady_clock::now() < until) {
+      const timespec wait = {0, 500 * 1000 * 1000};
+      const int sig = sigtimedwait(&signals, nullptr, &wait);
+      if (sig == SIGINT || sig == SIGTERM) break;
+      Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
+    }
     Call(m, [&] { m.model->release_pull(); });
-    std::cout << "pull released\n";
+    std::cerr << "pull released\n";
     return 0;
   } else if (what == "select") {
     if (a.empty() || a.size() > 3) throw UsageError("expected: edit select KIND NAME [INDEX] or none");
@@ -1006,9 +1030,10 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "    shapes BODY / shape BODY INDEX DIM...   list / set a collision shape's dimensions\n"
       "    mass BODY KG                       the inertia scales with the mass\n"
       "    undo / redo\n"
-      "    pull BODY X Y Z [--stiffness K]    spring the body's origin toward a world point\n"
-      "    release                            end the pull\n"
-      "    select KIND NAME [INDEX] / select none   what the GUI shows as selected\n");
+      "    pull BODY X Y Z [--stiffness K] [--for S]   spring the body's origin toward a world\n"
+      "                                       point [m] until Ctrl-C (or S seconds), then release\n"
+      "    select KIND NAME [INDEX] / select none   what the GUI shows as selected\n",
+      true);
   add("save", "save FILE [--send] [--model NAME]",
       "export the scene with its current parameters as COLLADA", Save,
       "  Whatever was loaded (COLLADA or URDF), FILE is COLLADA with Caliper's technique.\n"

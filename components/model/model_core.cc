@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <thread>
 
 #include "caliper/collada/exporter.h"
@@ -240,6 +241,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   BuildLocked(std::move(loaded));
   undo_.clear();
   redo_.clear();
+  removed_actuators_.clear();
   last_edit_.clear();
   state_ = RunState::kPaused;
   last_error_.clear();
@@ -351,6 +353,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   last_error_.clear();
   undo_.clear();
   redo_.clear();
+  removed_actuators_.clear();
   last_edit_.clear();
   selection_ = {"", "", 0, selection_.revision + 1};
   logging::Get("model").notice("loaded %s: %zu bodies, %zu tendons, %zu actuators", source.c_str(),
@@ -557,6 +560,7 @@ void ModelCore::StepLocked() {
   // to the execution context or the caller.
   try {
     ApplyPendingLocked();
+    ExpirePullLocked();
     physics.Step();
   } catch (const sgal::SimulationFault& fault) {
     FaultLocked(fault.what());
@@ -1009,52 +1013,99 @@ std::string ModelCore::model_name() const {
 
 namespace caliper::model {
 
-void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
-                                const std::string& what) {
-  // the scene as loaded (what a rewind returns to) and the engine's copy (tuned parameters)
-  auto base = std::make_shared<sgal::Scene>(*loaded_->description);
-  sgal::Scene current = loaded_->physics->description();
-  apply(*base);
-  apply(current);
-  for (const sgal::Scene* s : {static_cast<const sgal::Scene*>(base.get()),
-                               static_cast<const sgal::Scene*>(&current)}) {
-    const auto problems = sgal::Validate(*s);
-    if (!problems.empty()) {
-      std::string reason = what + ": the scene would not be sound:";
-      for (const auto& p : problems) reason += "\n  " + p;
-      throw sgal::EditError(reason);
+ModelCore::EditStatus ModelCore::ApplyEdit(const Rebuild& rebuild) {
+  // Built outside the lock (a scene of meshes takes a while; steps and other clients go on),
+  // then swapped in if the scene did not change meanwhile: another edit, a load or a rewind in
+  // between means building again on the new scene (a few times), else a refusal.
+  for (int attempt = 0;; ++attempt) {
+    std::shared_ptr<const sgal::Scene> old_base;
+    sgal::Scene current;
+    uint64_t generation = 0;
+    {
+      const auto lock = Lock();
+      Require(true);
+      RequireNoExperiment();
+      old_base = loaded_->description;
+      current = loaded_->physics->description();
+      generation = generation_;
     }
+    // the scene as loaded (what a rewind returns to) and the engine's copy (tuned parameters)
+    auto base = std::make_shared<sgal::Scene>(*old_base);
+    const std::string what = rebuild(*base, current);
+    for (const sgal::Scene* s : {static_cast<const sgal::Scene*>(base.get()),
+                                 static_cast<const sgal::Scene*>(&current)}) {
+      const auto problems = sgal::Validate(*s);
+      if (!problems.empty()) {
+        std::string reason = what + ": the scene would not be sound:";
+        for (const auto& p : problems) reason += "\n  " + p;
+        throw sgal::EditError(reason);
+      }
+    }
+    std::unique_ptr<sgal::PhysicsScene> physics;
+    try {
+      physics = MakePhysics(current);
+    } catch (const std::exception& e) {
+      throw sgal::EditError(what + ": the engine refuses the edited scene: " + e.what());
+    }
+    const auto lock = Lock();
+    if (!loaded_ || generation_ != generation) {
+      if (attempt < 4) continue;
+      throw sgal::EditError(what + ": the scene kept changing while the edit was built (other "
+                                   "edits, loads or rewinds); try again");
+    }
+    SwapEditedLocked(base, std::move(physics), what);
+    return EditStatusLocked();
   }
-  std::unique_ptr<sgal::PhysicsScene> physics;
-  try {
-    physics = MakePhysics(current);
-  } catch (const std::exception& e) {
-    throw sgal::EditError(what + ": the engine refuses the edited scene: " + e.what());
-  }
-  // the dynamic state, matched by name: bodies and constraints are never added by an edit;
-  // actuators are, and removed (a new one starts from its own rest state)
+}
+
+void ModelCore::SwapEditedLocked(std::shared_ptr<const sgal::Scene> base,
+                                 std::unique_ptr<sgal::PhysicsScene> physics,
+                                 const std::string& what) {
+  // the dynamic state now (the engine stepped while the edit was built), matched by name:
+  // bodies and constraints are never added by an edit; an actuator that an edit removes keeps
+  // its state and command aside, for the undo that brings it back
+  const sgal::Scene& current = physics->description();
   const sgal::DynamicState old_state = loaded_->physics->SaveDynamicState();
   const sgal::Scene& old_scene = loaded_->physics->description();
   sgal::DynamicState state = old_state;
   state.engine.clear();  // the engine's own numbers belong to the scene before the edit
   state.actuators.assign(current.actuators.size(), {});
   state.commands.assign(current.actuators.size(), 0.0);
-  for (size_t k = 0; k < current.actuators.size(); ++k)
-    for (size_t j = 0; j < old_scene.actuators.size(); ++j)
-      if (old_scene.actuators[j].name == current.actuators[k].name &&
-          old_scene.actuators[j].kind == current.actuators[k].kind) {
-        state.actuators[k] = old_state.actuators[j];
-        state.commands[k] = old_state.commands[j];
-      }
+  std::map<std::string, size_t> before;
+  for (size_t j = 0; j < old_scene.actuators.size(); ++j) before[old_scene.actuators[j].name] = j;
+  std::set<std::string> kept;
+  for (size_t k = 0; k < current.actuators.size(); ++k) {
+    const sgal::Actuator& a = current.actuators[k];
+    const auto was = before.find(a.name);
+    if (was != before.end() && old_scene.actuators[was->second].kind == a.kind) {
+      state.actuators[k] = old_state.actuators[was->second];
+      state.commands[k] = old_state.commands[was->second];
+      kept.insert(a.name);
+    } else if (const auto aside = removed_actuators_.find(a.name);
+               aside != removed_actuators_.end() && aside->second.kind == a.kind) {
+      state.actuators[k] = aside->second.state;
+      state.commands[k] = aside->second.command;
+      removed_actuators_.erase(aside);
+    }
+  }
+  for (const auto& [name, j] : before)
+    if (kept.count(name) == 0 && removed_actuators_.size() < 256)
+      removed_actuators_[name] = {old_scene.actuators[j].kind, old_state.actuators[j],
+                                  old_state.commands[j]};
   try {
     physics->RestoreDynamicState(state);
-    if (pull_) physics->SetPull(*pull_);
   } catch (const std::exception& e) {
     throw sgal::EditError(what + ": the state does not carry over: " + e.what());
   }
+  if (pull_) {
+    // the pull goes on, on the body of the same name
+    const int index = current.BodyIndex(old_scene.bodies.at(pull_->body).name);
+    pull_->body = index;
+    if (index >= 0) physics->SetPull(*pull_);
+  }
   const std::shared_ptr<const sgal::Scene> old_base = loaded_->description;
   auto loaded = std::make_unique<Loaded>();
-  loaded->description = base;
+  loaded->description = std::move(base);
   loaded->source = loaded_->source;
   loaded->name = loaded_->name;
   loaded->physics = std::move(physics);
@@ -1072,13 +1123,14 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
   }
   ++edit_revision_;
   last_edit_ = what;
+  const sgal::Scene& edited = *loaded_->description;
   // a selection of what the edit removed is gone; a selected path element that an insert or a
   // removal before it shifted keeps pointing at the same element
   if ((selection_.kind == "tendon" || selection_.kind == "path_point") &&
-      base->FindTendon(selection_.name) == nullptr)
+      edited.FindTendon(selection_.name) == nullptr)
     selection_ = {"", "", 0, selection_.revision + 1};
   if (selection_.kind == "path_point") {
-    const auto& now = base->FindTendon(selection_.name)->path;
+    const auto& now = edited.FindTendon(selection_.name)->path;
     const sgal::Tendon* was = old_base->FindTendon(selection_.name);
     if (was != nullptr && was->path.size() != now.size() && selection_.index < was->path.size()) {
       const sgal::PathElement& e = was->path[selection_.index];
@@ -1094,7 +1146,7 @@ void ModelCore::ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply,
                       selection_.revision + 1};
     }
   }
-  if (selection_.kind == "obstacle" && base->FindObstacle(selection_.name) == nullptr)
+  if (selection_.kind == "obstacle" && edited.FindObstacle(selection_.name) == nullptr)
     selection_ = {"", "", 0, selection_.revision + 1};
   logging::Get("model").notice("scene edit: %s (t = %.3f s)", what.c_str(),
                                loaded_->physics->time());
@@ -1104,43 +1156,56 @@ ModelCore::EditStatus ModelCore::EditStatusLocked() const {
   EditStatus s;
   s.revision = edit_revision_;
   s.last = last_edit_;
-  if (!undo_.empty()) s.undo = undo_.back().label;
-  if (!redo_.empty()) s.redo = redo_.back().label;
+  if (!undo_.empty()) s.undo = undo_.back().base.label;
+  if (!redo_.empty()) s.redo = redo_.back().base.label;
   return s;
 }
 
 ModelCore::EditStatus ModelCore::Edit(
     const std::function<sgal::SceneEdit(const sgal::Scene&)>& make) {
+  // one edit per scene, each made against its own scene: its revert puts back exactly what
+  // that scene held (the engine's copy has tuned parameters the loaded scene lacks)
+  std::shared_ptr<HistoryEntry> entry;
+  const EditStatus status = ApplyEdit([&](sgal::Scene& base, sgal::Scene& current) {
+    entry = std::make_shared<HistoryEntry>(HistoryEntry{make(base), make(current)});
+    entry->base.apply(base);
+    entry->current.apply(current);
+    return entry->base.label;
+  });
   const auto lock = Lock();
-  Require(true);
-  RequireNoExperiment();
-  sgal::SceneEdit edit = make(*loaded_->description);
-  ApplyEditLocked(edit.apply, edit.label);
-  undo_.push_back(std::move(edit));
+  undo_.push_back(std::move(*entry));
   if (undo_.size() > 200) undo_.erase(undo_.begin());  // a bounded history
   redo_.clear();
   return EditStatusLocked();
 }
 
-ModelCore::EditStatus ModelCore::Undo() {
-  const auto lock = Lock();
-  Require(true);
-  RequireNoExperiment();
-  if (undo_.empty()) throw sgal::EditError("nothing to undo");
-  ApplyEditLocked(undo_.back().revert, "undo " + undo_.back().label);
-  redo_.push_back(std::move(undo_.back()));
-  undo_.pop_back();
-  return EditStatusLocked();
-}
+ModelCore::EditStatus ModelCore::Undo() { return Walk(true); }
 
-ModelCore::EditStatus ModelCore::Redo() {
+ModelCore::EditStatus ModelCore::Redo() { return Walk(false); }
+
+ModelCore::EditStatus ModelCore::Walk(bool undo) {
+  std::vector<HistoryEntry>* from = undo ? &undo_ : &redo_;
+  std::vector<HistoryEntry>* to = undo ? &redo_ : &undo_;
+  size_t depth = 0;
+  const EditStatus status = ApplyEdit([&](sgal::Scene& base, sgal::Scene& current) {
+    HistoryEntry entry;
+    {
+      const auto lock = Lock();
+      if (from->empty()) throw sgal::EditError(undo ? "nothing to undo" : "nothing to redo");
+      entry = from->back();
+      depth = from->size();
+    }
+    (undo ? entry.base.revert : entry.base.apply)(base);
+    (undo ? entry.current.revert : entry.current.apply)(current);
+    return (undo ? "undo " : "redo ") + entry.base.label;
+  });
   const auto lock = Lock();
-  Require(true);
-  RequireNoExperiment();
-  if (redo_.empty()) throw sgal::EditError("nothing to redo");
-  ApplyEditLocked(redo_.back().apply, "redo " + redo_.back().label);
-  undo_.push_back(std::move(redo_.back()));
-  redo_.pop_back();
+  // the entry walked is the last one, unless a load emptied the history meanwhile
+  if (from->size() == depth) {
+    to->push_back(std::move(from->back()));
+    from->pop_back();
+  }
+  (void)status;
   return EditStatusLocked();
 }
 
@@ -1159,9 +1224,17 @@ void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
   if (index < 0) throw sgal::EditError("pull: no body '" + body + "'");
   if (scene.bodies[index].type != sgal::BodyType::kDynamic)
     throw sgal::EditError("pull: body '" + body + "' does not move");
-  if (!(stiffness_n_per_m >= 0) || !std::isfinite(stiffness_n_per_m))
-    throw sgal::EditError("pull: stiffness must be >= 0 N/m (0: the default)");
   const double mass = scene.bodies[index].inertia.mass;
+  const double dt = scene.settings.time_step;
+  // stiffer than mass / dt^2 the explicit spring would swing wider each step
+  const double stiffest = mass / (dt * dt);
+  if (!(stiffness_n_per_m >= 0) || !std::isfinite(stiffness_n_per_m) || stiffness_n_per_m > stiffest)
+    throw sgal::EditError("pull: stiffness must be in [0, " + std::to_string(stiffest) +
+                          "] N/m (0: the default; stiffer than mass / time_step^2 is unstable)");
+  const double reach = options_.max_distance;
+  if (!point.allFinite() || !target.allFinite() || point.norm() > reach || target.norm() > reach)
+    throw sgal::EditError("pull: the point and the target must be finite and within " +
+                          std::to_string(reach) + " m of the origin");
   const double omega = 2 * M_PI * 2.0;  // the default spring moves the body at about 2 Hz
   sgal::Pull pull;
   pull.body = index;
@@ -1178,6 +1251,16 @@ void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
     logging::Get("model").info("pull on %s at %.3f %.3f %.3f m (body frame), %.1f N/m",
                                body.c_str(), point.x(), point.y(), point.z(), pull.stiffness);
   pull_ = pull;
+  pull_until_ = Clock::now() + limits_.pull_lease;
+}
+
+void ModelCore::ExpirePullLocked() {
+  if (!pull_ || Clock::now() < pull_until_) return;
+  logging::Get("model").notice("the pull on %s ended: not renewed for %.1f s (its client is gone?)",
+                               loaded_->physics->description().bodies.at(pull_->body).name.c_str(),
+                               std::chrono::duration<double>(limits_.pull_lease).count());
+  pull_.reset();
+  loaded_->physics->ClearPull();
 }
 
 void ModelCore::ReleasePull() {

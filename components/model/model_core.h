@@ -72,6 +72,7 @@ struct Limits {
   size_t pending_writes = 100000;        // motor commands queued for the next step
   size_t subscribed_values = 100000;     // values of all data subscriptions together
   size_t queued_bytes = size_t{256} << 20;  // batches waiting for slow consumers, in all
+  std::chrono::milliseconds pull_lease{2000};  // a pull not renewed for this long ends
 };
 
 /// Wall time a step request or an experiment holds the lock before letting other calls in.
@@ -209,6 +210,9 @@ class ModelCore {
   EditStatus edit_status() const;
   /// A spring on a moving body's point (body frame) towards a world target from the next step;
   /// stiffness 0 takes the body's mass times (2 pi 2 Hz)^2. Damping is critical for the mass.
+  /// A lease: a pull not renewed (called again) within Limits::pull_lease of wall time ends by itself.
+  /// Throws sgal::EditError for a body that does not move, a stiffness above mass / dt^2 (the
+  /// spring would be unstable), or a point or target beyond the engine's max_distance.
   void Pull(const std::string& body, const Eigen::Vector3d& point, const Eigen::Vector3d& target,
             double stiffness_n_per_m);
   void ReleasePull();
@@ -281,9 +285,16 @@ class ModelCore {
   struct Loaded;
   /// `edit`: the same scene edited (history, commands and step requests go on).
   void BuildLocked(std::unique_ptr<Loaded> loaded, bool edit = false);
-  /// Applies `apply` (an edit's apply or revert) to the scene and the engine's copy; see Edit.
-  void ApplyEditLocked(const std::function<void(sgal::Scene&)>& apply, const std::string& what);
+  /// Changes copies of the scene as loaded and of the engine's (returning what it did), builds
+  /// and checks them outside the lock, and swaps them in; see Edit.
+  using Rebuild = std::function<std::string(sgal::Scene& base, sgal::Scene& current)>;
+  EditStatus ApplyEdit(const Rebuild& rebuild);
+  void SwapEditedLocked(std::shared_ptr<const sgal::Scene> base,
+                        std::unique_ptr<sgal::PhysicsScene> physics, const std::string& what);
+  EditStatus Walk(bool undo);
   EditStatus EditStatusLocked() const;
+  /// Ends a pull its client stopped renewing.
+  void ExpirePullLocked();
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();
@@ -332,7 +343,20 @@ class ModelCore {
   std::unique_ptr<Loaded> loaded_;
   uint64_t generation_ = 0;  // of the scene observers see: every load, rewind and edit
   uint64_t restarts_ = 0;    // loads and rewinds (a step request ends on one, not on an edit)
-  std::vector<sgal::SceneEdit> undo_, redo_;  // of the loaded scene; cleared by a load
+  // an edit of the scene as loaded and the same edit of the engine's copy, each made against its
+  // own scene (its revert restores exactly that scene's values)
+  struct HistoryEntry {
+    sgal::SceneEdit base, current;
+  };
+  std::vector<HistoryEntry> undo_, redo_;  // of the loaded scene; cleared by a load
+  // actuators an edit removed: their state and command, for the undo that brings them back
+  struct RemovedActuator {
+    std::string kind;
+    std::vector<double> state;
+    double command = 0;
+  };
+  std::map<std::string, RemovedActuator> removed_actuators_;
+  std::chrono::steady_clock::time_point pull_until_;
   uint64_t edit_revision_ = 0;
   std::string last_edit_;
   Selection selection_;

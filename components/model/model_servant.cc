@@ -1173,7 +1173,7 @@ M::EditStatus* ModelServant::remove_obstacle(const char* obstacle) {
 M::EditStatus* ModelServant::set_shape_dims(const char* body, CORBA::ULong index,
                                             const S::DoubleSeq& dims) {
   return Guard([&] {
-    if (dims.length() > 16) throw sgal::EditError("set_shape_dims: at most 4 dimensions");
+    if (dims.length() > 4) throw sgal::EditError("set_shape_dims: a shape has at most 4 dimensions");
     std::vector<double> values(dims.get_buffer(), dims.get_buffer() + dims.length());
     return ToIdl(core_.Edit(
         [&](const sgal::Scene& s) { return sgal::SetShapeDims(s, body, index, values); }));

@@ -59,6 +59,29 @@ ctl edit insert elbow_extensor 1 knob >/dev/null 2>&1 || fail "wrap around the n
 ctl edit path elbow_extensor | grep -q "wrap knob" && pass "elbow_extensor wraps around knob" ||
   fail "no wrap around knob"
 ctl edit obstacle knob upper_arm sphere 0.03 0 -0.2 0.02 >/dev/null 2>&1 || fail "resize the obstacle"
+# a cylinder moved and resized keeps its axis (the elbow pulley turns about x)
+ctl edit obstacle elbow_pulley upper_arm cylinder 0 0 -0.29 0.045 0.06 >/dev/null 2>&1 ||
+  fail "move the elbow pulley"
+ctl save "$WORK/pulley.dae" >/dev/null 2>&1
+if grep -A3 '<obstacle name="elbow_pulley"' "$WORK/pulley.dae" | grep -q 'radius="0.045"' &&
+   grep -A3 '<obstacle name="elbow_pulley"' "$WORK/pulley.dae" | grep -Eq '<rotate>-?1 0 0 -?90'; then
+  pass "the moved pulley keeps its axis"
+else grep -A3 '<obstacle name="elbow_pulley"' "$WORK/pulley.dae"; fail "the pulley's axis"; fi
+
+# a pull while stepping: a command the Model shows as channels; released at the end
+ctl edit pull hand 0.3 0 -0.5 --for 1.5 >"$WORK/pull" 2>&1 &
+pull_pid=$!
+sleep 0.7
+ctl step 100 >/dev/null 2>&1
+body=$(ctl get ecce_arm.pull.body | awk '{print $3}')
+force=$(ctl get ecce_arm.pull.force_x | awk '{print $3}')
+wait $pull_pid || fail "pull --for"
+[ "$body" = "5" ] && awk -v f="$force" 'BEGIN {exit !(f > 0.1)}' &&
+  pass "pulling the hand: pull.body = $body, pull.force_x = $force N" ||
+  { cat "$WORK/pull"; fail "pull channels: body '$body' force '$force'"; }
+ctl step 1 >/dev/null 2>&1
+[ "$(ctl get ecce_arm.pull.body | awk '{print $3}')" = "-1" ] && pass "released after --for" ||
+  fail "the pull outlived ctl"
 
 # a new tendon with a ligament at its defaults, a mass, a shape
 ctl edit add-tendon strap upper_arm 0.03 0 -0.05 forearm 0.03 0 -0.05 ligament strap_ligament \

@@ -674,6 +674,10 @@ TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
     EXPECT_REFUSED(ref_->pull("pendulum", {bad, 0, 0}, {0, 0, 0}, 0), "");
     EXPECT_REFUSED(ref_->pull("pendulum", {0, 0, 0}, {0, 0, 0}, bad), "");
   }
+  // huge but finite pulls: refused with the bound, never an infinite force and a fault
+  EXPECT_REFUSED(ref_->pull("pendulum", {0, 0, 0}, {kHuge, 0, 0}, 0), "within");
+  EXPECT_REFUSED(ref_->pull("pendulum", {0, 0, 0}, {0, 0, 0}, kHuge), "stiffness");
+  EXPECT_REFUSED(ref_->pull("frame", {0, 0, 0}, {0, 0, 0}, 0), "does not move");
   EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass("pendulum", -1)), "mass");
   EXPECT_REFUSED(M::EditStatus_var(ref_->set_mass("frame", 1)), "does not move");
   S::DoubleSeq dims;
@@ -718,8 +722,8 @@ TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
   EXPECT_ANSWERED(M::ActuatorKindSeq_var(ref_->actuator_kinds()));
   EXPECT_ANSWERED(ref_->release_pull());
 
-  // a thousand sound edits from four clients at once while stepping, then as many undos: all
-  // answered, the path as it was
+  // a thousand sound edits from four clients at once while stepping, all answered; then undos:
+  // the history keeps the last 200, and what undo walks back are moves of the via point
   std::vector<std::thread> clients;
   std::atomic<int> answered{0};
   for (int c = 0; c < 4; ++c)
@@ -737,13 +741,21 @@ TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
     });
   for (auto& t : clients) t.join();
   EXPECT_EQ(answered.load(), 1000);
-  for (int i = 0; i < 1000; ++i) {
+  int undone = 0;
+  for (; undone < 1000; ++undone) {
     try {
       M::EditStatus_var s = ref_->undo();
-    } catch (const M::EditRefused&) {
-      break;  // the history holds the last 200
+      EXPECT_EQ(std::string(s->last.in()).rfind("undo move via point 1 of line", 0), 0u) << s->last.in();
+    } catch (const M::EditRefused& e) {
+      EXPECT_TRUE(Contains(e.reason.in(), "nothing to undo")) << e.reason.in();
+      break;
     }
   }
+  EXPECT_EQ(undone, 200) << "the history holds the last 200 edits";
+  S::Description_var d = ref_->scene_description();
+  EXPECT_EQ(d->tendons[0].path.length(), path);
+  EXPECT_GE(d->tendons[0].path[1].z, 1.0);  // one of the moves, not the file's point (1.125)
+  EXPECT_LT(d->tendons[0].path[1].z, 1.0 + 1e-4 * 250);
   EXPECT_ANSWERED(ref_->step(10));
 }
 

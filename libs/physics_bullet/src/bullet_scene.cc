@@ -191,7 +191,10 @@ class BulletScene : public sgal::PhysicsScene {
   sgal::DynamicState SaveDynamicState() const override;
   void RestoreDynamicState(const sgal::DynamicState& state) override;
   void SetPull(const sgal::Pull& pull) override;
-  void ClearPull() override { pull_.reset(); }
+  void ClearPull() override {
+    pull_.reset();
+    pull_force_.setZero();
+  }
   void ResetCaches() override;
 
  private:
@@ -232,6 +235,7 @@ class BulletScene : public sgal::PhysicsScene {
   double time_ = 0;
   uint64_t steps_ = 0;
   std::optional<sgal::Pull> pull_;  // the GUI's spring on a body, while it lasts
+  Vector3d pull_force_ = Vector3d::Zero();  // what it applied in the last step [N]
 
   std::unique_ptr<btDefaultCollisionConfiguration> configuration_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
@@ -957,11 +961,13 @@ void BulletScene::Step() {
 }
 
 void BulletScene::ApplyPull() {
+  pull_force_.setZero();
   if (!pull_) return;
   const int i = pull_->body;
   const Vector3d at = poses_[i] * pull_->point;
   const Vector3d v = velocities_[i] + spins_[i].cross(at - coms_[i]);
   const Vector3d force = pull_->stiffness * (pull_->target - at) - pull_->damping * v;
+  pull_force_ = force;
   bodies_[i].rigid->applyForce(ToBt(force, scale_), ToBt(at - coms_[i], scale_));
 }
 
@@ -1192,6 +1198,14 @@ void BulletScene::BuildParameters() {
     parameter_index_[info.id] = static_cast<int>(parameters_.size());
     parameters_.push_back({std::move(info), std::move(get), std::move(set)});
   };
+  // the GUI's pull (a command: recordings and plots show it); body -1 when none
+  add({"pull.body", "", false, false}, [this] { return pull_ ? double(pull_->body) : -1.0; });
+  for (int k = 0; k < 3; ++k) {
+    const std::string axis(1, "xyz"[k]);
+    add({"pull.force_" + axis, "N", false, false}, [this, k] { return pull_force_[k]; });
+    add({"pull.target_" + axis, "m", false, false},
+        [this, k] { return pull_ ? pull_->target[k] : 0.0; });
+  }
   add({"simulation.time_step", "s", true, true}, [this] { return dt_; }, [this](double v) {
     if (!(v > 0 && v <= 0.1)) throw std::invalid_argument("simulation.time_step: must be in (0, 0.1] s");
     // A time step that an actuator cannot take within its bound of sub-steps per step is refused

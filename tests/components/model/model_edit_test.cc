@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "caliper/collada/importer.h"
@@ -196,13 +197,51 @@ TEST_F(ModelEdit, AddedTendonPullsAndRemovingItUndoes) {
   core_.Edit([&](const sgal::Scene& s) { return sgal::AddTendon(s, t, a); });
   ASSERT_NE(scene()->FindTendon("extra"), nullptr);
   EXPECT_EQ(scene()->actuators.back().tendon, "extra");
-  EXPECT_FALSE(Read(core_, "ecce_arm.extra.tendon.length").empty());
+  const double length = Read(core_, "ecce_arm.extra.tendon.length").at(0);
+  EXPECT_GT(length, 0.01);
+  // stretched past its rest length by the elbow's bending, it pulls
+  core_.SetChannel("ecce_arm.extra_ligament.rest_length", {0.5 * length});
+  core_.StepNow(20);
+  EXPECT_GT(Read(core_, "ecce_arm.extra.tendon.tension").at(0), 1.0);
   core_.Edit([&](const sgal::Scene& s) { return sgal::RemoveTendon(s, "extra"); });
   EXPECT_EQ(scene()->FindTendon("extra"), nullptr);
   EXPECT_THROW(Read(core_, "ecce_arm.extra.tendon.length"), UnknownId);
   core_.Undo();
   EXPECT_NE(scene()->FindTendon("extra"), nullptr);
   EXPECT_EQ(scene()->actuators.back().name, "extra_ligament");
+  // back with its channels and the rest length tuned while it ran
+  EXPECT_GT(Read(core_, "ecce_arm.extra.tendon.length").at(0), 0.01);
+  EXPECT_EQ(Read(core_, "ecce_arm.extra_ligament.rest_length").at(0), 0.5 * length);
+}
+
+TEST_F(ModelEdit, UndoPutsBackTunedValuesActuatorStatesAndCommands) {
+  // a mass tuned while running, then edited: the undo gives the tuned mass back
+  core_.SetChannel("ecce_arm.forearm.mass", {1.7});
+  core_.Edit([&](const sgal::Scene& s) { return sgal::SetMass(s, "forearm", 0.9); });
+  EXPECT_NEAR(Read(core_, "ecce_arm.forearm.mass").at(0), 0.9, 1e-6);
+  core_.Undo();
+  EXPECT_NEAR(Read(core_, "ecce_arm.forearm.mass").at(0), 1.7, 1e-6);
+  // the scene as loaded (what a rewind returns to) never had the tuned value
+  EXPECT_NE(scene()->FindBody("forearm")->inertia.mass, 1.7);
+
+  // a driven motor with a tuned stiffness, removed and brought back: stiffness, command and the
+  // motor's state (its tension) as they were at the removal
+  core_.SetChannel("ecce_arm.elbow_flexor.stiffness", {4321});
+  core_.SetCommands({{"elbow_flexor", 6.0}});
+  core_.StepNow(200);
+  const auto tension = [&] {
+    for (const auto& x : core_.ActuatorStates())
+      if (x.name == "elbow_flexor") return x.tension;
+    return -1.0;
+  };
+  const double at_removal = tension();
+  ASSERT_GT(at_removal, 1.0);
+  core_.Edit([&](const sgal::Scene& s) { return sgal::RemoveTendon(s, "elbow_flexor"); });
+  core_.StepNow(50);
+  core_.Undo();
+  EXPECT_EQ(Read(core_, "ecce_arm.elbow_flexor.stiffness").at(0), 4321);
+  EXPECT_EQ(Read(core_, "ecce_arm.elbow_flexor.command").at(0), 6.0);
+  EXPECT_EQ(tension(), at_removal);
 }
 
 TEST_F(ModelEdit, StopRewindsTimeButKeepsEditsAndLoadForgetsThem) {
@@ -232,13 +271,24 @@ TEST_F(ModelEdit, TheEditedSceneExportsAndLoadsAgainIdentically) {
   wrap.kind = sgal::PathElement::Kind::kWrap;
   wrap.obstacle = "new_pulley";
   core_.Edit([&](const sgal::Scene& s) { return sgal::InsertPathPoint(s, "elbow_extensor", 1, wrap); });
-  const auto& forearm = *scene()->FindBody("forearm");
+  const sgal::Body forearm = *scene()->FindBody("forearm");  // a copy: edits replace the scene
   std::vector<double> dims = sgal::GeometryDims(forearm.shapes.at(0).geometry);
   ASSERT_FALSE(dims.empty());
   for (double& d : dims) d *= 1.25;
   core_.Edit([&](const sgal::Scene& s) { return sgal::SetShapeDims(s, "forearm", 0, dims); });
   core_.Edit([&](const sgal::Scene& s) { return sgal::SetMass(s, "forearm", 0.9); });
+  sgal::Tendon strap;
+  strap.name = "strap";
+  strap.path = {Point("upper_arm", 0.03, 0, -0.05), Point("forearm", 0.03, 0, -0.05)};
+  sgal::Actuator strap_ligament{"strap_ligament", "ligament", "", {{"stiffness", 1234}}, {}};
+  core_.Edit([&](const sgal::Scene& s) { return sgal::AddTendon(s, strap, strap_ligament); });
   const sgal::Scene edited = *scene();
+  // the visual drawn from the resized shape follows it
+  for (const auto& v : edited.FindBody("forearm")->visuals) {
+    if (v.geometry.index() == forearm.shapes.at(0).geometry.index()) {
+      EXPECT_EQ(sgal::GeometryDims(v.geometry), dims) << v.name;
+    }
+  }
 
   core::ScratchDirectory dir("model-edit");
   const std::string file = dir.path() + "/edited.dae";
@@ -259,6 +309,13 @@ TEST_F(ModelEdit, TheEditedSceneExportsAndLoadsAgainIdentically) {
       EXPECT_LT((a.path[k].position - b.path[k].position).norm(), 1e-12) << a.name << " " << k;
     }
   }
+  ASSERT_EQ(again.actuators.size(), edited.actuators.size());
+  for (size_t i = 0; i < edited.actuators.size(); ++i) {
+    EXPECT_EQ(again.actuators[i].name, edited.actuators[i].name);
+    EXPECT_EQ(again.actuators[i].tendon, edited.actuators[i].tendon);
+    EXPECT_EQ(again.actuators[i].kind, edited.actuators[i].kind);
+  }
+  EXPECT_NEAR(again.actuators.back().parameters.at("stiffness"), 1234, 1e-9);
   const sgal::WrapObstacle* pulley = again.FindObstacle("new_pulley");
   ASSERT_NE(pulley, nullptr);
   EXPECT_EQ(pulley->kind, sgal::ObstacleKind::kSphere);
@@ -277,6 +334,36 @@ TEST_F(ModelEdit, TheEditedSceneExportsAndLoadsAgainIdentically) {
   core_.StepNow(200);
   other.StepNow(200);
   EXPECT_EQ(Read(other, "ecce_arm.hand.position"), Read(core_, "ecce_arm.hand.position"));
+}
+
+TEST(ModelPull, APullNotRenewedEndsByItself) {
+  Limits limits;
+  limits.pull_lease = std::chrono::milliseconds(50);
+  ModelCore core({}, limits);
+  core.Load(Model("ecce_arm.dae"));
+  const auto start = Read(core, "ecce_arm.hand.position");
+  const Eigen::Vector3d target(start[0] + 0.3, start[1], start[2] + 0.2);
+  core.Pull("hand", Eigen::Vector3d::Zero(), target, 0);
+  core.StepNow(20);
+  EXPECT_GT(Read(core, "ecce_arm.pull.force_x").at(0), 1.0) << "the pull acts while it lasts";
+  EXPECT_EQ(Read(core, "ecce_arm.pull.body").at(0), 5.0);  // the hand
+  EXPECT_NEAR(Read(core, "ecce_arm.pull.target_z").at(0), target.z(), 1e-12);
+  std::this_thread::sleep_for(std::chrono::milliseconds(120));  // its client is gone
+  core.StepNow(1);
+  EXPECT_EQ(Read(core, "ecce_arm.pull.force_x").at(0), 0.0);
+  EXPECT_EQ(Read(core, "ecce_arm.pull.force_z").at(0), 0.0);
+  EXPECT_EQ(Read(core, "ecce_arm.pull.body"), std::vector<double>{-1});
+}
+
+TEST(ModelPull, HugeOrUnstablePullsAreRefused) {
+  ModelCore core;
+  core.Load(Model("ecce_arm.dae"));
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  EXPECT_THROW(core.Pull("hand", zero, Eigen::Vector3d(1e300, 0, 0), 0), sgal::EditError);
+  EXPECT_THROW(core.Pull("hand", Eigen::Vector3d(0, 0, 1e5), zero, 0), sgal::EditError);
+  EXPECT_THROW(core.Pull("hand", zero, zero, 1e12), sgal::EditError);
+  EXPECT_THROW(core.Pull("hand", zero, zero, -1), sgal::EditError);
+  EXPECT_NO_THROW(core.Pull("hand", zero, zero, 100));
 }
 
 TEST_F(ModelEdit, PullMovesAHangingLinkTowardTheTargetAndReleaseEndsIt) {
