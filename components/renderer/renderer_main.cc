@@ -302,6 +302,9 @@ int main(int argc, char** argv) {
   }
 
   app.exec();
+  // the editor's worker calls the Model through the ORB: end it (and a pull in progress)
+  // while the runtime still runs
+  editor.reset();
   request_exit();  // the window was closed: end the runtime too (a no-op when it has ended)
   runtime_thread.join();
   return screenshot_exit != 0 ? screenshot_exit : rtc_exit.load();

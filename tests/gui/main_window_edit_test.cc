@@ -267,6 +267,28 @@ TEST_F(MainWindowEditTest, AnEditByAnotherClientEnablesUndoAndUndoPutsTheViaPoin
                         seconds(5)));
 }
 
+// an edit that takes longer than a short call (a big scene's rebuild; here a Model stopped for
+// 0.8 s) is waited for with the long timeout, not reported failed although the Model applied it
+TEST_F(MainWindowEditTest, AnEditSlowerThanAShortCallIsWaitedFor) {
+  ModelLink::Options options;
+  options.nameservice = naming_->address();
+  options.call_timeout_ms = 300;
+  options.poll_period_ms = 60000;        // no poll while the Model is stopped: only the edit
+  options.components_period_ms = 60000;  // waits on it
+  ModelLink link(options);
+  ASSERT_TRUE(WaitInGui([&] { return link.snapshot().connected; }, seconds(10)));
+  const CORBA::ULongLong revision = M::EditStatus_var(model_->edit_status())->revision;
+  const main_window::Snapshot before = link.snapshot();
+  link.SetMass("forearm", 1.25);
+  process_->Signal(SIGSTOP);
+  QTest::qWait(800);
+  process_->Signal(SIGCONT);
+  ASSERT_TRUE(WaitInGui([&] { return link.snapshot().commands_done > before.commands_done; },
+                        seconds(10)));
+  EXPECT_EQ(link.snapshot().error_serial, before.error_serial) << link.snapshot().last_error;
+  EXPECT_EQ(M::EditStatus_var(model_->edit_status())->revision, revision + 1);
+}
+
 TEST_F(MainWindowEditTest, AddTendonAndRemoveItThroughThePanel) {
   model_->select("body", "upper_arm", 0);
   ASSERT_TRUE(WaitInGui([&] { return Find<QLabel>("selection_title")->text() == "Body upper_arm"; },
