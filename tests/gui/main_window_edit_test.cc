@@ -283,8 +283,8 @@ TEST_F(MainWindowEditTest, AnEditSlowerThanAShortCallIsWaitedFor) {
   process_->Signal(SIGSTOP);
   QTest::qWait(800);
   process_->Signal(SIGCONT);
-  ASSERT_TRUE(WaitInGui([&] { return link.snapshot().commands_done > before.commands_done; },
-                        seconds(10)));
+  ASSERT_TRUE(
+      WaitInGui([&] { return link.snapshot().commands_done > before.commands_done; }, seconds(10)));
   EXPECT_EQ(link.snapshot().error_serial, before.error_serial) << link.snapshot().last_error;
   EXPECT_EQ(M::EditStatus_var(model_->edit_status())->revision, revision + 1);
 }
