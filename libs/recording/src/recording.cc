@@ -513,6 +513,10 @@ Writer::Writer(const std::string& path, const Header& header, const SceneVersion
     RemoveFiles(path);
     throw RecordingError("cannot record to " + path + ": " + e.what());
   }
+  // room for a commit interval of records at 1 kHz: the two vectors are swapped back and forth
+  // and keep their capacity, so a step's push allocates nothing beyond the record itself
+  impl_->queue.reserve(1024);
+  impl_->batch.reserve(1024);
   impl_->thread = std::thread([this] { impl_->Run(); });
 }
 
