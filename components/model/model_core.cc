@@ -48,14 +48,6 @@ std::string IdSafe(const std::string& name) {
 }
 
 // Everything that belongs to one loaded scene.
-struct ModelCore::Loaded {
-  std::shared_ptr<const sgal::Scene> description;  // as loaded (rewind rebuilds from it)
-  std::string source;
-  std::string name;                                 // id prefix
-  std::unique_ptr<sgal::PhysicsScene> physics;
-  std::shared_ptr<daq::SceneSampler> sampler;
-  std::map<std::string, double> commands;           // last command per actuator
-};
 
 ModelCore::ModelCore(physics_bullet::Options options, Limits limits, PhysicsFactory factory)
     : options_(options), limits_(limits), factory_(std::move(factory)) {}
@@ -67,6 +59,7 @@ std::unique_ptr<sgal::PhysicsScene> ModelCore::MakePhysics(const sgal::Scene& sc
 ModelCore::~ModelCore() {
   // the channels refer to the scene: remove them first
   const auto lock = Lock();
+  EndRecordingLocked("the Model is shutting down");
   registry_.Clear();
 }
 
@@ -202,11 +195,13 @@ void ModelCore::LoadData(const std::string& file_name, const std::string& bytes)
 }
 
 std::string ModelCore::ExportBytes() {
-  core::ScratchDirectory scratch("caliper-scene");
-  const std::string path = scratch.path() + "/scene.dae";
-  Save(path);
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  sgal::Scene current;
+  {
+    const auto lock = Lock();
+    Require(true);
+    current = loaded_->physics->description();  // with the parameters tuned while running
+  }
+  return ColladaBytesOf(current);
 }
 
 RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::string& file_name,
@@ -238,6 +233,8 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   loaded->physics = MakePhysics(*scene);
   std::unique_lock<std::mutex> lock(mutex_);
   if (loaded_) loaded_->commands.clear();
+  EndRecordingLocked("an experiment was run");
+  replay_.reset();
   BuildLocked(std::move(loaded));
   undo_.clear();
   redo_.clear();
@@ -348,6 +345,8 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   loaded->physics = MakePhysics(scene);
   const auto lock = Lock();
   RequireIdle();  // again: an experiment may have begun while this scene was built
+  EndRecordingLocked("another scene was loaded");
+  replay_.reset();
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
   last_error_.clear();
@@ -425,8 +424,12 @@ void ModelCore::Stop() {
     const auto lock = Lock();
     Require(true);
     if (!EndExperimentLocked("stop")) {
+      EndRecordingLocked("the simulation was stopped (rewound)");
       // a step request running sees the new scene generation and ends without another step
-      RewindLocked();
+      if (replay_)
+        RestoreReplayLocked(replay_->reader->header().first_step);  // the replay's start
+      else
+        RewindLocked();
       state_ = RunState::kStopped;
     }
   }
@@ -438,7 +441,11 @@ void ModelCore::Reset() {
   Require(true);
   RequireIdle();
   const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
-  RewindLocked();
+  EndRecordingLocked("the simulation was reset (rewound)");
+  if (replay_)
+    RestoreReplayLocked(replay_->reader->header().first_step);
+  else
+    RewindLocked();
   state_ = keep;
   // pacing and the achieved factor start again from the rewound time
   run_wall_start_ = Clock::now();
@@ -511,7 +518,9 @@ void ModelCore::SetTimeStep(double seconds) {
   const auto lock = Lock();
   Require(true);
   RequireIdle();
+  RequireNotReplaying("set_time_step");
   loaded_->physics->SetParameter("simulation.time_step", seconds);
+  RecordEventLocked("parameter", loaded_->name + ".simulation.time_step", {seconds});
 }
 
 void ModelCore::SetRealTimeFactor(double factor) {
@@ -548,12 +557,12 @@ void ModelCore::ApplyPendingLocked() {
   for (const auto& [name, value] : pending_commands_) {
     loaded_->physics->SetCommand(name, value);
     loaded_->commands[name] = value;
+    RecordEventLocked("command", name, {value});
   }
   pending_commands_.clear();
 }
 
 void ModelCore::StepLocked() {
-  sgal::PhysicsScene& physics = *loaded_->physics;
   // commands and parameter writes take effect at this step boundary, in the order they came
   // Any exception ends here, as a NaN does: the engine stays at the start of the failing step
   // (PhysicsScene::Step promises it) and the Model says FAULTED with the reason; nothing escapes
@@ -561,7 +570,8 @@ void ModelCore::StepLocked() {
   try {
     ApplyPendingLocked();
     ExpirePullLocked();
-    physics.Step();
+    BeforeStepLocked();  // a replayed edit may swap the engine: take it afterwards
+    loaded_->physics->Step();
   } catch (const sgal::SimulationFault& fault) {
     FaultLocked(fault.what());
     return;
@@ -574,10 +584,11 @@ void ModelCore::StepLocked() {
   }
   try {
     loaded_->sampler->Refresh();
-    recorder_.OnStep(physics.steps(), physics.time());
+    AfterStepLocked();
+    recorder_.OnStep(loaded_->physics->steps(), loaded_->physics->time());
     PublishLocked();
   } catch (const std::exception& e) {
-    FaultLocked(std::string("after step ") + std::to_string(physics.steps()) +
+    FaultLocked(std::string("after step ") + std::to_string(loaded_->physics->steps()) +
                 ", sampling or publishing failed: " + e.what());
   }
 }
@@ -674,6 +685,7 @@ void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& c
   const auto lock = Lock();
   Require(true);
   RequireNoExperiment();
+  RequireNotReplaying("motor commands");
   if (commands.size() > limits_.ids_per_call)
     throw InvalidValue(std::to_string(commands.size()) + " commands in one call; at most " +
                        std::to_string(limits_.ids_per_call));
@@ -752,6 +764,7 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
   const auto lock = Lock();
   Require(true);
   RequireNoExperiment();
+  RequireNotReplaying("set");
   if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
   const daq::ChannelInfo& info = registry_.Info(id);
   if (!info.writable) throw InvalidValue(id + ": read-only (a state of the simulation)");
@@ -769,6 +782,7 @@ void ModelCore::SetChannel(const std::string& id, const std::vector<double>& val
   } catch (const daq::InvalidValue& e) {
     throw InvalidValue(e.what());
   }
+  RecordEventLocked("parameter", id, values);
   loaded_->sampler->Refresh();
 }
 
@@ -1025,6 +1039,7 @@ ModelCore::EditStatus ModelCore::ApplyEdit(const Rebuild& rebuild) {
       const auto lock = Lock();
       Require(true);
       RequireNoExperiment();
+      RequireNotReplaying("edit");
       old_base = loaded_->description;
       current = loaded_->physics->description();
       generation = generation_;
@@ -1123,6 +1138,15 @@ void ModelCore::SwapEditedLocked(std::shared_ptr<const sgal::Scene> base,
   }
   ++edit_revision_;
   last_edit_ = what;
+  if (recorder_session_) {
+    // the edited scene from this step on, and a keyframe of the engine built from it
+    Recorder& r = *recorder_session_;
+    r.writer->AddScene({++r.scene_version, loaded_->physics->steps(), loaded_->name + ".dae",
+                        ColladaBytesOf(loaded_->physics->description())});
+    RecordEventLocked("edit", what, {});
+    RecordKeyframeLocked();
+    ResolveRecordedChannelsLocked();
+  }
   const sgal::Scene& edited = *loaded_->description;
   // a selection of what the edit removed is gone; a selected path element that an insert or a
   // removal before it shifted keeps pointing at the same element
@@ -1219,6 +1243,7 @@ void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
   const auto lock = Lock();
   Require(true);
   RequireNoExperiment();
+  RequireNotReplaying("pull");
   const sgal::Scene& scene = loaded_->physics->description();
   const int index = scene.BodyIndex(body);
   if (index < 0) throw sgal::EditError("pull: no body '" + body + "'");
@@ -1250,8 +1275,13 @@ void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
   if (!pull_ || pull_->body != index)
     logging::Get("model").info("pull on %s at %.3f %.3f %.3f m (body frame), %.1f N/m",
                                body.c_str(), point.x(), point.y(), point.z(), pull.stiffness);
+  const bool changed = !pull_ || pull_->body != pull.body || pull_->point != pull.point ||
+                       pull_->target != pull.target || pull_->stiffness != pull.stiffness;
   pull_ = pull;
   pull_until_ = Clock::now() + limits_.pull_lease;
+  if (changed)  // a renewal of the same pull changes nothing in the simulation
+    RecordEventLocked("pull", body, {point.x(), point.y(), point.z(), target.x(), target.y(),
+                                     target.z(), pull.stiffness});
 }
 
 void ModelCore::ExpirePullLocked() {
@@ -1261,12 +1291,16 @@ void ModelCore::ExpirePullLocked() {
                                std::chrono::duration<double>(limits_.pull_lease).count());
   pull_.reset();
   loaded_->physics->ClearPull();
+  RecordEventLocked("release", "", {});
 }
 
 void ModelCore::ReleasePull() {
   const auto lock = Lock();
   if (!loaded_) return;
-  if (pull_) logging::Get("model").info("pull released");
+  if (pull_) {
+    logging::Get("model").info("pull released");
+    RecordEventLocked("release", "", {});
+  }
   pull_.reset();
   loaded_->physics->ClearPull();
 }

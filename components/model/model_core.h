@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "caliper/recording/recording.h"
 #include "caliper/sgal/edits.h"
 #include "caliper/daq/daq_scene.h"
 #include "caliper/daq/recorder.h"
@@ -226,6 +227,45 @@ class ModelCore {
   void Select(const std::string& kind, const std::string& name, uint32_t index);
   Selection selection() const;
 
+  // session recordings (libs/recording; idl/caliper/recording.idl has the meaning)
+  struct RecordOptions {
+    uint32_t keyframe_every = 100;       // steps between keyframes
+    uint32_t channels_every = 1;         // steps between samples of `channels`
+    std::vector<std::string> channels;   // ids sampled (none: keyframes and events only)
+    uint64_t max_bytes = 0;              // stop (as on a full disk) beyond this size; 0: none
+  };
+  struct RecordStatus {
+    bool recording = false;
+    std::string path;
+    uint64_t first_step = 0, steps = 0, bytes = 0;
+    std::string error;  // why the last recording stopped early ("" when it did not)
+  };
+  /// Records from the present step into a new file at `path` (the caller checks where it may
+  /// write): the scene as it runs, a keyframe now and every keyframe_every steps, every command,
+  /// parameter write, pull and edit with its step, the channels and the Model's log. A load,
+  /// stop or reset ends it. Throws NotAvailable (no scene, already recording, replaying),
+  /// UnknownId (a channel), InvalidValue (options), recording::RecordingError (the file).
+  RecordStatus StartRecording(const std::string& path, const RecordOptions& options);
+  RecordStatus StopRecording();
+  RecordStatus recording_status() const;
+  struct ReplayStatus {
+    bool replaying = false;
+    std::string path;
+    uint64_t first_step = 0, last_step = 0, step = 0;
+    double start_time = 0, end_time = 0, time = 0;  // [s]
+  };
+  /// Loads a recording to play it: its scene at its first keyframe, paused. Start, pause, step
+  /// and the real-time factor play it (re-simulating with its events, which reproduces it bit for
+  /// bit); it pauses at its end. Commands, parameter writes and edits are refused until Fork().
+  /// Throws LoadError or recording::RecordingError naming the file and why.
+  ReplayStatus OpenReplay(const std::string& path);
+  /// Goes to the step nearest `time_s` (clamped to the recording): its keyframe, then at most
+  /// keyframe_every - 1 steps.
+  ReplayStatus Seek(double time_s);
+  ReplayStatus replay_status() const;
+  /// Leaves the replay where it stands: the Model simulates on from there as any other.
+  void Fork();
+
   // scene and actuators
   std::shared_ptr<const sgal::Scene> description() const;  // nullptr when empty
   void Save(const std::string& path);
@@ -282,7 +322,14 @@ class ModelCore {
   std::string model_name() const;
 
  private:
-  struct Loaded;
+  struct Loaded {
+    std::shared_ptr<const sgal::Scene> description;  // as loaded (rewind rebuilds from it)
+    std::string source;
+    std::string name;                                 // id prefix
+    std::unique_ptr<sgal::PhysicsScene> physics;
+    std::shared_ptr<daq::SceneSampler> sampler;
+    std::map<std::string, double> commands;           // last command per actuator
+  };
   /// `edit`: the same scene edited (history, commands and step requests go on).
   void BuildLocked(std::unique_ptr<Loaded> loaded, bool edit = false);
   /// Changes copies of the scene as loaded and of the engine's (returning what it did), builds
@@ -295,6 +342,47 @@ class ModelCore {
   EditStatus EditStatusLocked() const;
   /// Ends a pull its client stopped renewing.
   void ExpirePullLocked();
+  // recording and replay (model_recording.cc)
+  struct Recorder {
+    std::unique_ptr<recording::Writer> writer;
+    RecordOptions options;
+    std::vector<std::pair<daq::Handle, size_t>> columns;  // handle, first value in a sample
+    std::vector<recording::Channel> writer_channels;       // as in the file's header
+    std::vector<std::pair<size_t, size_t>> missing;        // first value, count: gone (NaN)
+    size_t values = 0;
+    uint64_t first_step = 0;
+    uint64_t last_keyframe = UINT64_MAX;
+    uint32_t scene_version = 0;
+  };
+
+  struct Replay {
+    std::unique_ptr<recording::Reader> reader;
+    std::string path;
+    std::vector<recording::Event> events;          // all, in order
+    std::vector<recording::SceneVersion> scenes;
+    size_t next = 0;                               // the next event to apply
+    uint64_t last_reset = UINT64_MAX;              // the step caches were last reset at
+    uint32_t keyframe_every = 100;
+  };
+
+  void RecordEventLocked(const std::string& kind, const std::string& target,
+                         std::vector<double> values);
+  void RecordKeyframeLocked();
+  /// After an edit: the recorded channels' handles again (the channels were registered anew).
+  void ResolveRecordedChannelsLocked();
+  /// Before a step: replayed events due, keyframes (recording) or cache resets (replay).
+  void BeforeStepLocked();
+  /// After a step: the channels' sample, the end of a replay.
+  void AfterStepLocked();
+  void EndRecordingLocked(const std::string& why);
+  void RequireNotReplaying(const char* what) const;
+  /// Rebuilds the replay's engine at keyframe `step` (its scene version, the parameter writes
+  /// before it, the pull then).
+  void RestoreReplayLocked(uint64_t step);
+  ReplayStatus ReplayStatusLocked() const;
+  std::unique_ptr<Recorder> recorder_session_;
+  std::unique_ptr<Replay> replay_;
+  std::string last_recording_error_;
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();
@@ -400,6 +488,9 @@ class ModelCore {
   double rate_sim_ = 0;
   double achieved_rtf_ = 0;
 };
+
+/// A scene as the bytes of a COLLADA file with Caliper's technique (exports, recordings).
+std::string ColladaBytesOf(const sgal::Scene& scene);
 
 /// `arm.v2` from `Arm V2!`: lower case, letters, digits, underscores.
 std::string IdSafe(const std::string& name);

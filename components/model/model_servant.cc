@@ -1275,4 +1275,100 @@ M::Selection* ModelServant::current_selection() {
   return out;
 }
 
+// ------------------------------------------------------------------------ recordings
+
+namespace {
+
+M::RecordStatus* ToIdl(const ModelCore::RecordStatus& s) {
+  auto* out = new M::RecordStatus;
+  out->recording = s.recording;
+  out->path = s.path.c_str();
+  out->first_step = s.first_step;
+  out->steps = s.steps;
+  out->bytes = s.bytes;
+  out->error = s.error.c_str();
+  return out;
+}
+
+M::ReplayStatus* ToIdl(const ModelCore::ReplayStatus& s) {
+  auto* out = new M::ReplayStatus;
+  out->replaying = s.replaying;
+  out->path = s.path.c_str();
+  out->first_step = s.first_step;
+  out->last_step = s.last_step;
+  out->step = s.step;
+  out->start_time = s.start_time;
+  out->end_time = s.end_time;
+  out->time = s.time;
+  return out;
+}
+
+}  // namespace
+
+M::RecordStatus* ModelServant::start_recording(const char* path, const M::RecordOptions& options) {
+  return Guard([&] {
+    // only into the write directory: a client must not make the Model write any file
+    std::string where;
+    try {
+      where = files_.write.Resolve(path, core::ConfinedPaths::Access::kWrite).string();
+    } catch (const std::exception& e) {
+      throw InvalidValue(std::string("start_recording: ") + e.what());
+    }
+    ModelCore::RecordOptions o;
+    o.keyframe_every = options.keyframe_every == 0 ? 100 : options.keyframe_every;
+    o.channels_every = options.channels_every == 0 ? 1 : options.channels_every;
+    o.channels = FromIdl(options.channels);
+    o.max_bytes = options.max_bytes;
+    try {
+      return ToIdl(core_.StartRecording(where, o));
+    } catch (const recording::RecordingError& e) {
+      throw InvalidValue(e.what());
+    }
+  });
+}
+
+M::RecordStatus* ModelServant::stop_recording() {
+  return Guard([&] { return ToIdl(core_.StopRecording()); });
+}
+
+M::RecordStatus* ModelServant::recording_status() {
+  return Guard([&] { return ToIdl(core_.recording_status()); });
+}
+
+M::ReplayStatus* ModelServant::open_replay(const char* path) {
+  return Guard([&] {
+    std::string where;
+    try {
+      where = files_.read.Resolve(path, core::ConfinedPaths::Access::kRead).string();
+    } catch (const std::exception& e) {
+      throw M::LoadFailed(rtc::BoundedReason(std::string("open_replay: ") + e.what()).c_str());
+    }
+    try {
+      return ToIdl(core_.OpenReplay(where));
+    } catch (const recording::RecordingError& e) {
+      throw M::LoadFailed(rtc::BoundedReason(e.what()).c_str());
+    } catch (const collada::ImportError& e) {
+      throw M::LoadFailed(rtc::BoundedReason(e.what()).c_str());
+    }
+  });
+}
+
+M::ReplayStatus* ModelServant::seek(CORBA::Double time) {
+  return Guard([&] {
+    try {
+      return ToIdl(core_.Seek(time));
+    } catch (const recording::RecordingError& e) {
+      throw NotAvailable(e.what());
+    }
+  });
+}
+
+M::ReplayStatus* ModelServant::replay_status() {
+  return Guard([&] { return ToIdl(core_.replay_status()); });
+}
+
+void ModelServant::fork() {
+  Guard([&] { core_.Fork(); });
+}
+
 }  // namespace caliper::model

@@ -254,6 +254,15 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   void release_pull() override;
   void select(const char* kind, const char* name, CORBA::ULong index) override;
   Caliper::Simulation::Selection* current_selection() override;
+  // SessionRecording
+  Caliper::Simulation::RecordStatus* start_recording(
+      const char* path, const Caliper::Simulation::RecordOptions& options) override;
+  Caliper::Simulation::RecordStatus* stop_recording() override;
+  Caliper::Simulation::RecordStatus* recording_status() override;
+  Caliper::Simulation::ReplayStatus* open_replay(const char* path) override;
+  Caliper::Simulation::ReplayStatus* seek(CORBA::Double time) override;
+  Caliper::Simulation::ReplayStatus* replay_status() override;
+  void fork() override;
 
  private:
   /// subscribe and subscribe_lossless.

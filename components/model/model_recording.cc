@@ -1,0 +1,440 @@
+// ModelCore's session recordings and replays (libs/recording). A recording holds the scene as it
+// runs, keyframes of the engine's exact state, and every event that changed the simulation with
+// the step it took effect at; replaying re-simulates from a keyframe with those events, which
+// gives the recorded run again bit for bit because keyframes also reset the engine's caches in
+// the recorded run (PhysicsScene::ResetCaches) exactly where the replay does.
+#include <log4cpp/AppenderSkeleton.hh>
+#include <log4cpp/Category.hh>
+#include <log4cpp/Priority.hh>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include "caliper/collada/exporter.h"
+#include "caliper/core/scratch_directory.h"
+#include "caliper/logging/log.h"
+#include "model_core.h"
+
+namespace caliper::model {
+
+namespace {
+
+// the Model's own log records, into the recording while one runs
+class RecordingAppender : public log4cpp::AppenderSkeleton {
+ public:
+  RecordingAppender() : log4cpp::AppenderSkeleton("caliper-recording") {}
+  void Attach(recording::Writer* writer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    writer_ = writer;
+  }
+  void close() override {}
+  bool requiresLayout() const override { return false; }
+  void setLayout(log4cpp::Layout*) override {}
+
+ protected:
+  void _append(const log4cpp::LoggingEvent& e) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (writer_ == nullptr) return;
+    recording::LogRecord r;
+    r.time = static_cast<double>(e.timeStamp.getSeconds()) + 1e-6 * e.timeStamp.getMicroSeconds();
+    r.priority = log4cpp::Priority::getPriorityName(e.priority);
+    r.category = e.categoryName;
+    r.component = "model";
+    r.message = e.message;
+    writer_->AddLog(r);
+  }
+
+ private:
+  std::mutex mutex_;
+  recording::Writer* writer_ = nullptr;
+};
+
+RecordingAppender& Appender() {
+  // lives as long as the process: log4cpp may still be inside it on another thread
+  static auto* appender = [] {
+    auto* a = new RecordingAppender;
+    log4cpp::Category::getInstance("caliper").addAppender(*a);
+    return a;
+  }();
+  return *appender;
+}
+
+}  // namespace
+
+std::string ColladaBytesOf(const sgal::Scene& scene) {
+  core::ScratchDirectory scratch("caliper-scene");
+  const std::string path = scratch.path() + "/scene.dae";
+  collada::Export(scene, path);
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void ModelCore::RequireNotReplaying(const char* what) const {
+  if (replay_)
+    throw NotAvailable(std::string(what) + ": the Model replays " + replay_->path +
+                       "; fork it first (caliper-ctl replay --fork) to change the simulation");
+}
+
+void ModelCore::RecordEventLocked(const std::string& kind, const std::string& target,
+                                  std::vector<double> values) {
+  if (!recorder_session_ || !loaded_) return;
+  recorder_session_->writer->AddEvent(
+      {loaded_->physics->steps(), kind, target, std::move(values)});
+}
+
+void ModelCore::RecordKeyframeLocked() {
+  Recorder& r = *recorder_session_;
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  recording::Keyframe k;
+  k.step = physics.steps();
+  k.time = physics.time();
+  k.scene_version = r.scene_version;
+  k.state = physics.SaveDynamicState();
+  r.writer->AddKeyframe(k);
+  // where the keyframe falls among the events of its step: a replay restoring it applies only
+  // the events after this mark
+  r.writer->AddEvent({k.step, "keyframe", "", {}});
+  physics.ResetCaches();  // as a replay restoring this keyframe will
+  r.last_keyframe = k.step;
+}
+
+void ModelCore::ResolveRecordedChannelsLocked() {
+  Recorder& r = *recorder_session_;
+  size_t offset = 0;
+  r.columns.clear();
+  r.missing.clear();
+  for (const auto& c : r.writer_channels) {
+    if (registry_.Contains(c.id)) {
+      r.columns.emplace_back(registry_.Resolve(c.id), offset);
+    } else {
+      // an edit removed it (its tendon): NaN from here on
+      r.missing.emplace_back(offset, static_cast<size_t>(c.rows) * c.cols);
+    }
+    offset += static_cast<size_t>(c.rows) * c.cols;
+  }
+}
+
+void ModelCore::EndRecordingLocked(const std::string& why) {
+  if (!recorder_session_) return;
+  Appender().Attach(nullptr);
+  const std::string path = recorder_session_->writer->path();
+  recorder_session_->writer->Flush();
+  last_recording_error_ = recorder_session_->writer->error();
+  recorder_session_.reset();  // commits and closes
+  logging::Get("model").notice("recording %s ended: %s", path.c_str(), why.c_str());
+}
+
+ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
+                                                  const RecordOptions& options) {
+  const auto lock = Lock();
+  Require(true);
+  RequireNoExperiment();
+  if (recorder_session_)
+    throw NotAvailable("already recording to " + recorder_session_->writer->path() +
+                       "; stop that first");
+  RequireNotReplaying("record");
+  if (options.keyframe_every < 1 || options.keyframe_every > 1000000)
+    throw InvalidValue("keyframe_every must be in [1, 1000000] steps");
+  if (!options.channels.empty() && options.channels_every < 1)
+    throw InvalidValue("channels_every must be at least 1 step");
+  auto r = std::make_unique<Recorder>();
+  r->options = options;
+  recording::Header header;
+  header.model_name = loaded_->name;
+  header.time_step = loaded_->physics->description().settings.time_step;
+  header.keyframe_every = options.keyframe_every;
+  header.channels_every = options.channels.empty() ? 0 : options.channels_every;
+  header.first_step = loaded_->physics->steps();
+  for (const auto& id : options.channels) {
+    if (!registry_.Contains(id)) throw UnknownId("record: unknown id '" + id + "'", id);
+    const daq::ChannelInfo& info = registry_.Info(id);
+    header.channels.push_back({id, info.unit, info.shape.rows, info.shape.cols});
+    r->columns.emplace_back(registry_.Resolve(id), r->values);
+    r->values += info.shape.size();
+  }
+  r->writer_channels = header.channels;
+  // the scene as the engine runs it (tuned parameters included), as a COLLADA file
+  recording::SceneVersion scene;
+  scene.version = 0;
+  scene.step = header.first_step;
+  scene.file_name = loaded_->name + ".dae";
+  scene.bytes = ColladaBytesOf(loaded_->physics->description());
+  header.scene_file_name = scene.file_name;
+  r->writer = std::make_unique<recording::Writer>(path, header, scene,
+                                                  std::chrono::milliseconds(500),
+                                                  options.max_bytes);
+  r->first_step = header.first_step;
+  recorder_session_ = std::move(r);
+  last_recording_error_.clear();
+  // the pull and the commands in force are part of the keyframe or recorded now
+  if (pull_)
+    RecordEventLocked("pull", loaded_->physics->description().bodies.at(pull_->body).name,
+                      {pull_->point.x(), pull_->point.y(), pull_->point.z(), pull_->target.x(),
+                       pull_->target.y(), pull_->target.z(), pull_->stiffness});
+  RecordKeyframeLocked();
+  Appender().Attach(recorder_session_->writer.get());
+  logging::Get("model").notice("recording to %s from step %llu (keyframes every %u steps, %zu "
+                               "channels)",
+                               path.c_str(), static_cast<unsigned long long>(header.first_step),
+                               options.keyframe_every, options.channels.size());
+  RecordStatus s;
+  s.recording = true;
+  s.path = path;
+  s.first_step = header.first_step;
+  return s;
+}
+
+ModelCore::RecordStatus ModelCore::StopRecording() {
+  const auto lock = Lock();
+  RecordStatus s;
+  if (!recorder_session_) {
+    s.error = last_recording_error_;
+    return s;
+  }
+  s.path = recorder_session_->writer->path();
+  s.first_step = recorder_session_->first_step;
+  s.steps = loaded_ ? loaded_->physics->steps() - s.first_step : 0;
+  EndRecordingLocked("stopped");
+  s.error = last_recording_error_;
+  return s;
+}
+
+ModelCore::RecordStatus ModelCore::recording_status() const {
+  const auto lock = Lock();
+  RecordStatus s;
+  s.error = last_recording_error_;
+  if (!recorder_session_) return s;
+  s.recording = recorder_session_->writer->error().empty();
+  s.path = recorder_session_->writer->path();
+  s.first_step = recorder_session_->first_step;
+  s.steps = loaded_ ? loaded_->physics->steps() - s.first_step : 0;
+  s.bytes = recorder_session_->writer->bytes_written();
+  if (!s.recording) s.error = recorder_session_->writer->error();
+  return s;
+}
+
+void ModelCore::BeforeStepLocked() {
+  sgal::PhysicsScene& physics = *loaded_->physics;
+  const uint64_t step = physics.steps();
+  if (recorder_session_) {
+    Recorder& r = *recorder_session_;
+    if (!r.writer->error().empty()) {
+      // a full disk or a vanished file: the recording ends, the simulation goes on
+      logging::Get("model").error("%s", r.writer->error().c_str());
+      EndRecordingLocked("write failed");
+      return;
+    }
+    if (step % r.options.keyframe_every == 0 && step != r.last_keyframe) RecordKeyframeLocked();
+  }
+  if (replay_) {
+    Replay& p = *replay_;
+    for (; p.next < p.events.size() && p.events[p.next].step <= step; ++p.next) {
+      const recording::Event& e = p.events[p.next];
+      if (e.kind == "keyframe") continue;
+      if (e.kind == "command") {
+        physics.SetCommand(e.target, e.values.at(0));
+        loaded_->commands[e.target] = e.values.at(0);
+      } else if (e.kind == "parameter") {
+        registry_.Set(e.target, e.values);
+      } else if (e.kind == "pull") {
+        sgal::Pull pull;
+        pull.body = physics.description().BodyIndex(e.target);
+        pull.point = {e.values.at(0), e.values.at(1), e.values.at(2)};
+        pull.target = {e.values.at(3), e.values.at(4), e.values.at(5)};
+        pull.stiffness = e.values.at(6);
+        pull.damping = 2 * std::sqrt(pull.stiffness *
+                                     physics.description().bodies.at(pull.body).inertia.mass);
+        physics.SetPull(pull);
+      } else if (e.kind == "release") {
+        physics.ClearPull();
+      } else if (e.kind == "edit") {
+        // the edited scene and its keyframe at this step
+        RestoreReplayLocked(step);
+        BeforeStepLocked();  // the events after that keyframe's mark
+        return;
+      }
+    }
+    if (step % p.keyframe_every == 0 && step != p.last_reset) {
+      loaded_->physics->ResetCaches();
+      p.last_reset = step;
+    }
+  }
+}
+
+void ModelCore::AfterStepLocked() {
+  if (recorder_session_ && recorder_session_->values > 0) {
+    Recorder& r = *recorder_session_;
+    const uint64_t step = loaded_->physics->steps();
+    if ((step - r.first_step) % r.options.channels_every == 0) {
+      recording::Sample sample;
+      sample.step = step;
+      sample.time = loaded_->physics->time();
+      sample.values.resize(r.values);
+      for (const auto& [handle, offset] : r.columns) registry_.Read(handle, &sample.values[offset]);
+      for (const auto& [offset, count] : r.missing)
+        std::fill_n(sample.values.begin() + static_cast<long>(offset), count,
+                    std::numeric_limits<double>::quiet_NaN());
+      r.writer->AddSample(std::move(sample));
+    }
+  }
+  if (replay_ && loaded_->physics->steps() >= replay_->reader->last_step() &&
+      state_ == RunState::kRunning) {
+    state_ = RunState::kPaused;  // the end of the recording
+    logging::Get("model").notice("replay of %s: at its end (t = %.3f s)", replay_->path.c_str(),
+                                 loaded_->physics->time());
+  }
+}
+
+void ModelCore::RestoreReplayLocked(uint64_t step) {
+  Replay& p = *replay_;
+  const recording::Keyframe k = p.reader->KeyframeAtOrBefore(step);
+  const recording::SceneVersion* version = nullptr;
+  for (const auto& v : p.scenes)
+    if (v.version == k.scene_version) version = &v;
+  if (version == nullptr)
+    throw recording::RecordingError(p.path + ": keyframe at step " + std::to_string(k.step) +
+                                    " names scene version " + std::to_string(k.scene_version) +
+                                    ", which the file lacks");
+  sgal::Scene scene = ImportBytes(version->file_name, version->bytes);
+  auto loaded = std::make_unique<Loaded>();
+  loaded->description = std::make_shared<const sgal::Scene>(scene);
+  loaded->source = p.path + " (replay)";
+  loaded->name = p.reader->header().model_name;
+  loaded->physics = MakePhysics(scene);
+  // as an edit does: a step request playing on goes on across a replayed edit
+  BuildLocked(std::move(loaded), /*edit=*/true);
+  // the keyframe's mark among the events: what came before it is in the keyframe's state or
+  // (parameter writes, the pull) applied here; what came after is applied by the steps
+  size_t mark = 0;
+  bool marked = false;
+  for (size_t i = 0; i < p.events.size(); ++i)
+    if (p.events[i].kind == "keyframe" && p.events[i].step == k.step) {
+      mark = i;
+      marked = true;
+    }
+  if (!marked)
+    throw recording::RecordingError(p.path + ": the keyframe at step " + std::to_string(k.step) +
+                                    " has no mark among the events (a damaged file)");
+  // parameter writes since the scene version began are not in a keyframe: apply them first
+  for (size_t i = 0; i < mark; ++i) {
+    const auto& e = p.events[i];
+    if (e.kind == "parameter" && e.step >= version->step) registry_.Set(e.target, e.values);
+  }
+  try {
+    loaded_->physics->RestoreDynamicState(k.state);
+  } catch (const std::exception& e) {
+    throw recording::RecordingError(
+        p.path + ": the keyframe at step " + std::to_string(k.step) + " does not fit its scene " +
+        "(a recording of another scene version or another Caliper build): " + e.what());
+  }
+  // the pull in force then
+  const recording::Event* pull = nullptr;
+  for (size_t i = 0; i < mark; ++i) {
+    const auto& e = p.events[i];
+    if ((e.kind == "pull" || e.kind == "release") && e.step >= version->step) pull = &e;
+  }
+  if (pull != nullptr && pull->kind == "pull") {
+    sgal::Pull x;
+    x.body = scene.BodyIndex(pull->target);
+    x.point = {pull->values.at(0), pull->values.at(1), pull->values.at(2)};
+    x.target = {pull->values.at(3), pull->values.at(4), pull->values.at(5)};
+    x.stiffness = pull->values.at(6);
+    x.damping = 2 * std::sqrt(x.stiffness * scene.bodies.at(x.body).inertia.mass);
+    loaded_->physics->SetPull(x);
+  }
+  loaded_->physics->ResetCaches();
+  p.last_reset = k.step;
+  p.next = mark + 1;
+  loaded_->sampler->Refresh();
+  PublishLocked();
+}
+
+ModelCore::ReplayStatus ModelCore::ReplayStatusLocked() const {
+  ReplayStatus s;
+  if (!replay_) return s;
+  const recording::Header& h = replay_->reader->header();
+  s.replaying = true;
+  s.path = replay_->path;
+  s.first_step = h.first_step;
+  s.last_step = replay_->reader->last_step();
+  s.step = loaded_ ? loaded_->physics->steps() : 0;
+  s.start_time = replay_->reader->KeyframeAtOrBefore(h.first_step).time;
+  s.end_time = s.start_time + (s.last_step - s.first_step) * h.time_step;
+  s.time = loaded_ ? loaded_->physics->time() : 0;
+  return s;
+}
+
+ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
+  auto replay = std::make_unique<Replay>();
+  replay->reader = std::make_unique<recording::Reader>(path);
+  replay->path = path;
+  const uint64_t last = replay->reader->last_step();
+  replay->events = replay->reader->Events(0, last + 1);
+  replay->scenes = replay->reader->scenes();
+  replay->keyframe_every = replay->reader->header().keyframe_every;
+  const auto lock = Lock();
+  RequireIdle();
+  if (recorder_session_) EndRecordingLocked("a replay was opened");
+  std::unique_ptr<Replay> previous = std::move(replay_);
+  replay_ = std::move(replay);
+  try {
+    RestoreReplayLocked(replay_->reader->header().first_step);
+  } catch (...) {
+    replay_ = std::move(previous);
+    throw;
+  }
+  undo_.clear();
+  redo_.clear();
+  state_ = RunState::kPaused;
+  last_error_.clear();
+  logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(),
+                               replay_->reader->duration(),
+                               replay_->reader->header().model_name.c_str());
+  return ReplayStatusLocked();
+}
+
+ModelCore::ReplayStatus ModelCore::Seek(double time_s) {
+  auto lock = Lock();
+  if (!replay_) throw NotAvailable("seek: no replay is open (caliper-ctl replay FILE)");
+  RequireIdle();
+  if (!std::isfinite(time_s)) throw InvalidValue("seek: the time is not finite");
+  const ReplayStatus now = ReplayStatusLocked();
+  const double dt = replay_->reader->header().time_step;
+  const double clamped = std::min(std::max(time_s, now.start_time), now.end_time);
+  const uint64_t target =
+      now.first_step + static_cast<uint64_t>(std::llround((clamped - now.start_time) / dt));
+  const RunState keep = state_;
+  // from the current state when the target lies ahead within a keyframe interval, else from the
+  // keyframe at or before it
+  const uint64_t at = loaded_->physics->steps();
+  const uint64_t keyframe = replay_->reader->KeyframeAtOrBefore(target).step;
+  if (!(target >= at && keyframe <= at)) RestoreReplayLocked(target);
+  while (loaded_->physics->steps() < target && state_ != RunState::kFaulted) StepLocked();
+  state_ = keep == RunState::kRunning ? RunState::kRunning : RunState::kPaused;
+  run_wall_start_ = std::chrono::steady_clock::now();
+  run_sim_start_ = loaded_->physics->time();
+  return ReplayStatusLocked();
+}
+
+ModelCore::ReplayStatus ModelCore::replay_status() const {
+  const auto lock = Lock();
+  return ReplayStatusLocked();
+}
+
+void ModelCore::Fork() {
+  const auto lock = Lock();
+  if (!replay_) throw NotAvailable("fork: no replay is open");
+  const std::string path = replay_->path;
+  loaded_->source = path + " (forked at t = " + std::to_string(loaded_->physics->time()) + " s)";
+  replay_.reset();
+  loaded_->physics->ClearPull();  // a replayed pull ends: its client was the recording
+  if (state_ == RunState::kRunning) state_ = RunState::kPaused;
+  logging::Get("model").notice("forked from %s at t = %.3f s: simulating on", path.c_str(),
+                               loaded_->physics->time());
+}
+
+}  // namespace caliper::model

@@ -1,0 +1,194 @@
+// Session recordings on ModelCore, without CORBA: a session with commands, parameter writes, a
+// pull and a scene edit recorded; replayed, it gives every keyframe again bit for bit and the
+// recorded channels equal; seeking back and forth lands on the same states; a fork from a middle
+// keyframe goes on as the uninterrupted run did; a damaged scene version is refused saying so.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <fstream>
+#include <iterator>
+#include <sqlite3.h>
+#include <vector>
+
+#include "caliper/core/scratch_directory.h"
+#include "caliper/recording/recording.h"
+#include "caliper/sgal/edits.h"
+#include "model_core.h"
+
+namespace caliper::model {
+namespace {
+
+std::string Model(const std::string& file) {
+  const char* src = std::getenv("CALIPER_SOURCE_DIR");
+  return std::string(src ? src : ".") + "/models/" + file;
+}
+
+std::vector<double> Read(ModelCore& core, const std::string& id) {
+  return core.Sample({id}).at(0).values;
+}
+
+constexpr const char* kHand = "ecce_arm.hand.position";
+constexpr const char* kTension = "ecce_arm.elbow_flexor.tendon.tension";
+
+// 1.2 s of the arm: motors driven and changed, a tuned stiffness, a pull and its release, a
+// via point moved; the hand's position at every step of the run
+struct Session {
+  std::vector<std::vector<double>> hand;  // after each step from the recording's start
+  std::vector<double> hand_at_599;
+};
+
+Session RecordSession(ModelCore& core, const std::string& file) {
+  Session s;
+  core.Load(Model("ecce_arm.dae"));
+  core.StepNow(37);  // the recording starts between keyframes
+  ModelCore::RecordOptions options;
+  options.keyframe_every = 100;
+  options.channels = {kHand, kTension};
+  core.StartRecording(file, options);
+  auto run = [&](int n) {
+    for (int i = 0; i < n; ++i) {
+      core.StepNow(1);
+      s.hand.push_back(Read(core, kHand));
+    }
+  };
+  core.SetCommands({{"elbow_flexor", 6.0}});
+  run(150);
+  core.SetChannel("ecce_arm.elbow_flexor.stiffness", {4000});
+  core.SetCommands({{"shoulder_flexor", 4.0}, {"elbow_flexor", 2.0}});
+  run(200);
+  const auto hand = Read(core, kHand);
+  core.Pull("hand", Eigen::Vector3d::Zero(), {hand[0] + 0.2, hand[1], hand[2] + 0.1}, 0);
+  run(150);
+  core.ReleasePull();
+  run(62);
+  s.hand_at_599 = Read(core, kHand);
+  run(1);  // step 600 of the session (37 + 563)
+  sgal::PathElement via;
+  via.body = "upper_arm";
+  via.position = {0.02, 0, -0.1};
+  core.Edit([&](const sgal::Scene& sc) { return sgal::InsertPathPoint(sc, "elbow_flexor", 1, via); });
+  run(400);
+  core.StopRecording();
+  return s;
+}
+
+class ModelRecording : public ::testing::Test {
+ protected:
+  core::ScratchDirectory dir_{"model-recording"};
+  std::string file_ = dir_.path() + "/session.calrec";
+};
+
+TEST_F(ModelRecording, ReplayGivesEveryKeyframeAndChannelBackBitForBit) {
+  ModelCore live;
+  const Session session = RecordSession(live, file_);
+  recording::Reader reader(file_);
+  EXPECT_EQ(reader.header().first_step, 37u);
+  EXPECT_EQ(reader.last_step(), 37u + 963u);
+  const auto keyframes = reader.keyframe_steps();
+  ASSERT_GE(keyframes.size(), 10u);  // 37, 100, ..., 900 and the edit's
+  const auto samples = reader.Samples(0, reader.last_step() + 1);
+  ASSERT_EQ(samples.size(), 963u);
+
+  ModelCore replay;
+  auto status = replay.OpenReplay(file_);
+  EXPECT_TRUE(status.replaying);
+  EXPECT_EQ(status.step, 37u);
+  // commands and edits are refused while replaying
+  EXPECT_THROW(replay.SetCommands({{"elbow_flexor", 1.0}}), NotAvailable);
+  size_t identical = 0, compared = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    replay.StepNow(1);
+    const auto hand = Read(replay, kHand);
+    EXPECT_EQ(hand, session.hand[i]) << "step " << samples[i].step;
+    const std::vector<double> recorded(samples[i].values.begin(), samples[i].values.begin() + 3);
+    EXPECT_EQ(hand, recorded) << "step " << samples[i].step;
+    ++compared;
+    if (hand == session.hand[i]) ++identical;
+    if (HasFailure()) break;
+  }
+  EXPECT_EQ(identical, compared);
+  // it pauses at its end
+  EXPECT_EQ(replay.replay_status().step, reader.last_step());
+}
+
+TEST_F(ModelRecording, SeekingBackAndForthLandsOnTheRecordedStates) {
+  ModelCore live;
+  const Session session = RecordSession(live, file_);
+  ModelCore replay;
+  const auto opened = replay.OpenReplay(file_);
+  const double dt = 0.001;
+  // (at step 600 the edit took place: seeking there gives the state after it)
+  for (const uint64_t step : {650u, 120u, 999u, 599u, 38u, 601u, 599u}) {
+    const auto status = replay.Seek(opened.start_time + (step - 37) * dt);
+    ASSERT_EQ(status.step, step);
+    EXPECT_EQ(Read(replay, kHand), session.hand[step - 38]) << "after seeking to step " << step;
+  }
+  EXPECT_EQ(Read(replay, kHand), session.hand_at_599);
+}
+
+TEST_F(ModelRecording, AForkFromAMiddleKeyframeGoesOnAsTheUninterruptedRun) {
+  ModelCore live;
+  const Session session = RecordSession(live, file_);
+  ModelCore fork;
+  const auto opened = fork.OpenReplay(file_);
+  fork.Seek(opened.start_time + (300 - 37) * 0.001);  // a keyframe in the middle
+  fork.Fork();
+  EXPECT_FALSE(fork.replay_status().replaying);
+  // no event from here until the pull at step 387: the fork goes on as the live run did
+  fork.StepNow(80);
+  EXPECT_EQ(Read(fork, kHand), session.hand[380 - 38]);
+  // and after the fork the Model takes commands again
+  EXPECT_NO_THROW(fork.SetCommands({{"elbow_flexor", 1.0}}));
+}
+
+TEST_F(ModelRecording, AChangedSceneVersionIsRefusedSayingSo) {
+  ModelCore live;
+  RecordSession(live, file_);
+  // the recording's scene replaced by another model's (a file edited behind its back): its
+  // keyframes do not fit it
+  std::ifstream in(Model("pendulum_tendon.dae"), std::ios::binary);
+  const std::string other((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file_.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* update = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "UPDATE scenes SET data = ? WHERE version = 0", -1, &update,
+                               nullptr),
+            SQLITE_OK);
+  sqlite3_bind_blob(update, 1, other.data(), static_cast<int>(other.size()), SQLITE_TRANSIENT);
+  EXPECT_EQ(sqlite3_step(update), SQLITE_DONE);
+  sqlite3_finalize(update);
+  sqlite3_close(db);
+  ModelCore replay;
+  try {
+    replay.OpenReplay(file_);
+    ADD_FAILURE() << "a recording whose scene changed was replayed";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(file_), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not fit its scene"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ModelRecording, AFullDiskEndsTheRecordingAndTheSimulationGoesOn) {
+  ModelCore core;
+  core.Load(Model("ecce_arm.dae"));
+  ModelCore::RecordOptions options;
+  options.channels = {kHand, kTension};
+  options.max_bytes = 1024 * 1024;  // the scene's 0.2 MB and some seconds of samples
+  core.StartRecording(file_, options);
+  for (int i = 0; i < 40 && core.recording_status().recording; ++i) {
+    core.StepNow(500);
+    std::this_thread::sleep_for(std::chrono::milliseconds(120));  // commits
+  }
+  const auto status = core.recording_status();
+  EXPECT_FALSE(status.recording);
+  EXPECT_NE(status.error.find("full"), std::string::npos) << status.error;
+  EXPECT_EQ(core.StepNow(100), 100u);  // the simulation goes on
+  EXPECT_EQ(core.status().state, RunState::kPaused);
+  recording::Reader reader(file_);  // what was committed opens
+  EXPECT_GT(reader.last_step(), 0u);
+}
+
+}  // namespace
+}  // namespace caliper::model
