@@ -265,6 +265,8 @@ class ModelCore {
   ReplayStatus replay_status() const;
   /// Leaves the replay where it stands: the Model simulates on from there as any other.
   void Fork();
+  /// The engine's dynamic state now (exact numbers included).
+  sgal::DynamicState dynamic_state() const;
 
   // scene and actuators
   std::shared_ptr<const sgal::Scene> description() const;  // nullptr when empty
@@ -491,6 +493,21 @@ class ModelCore {
 
 /// A scene as the bytes of a COLLADA file with Caliper's technique (exports, recordings).
 std::string ColladaBytesOf(const sgal::Scene& scene);
+
+/// What re-simulating a recording from its start with its events gave.
+struct Verification {
+  uint64_t steps = 0;          // re-simulated
+  uint64_t keyframes = 0;      // compared bit for bit
+  uint64_t samples = 0;        // channel samples compared bit for bit
+  bool identical = true;
+  uint64_t divergent_step = 0;  // the first step that differs (when not identical)
+  std::string detail;           // what differs there, and by how much
+};
+/// Replays `path` in a Model of its own and compares every keyframe and channel sample with the
+/// recorded bits; stops at the first divergence. `progress` is told the step now and the last.
+/// Throws recording::RecordingError (or the scene's import error) for a file it cannot replay.
+Verification VerifyRecording(const std::string& path,
+                             const std::function<void(uint64_t, uint64_t)>& progress = nullptr);
 
 /// `arm.v2` from `Arm V2!`: lower case, letters, digits, underscores.
 std::string IdSafe(const std::string& name);

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <set>
 #include <limits>
 #include <cmath>
 #include <fstream>
@@ -435,6 +437,128 @@ void ModelCore::Fork() {
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
   logging::Get("model").notice("forked from %s at t = %.3f s: simulating on", path.c_str(),
                                loaded_->physics->time());
+}
+
+sgal::DynamicState ModelCore::dynamic_state() const {
+  const auto lock = Lock();
+  Require(true);
+  return loaded_->physics->SaveDynamicState();
+}
+
+namespace {
+
+// bitwise, NaN equal to NaN
+bool Same(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+std::string Number(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  return text;
+}
+
+// the first difference between two states, named (empty when there is none)
+std::string Difference(const sgal::DynamicState& got, const sgal::DynamicState& recorded,
+                       const sgal::Scene& scene) {
+  if (!Same(got.time, recorded.time))
+    return "time " + Number(got.time) + " s, recorded " + Number(recorded.time) + " s";
+  if (got.engine.size() != recorded.engine.size())
+    return "the engine state has " + std::to_string(got.engine.size()) + " values, recorded " +
+           std::to_string(recorded.engine.size());
+  constexpr size_t kPerBody = 36;  // two transforms, four velocities (BulletScene)
+  static const char* const kParts[] = {"orientation", "orientation", "orientation",
+                                       "orientation", "orientation", "orientation",
+                                       "orientation", "orientation", "orientation",
+                                       "position",    "position",    "position"};
+  for (size_t i = 0; i < got.engine.size(); ++i) {
+    if (Same(got.engine[i], recorded.engine[i])) continue;
+    std::string what = "engine value " + std::to_string(i);
+    if (i < scene.bodies.size() * kPerBody) {
+      const size_t k = i % kPerBody;
+      const std::string part = k < 12    ? kParts[k]
+                               : k < 24  ? "interpolation transform"
+                               : k < 27  ? "linear velocity"
+                               : k < 30  ? "angular velocity"
+                                         : "interpolation velocity";
+      what = "body '" + scene.bodies[i / kPerBody].name + "' " + part;
+    }
+    return what + ": " + Number(got.engine[i]) + ", recorded " + Number(recorded.engine[i]) +
+           " (differs by " + Number(got.engine[i] - recorded.engine[i]) + ")";
+  }
+  for (size_t a = 0; a < got.actuators.size() && a < recorded.actuators.size(); ++a)
+    for (size_t k = 0; k < got.actuators[a].size() && k < recorded.actuators[a].size(); ++k)
+      if (!Same(got.actuators[a][k], recorded.actuators[a][k]))
+        return "actuator '" + (a < scene.actuators.size() ? scene.actuators[a].name : "?") +
+               "' state value " + std::to_string(k) + ": " + Number(got.actuators[a][k]) +
+               ", recorded " + Number(recorded.actuators[a][k]);
+  for (size_t j = 0; j < got.joint_positions.size() && j < recorded.joint_positions.size(); ++j)
+    if (!Same(got.joint_positions[j], recorded.joint_positions[j]))
+      return "joint '" + scene.constraints.at(j).name + "' position " +
+             Number(got.joint_positions[j]) + ", recorded " + Number(recorded.joint_positions[j]);
+  return "";
+}
+
+}  // namespace
+
+Verification VerifyRecording(const std::string& path,
+                             const std::function<void(uint64_t, uint64_t)>& progress) {
+  Verification v;
+  recording::Reader reader(path);
+  const recording::Header& h = reader.header();
+  const uint64_t last = reader.last_step();
+  std::vector<std::string> ids;
+  for (const auto& c : h.channels) ids.push_back(c.id);
+  std::set<uint64_t> keyframes;
+  for (uint64_t k : reader.keyframe_steps()) keyframes.insert(k);
+  std::set<uint64_t> edits;  // their keyframes hold the state after the edit: compared after it
+  for (const auto& e : reader.Events(0, last + 1))
+    if (e.kind == "edit") edits.insert(e.step);
+  ModelCore core;
+  core.OpenReplay(path);
+  uint64_t step = h.first_step;
+  const uint64_t chunk = 1000;
+  for (uint64_t from = step; from < last; from += chunk) {
+    const std::vector<recording::Sample> samples = reader.Samples(from + 1, std::min(last, from + chunk) + 1);
+    size_t next_sample = 0;
+    while (step < std::min(last, from + chunk)) {
+      if (core.StepNow(1) != 1)
+        throw recording::RecordingError(path + ": the replay faulted at step " +
+                                        std::to_string(step + 1) + ": " + core.status().last_error);
+      ++step;
+      ++v.steps;
+      if (keyframes.count(step) != 0 && edits.count(step) == 0) {
+        const recording::Keyframe k = reader.KeyframeAtOrBefore(step);
+        const std::shared_ptr<const sgal::Scene> scene = core.description();
+        const std::string diff = Difference(core.dynamic_state(), k.state, *scene);
+        ++v.keyframes;
+        if (!diff.empty()) {
+          v.identical = false;
+          v.divergent_step = step;
+          v.detail = "keyframe at step " + std::to_string(step) + " (t = " + Number(k.time) +
+                     " s): " + diff;
+          return v;
+        }
+      }
+      while (next_sample < samples.size() && samples[next_sample].step < step) ++next_sample;
+      if (next_sample < samples.size() && samples[next_sample].step == step && !ids.empty()) {
+        std::vector<double> now;
+        for (const auto& reading : core.Sample(ids))
+          now.insert(now.end(), reading.values.begin(), reading.values.end());
+        const auto& recorded = samples[next_sample].values;
+        ++v.samples;
+        for (size_t i = 0; i < now.size() && i < recorded.size(); ++i)
+          if (!Same(now[i], recorded[i])) {
+            v.identical = false;
+            v.divergent_step = step;
+            v.detail = "channel value " + std::to_string(i) + " at step " + std::to_string(step) +
+                       ": " + Number(now[i]) + ", recorded " + Number(recorded[i]);
+            return v;
+          }
+      }
+      if (progress && step % 1000 == 0) progress(step, last);
+    }
+  }
+  if (progress) progress(step, last);
+  return v;
 }
 
 }  // namespace caliper::model

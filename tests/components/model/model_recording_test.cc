@@ -4,6 +4,7 @@
 // keyframe goes on as the uninterrupted run did; a damaged scene version is refused saying so.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <thread>
@@ -111,6 +112,38 @@ TEST_F(ModelRecording, ReplayGivesEveryKeyframeAndChannelBackBitForBit) {
   EXPECT_EQ(identical, compared);
   // it pauses at its end
   EXPECT_EQ(replay.replay_status().step, reader.last_step());
+}
+
+TEST_F(ModelRecording, VerifyFindsItIdenticalAndNamesTheFirstDivergence) {
+  ModelCore live;
+  RecordSession(live, file_);
+  uint64_t told = 0;
+  const Verification v = VerifyRecording(file_, [&](uint64_t step, uint64_t) { told = step; });
+  EXPECT_TRUE(v.identical) << v.detail;
+  EXPECT_EQ(v.steps, 963u);
+  EXPECT_EQ(v.keyframes, 8u);  // 100 ... 900 but 600, where the edit's keyframe restarts the replay
+  EXPECT_EQ(v.samples, 963u);
+  EXPECT_EQ(told, 1000u);
+  // a keyframe changed in its last bit: the first divergence is named there
+  recording::Reader reader(file_);
+  recording::Keyframe k = reader.KeyframeAtOrBefore(500);
+  ASSERT_EQ(k.step, 500u);
+  k.state.engine[36 * 5 + 9] = std::nextafter(k.state.engine[36 * 5 + 9], 1e9);  // hand x
+  const std::string bytes = recording::EncodeState(k.state);
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file_.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* update = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "UPDATE keyframes SET state = ? WHERE step = 500", -1, &update,
+                               nullptr),
+            SQLITE_OK);
+  sqlite3_bind_blob(update, 1, bytes.data(), static_cast<int>(bytes.size()), SQLITE_TRANSIENT);
+  EXPECT_EQ(sqlite3_step(update), SQLITE_DONE);
+  sqlite3_finalize(update);
+  sqlite3_close(db);
+  const Verification damaged = VerifyRecording(file_);
+  EXPECT_FALSE(damaged.identical);
+  EXPECT_EQ(damaged.divergent_step, 500u);
+  EXPECT_NE(damaged.detail.find("body 'hand' position"), std::string::npos) << damaged.detail;
 }
 
 TEST_F(ModelRecording, SeekingBackAndForthLandsOnTheRecordedStates) {
