@@ -6,6 +6,10 @@
 //            of the run the stepping waited for the taker)
 //   RATIO lossless_overhead_SCENE  lossless / plain subscription when the taker keeps up (the
 //            plain one dropped nothing): the cost of the check before each step
+// Session recordings (issue #14): the shipped arm at 1 kHz, keyframes every 100 steps, stepping
+// 5 s of simulated time with and without a recording (and with 10 channels sampled each step):
+//   RATIO record_overhead  recording / not recording, us per step (target <= 1.05)
+//   bytes per simulated minute of the file, with and without channels
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -15,6 +19,9 @@
 #include <thread>
 #include <vector>
 
+#include <filesystem>
+
+#include "caliper/core/scratch_directory.h"
 #include "model_core.h"
 
 namespace {
@@ -90,9 +97,67 @@ std::vector<Run> Measure(const std::string& scene, const std::vector<std::string
 
 }  // namespace
 
+/// us per step of `steps` of `scene`, recording (with `channels` sampled) or not; the file's
+/// size [bytes] in *bytes.
+double Recorded(const std::string& scene, uint64_t steps, int record,
+                const std::vector<std::string>& channels, uint64_t* bytes) {
+  ModelCore core;
+  core.Load(scene);
+  caliper::core::ScratchDirectory dir("recording-bench");
+  const std::string file = dir.path() + "/run.caliper";
+  if (record) {
+    ModelCore::RecordOptions options;
+    options.keyframe_every = 100;
+    options.channels = channels;
+    core.StartRecording(file, options);
+  }
+  const auto begin = Clock::now();
+  core.StepNow(steps);
+  const double wall = std::chrono::duration<double>(Clock::now() - begin).count();
+  if (record) {
+    core.StopRecording();
+    *bytes = std::filesystem::file_size(file);
+  }
+  return 1e6 * wall / static_cast<double>(steps);
+}
+
+void SessionRecordings(const std::string& root) {
+  const std::string scene = root + "/models/ecce_arm.dae";
+  std::vector<std::string> channels;
+  {
+    ModelCore core;
+    core.Load(scene);
+    for (const auto& c : core.Channels("*.tendon.tension"))
+      if (channels.size() < 10) channels.push_back(c.id);
+  }
+  const uint64_t steps = 5000;  // 5 s at 1 ms
+  std::vector<double> plain, recorded, sampled;
+  uint64_t bytes = 0, bytes_sampled = 0;
+  for (int r = 0; r < 5; ++r) {  // in turn, so that other load hits all alike
+    plain.push_back(Recorded(scene, steps, 0, {}, nullptr));
+    recorded.push_back(Recorded(scene, steps, 1, {}, &bytes));
+    sampled.push_back(Recorded(scene, steps, 1, channels, &bytes_sampled));
+  }
+  for (auto* v : {&plain, &recorded, &sampled}) std::sort(v->begin(), v->end());
+  const double minutes = steps * 0.001 / 60;
+  std::printf("ecce_arm %llu steps at 1 ms, keyframes every 100: us/step  not recording %.2f | "
+              "recording %.2f | recording %zu channels every step %.2f\n",
+              static_cast<unsigned long long>(steps), plain[2], recorded[2], channels.size(),
+              sampled[2]);
+  std::printf("recording size: %.2f MB per simulated minute (keyframes and events), %.2f MB with "
+              "%zu channels every step\n",
+              bytes / minutes / 1e6, bytes_sampled / minutes / 1e6, channels.size());
+  std::printf("RATIO record_overhead %.3f (target <= 1.05; recording / not, keyframes every 100 "
+              "steps)\n",
+              recorded[2] / plain[2]);
+  std::printf("RATIO record_overhead_with_channels %.3f (10 channels every step)\n",
+              sampled[2] / plain[2]);
+}
+
 int main() {
   const char* source = std::getenv("CALIPER_SOURCE_DIR");
   const std::string root = source != nullptr ? source : CALIPER_SOURCE_DIR_DEFAULT;
+  SessionRecordings(root);
   // a step of the arm costs about 20 times one of the pendulum: as many wall seconds for each
   for (const auto& [name, steps] : {std::pair<std::string, uint64_t>{"ecce_arm", 2000},
                                     std::pair<std::string, uint64_t>{"pendulum_tendon", 20000}}) {
