@@ -143,6 +143,9 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
     throw InvalidValue("keyframe_every must be in [1, 1000000] steps");
   if (!options.channels.empty() && options.channels_every < 1)
     throw InvalidValue("channels_every must be at least 1 step");
+  if (options.channels.size() > limits_.ids_per_call)
+    throw InvalidValue(std::to_string(options.channels.size()) + " channels; a recording takes at "
+                       "most " + std::to_string(limits_.ids_per_call));
   auto r = std::make_unique<Recorder>();
   r->options = options;
   recording::Header header;

@@ -759,6 +759,32 @@ TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
   EXPECT_ANSWERED(ref_->step(10));
 }
 
+TEST_F(HostileModelTest, RecordingAndReplayRefuseHostilePathsOptionsAndTimes) {
+  rss_growth_kb_ = 96 * MiB;  // 10 MB paths, a million ids
+  const double kHuge = std::numeric_limits<double>::max();
+  M::RecordOptions options;
+  options.keyframe_every = 100;
+  options.channels_every = 1;
+  options.max_bytes = 0;
+  // no write directory is configured for this Model: every path is refused, saying why
+  for (const std::string& path : {std::string(), std::string("/etc/passwd"), kTenMegabytes,
+                                  std::string("../../x.caliper")})
+    EXPECT_REFUSED(M::RecordStatus_var(ref_->start_recording(path.c_str(), options)), "");
+  options.channels = Ids(kMillion, "x");
+  EXPECT_REFUSED(M::RecordStatus_var(ref_->start_recording("r.caliper", options)), "");
+  EXPECT_ANSWERED(M::RecordStatus_var(ref_->stop_recording()));
+  EXPECT_ANSWERED(M::RecordStatus_var(ref_->recording_status()));
+  // replays: paths that are no recording, or lead nowhere
+  for (const std::string& path : {std::string(), std::string("/etc/passwd"), kTenMegabytes, Pendulum()})
+    EXPECT_REFUSED(M::ReplayStatus_var(ref_->open_replay(path.c_str())), "");
+  for (const double t : {kNaN, kHuge, -kHuge, 0.0})
+    EXPECT_REFUSED(M::ReplayStatus_var(ref_->seek(t)), "no replay");
+  EXPECT_REFUSED(ref_->fork(), "no replay");
+  M::ReplayStatus_var replay = ref_->replay_status();
+  EXPECT_FALSE(replay->replaying);
+  EXPECT_ANSWERED(ref_->step(10));
+}
+
 TEST_F(HostileModelTest, LifecycleAndExecutionContextRefuseHostileArguments) {
   HammerLifecycle(ref_);
 }
