@@ -6,6 +6,7 @@
 
 #include <QCloseEvent>
 #include <QCoreApplication>
+#include <QDateTime>
 #include <QDir>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
@@ -22,6 +23,7 @@
 #include <QScreen>
 #include <QScrollArea>
 #include <QSettings>
+#include <QSlider>
 #include <QSpinBox>
 #include <QStatusBar>
 #include <QTimer>
@@ -41,6 +43,11 @@ namespace {
 constexpr int kIdRole = Qt::UserRole;
 constexpr int kGroupRole = Qt::UserRole + 2;  // a group row's dotted prefix
 constexpr int kErrorShowMs = 8000;
+// dragging the timeline sends at most one seek per period (a seek re-simulates up to a keyframe
+// interval); the last position is always sent
+constexpr int kSeekPeriodMs = 100;
+constexpr unsigned kKeyframeEverySteps = 100;
+const char* const kRecordingFilter = "Caliper recordings (*.caliper);;All files (*)";
 
 QPushButton* Button(const QString& text, const char* name, QWidget* parent) {
   auto* b = new QPushButton(text, parent);
@@ -104,6 +111,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   step_count_->setToolTip("steps per Step");
   stop_ = Button("Stop", "stop", central);
   reset_ = Button("Reset", "reset", central);
+  record_ = Button("Record", "record", central);
+  record_->setCheckable(true);
+  record_->setToolTip("record the session to a file in the Model's write directory");
   time_step_ = new QDoubleSpinBox(central);
   time_step_->setObjectName("time_step");
   time_step_->setDecimals(6);
@@ -122,10 +132,34 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   for (QWidget* w : {static_cast<QWidget*>(open_), static_cast<QWidget*>(start_),
                      static_cast<QWidget*>(pause_), static_cast<QWidget*>(step_),
                      static_cast<QWidget*>(step_count_), static_cast<QWidget*>(stop_),
-                     static_cast<QWidget*>(reset_)})
+                     static_cast<QWidget*>(reset_), static_cast<QWidget*>(record_)})
     controls->addWidget(w);
   controls->addStretch();
   layout->addLayout(controls);
+
+  // the replay's timeline: shown while the Model replays a recording
+  timeline_ = new QWidget(central);
+  timeline_->setObjectName("timeline");
+  auto* timeline = new QHBoxLayout(timeline_);
+  timeline->setContentsMargins(0, 0, 0, 0);
+  timeline_file_ = new QLabel(timeline_);
+  timeline_file_->setObjectName("timeline_file");
+  timeline_slider_ = new QSlider(Qt::Horizontal, timeline_);
+  timeline_slider_->setObjectName("timeline_slider");
+  timeline_slider_->setToolTip("drag to seek in the recording");
+  timeline_time_ = new QLabel(timeline_);
+  timeline_time_->setObjectName("timeline_time");
+  fork_ = Button("Fork", "fork", timeline_);
+  fork_->setToolTip("leave the replay here: the Model simulates on, commands and edits allowed");
+  timeline->addWidget(timeline_file_);
+  timeline->addWidget(timeline_slider_, 1);
+  timeline->addWidget(timeline_time_);
+  timeline->addWidget(fork_);
+  timeline_->hide();
+  layout->addWidget(timeline_);
+  seek_timer_ = new QTimer(this);
+  seek_timer_->setSingleShot(true);
+  seek_timer_->setInterval(kSeekPeriodMs);
   auto* settings = new QHBoxLayout;
   settings->addWidget(new QLabel("Time step", central));
   settings->addWidget(time_step_);
@@ -203,6 +237,11 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   tabifyDockWidget(dock, selection_dock);
   selection_dock_ = selection_dock;
 
+  QMenu* file = menuBar()->addMenu("&File");
+  open_recording_ = file->addAction("Open &recording...");
+  open_recording_->setObjectName("open_recording");
+  connect(open_recording_, &QAction::triggered, this, [this] { OpenRecording(); });
+
   QMenu* edit = menuBar()->addMenu("&Edit");
   undo_ = edit->addAction("&Undo");
   undo_->setObjectName("undo");
@@ -246,6 +285,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   tools->addAction(dock->toggleViewAction());
 
   // status bar
+  recording_ = new QLabel(this);
+  recording_->setObjectName("recording");
+  statusBar()->addPermanentWidget(recording_);
   state_ = new QLabel(this);
   state_->setObjectName("state");
   sim_time_ = new QLabel(this);
@@ -264,6 +306,21 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
           [this] { link_->Step(static_cast<unsigned>(step_count_->value())); });
   connect(stop_, &QPushButton::clicked, this, [this] { link_->Stop(); });
   connect(reset_, &QPushButton::clicked, this, [this] { link_->Reset(); });
+  connect(record_, &QPushButton::clicked, this, [this](bool on) { ToggleRecording(on); });
+  connect(fork_, &QPushButton::clicked, this, [this] {
+    link_->Fork();
+    statusBar()->showMessage("forking ...", 3000);
+  });
+  connect(timeline_slider_, &QSlider::valueChanged, this, [this](int value) {
+    timeline_time_->setText(
+        QString("%1 / %2 s").arg(TimelineTime(value), 0, 'f', 3).arg(replay_.end_time, 0, 'f', 3));
+    if (!moving_slider_) RequestSeek(TimelineTime(value));
+  });
+  connect(seek_timer_, &QTimer::timeout, this, [this] {
+    if (!seek_pending_) return;
+    seek_pending_ = false;
+    SendSeek(pending_seek_s_);
+  });
   connect(time_step_, &QDoubleSpinBox::editingFinished, this,
           [this] { link_->SetTimeStep(time_step_->value()); });
   connect(real_time_factor_, &QDoubleSpinBox::editingFinished, this,
@@ -474,8 +531,7 @@ void MainWindow::ArrangeWindows() {
   QStringList waiting;
   for (const auto& [name, process] : tools_) {
     if (process->state() != QProcess::Running) continue;
-    const gui_session::ToolWindowRecord record =
-        gui_session::ReadToolWindow(SettingsPath(), name);
+    const gui_session::ToolWindowRecord record = gui_session::ReadToolWindow(SettingsPath(), name);
     if (record.pid != process->processId() || record.window_id == 0) {
       waiting << name;  // started but not shown yet: it comes up in its place anyway
       continue;
@@ -572,6 +628,132 @@ void MainWindow::OpenModelFile() {
   if (path.isEmpty()) return;
   link_->LoadScene(path.toStdString());
   statusBar()->showMessage("loading " + path + " ...", kErrorShowMs);
+}
+
+namespace {
+
+QString ChooseWithDialog(QWidget* parent, bool save, const QString& title,
+                         const QString& suggested) {
+  return save ? QFileDialog::getSaveFileName(parent, title, suggested, kRecordingFilter)
+              : QFileDialog::getOpenFileName(parent, title, suggested, kRecordingFilter);
+}
+
+}  // namespace
+
+void MainWindow::ToggleRecording(bool on) {
+  const Snapshot s = link_->snapshot();
+  if (!on) {
+    link_->StopRecording();
+    record_mark_ = link_->snapshot().commands_queued;
+    statusBar()->showMessage("stopping the recording ...", 3000);
+    return;
+  }
+  record_->setChecked(false);  // checked when the Model says it records
+  if (s.write_dir.empty()) {
+    ShowError("the Model writes no files (its model.write_dir is empty): it cannot record");
+    return;
+  }
+  const QString name =
+      "session-" + QDateTime::currentDateTime().toString("yyyyMMdd-HHmmss") + ".caliper";
+  const QString suggested = QDir(QString::fromStdString(s.write_dir)).filePath(name);
+  const QString title = "Record to (a new file in the Model's write directory)";
+  const QString path = choose_file_ ? choose_file_(true, title, suggested)
+                                    : ChooseWithDialog(this, true, title, suggested);
+  if (path.isEmpty()) return;
+  link_->StartRecording(path.toStdString(), kKeyframeEverySteps);
+  record_mark_ = link_->snapshot().commands_queued;
+  statusBar()->showMessage("starting to record to " + path + " ...", 3000);
+}
+
+void MainWindow::OpenRecording() {
+  const Snapshot s = link_->snapshot();
+  const QString dir = QString::fromStdString(s.write_dir);
+  const QString title = "Open recording";
+  const QString path =
+      choose_file_ ? choose_file_(false, title, dir) : ChooseWithDialog(this, false, title, dir);
+  if (path.isEmpty()) return;
+  link_->OpenReplay(path.toStdString());
+  statusBar()->showMessage("opening " + path + " ...", kErrorShowMs);
+}
+
+double MainWindow::TimelineTime(int value) const {
+  const ReplayInfo& r = replay_;
+  if (r.last_step <= r.first_step) return r.start_time;
+  const double dt = (r.end_time - r.start_time) / static_cast<double>(r.last_step - r.first_step);
+  return r.start_time + value * dt;
+}
+
+void MainWindow::RequestSeek(double time_s) {
+  if (seek_timer_->isActive()) {
+    pending_seek_s_ = time_s;
+    seek_pending_ = true;
+    return;
+  }
+  SendSeek(time_s);
+}
+
+void MainWindow::SendSeek(double time_s) {
+  link_->Seek(time_s);
+  seek_mark_ = link_->snapshot().commands_queued;
+  seek_timer_->start();
+}
+
+void MainWindow::RefreshRecording(const Snapshot& s) {
+  const bool replaying = s.connected && s.replay.replaying;
+  record_->setEnabled(s.connected && s.recordings && !replaying);
+  open_recording_->setEnabled(s.connected && s.recordings);
+  // the button follows the Model once the last press was answered
+  if (s.commands_done >= record_mark_ && record_->isChecked() != s.record.recording)
+    record_->setChecked(s.connected && s.record.recording);
+
+  const RecordInfo& r = s.record;
+  const QString file = QFileInfo(QString::fromStdString(r.path)).fileName();
+  if (s.connected && r.recording) {
+    recording_->setStyleSheet("QLabel { color: #b00020; }");
+    recording_->setText(QString("recording %1 (%2 MB, %3 s)")
+                            .arg(file)
+                            .arg(static_cast<double>(r.bytes) / 1e6, 0, 'f', 1)
+                            .arg(static_cast<double>(r.steps) * s.status.time_step, 0, 'f', 1));
+    recording_->setToolTip(QString::fromStdString(r.path));
+  } else if (s.connected && !r.error.empty()) {
+    recording_->setStyleSheet("QLabel { color: #b00020; font-weight: bold; }");
+    recording_->setText(QString::fromStdString(r.error));
+    recording_->setToolTip(QString::fromStdString(r.path));
+  } else {
+    recording_->clear();
+    recording_->setToolTip(QString());
+  }
+  if (r.error != record_error_) {
+    record_error_ = r.error;
+    if (!r.error.empty()) ShowError(QString::fromStdString(r.error));
+  }
+
+  if (!replaying) {
+    timeline_->hide();
+    replay_ = ReplayInfo{};
+    setWindowTitle("Caliper");
+    return;
+  }
+  const ReplayInfo& p = s.replay;
+  const QString name = QFileInfo(QString::fromStdString(p.path)).fileName();
+  setWindowTitle("Caliper - replaying " + name);
+  timeline_file_->setText("replaying " + name);
+  timeline_file_->setToolTip(QString::fromStdString(p.path));
+  const bool changed = p.path != replay_.path || p.first_step != replay_.first_step ||
+                       p.last_step != replay_.last_step;
+  const std::uint64_t step = std::min(std::max(p.step, p.first_step), p.last_step);
+  replay_ = p;
+  moving_slider_ = true;
+  if (changed) timeline_slider_->setRange(0, static_cast<int>(p.last_step - p.first_step));
+  // the slider follows the replay unless the user holds it or a seek is on its way
+  const bool seeking = seek_timer_->isActive() || seek_pending_ || s.commands_done < seek_mark_;
+  if (changed || (!timeline_slider_->isSliderDown() && !seeking))
+    timeline_slider_->setValue(static_cast<int>(step - p.first_step));
+  moving_slider_ = false;
+  timeline_time_->setText(QString("%1 / %2 s")
+                              .arg(TimelineTime(timeline_slider_->value()), 0, 'f', 3)
+                              .arg(p.end_time, 0, 'f', 3));
+  timeline_->show();
 }
 
 void MainWindow::ShowError(const QString& message) {
@@ -725,11 +907,12 @@ void MainWindow::Refresh() {
   start_model_->setVisible(!s.connected);
   start_model_->setEnabled(model_process_ == nullptr ||
                            model_process_->state() == QProcess::NotRunning);
-  for (QWidget* w : {static_cast<QWidget*>(start_), static_cast<QWidget*>(pause_),
-                     static_cast<QWidget*>(step_), static_cast<QWidget*>(stop_),
-                     static_cast<QWidget*>(reset_), static_cast<QWidget*>(open_)})
+  for (QWidget* w :
+       {static_cast<QWidget*>(start_), static_cast<QWidget*>(pause_), static_cast<QWidget*>(step_),
+        static_cast<QWidget*>(stop_), static_cast<QWidget*>(reset_), static_cast<QWidget*>(open_)})
     w->setEnabled(s.connected);
   RefreshEditActions(s);
+  RefreshRecording(s);
   if (!s.connected) {
     const QString why = QString::fromStdString(s.connection_message);
     no_model_->setText(why);
@@ -824,8 +1007,8 @@ void MainWindow::BuildTree(const Snapshot& s) {
     item->setData(0, kIdRole, QString::fromStdString(c.id));
     item->setData(1, kIdRole + 1, c.scalar());
     item->setText(2, QString::fromStdString(c.unit));
-    item->setToolTip(0, QString::fromStdString(c.id + (c.description.empty() ? "" : ": ") +
-                                               c.description));
+    item->setToolTip(
+        0, QString::fromStdString(c.id + (c.description.empty() ? "" : ": ") + c.description));
     if (!c.scalar()) item->setText(1, QString("%1x%2").arg(c.rows).arg(c.cols));
     Qt::ItemFlags flags = Qt::ItemIsEnabled | Qt::ItemIsSelectable;
     if (c.writable && c.scalar()) {

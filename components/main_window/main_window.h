@@ -4,6 +4,7 @@
 
 #include <QMainWindow>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -18,6 +19,7 @@ class QDoubleSpinBox;
 class QProcess;
 class QRect;
 class QSettings;
+class QSlider;
 class QLabel;
 class QPushButton;
 class QSpinBox;
@@ -79,6 +81,20 @@ class MainWindow : public QMainWindow {
   /// The process id of a running tool started here, 0 when there is none.
   long long ToolPid(const QString& name) const;
 
+  /// Asks for a file: `save` for a new recording, else one to open; `suggested` is the
+  /// directory or the proposed file. Returns "" when cancelled. The default shows a QFileDialog;
+  /// tests set their own.
+  using FileChooser =
+      std::function<QString(bool save, const QString& title, const QString& suggested)>;
+  void SetFileChooser(FileChooser chooser) { choose_file_ = std::move(chooser); }
+  /// The Record button: starts a recording into a file chosen in the Model's write directory
+  /// (`on`), or stops it.
+  void ToggleRecording(bool on);
+  /// File > Open recording...: the Model replays a chosen recording; the timeline appears.
+  void OpenRecording();
+  /// The timeline's time [s] at slider position `value`.
+  double TimelineTime(int value) const;
+
  protected:
   void closeEvent(QCloseEvent* event) override;
 
@@ -102,6 +118,11 @@ class MainWindow : public QMainWindow {
   QStringList NameserviceArgs() const;
   /// Says in the status bar when `process` ends, and why when it failed.
   void ReportEnd(QProcess* process, const QString& what);
+  /// The Record button, the recording's status label and the replay's timeline.
+  void RefreshRecording(const Snapshot& s);
+  /// Seeks to `time_s`, at most every kSeekPeriodMs; the last one asked for is always sent.
+  void RequestSeek(double time_s);
+  void SendSeek(double time_s);
 
   std::unique_ptr<ModelLink> link_;
   QTimer* timer_ = nullptr;
@@ -126,9 +147,9 @@ class MainWindow : public QMainWindow {
   std::map<QString, QProcess*> tools_;             // tool name -> its process
   std::map<QString, QStringList> tool_arguments_;  // tool name -> extra arguments
   QStringList default_plots_;
-  QProcess* model_process_ = nullptr;              // a Model started by "Start a Model"
+  QProcess* model_process_ = nullptr;  // a Model started by "Start a Model"
   QString last_model_;
-  bool settings_applied_ = false;                  // saved simulation settings sent to the Model
+  bool settings_applied_ = false;  // saved simulation settings sent to the Model
   double saved_time_step_ = 0;
   double saved_real_time_factor_ = -1;
   QAction* undo_ = nullptr;
@@ -145,7 +166,24 @@ class MainWindow : public QMainWindow {
   std::uint64_t channels_version_ = 0;
   std::uint64_t error_serial_ = 0;
   std::uint64_t notice_serial_ = 0;
-  bool updating_ = false;                           // the tree is being filled, not edited
+  bool updating_ = false;  // the tree is being filled, not edited
+  FileChooser choose_file_;
+  QPushButton* record_ = nullptr;
+  QLabel* recording_ = nullptr;    // "recording FILE (N MB, T s)"
+  std::uint64_t record_mark_ = 0;  // commands queued by the last Record press
+  std::string record_error_;       // the recording error shown last
+  QAction* open_recording_ = nullptr;
+  QWidget* timeline_ = nullptr;  // the replay's row: file, slider, time, Fork
+  QLabel* timeline_file_ = nullptr;
+  QSlider* timeline_slider_ = nullptr;
+  QLabel* timeline_time_ = nullptr;
+  QPushButton* fork_ = nullptr;
+  ReplayInfo replay_;             // the replay the timeline shows
+  QTimer* seek_timer_ = nullptr;  // running: a seek went out less than kSeekPeriodMs ago
+  bool seek_pending_ = false;     // a position waits for the timer
+  double pending_seek_s_ = 0;
+  std::uint64_t seek_mark_ = 0;  // commands queued by the last seek
+  bool moving_slider_ = false;   // the slider follows the Model, not the user
 };
 
 }  // namespace caliper::main_window

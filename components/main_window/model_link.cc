@@ -30,7 +30,7 @@ using Clock = std::chrono::steady_clock;
 struct ModelLink::Impl {
   CORBA::ORB_var orb;
   M::Model_var model;
-  std::string scene;              // the scene the channel list belongs to
+  std::string scene;  // the scene the channel list belongs to
   bool channels_listed = false;
   Clock::time_point last_lookup{};
   Clock::time_point last_listing{};
@@ -38,6 +38,7 @@ struct ModelLink::Impl {
   bool scene_read = false;            // SceneInfo read for `edit_scene` at `edit_revision`
   std::string edit_scene;
   std::uint64_t edit_revision = 0;
+  bool files_read = false;  // write_dir read from this Model
 
   CosNaming::NamingContext_ptr Root(const std::string& nameservice) {
     if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
@@ -70,6 +71,7 @@ void ModelLink::Queue(std::string what, std::function<void(Impl&)> call, bool ne
   {
     std::lock_guard<std::mutex> lock(mutex_);
     queue_.push_back(Command{std::move(what), std::move(call), needs_model});
+    ++snapshot_.commands_queued;
   }
   wake_.notify_all();
 }
@@ -104,10 +106,11 @@ void ModelLink::LoadScene(const std::string& path) {
       if (!warnings.empty()) {
         // the Model imports the converted COLLADA without a word: the URDF's warnings are said
         // here, in the status bar and on the terminal
-        std::string notice = content.file_name + " (converted from " + path + "): " +
-                             std::to_string(warnings.size()) + " import warning" +
+        std::string notice = content.file_name + " (converted from " + path +
+                             "): " + std::to_string(warnings.size()) + " import warning" +
                              (warnings.size() == 1 ? "" : "s") + ": " + warnings.front();
-        for (const auto& w : warnings) std::fprintf(stderr, "caliper-main: warning: %s\n", w.c_str());
+        for (const auto& w : warnings)
+          std::fprintf(stderr, "caliper-main: warning: %s\n", w.c_str());
         std::lock_guard<std::mutex> lock(mutex_);
         snapshot_.last_notice = std::move(notice);
         ++snapshot_.notice_serial;
@@ -123,10 +126,18 @@ void ModelLink::LoadScene(const std::string& path) {
     i.channels_listed = false;
   });
 }
-void ModelLink::Start() { Queue("start", [](Impl& i) { i.model->start(); }); }
-void ModelLink::Pause() { Queue("pause", [](Impl& i) { i.model->pause(); }); }
-void ModelLink::Stop() { Queue("stop", [](Impl& i) { i.model->stop(); }); }
-void ModelLink::Reset() { Queue("reset", [](Impl& i) { i.model->reset(); }); }
+void ModelLink::Start() {
+  Queue("start", [](Impl& i) { i.model->start(); });
+}
+void ModelLink::Pause() {
+  Queue("pause", [](Impl& i) { i.model->pause(); });
+}
+void ModelLink::Stop() {
+  Queue("stop", [](Impl& i) { i.model->stop(); });
+}
+void ModelLink::Reset() {
+  Queue("reset", [](Impl& i) { i.model->reset(); });
+}
 void ModelLink::Step(unsigned n) {
   const int long_ms = options_.long_call_timeout_ms;
   Queue("step " + std::to_string(n), [n, long_ms](Impl& i) {
@@ -148,6 +159,69 @@ void ModelLink::Set(const std::string& id, double value) {
     v.data.length(1);
     v.data[0] = value;
     i.model->set(id.c_str(), v);
+  });
+}
+
+namespace {
+
+RecordInfo FromIdl(const M::RecordStatus& s) {
+  return RecordInfo{bool(s.recording), s.path.in(), s.first_step, s.steps, s.bytes, s.error.in()};
+}
+
+ReplayInfo FromIdl(const M::ReplayStatus& s) {
+  return ReplayInfo{bool(s.replaying), s.path.in(), s.first_step, s.last_step, s.step,
+                    s.start_time,      s.end_time,  s.time};
+}
+
+}  // namespace
+
+void ModelLink::StartRecording(const std::string& path, unsigned keyframe_every) {
+  Queue("record to " + path, [this, path, keyframe_every](Impl& i) {
+    M::RecordOptions options;
+    options.keyframe_every = keyframe_every;
+    options.channels_every = 1;
+    options.channels.length(0);
+    options.max_bytes = 0;
+    M::RecordStatus_var got = i.model->start_recording(path.c_str(), options);
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.recordings = true;
+    snapshot_.record = FromIdl(got.in());
+  });
+}
+void ModelLink::StopRecording() {
+  Queue("stop recording", [this](Impl& i) {
+    M::RecordStatus_var got = i.model->stop_recording();
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.record = FromIdl(got.in());
+  });
+}
+void ModelLink::OpenReplay(const std::string& path) {
+  const int long_ms = options_.long_call_timeout_ms;
+  Queue("open recording " + path, [this, path, long_ms](Impl& i) {
+    // the Model loads the recording's scene and its first keyframe: as long as a load
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
+    M::ReplayStatus_var got = i.model->open_replay(path.c_str());
+    i.channels_listed = false;  // the recording's scene may differ from the one loaded
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.replay = FromIdl(got.in());
+  });
+}
+void ModelLink::Seek(double time_s) {
+  const int long_ms = options_.long_call_timeout_ms;
+  Queue("seek", [this, time_s, long_ms](Impl& i) {
+    // a seek re-simulates from the keyframe before it: longer than a short call on a big scene
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
+    M::ReplayStatus_var got = i.model->seek(time_s);
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.replay = FromIdl(got.in());
+  });
+}
+void ModelLink::Fork() {
+  Queue("fork", [this](Impl& i) {
+    i.model->fork();
+    M::ReplayStatus_var got = i.model->replay_status();
+    std::lock_guard<std::mutex> lock(mutex_);
+    snapshot_.replay = FromIdl(got.in());
   });
 }
 
@@ -367,29 +441,32 @@ void ModelLink::ReadScene() {
 
 void ModelLink::ComponentAction(const std::string& instance, const std::string& verb) {
   const std::string ns = options_.nameservice;
-  Queue(verb + " " + instance, [instance, verb, ns](Impl& i) {
-    RTC::LightweightRTObject_var comp =
-        RTC::LightweightRTObject::_narrow(rtc::FindComponent(i.Root(ns), instance).object);
-    if (CORBA::is_nil(comp)) throw std::runtime_error(instance + " is not a component");
-    RTC::ReturnCode rc;
-    if (verb == "exit") {
-      rc = comp->exit();
-    } else {
-      RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
-      if (ecs->length() == 0) throw std::runtime_error(instance + " owns no execution context");
-      RTC::ExecutionContext_ptr ec = ecs[0];
-      rc = verb == "activate"     ? ec->activate_component(comp)
-           : verb == "deactivate" ? ec->deactivate_component(comp)
-           : verb == "reset"      ? ec->reset_component(comp)
-                                  : throw std::runtime_error("unknown action " + verb);
-    }
-    if (rc != RTC::RTC_OK) {
-      std::string msg = rtc::Name(rc);
-      CORBA::String_var why = comp->get_last_error();
-      if (std::string(why.in()).size() > 0) msg += "; reason: " + std::string(why.in());
-      throw std::runtime_error(msg);
-    }
-  }, false);
+  Queue(
+      verb + " " + instance,
+      [instance, verb, ns](Impl& i) {
+        RTC::LightweightRTObject_var comp =
+            RTC::LightweightRTObject::_narrow(rtc::FindComponent(i.Root(ns), instance).object);
+        if (CORBA::is_nil(comp)) throw std::runtime_error(instance + " is not a component");
+        RTC::ReturnCode rc;
+        if (verb == "exit") {
+          rc = comp->exit();
+        } else {
+          RTC::ExecutionContextList_var ecs = comp->get_owned_contexts();
+          if (ecs->length() == 0) throw std::runtime_error(instance + " owns no execution context");
+          RTC::ExecutionContext_ptr ec = ecs[0];
+          rc = verb == "activate"     ? ec->activate_component(comp)
+               : verb == "deactivate" ? ec->deactivate_component(comp)
+               : verb == "reset"      ? ec->reset_component(comp)
+                                      : throw std::runtime_error("unknown action " + verb);
+        }
+        if (rc != RTC::RTC_OK) {
+          std::string msg = rtc::Name(rc);
+          CORBA::String_var why = comp->get_last_error();
+          if (std::string(why.in()).size() > 0) msg += "; reason: " + std::string(why.in());
+          throw std::runtime_error(msg);
+        }
+      },
+      false);
 }
 
 // Lists the naming service's components with their states; on the worker thread only.
@@ -441,6 +518,7 @@ void ModelLink::Run() {
     i.model = M::Model::_nil();
     i.channels_listed = false;
     i.scene_read = false;
+    i.files_read = false;
     std::lock_guard<std::mutex> lock(mutex_);
     snapshot_.connected = false;
     snapshot_.connection_message = "no Model reachable: " + why;
@@ -504,8 +582,8 @@ void ModelLink::Run() {
     }
 
     omniORB::setClientThreadCallTimeout(short_ms);
-    if (relist_components || Clock::now() - i.last_listing >=
-                                 std::chrono::milliseconds(options_.components_period_ms)) {
+    if (relist_components ||
+        Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.components_period_ms)) {
       i.last_listing = Clock::now();
       ListComponents();
     }
@@ -521,8 +599,7 @@ void ModelLink::Run() {
       try {
         CosNaming::NamingContext_var root =
             rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-        M::Model_var model =
-            M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+        M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
         if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
         i.model = model;
       } catch (const CORBA::Exception& e) {
@@ -607,7 +684,29 @@ void ModelLink::Run() {
         omniORB::setClientThreadCallTimeout(short_ms);
       }
 
+      // the recording and the replay (a Model built before recordings has neither)
+      bool recordings = false;
+      RecordInfo record;
+      ReplayInfo replay;
+      try {
+        record = FromIdl(M::RecordStatus_var(i.model->recording_status()).in());
+        replay = FromIdl(M::ReplayStatus_var(i.model->replay_status()).in());
+        recordings = true;
+      } catch (const CORBA::BAD_OPERATION&) {
+      }
+      std::string write_dir;
+      if (!i.files_read) {
+        write_dir = M::FileAccess_var(i.model->file_access())->write_dir.in();
+      }
+
       std::lock_guard<std::mutex> lock(mutex_);
+      if (!i.files_read) {
+        snapshot_.write_dir = write_dir;
+        i.files_read = true;
+      }
+      snapshot_.recordings = recordings;
+      snapshot_.record = record;
+      snapshot_.replay = replay;
       snapshot_.editing = editing;
       if (editing) {
         snapshot_.edit = FromIdl(edit.in());

@@ -19,24 +19,24 @@ namespace caliper::main_window {
 
 /// The Model's SimulationStatus, without CORBA.
 struct ModelStatus {
-  std::string state;                       ///< EMPTY, STOPPED, RUNNING, PAUSED, FAULTED
-  std::string scene;                       ///< file of the loaded scene
-  double sim_time = 0;                     ///< simulated time [s]
-  std::uint64_t steps = 0;                 ///< steps since the scene was loaded or reset
-  double time_step = 0;                    ///< [s]
-  double real_time_factor = 0;             ///< requested: 1 real time, 0 as fast as possible
-  double achieved_real_time_factor = 0;    ///< measured over the last second
-  std::string last_error;                  ///< why the simulation last stopped, if it did
+  std::string state;                     ///< EMPTY, STOPPED, RUNNING, PAUSED, FAULTED
+  std::string scene;                     ///< file of the loaded scene
+  double sim_time = 0;                   ///< simulated time [s]
+  std::uint64_t steps = 0;               ///< steps since the scene was loaded or reset
+  double time_step = 0;                  ///< [s]
+  double real_time_factor = 0;           ///< requested: 1 real time, 0 as fast as possible
+  double achieved_real_time_factor = 0;  ///< measured over the last second
+  std::string last_error;                ///< why the simulation last stopped, if it did
 };
 
 /// One of the Model's parameter or state channels.
 struct Channel {
-  std::string id;           ///< e.g. pendulum_tendon.pendulum.mass
-  std::string unit;         ///< SI unit, "" for none
-  unsigned rows = 1;        ///< shape of the value
+  std::string id;     ///< e.g. pendulum_tendon.pendulum.mass
+  std::string unit;   ///< SI unit, "" for none
+  unsigned rows = 1;  ///< shape of the value
   unsigned cols = 1;
   bool writable = false;
-  bool is_static = false;   ///< a parameter (true) or a state changing every step (false)
+  bool is_static = false;  ///< a parameter (true) or a state changing every step (false)
   std::string description;
   bool scalar() const { return rows == 1 && cols == 1; }
 };
@@ -129,41 +129,68 @@ struct SelectionInfo {
   std::uint64_t revision = 0;  ///< grows by one with every select()
 };
 
+/// The Model's recording (SessionRecording::RecordStatus without CORBA).
+struct RecordInfo {
+  bool recording = false;
+  std::string path;  ///< on the Model's host
+  std::uint64_t first_step = 0;
+  std::uint64_t steps = 0;  ///< recorded so far
+  std::uint64_t bytes = 0;  ///< the file's size at its last commit
+  std::string error;        ///< why the last recording stopped early ("" when it did not)
+};
+
+/// The Model's replay (SessionRecording::ReplayStatus without CORBA).
+struct ReplayInfo {
+  bool replaying = false;
+  std::string path;
+  std::uint64_t first_step = 0;
+  std::uint64_t last_step = 0;
+  std::uint64_t step = 0;
+  double start_time = 0;  ///< [s]
+  double end_time = 0;    ///< [s]
+  double time = 0;        ///< [s]
+};
+
 /// What the GUI reads: a copy of everything the worker last learnt.
 struct Snapshot {
   bool connected = false;
-  std::string connection_message;          ///< why no Model is reachable (when not connected)
+  std::string connection_message;  ///< why no Model is reachable (when not connected)
   ModelStatus status;
-  std::uint64_t channels_version = 0;      ///< changes whenever `channels` is listed anew
+  std::uint64_t channels_version = 0;  ///< changes whenever `channels` is listed anew
   std::vector<Channel> channels;
-  std::map<std::string, double> values;    ///< latest values of the watched scalar ids
-  std::string last_error;                  ///< the latest failed command's message
-  std::uint64_t error_serial = 0;          ///< counts failed commands
-  std::string last_notice;                 ///< what a finished command has to say (warnings)
-  std::uint64_t notice_serial = 0;         ///< counts notices
-  std::uint64_t commands_done = 0;         ///< counts finished commands (failed or not)
-  bool naming_reachable = false;           ///< the naming service answered the last listing
-  std::uint64_t components_version = 0;    ///< counts the listings of `components`
-  std::vector<ComponentInfo> components;   ///< everything bound in the naming service
-  bool editing = false;                    ///< the Model answered edit_status()
-  EditInfo edit;                           ///< the Model's edit history
-  SelectionInfo selection;                 ///< the Model's shared selection
-  std::uint64_t scene_version = 0;         ///< changes whenever `scene` is read anew
-  SceneInfo scene;                         ///< the loaded scene, as edited
+  std::map<std::string, double> values;   ///< latest values of the watched scalar ids
+  std::string last_error;                 ///< the latest failed command's message
+  std::uint64_t error_serial = 0;         ///< counts failed commands
+  std::string last_notice;                ///< what a finished command has to say (warnings)
+  std::uint64_t notice_serial = 0;        ///< counts notices
+  std::uint64_t commands_done = 0;        ///< counts finished commands (failed or not)
+  bool naming_reachable = false;          ///< the naming service answered the last listing
+  std::uint64_t components_version = 0;   ///< counts the listings of `components`
+  std::vector<ComponentInfo> components;  ///< everything bound in the naming service
+  bool editing = false;                   ///< the Model answered edit_status()
+  EditInfo edit;                          ///< the Model's edit history
+  SelectionInfo selection;                ///< the Model's shared selection
+  std::uint64_t scene_version = 0;        ///< changes whenever `scene` is read anew
+  SceneInfo scene;                        ///< the loaded scene, as edited
   std::vector<ActuatorKindInfo> actuator_kinds;
+  std::uint64_t commands_queued = 0;  ///< counts queued commands (see commands_done)
+  bool recordings = false;            ///< the Model answered recording_status()
+  RecordInfo record;                  ///< the Model's recording
+  ReplayInfo replay;                  ///< the Model's replay
+  std::string write_dir;              ///< file_access().write_dir ("" = none)
 };
 
 /// The worker and its command queue. Every method returns at once.
 class ModelLink {
  public:
   struct Options {
-    std::string nameservice;          ///< corbaname::HOST:PORT; "" for the default
-    std::string instance = "model0";  ///< the Model's instance name
-    int call_timeout_ms = 1500;       ///< every short call (status, list, get, set, start, ...)
+    std::string nameservice;            ///< corbaname::HOST:PORT; "" for the default
+    std::string instance = "model0";    ///< the Model's instance name
+    int call_timeout_ms = 1500;         ///< every short call (status, list, get, set, start, ...)
     int long_call_timeout_ms = 120000;  ///< load_scene and step, which take as long as their work
-    int poll_period_ms = 200;         ///< status and values
-    int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
-    int components_period_ms = 1000;  ///< listing the naming service's components
+    int poll_period_ms = 200;           ///< status and values
+    int reconnect_period_ms = 1000;     ///< looking the Model up again while none is reachable
+    int components_period_ms = 1000;    ///< listing the naming service's components
   };
 
   /// Uses the process's ORB (initialises one when there is none) and starts the worker.
@@ -199,6 +226,16 @@ class ModelLink {
   void RemoveTendon(const std::string& tendon);
   void AddTendon(const std::string& tendon, const PathPointInfo& from, const PathPointInfo& to,
                  double radius_m, const std::string& actuator, const std::string& kind);
+
+  /// Session recordings (SessionRecording on the Model); each answer goes into the snapshot.
+  /// Records to `path` (on the Model's host, into its write_dir), a keyframe every
+  /// `keyframe_every` steps, no channels.
+  void StartRecording(const std::string& path, unsigned keyframe_every = 100);
+  void StopRecording();
+  void OpenReplay(const std::string& path);
+  /// Goes to the moment nearest `time_s` of the replay.
+  void Seek(double time_s);
+  void Fork();
 
   /// A lifecycle transition of a component in the naming service: `verb` is activate,
   /// deactivate, reset or exit. Needs no Model.
