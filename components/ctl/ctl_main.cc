@@ -30,6 +30,7 @@
 #include "inspect.h"
 #include "batch.h"
 #include "model_verbs.h"
+#include "recording_verbs.h"
 #include "renderer_verbs.h"
 
 namespace caliper::ctl {
@@ -303,6 +304,7 @@ std::map<std::string, Verb> Verbs() {
   AddModelVerbs(&verbs);
   AddRendererVerbs(&verbs);
   AddClusterVerbs(&verbs);
+  AddRecordingVerbs(&verbs);
   AddBatchVerb(&verbs);
   return verbs;
 }

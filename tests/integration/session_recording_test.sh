@@ -1,0 +1,172 @@
+#!/usr/bin/env bash
+# caliper-ctl recording and replay against real Models on a private loopback naming service: a
+# recording with two channels, motor commands, a parameter write and an edit verifies bit for
+# bit; --info and --csv report it with units; replayed in the Model, the DAQ recorder (`record`,
+# the Graph Plotter's interface) gets the recorded values; seek back and forth; fork accepts
+# commands; a Model killed with SIGKILL while recording leaves a file that opens and holds its
+# last 0.5 s; a recording whose scene was replaced is refused naming the file; a size limit ends
+# a recording with the reason while the simulation runs on.
+set -uo pipefail
+BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
+SRC=${CALIPER_SOURCE_DIR:?}
+FAILS=0
+fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
+pass() { echo "ok: $*"; }
+# shellcheck source=../../launch/local_models.sh
+source "$SRC/launch/local_models.sh"
+WORK=$(mktemp -d)
+trap 'local_models_stop; rm -rf "$WORK"' EXIT
+# the Models write recordings only below their write directory
+mkdir -p "$WORK/files"
+export CALIPER_FILES_DIR=$WORK/files
+local_models_start "$WORK" 1
+ctl() { timeout 60 "$BIN/caliper-ctl" "$@"; }
+F=$WORK/files
+field() { awk -v k="$1" 'index($0, k) == 1 {print $NF; exit}'; }  # LABEL: the line's last word
+
+ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load"
+
+# ------------------------------------------------------------------ a refused path, a recording
+if ctl recording start "$WORK/outside.sqlite" >"$WORK/out" 2>&1; then fail "recorded outside the write dir"
+elif grep -q "only below its write directory $F" "$WORK/out"; then pass "refused outside: $(head -1 "$WORK/out" | cut -c1-100)"
+else cat "$WORK/out"; fail "no reason for the refused path"; fi
+
+CH1=ecce_arm.elbow.position
+CH2=ecce_arm.elbow_flexor.tension
+ctl recording start "$F/run.sqlite" --channel $CH1 --channel $CH2 >"$WORK/out" 2>&1 ||
+  { cat "$WORK/out"; fail "recording start"; }
+grep -q "^recording  *yes" "$WORK/out" && pass "recording started" || fail "not recording"
+ctl motor elbow_flexor 3 >/dev/null && ctl step 300 >/dev/null || fail "command, step"
+ctl set ecce_arm.elbow_extensor.stiffness 4000 >/dev/null && ctl step 300 >/dev/null ||
+  fail "parameter write, step"
+ctl edit mass forearm 0.8 >/dev/null && ctl step 400 >/dev/null || fail "edit, step"
+ctl motor elbow_flexor -2 >/dev/null && ctl step 9000 >/dev/null || fail "command, step"
+ctl recording stop >"$WORK/stop" 2>&1 || { cat "$WORK/stop"; fail "recording stop"; }
+steps=$(field "steps recorded" <"$WORK/stop")
+seconds=$(field "simulated time recorded" <"$WORK/stop")
+bytes=$(awk '/^size/ {print $3}' "$WORK/stop")
+per_min=$(field "bytes per simulated minute" <"$WORK/stop")
+[ "$steps" = 10000 ] && [ "$seconds" = 10 ] && [ "$bytes" = "$(stat -c %s "$F/run.sqlite")" ] &&
+  pass "stop: $steps steps, $seconds s, $bytes bytes, $per_min bytes per simulated minute" ||
+  { cat "$WORK/stop"; fail "stop's numbers"; }
+
+# ------------------------------------------------------------------ the file alone
+ctl replay --verify "$F/run.sqlite" >"$WORK/verify" 2>"$WORK/verify.err"
+rc=$?
+if [ $rc = 0 ] && grep -q "^identical: 10000 steps, [0-9]* keyframes, 10000 samples compared bit for bit" "$WORK/verify"; then
+  pass "verify: $(cat "$WORK/verify"); $(tail -1 "$WORK/verify.err")"
+else cat "$WORK/verify" "$WORK/verify.err"; fail "verify (exit $rc)"; fi
+
+ctl replay --info "$F/run.sqlite" >"$WORK/info" 2>&1 || { cat "$WORK/info"; fail "--info"; }
+grep -q "^model  *ecce_arm$" "$WORK/info" && grep -q "^duration \[s\]  *10$" "$WORK/info" &&
+  grep -q "^steps  *10000 (0 to 10000)" "$WORK/info" && grep -q "^keyframes  *10[0-9] (every 100" "$WORK/info" &&
+  grep -q "^  $CH1 \[rad\]$" "$WORK/info" && grep -q "^  $CH2 \[N\]$" "$WORK/info" &&
+  grep -q "^events  *2 command, 1 edit, .*1 parameter" "$WORK/info" &&
+  grep -q "(and 1 edited versions)" "$WORK/info" &&
+  pass "--info: $(grep -E '^(events|bytes per)' "$WORK/info" | tr -s ' ' | paste -sd';')" ||
+  { cat "$WORK/info"; fail "--info's content"; }
+
+ctl replay --csv "$F/run.sqlite" "$WORK/run.csv" >/dev/null 2>&1 || fail "--csv"
+[ "$(head -1 "$WORK/run.csv")" = "time [s],$CH1 [rad],$CH2 [N]" ] &&
+  [ "$(wc -l <"$WORK/run.csv")" = 10001 ] && pass "--csv: $(head -1 "$WORK/run.csv"), 10000 rows" ||
+  { head -2 "$WORK/run.csv"; fail "--csv columns"; }
+
+# ------------------------------------------------------------------ replay in the Model
+ctl replay "$F/run.sqlite" >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "replay FILE"; }
+grep -q "^time / end \[s\]  *0 / 10$" "$WORK/open" && pass "replay opened at 0 of 10 s" ||
+  { cat "$WORK/open"; fail "replay status after open"; }
+if ctl motor elbow_flexor 1 >"$WORK/out" 2>&1; then fail "a command during a replay was accepted"
+else pass "command refused while replaying: $(cut -c1-90 "$WORK/out")"; fi
+
+# the DAQ recorder while stepping through the replay: the recorded values, bit for bit
+ctl record $CH1 $CH2 --csv "$WORK/daq.csv" --duration 1.5 >/dev/null 2>"$WORK/daq.err" &
+rec=$!
+for _ in $(seq 1 50); do grep -q "samples come once it runs" "$WORK/daq.err" && break; sleep 0.1; done
+ctl step 1600 >/dev/null || fail "step through the replay"
+wait $rec || { cat "$WORK/daq.err"; fail "record during the replay"; }
+if python3 - "$WORK/daq.csv" "$WORK/run.csv" >"$WORK/cmp" 2>&1 <<'EOF'
+import csv, sys
+daq = list(csv.reader(open(sys.argv[1])))
+recorded = list(csv.reader(open(sys.argv[2])))
+assert daq[0] == recorded[0], (daq[0], recorded[0])
+rec = {row[0]: row[1:] for row in recorded[1:]}
+rows = daq[1:]
+assert len(rows) == 1500, len(rows)
+for row in rows:
+    assert [float(v) for v in row[1:]] == [float(v) for v in rec[row[0]]], (row, rec.get(row[0]))
+print(f"{len(rows)} samples equal, t = {rows[0][0]} .. {rows[-1][0]} s")
+EOF
+then pass "record during the replay: $(cat "$WORK/cmp")"
+else cat "$WORK/cmp"; fail "the DAQ's values differ from the recording's"; fi
+
+# seek back and forth
+seek_time() { ctl replay seek "$1" | awk '/^time \/ end/ {print $5}'; }
+t1=$(seek_time 7.25) t2=$(seek_time 0.42) t3=$(seek_time 99) t4=$(seek_time 5)
+[ "$t1" = 7.25 ] && [ "$t2" = 0.42 ] && [ "$t3" = 10 ] && [ "$t4" = 5 ] &&
+  pass "seek 7.25, 0.42, 99 (clamped), 5: $t1 $t2 $t3 $t4 s" || fail "seek: $t1 $t2 $t3 $t4"
+[ "$(ctl replay status | awk '/^step \/ last/ {print $4}')" = 5000 ] && pass "replay status: step 5000" ||
+  fail "replay status after seek"
+# after a seek the replay goes on as recorded: the next step's value is the file's
+ctl step 1 >/dev/null
+got=$(ctl get $CH1 | awk '{print $3}')
+want=$(awk -F, 'NR == 5002 {printf "%.7g", $2}' "$WORK/run.csv")  # step 5001 (header, steps 1..)
+[ -n "$got" ] && [ "$got" = "$want" ] && pass "after the seek, t = 5.001 s: $CH1 = $got rad as recorded" ||
+  fail "after the seek: $CH1 = '$got', recorded '$want'"
+
+ctl replay fork >/dev/null 2>&1 || fail "fork"
+ctl motor elbow_flexor 1 >/dev/null 2>&1 && ctl step 10 >/dev/null 2>&1 &&
+  pass "fork at 5.001 s: a command is accepted, steps go on" || fail "command after fork"
+[ "$(ctl replay status | awk '/^replaying/ {print $2}')" = no ] || fail "still replaying after fork"
+
+# ------------------------------------------------------------------ a replaced scene is refused
+python3 - "$F/run.sqlite" "$F/changed.sqlite" "$SRC/models/pendulum_tendon.dae" <<'EOF'
+import shutil, sqlite3, sys
+shutil.copy(sys.argv[1], sys.argv[2])
+db = sqlite3.connect(sys.argv[2])
+db.execute("UPDATE scenes SET data = ?", (open(sys.argv[3], "rb").read(),))
+db.commit()
+EOF
+if ctl replay "$F/changed.sqlite" >"$WORK/out" 2>&1; then fail "a recording of another scene replayed"
+elif grep -q "changed.sqlite" "$WORK/out"; then pass "replaced scene refused: $(head -1 "$WORK/out" | cut -c1-140)"
+else cat "$WORK/out"; fail "the refusal does not name the file"; fi
+
+# ------------------------------------------------------------------ a size limit (a full disk)
+ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load again"
+ctl rtf 0 >/dev/null || fail "rtf 0"
+ctl recording start "$F/full.sqlite" --channel $CH1 --channel $CH2 --max-mb 1 >/dev/null 2>&1 ||
+  fail "recording start --max-mb 1"
+ctl start >/dev/null || fail "start"
+why=""
+for _ in $(seq 1 100); do
+  why=$(ctl recording status | sed -n 's/^error  *//p')
+  [ -n "$why" ] && [ "$why" != "-" ] && break
+  sleep 0.1
+done
+s1=$(ctl status | awk '/^steps/ {print $2}')
+sleep 0.3
+s2=$(ctl status | awk '/^steps/ {print $2}')
+state=$(ctl status | awk '/^state/ {print $2}')
+if [ -n "$why" ] && [ "$why" != "-" ] && [ "$state" = RUNNING ] && [ "$s2" -gt "$s1" ]; then
+  pass "--max-mb 1: '$(echo "$why" | cut -c1-100)'; still RUNNING ($s1 -> $s2 steps)"
+else fail "size limit: error '$why', state $state, steps $s1 -> $s2"; fi
+ctl stop >/dev/null
+
+# ------------------------------------------------------------------ SIGKILL while recording
+local_models_add "$WORK"
+victim=$LOCAL_MODEL_PID
+for _ in $(seq 1 100); do ctl state model1 >/dev/null 2>&1 && break; sleep 0.1; done
+ctl load "$SRC/models/ecce_arm.dae" --model model1 >/dev/null || fail "load model1"
+ctl recording start "$F/killed.sqlite" --channel $CH1 --model model1 >/dev/null || fail "start model1"
+ctl start --model model1 >/dev/null || fail "start model1"
+sleep 2
+at_kill=$(ctl status --model model1 | awk '/^simulated time/ {print $4}')
+kill -KILL "$victim"
+wait "$victim" 2>/dev/null
+ctl replay --info "$F/killed.sqlite" >"$WORK/killed" 2>&1 || { cat "$WORK/killed"; fail "the killed Model's file"; }
+last=$(field "duration" <"$WORK/killed")
+if awk -v a="$at_kill" -v l="$last" 'BEGIN {exit !(l > 0 && a - l <= 0.75 && l <= a + 0.1)}'; then
+  pass "kill -9 at t = $at_kill s: the file opens and ends at $last s (lost $(awk -v a="$at_kill" -v l="$last" 'BEGIN {print a - l}') s)"
+else cat "$WORK/killed"; fail "after kill -9: status said $at_kill s, the file ends at $last s"; fi
+
+echo "failures: $FAILS"
+[ "$FAILS" -eq 0 ]
