@@ -101,21 +101,21 @@ else cat "$WORK/cmp"; fail "the DAQ's values differ from the recording's"; fi
 
 # seek back and forth
 seek_time() { ctl replay seek "$1" | awk '/^time \/ end/ {print $5}'; }
-t1=$(seek_time 7.25) t2=$(seek_time 0.42) t3=$(seek_time 99) t4=$(seek_time 5)
-[ "$t1" = 7.25 ] && [ "$t2" = 0.42 ] && [ "$t3" = 10 ] && [ "$t4" = 5 ] &&
-  pass "seek 7.25, 0.42, 99 (clamped), 5: $t1 $t2 $t3 $t4 s" || fail "seek: $t1 $t2 $t3 $t4"
-[ "$(ctl replay status | awk '/^step \/ last/ {print $4}')" = 5000 ] && pass "replay status: step 5000" ||
+t1=$(seek_time 7.25) t2=$(seek_time 0.42) t3=$(seek_time 99) t4=$(seek_time 0.5)
+[ "$t1" = 7.25 ] && [ "$t2" = 0.42 ] && [ "$t3" = 10 ] && [ "$t4" = 0.5 ] &&
+  pass "seek 7.25, 0.42, 99 (clamped), 0.5: $t1 $t2 $t3 $t4 s" || fail "seek: $t1 $t2 $t3 $t4"
+[ "$(ctl replay status | awk '/^step \/ last/ {print $4}')" = 500 ] && pass "replay status: step 500" ||
   fail "replay status after seek"
 # after a seek the replay goes on as recorded: the next step's value is the file's
 ctl step 1 >/dev/null
-got=$(ctl get $CH1 | awk '{print $3}')
-want=$(awk -F, 'NR == 5002 {printf "%.7g", $2}' "$WORK/run.csv")  # step 5001 (header, steps 1..)
-[ -n "$got" ] && [ "$got" = "$want" ] && pass "after the seek, t = 5.001 s: $CH1 = $got rad as recorded" ||
-  fail "after the seek: $CH1 = '$got', recorded '$want'"
+got=$(ctl get $CH2 | awk '{print $3}')
+want=$(awk -F, 'NR == 502 {printf "%.7g", $3}' "$WORK/run.csv")  # step 501 (header, steps 1..)
+[ -n "$got" ] && [ "$got" = "$want" ] && pass "after the seek, t = 0.501 s: $CH2 = $got N as recorded" ||
+  fail "after the seek: $CH2 = '$got', recorded '$want'"
 
 ctl replay fork >/dev/null 2>&1 || fail "fork"
 ctl motor elbow_flexor 1 >/dev/null 2>&1 && ctl step 10 >/dev/null 2>&1 &&
-  pass "fork at 5.001 s: a command is accepted, steps go on" || fail "command after fork"
+  pass "fork at 0.501 s: a command is accepted, steps go on" || fail "command after fork"
 [ "$(ctl replay status | awk '/^replaying/ {print $2}')" = no ] || fail "still replaying after fork"
 
 # ------------------------------------------------------------------ a replaced scene is refused
