@@ -140,7 +140,7 @@ double BytesPerSimulatedMinute(unsigned long long bytes, double seconds) {
   return seconds > 0 ? bytes / seconds * 60 : 0;
 }
 
-void PrintRecordStatus(const M::RecordStatus& s, double time_step_s) {
+void PrintRecordStatus(const M::RecordStatus& s, double time_step_s, bool final = false) {
   const double seconds = s.steps * time_step_s;
   Line("recording", s.recording ? "yes" : "no");
   Line("file (on the Model's host)", std::strlen(s.path) > 0 ? s.path.in() : "-");
@@ -148,7 +148,8 @@ void PrintRecordStatus(const M::RecordStatus& s, double time_step_s) {
     Line("first step", std::to_string(s.first_step));
     Line("steps recorded", std::to_string(s.steps));
     Line("simulated time recorded [s]", Num(seconds, 9));
-    Line("size [bytes]", std::to_string(s.bytes) + " (at the last commit, <= 0.5 s ago)");
+    Line("size [bytes]",
+         std::to_string(s.bytes) + (final ? "" : " (at the last commit, <= 0.5 s ago)"));
     Line("bytes per simulated minute",
          seconds > 0 ? Num(BytesPerSimulatedMinute(s.bytes, seconds), 4) : "-");
   }
@@ -218,7 +219,7 @@ int RecordingStop(const ModelRef& m) {
   }
   s->bytes = bytes;
   std::cout << m.name << ": stopped recording " << s->path.in() << "\n";
-  PrintRecordStatus(s.in(), dt);
+  PrintRecordStatus(s.in(), dt, m.local);
   return 0;
 }
 
