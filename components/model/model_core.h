@@ -385,6 +385,7 @@ class ModelCore {
   std::unique_ptr<Recorder> recorder_session_;
   std::unique_ptr<Replay> replay_;
   std::string last_recording_error_;
+  uint64_t last_recording_bytes_ = 0;
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();

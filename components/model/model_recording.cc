@@ -124,7 +124,10 @@ void ModelCore::EndRecordingLocked(const std::string& why) {
   if (!recorder_session_) return;
   Appender().Attach(nullptr);
   const std::string path = recorder_session_->writer->path();
+  // the last step recorded, so that a replay plays to here (samples and keyframes may end before)
+  RecordEventLocked("end", why, {});
   recorder_session_->writer->Flush();
+  last_recording_bytes_ = recorder_session_->writer->bytes_written();
   last_recording_error_ = recorder_session_->writer->error();
   recorder_session_.reset();  // commits and closes
   logging::Get("model").notice("recording %s ended: %s", path.c_str(), why.c_str());
@@ -205,6 +208,7 @@ ModelCore::RecordStatus ModelCore::StopRecording() {
   s.steps = loaded_ ? loaded_->physics->steps() - s.first_step : 0;
   EndRecordingLocked("stopped");
   s.error = last_recording_error_;
+  s.bytes = last_recording_bytes_;
   return s;
 }
 
@@ -239,7 +243,7 @@ void ModelCore::BeforeStepLocked() {
     Replay& p = *replay_;
     for (; p.next < p.events.size() && p.events[p.next].step <= step; ++p.next) {
       const recording::Event& e = p.events[p.next];
-      if (e.kind == "keyframe") continue;
+      if (e.kind == "keyframe" || e.kind == "end") continue;
       if (e.kind == "command") {
         physics.SetCommand(e.target, e.values.at(0));
         loaded_->commands[e.target] = e.values.at(0);

@@ -71,7 +71,9 @@ Session RecordSession(ModelCore& core, const std::string& file) {
   via.position = {0.02, 0, -0.1};
   core.Edit([&](const sgal::Scene& sc) { return sgal::InsertPathPoint(sc, "elbow_flexor", 1, via); });
   run(400);
-  core.StopRecording();
+  const auto stopped = core.StopRecording();
+  EXPECT_GT(stopped.bytes, 100000u);  // the scene's 0.2 MB at least
+  EXPECT_EQ(stopped.steps, 963u);
   return s;
 }
 
@@ -201,6 +203,27 @@ TEST_F(ModelRecording, AChangedSceneVersionIsRefusedSayingSo) {
     EXPECT_NE(std::string(e.what()).find(file_), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("does not fit its scene"), std::string::npos) << e.what();
   }
+}
+
+TEST_F(ModelRecording, WithoutChannelsTheRecordingStillEndsWhereItStopped) {
+  ModelCore core;
+  core.Load(Model("ecce_arm.dae"));
+  core.StartRecording(file_, {});
+  core.SetCommands({{"elbow_flexor", 5.0}});
+  core.StepNow(550);  // the last keyframe is at 500
+  core.StopRecording();
+  const auto hand = Read(core, kHand);
+  recording::Reader reader(file_);
+  EXPECT_EQ(reader.last_step(), 550u);
+  ModelCore replay;
+  replay.OpenReplay(file_);
+  replay.Start();  // plays as fast as the real-time factor allows, and pauses at the end
+  replay.SetRealTimeFactor(0);
+  for (int i = 0; i < 200 && replay.replay_status().step < 550; ++i)
+    replay.Advance(std::chrono::milliseconds(5));
+  EXPECT_EQ(replay.replay_status().step, 550u);
+  EXPECT_EQ(replay.status().state, RunState::kPaused);
+  EXPECT_EQ(Read(replay, kHand), hand);
 }
 
 TEST_F(ModelRecording, AFullDiskEndsTheRecordingAndTheSimulationGoesOn) {
