@@ -129,10 +129,10 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   real_time_factor_->setValue(1.0);
   real_time_factor_->setSpecialValueText("max");
   real_time_factor_->setToolTip("real-time factor: 1 real time, 0 as fast as possible");
-  for (QWidget* w : {static_cast<QWidget*>(open_), static_cast<QWidget*>(start_),
-                     static_cast<QWidget*>(pause_), static_cast<QWidget*>(step_),
-                     static_cast<QWidget*>(step_count_), static_cast<QWidget*>(stop_),
-                     static_cast<QWidget*>(reset_), static_cast<QWidget*>(record_)})
+  for (QWidget* w :
+       {static_cast<QWidget*>(open_), static_cast<QWidget*>(start_), static_cast<QWidget*>(pause_),
+        static_cast<QWidget*>(step_), static_cast<QWidget*>(step_count_),
+        static_cast<QWidget*>(stop_), static_cast<QWidget*>(reset_)})
     controls->addWidget(w);
   controls->addStretch();
   layout->addLayout(controls);
@@ -144,6 +144,7 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   timeline->setContentsMargins(0, 0, 0, 0);
   timeline_file_ = new QLabel(timeline_);
   timeline_file_->setObjectName("timeline_file");
+  timeline_file_->setMaximumWidth(220);
   timeline_slider_ = new QSlider(Qt::Horizontal, timeline_);
   timeline_slider_->setObjectName("timeline_slider");
   timeline_slider_->setToolTip("drag to seek in the recording");
@@ -166,6 +167,10 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   settings->addSpacing(12);
   settings->addWidget(new QLabel("Real-time factor", central));
   settings->addWidget(real_time_factor_);
+  // beside the speed rather than after Reset: the arranged window is too narrow for one more
+  // button in the first row
+  settings->addSpacing(12);
+  settings->addWidget(record_);
   settings->addStretch();
   layout->addLayout(settings);
 
@@ -321,8 +326,11 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
     seek_pending_ = false;
     SendSeek(pending_seek_s_);
   });
-  connect(time_step_, &QDoubleSpinBox::editingFinished, this,
-          [this] { link_->SetTimeStep(time_step_->value()); });
+  // editingFinished comes with every focus change too: only a changed step goes to the Model
+  connect(time_step_, &QDoubleSpinBox::editingFinished, this, [this] {
+    if (time_step_->value() != link_->snapshot().status.time_step)
+      link_->SetTimeStep(time_step_->value());
+  });
   connect(real_time_factor_, &QDoubleSpinBox::editingFinished, this,
           [this] { link_->SetRealTimeFactor(real_time_factor_->value()); });
   connect(tree_, &QTreeWidget::itemDoubleClicked, this, [this](QTreeWidgetItem* item, int column) {
@@ -701,6 +709,7 @@ void MainWindow::SendSeek(double time_s) {
 void MainWindow::RefreshRecording(const Snapshot& s) {
   const bool replaying = s.connected && s.replay.replaying;
   record_->setEnabled(s.connected && s.recordings && !replaying);
+  time_step_->setEnabled(!replaying);  // a replay runs at its recording's step
   open_recording_->setEnabled(s.connected && s.recordings);
   // the button follows the Model once the last press was answered
   if (s.commands_done >= record_mark_ && record_->isChecked() != s.record.recording)
@@ -737,7 +746,9 @@ void MainWindow::RefreshRecording(const Snapshot& s) {
   const ReplayInfo& p = s.replay;
   const QString name = QFileInfo(QString::fromStdString(p.path)).fileName();
   setWindowTitle("Caliper - replaying " + name);
-  timeline_file_->setText("replaying " + name);
+  // elided: the row must leave room for the slider and Fork in a narrow window
+  timeline_file_->setText(timeline_file_->fontMetrics().elidedText(
+      "replaying " + name, Qt::ElideMiddle, timeline_file_->maximumWidth()));
   timeline_file_->setToolTip(QString::fromStdString(p.path));
   const bool changed = p.path != replay_.path || p.first_step != replay_.first_step ||
                        p.last_step != replay_.last_step;

@@ -96,7 +96,7 @@ class MainWindowRecordingTest : public ::testing::Test {
 };
 
 TEST_F(MainWindowRecordingTest, RecordOpenSeekPlayAndFork) {
-  const std::string file = dir_.path() + "/arm.caliper";
+  const std::string file = dir_.path() + "/session-20261125-073808-elbow-flexor-steps.caliper";
   record_to_ = QString::fromStdString(file);
   model_->pause();
   model_->set_command("elbow_flexor", 6.0);
@@ -113,13 +113,20 @@ TEST_F(MainWindowRecordingTest, RecordOpenSeekPlayAndFork) {
   ASSERT_TRUE(WaitInGui(
       [&] {
         M::RecordStatus_var r = model_->recording_status();
-        return r->recording && std::string(r->path.in()).find("arm.caliper") != std::string::npos;
+        return r->recording &&
+               std::string(r->path.in())
+                       .find("session-20261125-073808-elbow-flexor-steps.caliper") !=
+                   std::string::npos;
       },
       seconds(5)))
       << Status().toStdString();
   ASSERT_TRUE(WaitInGui([&] { return record_->isChecked(); }, seconds(5)));
-  EXPECT_TRUE(
-      WaitInGui([&] { return RecordingLabel().startsWith("recording arm.caliper ("); }, seconds(5)))
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return RecordingLabel().startsWith(
+            "recording session-20261125-073808-elbow-flexor-steps.caliper (");
+      },
+      seconds(5)))
       << RecordingLabel().toStdString();
 
   // 500 steps with the command changed half way
@@ -161,9 +168,14 @@ TEST_F(MainWindowRecordingTest, RecordOpenSeekPlayAndFork) {
   EXPECT_EQ(slider->value(), 0);
   EXPECT_TRUE(label->text().endsWith(QString(" / %1 s").arg(opened.end_time, 0, 'f', 3)))
       << label->text().toStdString() << " end " << opened.end_time;
-  EXPECT_TRUE(window_->windowTitle().contains("replaying arm.caliper"))
+  EXPECT_TRUE(window_->windowTitle().contains(
+      "replaying session-20261125-073808-elbow-flexor-steps.caliper"))
       << window_->windowTitle().toStdString();
   EXPECT_FALSE(record_->isEnabled()) << "no recording while replaying";
+  EXPECT_FALSE(Find<QDoubleSpinBox>("time_step")->isEnabled()) << "a replay keeps its step";
+  // the row fits a window as narrow as the arranged one (about 640 px on a 1600 px screen),
+  // where a long file name once pushed Fork out of view
+  EXPECT_LE(timeline->minimumSizeHint().width(), 640);
   // commands are refused until the fork
   EXPECT_THROW(model_->set_command("elbow_flexor", 1.0), M::NotAvailable);
 
@@ -211,6 +223,7 @@ TEST_F(MainWindowRecordingTest, RecordOpenSeekPlayAndFork) {
   EXPECT_NO_THROW(model_->set_command("elbow_flexor", 1.0));
   EXPECT_TRUE(WaitInGui([&] { return record_->isEnabled(); }, seconds(5)));
   EXPECT_EQ(window_->windowTitle().toStdString(), "Caliper");
+  EXPECT_TRUE(Find<QDoubleSpinBox>("time_step")->isEnabled());
 }
 
 TEST_F(MainWindowRecordingTest, ARefusedFileShowsTheModelsReasonAndACancelRecordsNothing) {
