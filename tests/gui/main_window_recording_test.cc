@@ -158,11 +158,9 @@ TEST_F(MainWindowRecordingTest, RecordOpenSeekPlayAndFork) {
       << Status().toStdString();
   const M::ReplayStatus opened = Replay();
   ASSERT_TRUE(opened.replaying);
-  // a recording without channels ends at its last keyframe or event: the 500 steps recorded
-  // replay up to the last keyframe at most 100 steps before the stop (the Model's side)
+  // the 500 steps recorded (no channels) replay to the step the recording stopped at
   const int span = static_cast<int>(opened.last_step - opened.first_step);
-  EXPECT_GE(span, 400);
-  EXPECT_LE(span, 500);
+  EXPECT_EQ(span, 500);
   EXPECT_EQ(slider->minimum(), 0);
   EXPECT_EQ(slider->maximum(), span);
   EXPECT_EQ(slider->value(), 0);
