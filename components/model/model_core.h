@@ -365,6 +365,8 @@ class ModelCore {
     size_t next = 0;                               // the next event to apply
     uint64_t last_reset = UINT64_MAX;              // the step caches were last reset at
     uint32_t keyframe_every = 100;
+    // each scene version imported once (a seek then builds only the engine)
+    std::map<uint32_t, std::shared_ptr<const sgal::Scene>> imported;
   };
 
   void RecordEventLocked(const std::string& kind, const std::string& target,

@@ -308,9 +308,12 @@ void ModelCore::RestoreReplayLocked(uint64_t step) {
     throw recording::RecordingError(p.path + ": keyframe at step " + std::to_string(k.step) +
                                     " names scene version " + std::to_string(k.scene_version) +
                                     ", which the file lacks");
-  sgal::Scene scene = ImportBytes(version->file_name, version->bytes);
+  std::shared_ptr<const sgal::Scene>& cached = p.imported[version->version];
+  if (!cached)
+    cached = std::make_shared<const sgal::Scene>(ImportBytes(version->file_name, version->bytes));
+  const sgal::Scene& scene = *cached;
   auto loaded = std::make_unique<Loaded>();
-  loaded->description = std::make_shared<const sgal::Scene>(scene);
+  loaded->description = cached;
   loaded->source = p.path + " (replay)";
   loaded->name = p.reader->header().model_name;
   loaded->physics = MakePhysics(scene);
