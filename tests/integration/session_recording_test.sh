@@ -151,6 +151,36 @@ if [ -n "$why" ] && [ "$why" != "-" ] && [ "$state" = RUNNING ] && [ "$s2" -gt "
 else fail "size limit: error '$why', state $state, steps $s1 -> $s2"; fi
 ctl stop >/dev/null
 
+# ------------------------------------------------------------------ a disk that is really full
+# (a 1 MB tmpfs inside the write directory; mounting needs root, which CI has)
+if [ "$(id -u)" = 0 ] && mkdir -p "$F/tiny" && mount -t tmpfs -o size=1m tmpfs "$F/tiny" 2>/dev/null; then
+  trap 'umount "$F/tiny" 2>/dev/null; local_models_stop; rm -rf "$WORK"' EXIT
+  ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load for the full disk"
+  ctl rtf 0 >/dev/null
+  ctl recording start "$F/tiny/full.sqlite" --channel $CH1 --channel $CH2 >/dev/null 2>&1 ||
+    fail "recording start on the tmpfs"
+  ctl start >/dev/null || fail "start"
+  why=""
+  for _ in $(seq 1 150); do
+    why=$(ctl recording status | sed -n 's/^error  *//p')
+    [ -n "$why" ] && [ "$why" != "-" ] && break
+    sleep 0.1
+  done
+  s1=$(ctl status | awk '/^steps/ {print $2}')
+  sleep 0.3
+  s2=$(ctl status | awk '/^steps/ {print $2}')
+  if echo "$why" | grep -qi "full" && [ "$s2" -gt "$s1" ]; then
+    pass "a full disk: '$(echo "$why" | cut -c1-110)'; the simulation ran on ($s1 -> $s2 steps)"
+  else fail "full disk: error '$why', steps $s1 -> $s2"; fi
+  ctl stop >/dev/null
+  ctl replay --info "$F/tiny/full.sqlite" >"$WORK/full" 2>&1 &&
+    pass "the full disk's file opens: $(grep -m1 duration "$WORK/full")" ||
+    { cat "$WORK/full"; fail "the full disk's file does not open"; }
+  umount "$F/tiny" || fail "umount"
+else
+  echo "note: the real full disk part needs root to mount a tmpfs; the size limit above stands in"
+fi
+
 # ------------------------------------------------------------------ SIGKILL while recording
 local_models_add "$WORK"
 victim=$LOCAL_MODEL_PID
