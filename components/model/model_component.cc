@@ -1,10 +1,39 @@
 #include "model_component.h"
 
+#include <log4cpp/Priority.hh>
+
+#include "caliper/logging.hh"
 #include "caliper/logging/log.h"
+#include "caliper/rtc/naming.h"
 #include "fault_injection.h"
 #include "model_files.h"
 
 namespace caliper::model {
+
+namespace {
+
+// the session log's records, into the Model's recording (if one runs)
+class SessionLogListener : public virtual POA_Caliper::Logging::LogListener {
+ public:
+  explicit SessionLogListener(ModelCore& core) : core_(core) {}
+  void on_records(const Caliper::Logging::StoredRecordSeq& records) override {
+    for (CORBA::ULong i = 0; i < records.length(); ++i) {
+      const Caliper::Logging::Record& r = records[i].rec;
+      recording::LogRecord out;
+      out.time = 1e-6 * static_cast<double>(r.time_us);
+      out.priority = log4cpp::Priority::getPriorityName(static_cast<int>(r.priority));
+      out.category = r.category.in();
+      out.component = r.instance.in();
+      out.message = r.message.in();
+      core_.AddSessionLog(out);
+    }
+  }
+
+ private:
+  ModelCore& core_;
+};
+
+}  // namespace
 
 std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
   using Type = core::ConfigKey::Type;
@@ -68,7 +97,29 @@ rtc::ReturnCode ModelComponent::OnFinalize() {
   return rtc::ReturnCode::kOk;
 }
 
+void ModelComponent::ListenToSessionLog() {
+  next_log_check_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  const std::string name = runtime_.config().GetString("log.service");
+  if (name.empty() || name == "none") return;
+  try {
+    CosNaming::NamingContext_var root =
+        rtc::ResolveRoot(runtime_.orb(), runtime_.naming_address());
+    Caliper::Logging::LogService_var logger =
+        Caliper::Logging::LogService::_narrow(rtc::FindComponent(root, name).object);
+    if (CORBA::is_nil(logger)) return;
+    CORBA::Object_var ref = runtime_.Activate(new SessionLogListener(*core_));
+    logger->add_listener(Caliper::Logging::LogListener::_narrow(ref));
+    core_->UseSessionLog(true);
+    listening_ = true;
+    logging::Get("model").info("recordings take the session log of '%s'", name.c_str());
+  } catch (const std::exception&) {
+    // no Logging component (yet): the Model's own records go into recordings
+  } catch (const CORBA::Exception&) {
+  }
+}
+
 rtc::ReturnCode ModelComponent::OnExecute() {
+  if (!listening_ && std::chrono::steady_clock::now() >= next_log_check_) ListenToSessionLog();
   if (runtime_.context().kind() == rtc::ContextKind::kExternal) {
     core_->Tick();
   } else {

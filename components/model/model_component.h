@@ -10,6 +10,7 @@
 // The execution context drives stepping: PERIODIC ticks advance the simulation by what the
 // real-time factor makes due; an EXTERNAL context steps once per tick (lock-step).
 
+#include <chrono>
 #include <memory>
 
 #include "caliper/rtc/runtime.h"
@@ -31,9 +32,15 @@ class ModelComponent : public rtc::Component {
   static std::vector<core::ConfigKey> ConfigKeys();
 
  private:
+  /// Listens to the Logging component (log.service) so that recordings hold the whole
+  /// session's log, every component's records; until then the Model's own records go in.
+  void ListenToSessionLog();
+
   rtc::Runtime& runtime_;
   std::unique_ptr<ModelCore> core_;
   bool autostart_;
+  bool listening_ = false;
+  std::chrono::steady_clock::time_point next_log_check_{};
 };
 
 }  // namespace caliper::model

@@ -267,6 +267,11 @@ class ModelCore {
   void Fork();
   /// The engine's dynamic state now (exact numbers included).
   sgal::DynamicState dynamic_state() const;
+  /// A record of the session's log (any component's) for the recording, if one runs.
+  void AddSessionLog(const recording::LogRecord& record);
+  /// `on`: the session log comes through AddSessionLog (the Logging component); otherwise
+  /// recordings take the Model's own records.
+  void UseSessionLog(bool on);
 
   // scene and actuators
   std::shared_ptr<const sgal::Scene> description() const;  // nullptr when empty
@@ -388,6 +393,7 @@ class ModelCore {
   std::unique_ptr<Replay> replay_;
   std::string last_recording_error_;
   uint64_t last_recording_bytes_ = 0;
+  bool session_log_ = false;  // records come through AddSessionLog
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();

@@ -184,7 +184,7 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
                       {pull_->point.x(), pull_->point.y(), pull_->point.z(), pull_->target.x(),
                        pull_->target.y(), pull_->target.z(), pull_->stiffness});
   RecordKeyframeLocked();
-  Appender().Attach(recorder_session_->writer.get());
+  if (!session_log_) Appender().Attach(recorder_session_->writer.get());
   logging::Get("model").notice("recording to %s from step %llu (keyframes every %u steps, %zu "
                                "channels)",
                                path.c_str(), static_cast<unsigned long long>(header.first_step),
@@ -447,6 +447,17 @@ void ModelCore::Fork() {
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
   logging::Get("model").notice("forked from %s at t = %.3f s: simulating on", path.c_str(),
                                loaded_->physics->time());
+}
+
+void ModelCore::AddSessionLog(const recording::LogRecord& record) {
+  const auto lock = Lock();
+  if (recorder_session_) recorder_session_->writer->AddLog(record);
+}
+
+void ModelCore::UseSessionLog(bool on) {
+  const auto lock = Lock();
+  session_log_ = on;
+  if (recorder_session_) Appender().Attach(on ? nullptr : recorder_session_->writer.get());
 }
 
 sgal::DynamicState ModelCore::dynamic_state() const {

@@ -130,6 +130,30 @@ if ctl replay "$F/changed.sqlite" >"$WORK/out" 2>&1; then fail "a recording of a
 elif grep -q "changed.sqlite" "$WORK/out"; then pass "replaced scene refused: $(head -1 "$WORK/out" | cut -c1-140)"
 else cat "$WORK/out"; fail "the refusal does not name the file"; fi
 
+# ------------------------------------------------------------------ the session's log
+# a Logging component joins; the Model listens to it (within its 2 s check), so a recording holds
+# every component's records: here those of a second Model that starts while recording
+"$BIN/caliper-logger" -o logger.directory="$WORK/logs" -o log.spool_dir="$WORK/spool" \
+  >>"$WORK/logger.out" 2>&1 &
+LOCAL_MODELS_PIDS+=($!)
+for _ in $(seq 1 100); do ctl state logger0 >/dev/null 2>&1 && break; sleep 0.1; done
+sleep 2.5  # the Model's next look for the Logging component
+ctl recording start "$F/with_log.sqlite" >/dev/null 2>&1 || fail "recording start (log)"
+local_models_add "$WORK"
+logged_model=$LOCAL_MODEL_PID
+for _ in $(seq 1 100); do ctl state model1 >/dev/null 2>&1 && break; sleep 0.1; done
+ctl step 50 >/dev/null
+sleep 1.5  # the records reach the logger and its listeners
+ctl recording stop >/dev/null || fail "recording stop (log)"
+kill -TERM "$logged_model" 2>/dev/null; wait "$logged_model" 2>/dev/null
+components=$(python3 -c "
+import sqlite3, sys
+db = sqlite3.connect('file:' + sys.argv[1] + '?mode=ro', uri=True)
+print(' '.join(sorted({c for (c,) in db.execute('SELECT component FROM log')})))" "$F/with_log.sqlite")
+if echo " $components " | grep -q " model1 "; then
+  pass "the recording holds the session log: records of $components"
+else fail "the recording's log has records of '$components', none of model1"; fi
+
 # ------------------------------------------------------------------ a size limit (a full disk)
 ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load again"
 ctl rtf 0 >/dev/null || fail "rtf 0"

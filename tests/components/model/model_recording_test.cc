@@ -226,6 +226,26 @@ TEST_F(ModelRecording, WithoutChannelsTheRecordingStillEndsWhereItStopped) {
   EXPECT_EQ(Read(replay, kHand), hand);
 }
 
+TEST_F(ModelRecording, TheLogGoesIntoTheRecording) {
+  ModelCore core;
+  core.Load(Model("ecce_arm.dae"));
+  core.StartRecording(file_, {});
+  core.StepNow(10);
+  core.Edit([](const sgal::Scene& s) { return sgal::SetMass(s, "hand", 0.4); });  // logs a notice
+  // a record of another component, as the Logging component hands them to the Model's listener
+  core.UseSessionLog(true);
+  core.AddSessionLog({1.7e9, "WARN", "caliper.renderer.renderer", "renderer0", "a renderer's word"});
+  core.StopRecording();
+  recording::Reader reader(file_);
+  bool own = false, other = false;
+  for (const auto& r : reader.Log()) {
+    own |= r.message.find("scene edit: set the mass of hand to 0.4 kg") != std::string::npos;
+    other |= r.component == "renderer0" && r.message == "a renderer's word";
+  }
+  EXPECT_TRUE(own) << "the Model's own record of the edit";
+  EXPECT_TRUE(other) << "another component's record";
+}
+
 TEST_F(ModelRecording, AFullDiskEndsTheRecordingAndTheSimulationGoesOn) {
   ModelCore core;
   core.Load(Model("ecce_arm.dae"));
