@@ -7,9 +7,8 @@
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
-FAILS=0
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
+# shellcheck source=support/checks.sh
+source "$SRC/tests/integration/support/checks.sh"
 # shellcheck source=../../launch/local_models.sh
 source "$SRC/launch/local_models.sh"
 local_models_session 2

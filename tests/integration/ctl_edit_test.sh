@@ -7,9 +7,8 @@
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
-FAILS=0
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
+# shellcheck source=support/checks.sh
+source "$SRC/tests/integration/support/checks.sh"
 # shellcheck source=../../launch/local_models.sh
 source "$SRC/launch/local_models.sh"
 local_models_session 1
@@ -123,5 +122,4 @@ if cmp -s "$WORK/path.edited" "$WORK/path.loaded" && ctl edit path elbow_extenso
 else diff "$WORK/path.edited" "$WORK/path.loaded"; fail "round trip"; fi
 ctl edit | grep -q "undo: (nothing)" && pass "a load starts a new history" || fail "history after load"
 
-[ "$FAILS" -eq 0 ] && echo "all passed" || echo "$FAILS failed"
-exit $((FAILS > 0))
+finish

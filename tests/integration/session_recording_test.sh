@@ -9,9 +9,8 @@
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
-FAILS=0
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
+# shellcheck source=support/checks.sh
+source "$SRC/tests/integration/support/checks.sh"
 # shellcheck source=../../launch/local_models.sh
 source "$SRC/launch/local_models.sh"
 WORK=$(mktemp -d)
@@ -154,37 +153,17 @@ if echo " $components " | grep -q " model1 "; then
   pass "the recording holds the session log: records of $components"
 else fail "the recording's log has records of '$components', none of model1"; fi
 
-# ------------------------------------------------------------------ a size limit (a full disk)
-ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load again"
-ctl rtf 0 >/dev/null || fail "rtf 0"
-ctl recording start "$F/full.sqlite" --channel $CH1 --channel $CH2 --max-mb 1 >/dev/null 2>&1 ||
-  fail "recording start --max-mb 1"
-ctl start >/dev/null || fail "start"
-why=""
-for _ in $(seq 1 100); do
-  why=$(ctl recording status | sed -n 's/^error  *//p')
-  [ -n "$why" ] && [ "$why" != "-" ] && break
-  sleep 0.1
-done
-s1=$(ctl status | awk '/^steps/ {print $2}')
-sleep 0.3
-s2=$(ctl status | awk '/^steps/ {print $2}')
-state=$(ctl status | awk '/^state/ {print $2}')
-if [ -n "$why" ] && [ "$why" != "-" ] && [ "$state" = RUNNING ] && [ "$s2" -gt "$s1" ]; then
-  pass "--max-mb 1: '$(echo "$why" | cut -c1-100)'; still RUNNING ($s1 -> $s2 steps)"
-else fail "size limit: error '$why', state $state, steps $s1 -> $s2"; fi
-ctl stop >/dev/null
-
-# ------------------------------------------------------------------ a disk that is really full
-# (a 1 MB tmpfs inside the write directory; mounting needs root, which CI has)
-if [ "$(id -u)" = 0 ] && mkdir -p "$F/tiny" && mount -t tmpfs -o size=1m tmpfs "$F/tiny" 2>/dev/null; then
-  trap 'umount "$F/tiny" 2>/dev/null; local_models_stop; rm -rf "$WORK"' EXIT
-  ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load for the full disk"
-  ctl rtf 0 >/dev/null
-  ctl recording start "$F/tiny/full.sqlite" --channel $CH1 --channel $CH2 >/dev/null 2>&1 ||
-    fail "recording start on the tmpfs"
-  ctl start >/dev/null || fail "start"
-  why=""
+# ------------------------------------------------------------------ a size limit, a full disk
+# records FILE with two channels at full speed until the recording stops by itself; then the
+# reason must match PATTERN and the simulation must still be stepping
+fills_up() {  # LABEL FILE PATTERN [recording start options]
+  local label=$1 file=$2 pattern=$3 why="" s1 s2
+  shift 3
+  ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "$label: load"
+  ctl rtf 0 >/dev/null || fail "$label: rtf 0"
+  ctl recording start "$file" --channel $CH1 --channel $CH2 "$@" >/dev/null 2>&1 ||
+    fail "$label: recording start"
+  ctl start >/dev/null || fail "$label: start"
   for _ in $(seq 1 150); do
     why=$(ctl recording status | sed -n 's/^error  *//p')
     [ -n "$why" ] && [ "$why" != "-" ] && break
@@ -193,10 +172,18 @@ if [ "$(id -u)" = 0 ] && mkdir -p "$F/tiny" && mount -t tmpfs -o size=1m tmpfs "
   s1=$(ctl status | awk '/^steps/ {print $2}')
   sleep 0.3
   s2=$(ctl status | awk '/^steps/ {print $2}')
-  if echo "$why" | grep -qi "full" && [ "$s2" -gt "$s1" ]; then
-    pass "a full disk: '$(echo "$why" | cut -c1-110)'; the simulation ran on ($s1 -> $s2 steps)"
-  else fail "full disk: error '$why', steps $s1 -> $s2"; fi
+  if echo "$why" | grep -qi "$pattern" && [ "$s2" -gt "$s1" ]; then
+    pass "$label: '$(echo "$why" | cut -c1-110)'; the simulation ran on ($s1 -> $s2 steps)"
+  else fail "$label: error '$why', steps $s1 -> $s2"; fi
   ctl stop >/dev/null
+}
+fills_up "--max-mb 1" "$F/full.sqlite" "limit" --max-mb 1
+
+# a disk that is really full: a 1 MB tmpfs inside the write directory (mounting needs root, which
+# CI has)
+if [ "$(id -u)" = 0 ] && mkdir -p "$F/tiny" && mount -t tmpfs -o size=1m tmpfs "$F/tiny" 2>/dev/null; then
+  trap 'umount "$F/tiny" 2>/dev/null; local_models_stop; rm -rf "$WORK"' EXIT
+  fills_up "a full disk" "$F/tiny/full.sqlite" "disk full"
   ctl replay --info "$F/tiny/full.sqlite" >"$WORK/full" 2>&1 &&
     pass "the full disk's file opens: $(grep -m1 duration "$WORK/full")" ||
     { cat "$WORK/full"; fail "the full disk's file does not open"; }
@@ -222,5 +209,4 @@ if awk -v a="$at_kill" -v l="$last" 'BEGIN {exit !(l > 0 && a - l <= 0.75 && l <
   pass "kill -9 at t = $at_kill s: the file opens and ends at $last s (lost $(awk -v a="$at_kill" -v l="$last" 'BEGIN {print a - l}') s)"
 else cat "$WORK/killed"; fail "after kill -9: status said $at_kill s, the file ends at $last s"; fi
 
-echo "failures: $FAILS"
-[ "$FAILS" -eq 0 ]
+finish
