@@ -1,12 +1,9 @@
 #include "model_verbs.h"
 
-#include <limits.h>
 #include <signal.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -24,11 +21,11 @@
 
 #include "caliper/model.hh"
 #include "caliper/core/confined_path.h"
-#include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/urdf/model_file.h"
 #include "csv_recording.h"
+#include "model_client.h"
 #include "model_runs.h"
 
 namespace caliper::ctl {
@@ -38,44 +35,8 @@ namespace M = ::Caliper::Simulation;
 namespace D = ::Caliper::Daq;
 namespace S = ::Caliper::Scene;
 
-constexpr const char* kDefaultModel = "model0";
 // load, step and save take as long as their work: no short call timeout for them [ms]
 constexpr CORBA::ULong kLongCallMs = 3600 * 1000;
-constexpr int kLabelWidth = 22;
-
-// values print with 7 significant digits (Bullet computes in single precision); times with more
-std::string Num(double v, int precision = 7) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
-
-// A number given on the command line (nan and inf pass: the Model judges values).
-double ParseNumber(const std::string& text, const std::string& what) {
-  double v = 0;
-  std::string why;
-  if (!core::ParseDouble(text, &v, &why)) throw UsageError(what + ": " + why);
-  return v;
-}
-
-// A count from 1 to 2^32 - 1.
-CORBA::ULong ParseCount(const std::string& text, const std::string& what) {
-  const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c));
-  });
-  const unsigned long long v = digits && text.size() <= 10 ? std::stoull(text) : 0;
-  if (v < 1 || v > std::numeric_limits<CORBA::ULong>::max())
-    throw UsageError(what + ": '" + text + "' is not a whole number from 1 to 4294967295");
-  return static_cast<CORBA::ULong>(v);
-}
-
-// The Model's process has another working directory: send it absolute paths.
-std::string Absolute(const std::string& path) {
-  if (path.empty() || path[0] == '/') return path;
-  char cwd[PATH_MAX];
-  if (getcwd(cwd, sizeof cwd) == nullptr) return path;
-  return std::string(cwd) + "/" + path;
-}
 
 S::StringSeq ToSeq(const std::vector<std::string>& ids) {
   S::StringSeq out;
@@ -84,76 +45,8 @@ S::StringSeq ToSeq(const std::vector<std::string>& ids) {
   return out;
 }
 
-// The Model a verb works on.
-struct ModelRef {
-  std::string name;
-  std::string path;
-  std::string host;  // the host context it is bound under
-  M::Model_var model;
-};
-
 // Files go by content to a Model on another host (or with --send): it shares no disk with us.
-bool ByContent(const ModelRef& m, bool send_flag) {
-  return send_flag || m.host != core::HostName();
-}
-
-std::string TakeModel(std::vector<std::string>& args) {
-  std::string name = kDefaultModel;
-  TakeOption(args, "--model", &name);
-  return name;
-}
-
-void NoArguments(const std::vector<std::string>& args) {
-  RejectOptions(args);
-  if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
-}
-
-ModelRef Connect(Client& client, const std::string& name) {
-  rtc::ComponentEntry e = client.Find(name);
-  ModelRef ref;
-  ref.name = name;
-  ref.path = e.path;
-  ref.host = e.host;
-  try {
-    ref.model = M::Model::_narrow(e.object);
-  } catch (const CORBA::Exception& ex) {
-    throw Failure(Client::Unreachable(e.path, ex));
-  }
-  if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
-  return ref;
-}
-
-// Runs calls on the Model and turns what they raise into messages: a user exception's reason
-// (exit 1), or that the Model cannot be reached.
-template <class F>
-auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const D::UnknownId& e) {
-    const std::string reason = e.reason.in(), id = e.id.in();
-    throw Failure(reason.find("'" + id + "'") != std::string::npos
-                      ? reason
-                      : "unknown id '" + id + "': " + reason);
-  } catch (const D::InvalidParameter& e) {
-    throw Failure(e.reason.in());
-  } catch (const M::NotAvailable& e) {
-    throw Failure(m.name + ": " + e.reason.in());
-  } catch (const D::NotAvailable& e) {
-    throw Failure(m.name + ": " + e.reason.in());
-  } catch (const M::LoadFailed& e) {
-    throw Failure(e.reason.in());
-  } catch (const M::EditRefused& e) {
-    throw Failure(m.name + ": edit refused: " + e.reason.in());
-  } catch (const CORBA::UserException& e) {
-    throw Failure(m.path + ": " + rtc::Describe(e));
-  } catch (const CORBA::SystemException& e) {
-    throw Failure(Client::Unreachable(m.path, e));
-  }
-}
-
-M::SimulationStatus* StatusOf(const ModelRef& m) {
-  return Call(m, [&] { return m.model->status(); });
-}
+bool ByContent(const ModelRef& m, bool send_flag) { return send_flag || !m.local; }
 
 // Whether a Model on this host takes `path` itself: it reads only below its search path and
 // writes only below its write directory (file_access); other files go by content.
@@ -219,10 +112,6 @@ void PrintValue(const std::string& id, const std::string& unit, const D::Value& 
       std::cout << "\n";
     }
   }
-}
-
-void Line(const std::string& label, const std::string& value) {
-  std::cout << std::left << std::setw(kLabelWidth) << label << value << "\n";
 }
 
 // ------------------------------------------------------------------------ simulation control

@@ -1,110 +1,32 @@
 #include "recording_verbs.h"
 
-#include <limits.h>
-#include <unistd.h>
-
-#include <algorithm>
-#include <cctype>
 #include <chrono>
-#include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
 #include <map>
-#include <sstream>
 
 #include "caliper/collada/importer.h"
 #include "caliper/core/numbers.h"
-#include "caliper/core/system.h"
 #include "caliper/model.hh"
 #include "caliper/recording/recording.h"
-#include "caliper/rtc/idl_names.h"
+#include "model_client.h"
 #include "model_core.h"
 
 namespace caliper::ctl {
 namespace {
 
 namespace M = ::Caliper::Simulation;
-namespace D = ::Caliper::Daq;
 
 // open_replay and seek re-simulate up to a keyframe interval: no short call timeout [ms]
 constexpr CORBA::ULong kLongCallMs = 600 * 1000;
+// the recording summaries' labels are longer than the Model's status labels
 constexpr int kLabelWidth = 30;
 
-std::string Num(double v, int precision = 7) {
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
-
-void Line(const std::string& label, const std::string& value) {
-  std::cout << std::left << std::setw(kLabelWidth) << label << value << "\n";
-}
-
-// The Model's process has another working directory: send it absolute paths.
-std::string Absolute(const std::string& path) {
-  if (path.empty() || path[0] == '/') return path;
-  char cwd[PATH_MAX];
-  if (getcwd(cwd, sizeof cwd) == nullptr) return path;
-  return std::string(cwd) + "/" + path;
-}
-
-unsigned long long ParseWhole(const std::string& text, const std::string& what,
-                              unsigned long long max) {
-  const bool digits =
-      !text.empty() && text.size() <= 19 && std::all_of(text.begin(), text.end(), [](char c) {
-        return std::isdigit(static_cast<unsigned char>(c));
-      });
-  const unsigned long long v = digits ? std::stoull(text) : 0;
-  if (v < 1 || v > max)
-    throw UsageError(what + ": '" + text + "' is not a whole number from 1 to " +
-                     std::to_string(max));
-  return v;
-}
-
-struct ModelRef {
-  std::string name;
-  std::string path;
-  bool local = true;  // on this host: it shares our files
-  M::Model_var model;
-};
-
-ModelRef Connect(Client& client, std::vector<std::string>& args) {
-  ModelRef ref;
-  ref.name = "model0";
-  TakeOption(args, "--model", &ref.name);
-  rtc::ComponentEntry e = client.Find(ref.name);
-  ref.path = e.path;
-  ref.local = e.host == core::HostName();
-  try {
-    ref.model = M::Model::_narrow(e.object);
-  } catch (const CORBA::Exception& ex) {
-    throw Failure(Client::Unreachable(e.path, ex));
-  }
-  if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
-  omniORB::setClientCallTimeout(ref.model, kLongCallMs);
-  return ref;
-}
-
-// Runs a call on the Model; its user exceptions become their reasons (exit 1).
-template <class F>
-auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const D::UnknownId& e) {
-    throw Failure(std::string(e.reason.in()));
-  } catch (const D::InvalidParameter& e) {
-    throw Failure(e.reason.in());
-  } catch (const M::NotAvailable& e) {
-    throw Failure(m.name + ": " + e.reason.in());
-  } catch (const M::LoadFailed& e) {
-    throw Failure(e.reason.in());
-  } catch (const CORBA::UserException& e) {
-    throw Failure(m.path + ": " + rtc::Describe(e));
-  } catch (const CORBA::SystemException& e) {
-    throw Failure(Client::Unreachable(m.path, e));
-  }
+ModelRef ConnectWithLongCalls(Client& client, std::vector<std::string>& args) {
+  ModelRef m = Connect(client, TakeModel(args));
+  omniORB::setClientCallTimeout(m.model, kLongCallMs);
+  return m;
 }
 
 // A path for the Model: absolute from here for a Model on this host, else as given (relative
@@ -142,22 +64,23 @@ double BytesPerSimulatedMinute(unsigned long long bytes, double seconds) {
 
 void PrintRecordStatus(const M::RecordStatus& s, double time_step_s, bool final = false) {
   const double seconds = s.steps * time_step_s;
-  Line("recording", s.recording ? "yes" : "no");
-  Line("file (on the Model's host)", std::strlen(s.path) > 0 ? s.path.in() : "-");
+  Line("recording", s.recording ? "yes" : "no", kLabelWidth);
+  Line("file (on the Model's host)", std::strlen(s.path) > 0 ? s.path.in() : "-", kLabelWidth);
   if (std::strlen(s.path) > 0) {
-    Line("first step", std::to_string(s.first_step));
-    Line("steps recorded", std::to_string(s.steps));
-    Line("simulated time recorded [s]", Num(seconds, 9));
+    Line("first step", std::to_string(s.first_step), kLabelWidth);
+    Line("steps recorded", std::to_string(s.steps), kLabelWidth);
+    Line("simulated time recorded [s]", Num(seconds, 9), kLabelWidth);
     Line("size [bytes]",
-         std::to_string(s.bytes) + (final ? "" : " (at the last commit, <= 0.5 s ago)"));
+         std::to_string(s.bytes) + (final ? "" : " (at the last commit, <= 0.5 s ago)"),
+         kLabelWidth);
     Line("bytes per simulated minute",
-         seconds > 0 ? Num(BytesPerSimulatedMinute(s.bytes, seconds), 4) : "-");
+         seconds > 0 ? Num(BytesPerSimulatedMinute(s.bytes, seconds), 4) : "-", kLabelWidth);
   }
-  Line("error", std::strlen(s.error) > 0 ? s.error.in() : "-");
+  Line("error", std::strlen(s.error) > 0 ? s.error.in() : "-", kLabelWidth);
 }
 
 double TimeStepOf(const ModelRef& m) {
-  M::SimulationStatus_var st = Call(m, [&] { return m.model->status(); });
+  M::SimulationStatus_var st = StatusOf(m);
   return st->time_step;
 }
 
@@ -169,8 +92,7 @@ int RecordingStart(const ModelRef& m, std::vector<std::string>& args) {
   std::vector<std::string> channels;
   std::string value;
   while (TakeOption(args, "--channel", &value)) channels.push_back(value);
-  if (TakeOption(args, "--every", &value))
-    o.channels_every = static_cast<CORBA::ULong>(ParseWhole(value, "--every", 4294967295ull));
+  if (TakeOption(args, "--every", &value)) o.channels_every = ParseCount(value, "--every");
   if (TakeOption(args, "--keyframe-every", &value))
     o.keyframe_every = static_cast<CORBA::ULong>(ParseWhole(value, "--keyframe-every", 1000000ull));
   if (TakeOption(args, "--max-mb", &value)) {
@@ -228,10 +150,9 @@ int Recording(Client& client, std::vector<std::string>& args) {
     throw UsageError("expected: recording start FILE | stop | status");
   const std::string what = args[0];
   args.erase(args.begin());
-  ModelRef m = Connect(client, args);
+  ModelRef m = ConnectWithLongCalls(client, args);
   if (what == "start") return RecordingStart(m, args);
-  RejectOptions(args);
-  if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
+  NoArguments(args);
   if (what == "stop") return RecordingStop(m);
   if (what == "status") {
     M::RecordStatus_var s = Call(m, [&] { return m.model->recording_status(); });
@@ -244,13 +165,13 @@ int Recording(Client& client, std::vector<std::string>& args) {
 // ------------------------------------------------------------------------ replay on a Model
 
 void PrintReplayStatus(const M::ReplayStatus& s) {
-  Line("replaying", s.replaying ? "yes" : "no");
+  Line("replaying", s.replaying ? "yes" : "no", kLabelWidth);
   if (!s.replaying) return;
-  Line("file (on the Model's host)", s.path.in());
-  Line("time / end [s]", Num(s.time, 9) + " / " + Num(s.end_time, 9));
-  Line("step / last", std::to_string(s.step) + " / " + std::to_string(s.last_step));
-  Line("first step", std::to_string(s.first_step));
-  Line("start time [s]", Num(s.start_time, 9));
+  Line("file (on the Model's host)", s.path.in(), kLabelWidth);
+  Line("time / end [s]", Num(s.time, 9) + " / " + Num(s.end_time, 9), kLabelWidth);
+  Line("step / last", std::to_string(s.step) + " / " + std::to_string(s.last_step), kLabelWidth);
+  Line("first step", std::to_string(s.first_step), kLabelWidth);
+  Line("start time [s]", Num(s.start_time, 9), kLabelWidth);
 }
 
 // ------------------------------------------------------------------------ the file alone
@@ -270,24 +191,31 @@ int Info(const std::string& path) {
   recording::Reader reader(path);
   const recording::Header& h = reader.header();
   const uint64_t last = reader.last_step();
-  Line("file", path);
-  Line("model", h.model_name);
+  Line("file", path, kLabelWidth);
+  Line("model", h.model_name, kLabelWidth);
   const auto scenes = reader.scenes();
   Line("scene",
        h.scene_file_name + (scenes.size() > 1
                                 ? " (and " + std::to_string(scenes.size() - 1) + " edited versions)"
-                                : std::string()));
-  Line("time step [s]", Num(h.time_step));
-  Line("steps", std::to_string(last - h.first_step) + " (" + std::to_string(h.first_step) + " to " +
-                    std::to_string(last) + ")");
-  Line("duration [s]", Num(reader.duration(), 9));
-  Line("keyframes", std::to_string(reader.keyframe_steps().size()) + " (every " +
-                        std::to_string(h.keyframe_every) + " steps)");
+                                : std::string()),
+       kLabelWidth);
+  Line("time step [s]", Num(h.time_step), kLabelWidth);
+  Line("steps",
+       std::to_string(last - h.first_step) + " (" + std::to_string(h.first_step) + " to " +
+           std::to_string(last) + ")",
+       kLabelWidth);
+  Line("duration [s]", Num(reader.duration(), 9), kLabelWidth);
+  Line("keyframes",
+       std::to_string(reader.keyframe_steps().size()) + " (every " +
+           std::to_string(h.keyframe_every) + " steps)",
+       kLabelWidth);
   if (h.channels.empty()) {
-    Line("channels", "none");
+    Line("channels", "none", kLabelWidth);
   } else {
-    Line("channels", std::to_string(h.channels.size()) + " (a sample every " +
-                         std::to_string(h.channels_every) + " steps)");
+    Line("channels",
+         std::to_string(h.channels.size()) + " (a sample every " +
+             std::to_string(h.channels_every) + " steps)",
+         kLabelWidth);
     // ids are often longer than the label column: one per line, the unit after a space
     for (const auto& c : h.channels)
       std::cout << "  " << c.id << " [" << c.unit << "]"
@@ -301,12 +229,13 @@ int Info(const std::string& path) {
   std::string events;
   for (const auto& [kind, n] : kinds)
     events += (events.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
-  Line("events", events.empty() ? "none" : events);
-  Line("log records", std::to_string(reader.Log().size()));
+  Line("events", events.empty() ? "none" : events, kLabelWidth);
+  Line("log records", std::to_string(reader.Log().size()), kLabelWidth);
   unsigned long long bytes = 0;
-  Line("file size [bytes]", FileSize(path, &bytes));
+  Line("file size [bytes]", FileSize(path, &bytes), kLabelWidth);
   Line("bytes per simulated minute",
-       reader.duration() > 0 ? Num(BytesPerSimulatedMinute(bytes, reader.duration()), 4) : "-");
+       reader.duration() > 0 ? Num(BytesPerSimulatedMinute(bytes, reader.duration()), 4) : "-",
+       kLabelWidth);
   return 0;
 }
 
@@ -340,13 +269,11 @@ int Verify(const std::string& path) {
 int Replay(Client& client, std::vector<std::string>& args) {
   std::string file;
   if (TakeOption(args, "--info", &file)) {
-    RejectOptions(args);
-    if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
+    NoArguments(args);
     return Info(file);
   }
   if (TakeOption(args, "--verify", &file)) {
-    RejectOptions(args);
-    if (!args.empty()) throw UsageError("unexpected argument '" + args[0] + "'");
+    NoArguments(args);
     return Verify(file);
   }
   if (TakeOption(args, "--csv", &file)) {
@@ -356,7 +283,7 @@ int Replay(Client& client, std::vector<std::string>& args) {
     std::cout << "wrote the channels of " << file << " to " << args[0] << "\n";
     return 0;
   }
-  ModelRef m = Connect(client, args);
+  ModelRef m = ConnectWithLongCalls(client, args);
   // the Model's refusals of commands during a replay name `replay --fork`
   if (TakeFlag(args, "--fork")) args.insert(args.begin(), "fork");
   RejectOptions(args);
@@ -365,9 +292,7 @@ int Replay(Client& client, std::vector<std::string>& args) {
   M::ReplayStatus_var s;
   if (what == "seek") {
     if (args.size() != 2) throw UsageError("expected: replay seek SECONDS");
-    double t = 0;
-    std::string why;
-    if (!core::ParseDouble(args[1], &t, &why)) throw UsageError("SECONDS: " + why);
+    const double t = ParseNumber(args[1], "SECONDS");
     s = Call(m, [&] { return m.model->seek(t); });
   } else if (what == "fork") {
     if (args.size() != 1) throw UsageError("replay fork takes no arguments");
@@ -399,16 +324,14 @@ int Replay(Client& client, std::vector<std::string>& args) {
 
 // The speed of a run or a replay (there was no verb for set_real_time_factor before replays).
 int Rtf(Client& client, std::vector<std::string>& args) {
-  ModelRef m = Connect(client, args);
+  ModelRef m = ConnectWithLongCalls(client, args);
   RejectOptions(args);
   if (args.size() > 1) throw UsageError("expected at most one FACTOR");
   if (args.size() == 1) {
-    double f = 0;
-    std::string why;
-    if (!core::ParseDouble(args[0], &f, &why)) throw UsageError("FACTOR: " + why);
+    const double f = ParseNumber(args[0], "FACTOR");
     Call(m, [&] { m.model->set_real_time_factor(f); });
   }
-  M::SimulationStatus_var s = Call(m, [&] { return m.model->status(); });
+  M::SimulationStatus_var s = StatusOf(m);
   std::cout << m.name << ": real-time factor "
             << (s->real_time_factor == 0 ? std::string("0 (as fast as possible)")
                                          : Num(s->real_time_factor))
