@@ -38,18 +38,10 @@ namespace S = ::Caliper::Scene;
 using main_window::MainWindow;
 using main_window::ModelLink;
 
-class MainWindowEditTest : public ::testing::Test {
+class MainWindowEditTest : public ModelProcessTest {
  protected:
   void SetUp() override {
-    App();
-    Orb();
-    naming_ = std::make_unique<NamingService>(dir_.path());
-    qputenv("CALIPER_MAIN_SETTINGS", QByteArray::fromStdString(dir_.path() + "/caliper-main.ini"));
-    const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
-    process_ = StartModelProcess(naming_->address(), models + "/ecce_arm.dae", dir_.path(),
-                                 dir_.path() + "/model.out");
-    model_ = WaitForModel(naming_->address());
-    ASSERT_FALSE(CORBA::is_nil(model_)) << process_->Output();
+    ASSERT_NO_FATAL_FAILURE(StartModelSession("models/ecce_arm.dae"));
     ModelLink::Options options;
     options.nameservice = naming_->address();
     options.reconnect_period_ms = 300;
@@ -64,10 +56,7 @@ class MainWindowEditTest : public ::testing::Test {
 
   void TearDown() override {
     window_.reset();
-    if (process_) {
-      process_->Signal(SIGTERM);
-      EXPECT_EQ(process_->Wait(seconds(10)), 0) << process_->Output();
-    }
+    StopModel();
   }
 
   double Get(const std::string& id) {
@@ -86,10 +75,6 @@ class MainWindowEditTest : public ::testing::Test {
     return w;
   }
 
-  TempDir dir_;
-  std::unique_ptr<NamingService> naming_;
-  std::unique_ptr<Process> process_;
-  M::Model_var model_;
   std::unique_ptr<MainWindow> window_;
 };
 

@@ -47,17 +47,10 @@ TEST(MainWindowOpen, TheFilterOffersUrdfBesideCollada) {
   EXPECT_TRUE(entries.contains("COLLADA (*.dae *.zae)")) << filter.toStdString();
 }
 
-class MainWindowOpenTest : public ::testing::Test {
+class MainWindowOpenTest : public ModelProcessTest {
  protected:
   void SetUp() override {
-    App();
-    Orb();
-    naming_ = std::make_unique<NamingService>(dir_.path());
-    qputenv("CALIPER_MAIN_SETTINGS", QByteArray::fromStdString(dir_.path() + "/caliper-main.ini"));
-    model_ = StartModelProcess(naming_->address(), Source("models/pendulum_tendon.dae"),
-                               dir_.path(), dir_.path() + "/model.out");
-    ref_ = WaitForModel(naming_->address());
-    ASSERT_FALSE(CORBA::is_nil(ref_)) << model_->Output();
+    ASSERT_NO_FATAL_FAILURE(StartModelSession("models/pendulum_tendon.dae"));
     ModelLink::Options options;
     options.nameservice = naming_->address();
     options.reconnect_period_ms = 300;
@@ -93,14 +86,11 @@ class MainWindowOpenTest : public ::testing::Test {
   }
 
   std::string Scene() {
-    M::SimulationStatus_var s = ref_->status();
+    M::SimulationStatus_var s = model_->status();
     return s->scene.in();
   }
 
-  TempDir dir_, elsewhere_;
-  std::unique_ptr<NamingService> naming_;
-  std::unique_ptr<Process> model_;
-  M::Model_var ref_;
+  TempDir elsewhere_;
   std::unique_ptr<MainWindow> window_;
 };
 

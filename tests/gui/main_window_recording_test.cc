@@ -5,7 +5,6 @@
 // following; Fork hides the timeline and the Model takes commands again. The file dialogs are
 // replaced by a chooser the test sets. Widgets run on QT_QPA_PLATFORM=offscreen.
 #include <gtest/gtest.h>
-#include <signal.h>
 
 #include <QAction>
 #include <QApplication>
@@ -36,18 +35,10 @@ namespace M = ::Caliper::Simulation;
 using main_window::MainWindow;
 using main_window::ModelLink;
 
-class MainWindowRecordingTest : public ::testing::Test {
+class MainWindowRecordingTest : public ModelProcessTest {
  protected:
   void SetUp() override {
-    App();
-    Orb();
-    naming_ = std::make_unique<NamingService>(dir_.path());
-    qputenv("CALIPER_MAIN_SETTINGS", QByteArray::fromStdString(dir_.path() + "/caliper-main.ini"));
-    const std::string models = std::string(std::getenv("CALIPER_SOURCE_DIR")) + "/models";
-    process_ = StartModelProcess(naming_->address(), models + "/ecce_arm.dae", dir_.path(),
-                                 dir_.path() + "/model.out");
-    model_ = WaitForModel(naming_->address());
-    ASSERT_FALSE(CORBA::is_nil(model_)) << process_->Output();
+    ASSERT_NO_FATAL_FAILURE(StartModelSession("models/ecce_arm.dae"));
     ModelLink::Options options;
     options.nameservice = naming_->address();
     options.reconnect_period_ms = 300;
@@ -67,10 +58,7 @@ class MainWindowRecordingTest : public ::testing::Test {
 
   void TearDown() override {
     window_.reset();
-    if (process_) {
-      process_->Signal(SIGTERM);
-      EXPECT_EQ(process_->Wait(seconds(10)), 0) << process_->Output();
-    }
+    StopModel();
   }
 
   QString Status() { return window_->statusBar()->currentMessage(); }
@@ -83,10 +71,6 @@ class MainWindowRecordingTest : public ::testing::Test {
   }
   M::ReplayStatus Replay() { return M::ReplayStatus_var(model_->replay_status()).in(); }
 
-  TempDir dir_;
-  std::unique_ptr<NamingService> naming_;
-  std::unique_ptr<Process> process_;
-  M::Model_var model_;
   std::unique_ptr<MainWindow> window_;
   QPushButton* record_ = nullptr;
   QString record_to_;  // what the chooser answers

@@ -1,5 +1,7 @@
 #include "support/gui_test.h"
 
+#include <signal.h>
+
 #include <QElapsedTimer>
 #include <algorithm>
 #include <QTest>
@@ -90,6 +92,25 @@ std::unique_ptr<Process> StartModelProcess(const std::string& address, const std
       },
       std::chrono::seconds(20));
   return model._retn();
+}
+
+void ModelProcessTest::StartModelSession(const std::string& scene) {
+  App();
+  Orb();
+  naming_ = std::make_unique<NamingService>(dir_.path());
+  qputenv("CALIPER_MAIN_SETTINGS", QByteArray::fromStdString(dir_.path() + "/caliper-main.ini"));
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  process_ = StartModelProcess(naming_->address(),
+                               std::string(source != nullptr ? source : ".") + "/" + scene,
+                               dir_.path(), dir_.path() + "/model.out");
+  model_ = WaitForModel(naming_->address());
+  ASSERT_FALSE(CORBA::is_nil(model_)) << process_->Output();
+}
+
+void ModelProcessTest::StopModel() {
+  if (!process_) return;
+  process_->Signal(SIGTERM);
+  EXPECT_EQ(process_->Wait(std::chrono::seconds(10)), 0) << process_->Output();
 }
 
 }  // namespace caliper::testing

@@ -2,6 +2,8 @@
 // Helpers for the GUI tests that run widgets in the test process: one QApplication, one ORB,
 // waiting while processing events, and where screenshots go.
 
+#include <gtest/gtest.h>
+
 #include <QApplication>
 #include <chrono>
 #include <functional>
@@ -41,5 +43,23 @@ std::unique_ptr<Process> StartModelProcess(const std::string& address, const std
 /// The Model bound as `instance` that answers, or nil after 20 s.
 ::Caliper::Simulation::Model_ptr WaitForModel(const std::string& address,
                                               const std::string& instance = "model0");
+
+/// A test of a window against a real caliper-model: a private naming service and the Model on
+/// it (StartModelProcess), its files and the Main Window's settings (CALIPER_MAIN_SETTINGS,
+/// caliper-main.ini) in dir_.
+class ModelProcessTest : public ::testing::Test {
+ protected:
+  /// Starts the naming service and the Model with `scene` (a path below $CALIPER_SOURCE_DIR)
+  /// and waits for the Model to answer: a fatal failure with its output when it does not
+  /// within 20 s (call it in ASSERT_NO_FATAL_FAILURE).
+  void StartModelSession(const std::string& scene);
+  /// Stops the Model with SIGTERM and expects it to exit 0 within 10 s.
+  void StopModel();
+
+  TempDir dir_;
+  std::unique_ptr<NamingService> naming_;
+  std::unique_ptr<Process> process_;
+  ::Caliper::Simulation::Model_var model_;
+};
 
 }  // namespace caliper::testing
