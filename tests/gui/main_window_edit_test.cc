@@ -26,6 +26,7 @@
 #include "main_window.h"
 #include "model_link.h"
 #include "support/gui_test.h"
+#include "support/main_window_on_model.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -42,12 +43,7 @@ class MainWindowEditTest : public ModelProcessTest {
  protected:
   void SetUp() override {
     ASSERT_NO_FATAL_FAILURE(StartModelSession("models/ecce_arm.dae"));
-    ModelLink::Options options;
-    options.nameservice = naming_->address();
-    options.reconnect_period_ms = 300;
-    options.poll_period_ms = 100;
-    window_ =
-        std::make_unique<MainWindow>(std::make_unique<ModelLink>(options), 20.0, nullptr, false);
+    window_ = MainWindowOnModel(naming_->address(), 100);
     window_->show();
     ASSERT_TRUE(
         WaitInGui([&] { return window_->GroupOf("ecce_arm.forearm") != nullptr; }, seconds(10)))

@@ -23,8 +23,8 @@
 
 #include "caliper/model.hh"
 #include "main_window.h"
-#include "model_link.h"
 #include "support/gui_test.h"
+#include "support/main_window_on_model.h"
 #include "support/process.h"
 
 namespace caliper::testing {
@@ -33,18 +33,12 @@ namespace {
 using std::chrono::seconds;
 namespace M = ::Caliper::Simulation;
 using main_window::MainWindow;
-using main_window::ModelLink;
 
 class MainWindowRecordingTest : public ModelProcessTest {
  protected:
   void SetUp() override {
     ASSERT_NO_FATAL_FAILURE(StartModelSession("models/ecce_arm.dae"));
-    ModelLink::Options options;
-    options.nameservice = naming_->address();
-    options.reconnect_period_ms = 300;
-    options.poll_period_ms = 50;
-    window_ =
-        std::make_unique<MainWindow>(std::make_unique<ModelLink>(options), 20.0, nullptr, false);
+    window_ = MainWindowOnModel(naming_->address(), 50);
     window_->SetFileChooser([this](bool save, const QString&, const QString& suggested) {
       (save ? saves_ : opens_) << suggested;
       return save ? record_to_ : open_;
