@@ -235,6 +235,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   if (loaded_) loaded_->commands.clear();
   EndRecordingLocked("an experiment was run");
   replay_.reset();
+  fork_reset_every_ = 0;
   BuildLocked(std::move(loaded));
   undo_.clear();
   redo_.clear();
@@ -347,6 +348,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   RequireIdle();  // again: an experiment may have begun while this scene was built
   EndRecordingLocked("another scene was loaded");
   replay_.reset();
+  fork_reset_every_ = 0;
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
   last_error_.clear();
@@ -519,8 +521,10 @@ void ModelCore::SetTimeStep(double seconds) {
   Require(true);
   RequireIdle();
   RequireNotReplaying("set_time_step");
+  // a recording maps time to steps with one time step
+  if (seconds != loaded_->physics->description().settings.time_step)
+    EndRecordingLocked("the time step changed");
   loaded_->physics->SetParameter("simulation.time_step", seconds);
-  RecordEventLocked("parameter", loaded_->name + ".simulation.time_step", {seconds});
 }
 
 void ModelCore::SetRealTimeFactor(double factor) {
@@ -1281,7 +1285,7 @@ void ModelCore::Pull(const std::string& body, const Eigen::Vector3d& point,
   pull_until_ = Clock::now() + limits_.pull_lease;
   if (changed)  // a renewal of the same pull changes nothing in the simulation
     RecordEventLocked("pull", body, {point.x(), point.y(), point.z(), target.x(), target.y(),
-                                     target.z(), pull.stiffness});
+                                     target.z(), pull.stiffness, pull.damping});
 }
 
 void ModelCore::ExpirePullLocked() {

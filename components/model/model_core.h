@@ -267,6 +267,10 @@ class ModelCore {
   void Fork();
   /// The engine's dynamic state now (exact numbers included).
   sgal::DynamicState dynamic_state() const;
+  /// Called by a replay where each periodic keyframe was taken (after its step's earlier events,
+  /// before the cache reset), with the engine as it stands there (verification).
+  using KeyframeHook = std::function<void(uint64_t step, const sgal::PhysicsScene& physics)>;
+  void SetReplayKeyframeHook(KeyframeHook hook);
   /// A record of the session's log (any component's) for the recording, if one runs.
   void AddSessionLog(const recording::LogRecord& record);
   /// `on`: the session log comes through AddSessionLog (the Logging component); otherwise
@@ -372,6 +376,7 @@ class ModelCore {
     uint32_t keyframe_every = 100;
     // each scene version imported once (a seek then builds only the engine)
     std::map<uint32_t, std::shared_ptr<const sgal::Scene>> imported;
+    KeyframeHook keyframe_hook;
   };
 
   void RecordEventLocked(const std::string& kind, const std::string& target,
@@ -394,6 +399,7 @@ class ModelCore {
   std::string last_recording_error_;
   uint64_t last_recording_bytes_ = 0;
   bool session_log_ = false;  // records come through AddSessionLog
+  uint32_t fork_reset_every_ = 0;  // a fork resets caches as its recording did (0: not a fork)
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();

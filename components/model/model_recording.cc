@@ -182,7 +182,7 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   if (pull_)
     RecordEventLocked("pull", loaded_->physics->description().bodies.at(pull_->body).name,
                       {pull_->point.x(), pull_->point.y(), pull_->point.z(), pull_->target.x(),
-                       pull_->target.y(), pull_->target.z(), pull_->stiffness});
+                       pull_->target.y(), pull_->target.z(), pull_->stiffness, pull_->damping});
   RecordKeyframeLocked();
   if (!session_log_) Appender().Attach(recorder_session_->writer.get());
   logging::Get("model").notice("recording to %s from step %llu (keyframes every %u steps, %zu "
@@ -239,10 +239,13 @@ void ModelCore::BeforeStepLocked() {
     }
     if (step % r.options.keyframe_every == 0 && step != r.last_keyframe) RecordKeyframeLocked();
   }
+  if (fork_reset_every_ != 0 && !recorder_session_ && step % fork_reset_every_ == 0)
+    physics.ResetCaches();
   if (replay_) {
     Replay& p = *replay_;
     for (; p.next < p.events.size() && p.events[p.next].step <= step; ++p.next) {
       const recording::Event& e = p.events[p.next];
+      if (e.kind == "keyframe" && p.keyframe_hook) p.keyframe_hook(step, physics);
       if (e.kind == "keyframe" || e.kind == "end") continue;
       if (e.kind == "command") {
         physics.SetCommand(e.target, e.values.at(0));
@@ -255,8 +258,10 @@ void ModelCore::BeforeStepLocked() {
         pull.point = {e.values.at(0), e.values.at(1), e.values.at(2)};
         pull.target = {e.values.at(3), e.values.at(4), e.values.at(5)};
         pull.stiffness = e.values.at(6);
-        pull.damping = 2 * std::sqrt(pull.stiffness *
-                                     physics.description().bodies.at(pull.body).inertia.mass);
+        pull.damping = e.values.size() > 7
+                           ? e.values[7]
+                           : 2 * std::sqrt(pull.stiffness *
+                                           physics.description().bodies.at(pull.body).inertia.mass);
         physics.SetPull(pull);
       } else if (e.kind == "release") {
         physics.ClearPull();
@@ -347,7 +352,8 @@ void ModelCore::RestoreReplayLocked(uint64_t step) {
   const recording::Event* pull = nullptr;
   for (size_t i = 0; i < mark; ++i) {
     const auto& e = p.events[i];
-    if ((e.kind == "pull" || e.kind == "release") && e.step >= version->step) pull = &e;
+    // across scene versions: a pull held through an edit goes on in the edited scene
+    if (e.kind == "pull" || e.kind == "release") pull = &e;
   }
   if (pull != nullptr && pull->kind == "pull") {
     sgal::Pull x;
@@ -355,7 +361,9 @@ void ModelCore::RestoreReplayLocked(uint64_t step) {
     x.point = {pull->values.at(0), pull->values.at(1), pull->values.at(2)};
     x.target = {pull->values.at(3), pull->values.at(4), pull->values.at(5)};
     x.stiffness = pull->values.at(6);
-    x.damping = 2 * std::sqrt(x.stiffness * scene.bodies.at(x.body).inertia.mass);
+    x.damping = pull->values.size() > 7
+                    ? pull->values[7]
+                    : 2 * std::sqrt(x.stiffness * scene.bodies.at(x.body).inertia.mass);
     loaded_->physics->SetPull(x);
   }
   loaded_->physics->ResetCaches();
@@ -393,6 +401,7 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   if (recorder_session_) EndRecordingLocked("a replay was opened");
   std::unique_ptr<Replay> previous = std::move(replay_);
   replay_ = std::move(replay);
+  fork_reset_every_ = 0;
   try {
     RestoreReplayLocked(replay_->reader->header().first_step);
   } catch (...) {
@@ -442,11 +451,18 @@ void ModelCore::Fork() {
   if (!replay_) throw NotAvailable("fork: no replay is open");
   const std::string path = replay_->path;
   loaded_->source = path + " (forked at t = " + std::to_string(loaded_->physics->time()) + " s)";
+  fork_reset_every_ = replay_->keyframe_every;  // as the recorded run did, so it goes on alike
   replay_.reset();
   loaded_->physics->ClearPull();  // a replayed pull ends: its client was the recording
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
   logging::Get("model").notice("forked from %s at t = %.3f s: simulating on", path.c_str(),
                                loaded_->physics->time());
+}
+
+void ModelCore::SetReplayKeyframeHook(KeyframeHook hook) {
+  const auto lock = Lock();
+  if (!replay_) throw NotAvailable("no replay is open");
+  replay_->keyframe_hook = std::move(hook);
 }
 
 void ModelCore::AddSessionLog(const recording::LogRecord& record) {
@@ -505,12 +521,28 @@ std::string Difference(const sgal::DynamicState& got, const sgal::DynamicState& 
     return what + ": " + Number(got.engine[i]) + ", recorded " + Number(recorded.engine[i]) +
            " (differs by " + Number(got.engine[i] - recorded.engine[i]) + ")";
   }
-  for (size_t a = 0; a < got.actuators.size() && a < recorded.actuators.size(); ++a)
-    for (size_t k = 0; k < got.actuators[a].size() && k < recorded.actuators[a].size(); ++k)
+  if (got.actuators.size() != recorded.actuators.size() ||
+      got.joint_positions.size() != recorded.joint_positions.size() ||
+      got.commands.size() != recorded.commands.size())
+    return "the state's layout differs: " + std::to_string(got.actuators.size()) +
+           " actuators, " + std::to_string(got.joint_positions.size()) + " joints; recorded " +
+           std::to_string(recorded.actuators.size()) + ", " +
+           std::to_string(recorded.joint_positions.size());
+  for (size_t a = 0; a < got.commands.size(); ++a)
+    if (!Same(got.commands[a], recorded.commands[a]))
+      return "actuator '" + (a < scene.actuators.size() ? scene.actuators[a].name : "?") +
+             "' command " + Number(got.commands[a]) + ", recorded " + Number(recorded.commands[a]);
+  for (size_t a = 0; a < got.actuators.size(); ++a) {
+    if (got.actuators[a].size() != recorded.actuators[a].size())
+      return "actuator '" + (a < scene.actuators.size() ? scene.actuators[a].name : "?") +
+             "' has " + std::to_string(got.actuators[a].size()) + " state values, recorded " +
+             std::to_string(recorded.actuators[a].size());
+    for (size_t k = 0; k < got.actuators[a].size(); ++k)
       if (!Same(got.actuators[a][k], recorded.actuators[a][k]))
         return "actuator '" + (a < scene.actuators.size() ? scene.actuators[a].name : "?") +
                "' state value " + std::to_string(k) + ": " + Number(got.actuators[a][k]) +
                ", recorded " + Number(recorded.actuators[a][k]);
+  }
   for (size_t j = 0; j < got.joint_positions.size() && j < recorded.joint_positions.size(); ++j)
     if (!Same(got.joint_positions[j], recorded.joint_positions[j]))
       return "joint '" + scene.constraints.at(j).name + "' position " +
@@ -528,13 +560,27 @@ Verification VerifyRecording(const std::string& path,
   const uint64_t last = reader.last_step();
   std::vector<std::string> ids;
   for (const auto& c : h.channels) ids.push_back(c.id);
-  std::set<uint64_t> keyframes;
-  for (uint64_t k : reader.keyframe_steps()) keyframes.insert(k);
   std::set<uint64_t> edits;  // their keyframes hold the state after the edit: compared after it
   for (const auto& e : reader.Events(0, last + 1))
     if (e.kind == "edit") edits.insert(e.step);
   ModelCore core;
   core.OpenReplay(path);
+  // each periodic keyframe compared where the recorded run took it: after its step's earlier
+  // events (a command at that step is in it), before the cache reset
+  std::string keyframe_diff;
+  uint64_t keyframe_step = 0;
+  core.SetReplayKeyframeHook([&](uint64_t at, const sgal::PhysicsScene& physics) {
+    if (!keyframe_diff.empty() || edits.count(at) != 0) return;
+    const recording::Keyframe k = reader.KeyframeAtOrBefore(at);
+    if (k.step != at) return;
+    ++v.keyframes;
+    const std::string diff = Difference(physics.SaveDynamicState(), k.state, physics.description());
+    if (!diff.empty()) {
+      keyframe_diff = "keyframe at step " + std::to_string(at) + " (t = " + Number(k.time) +
+                      " s): " + diff;
+      keyframe_step = at;
+    }
+  });
   uint64_t step = h.first_step;
   const uint64_t chunk = 1000;
   for (uint64_t from = step; from < last; from += chunk) {
@@ -546,18 +592,11 @@ Verification VerifyRecording(const std::string& path,
                                         std::to_string(step + 1) + ": " + core.status().last_error);
       ++step;
       ++v.steps;
-      if (keyframes.count(step) != 0 && edits.count(step) == 0) {
-        const recording::Keyframe k = reader.KeyframeAtOrBefore(step);
-        const std::shared_ptr<const sgal::Scene> scene = core.description();
-        const std::string diff = Difference(core.dynamic_state(), k.state, *scene);
-        ++v.keyframes;
-        if (!diff.empty()) {
-          v.identical = false;
-          v.divergent_step = step;
-          v.detail = "keyframe at step " + std::to_string(step) + " (t = " + Number(k.time) +
-                     " s): " + diff;
-          return v;
-        }
+      if (!keyframe_diff.empty()) {
+        v.identical = false;
+        v.divergent_step = keyframe_step;
+        v.detail = keyframe_diff;
+        return v;
       }
       while (next_sample < samples.size() && samples[next_sample].step < step) ++next_sample;
       if (next_sample < samples.size() && samples[next_sample].step == step && !ids.empty()) {
@@ -566,6 +605,14 @@ Verification VerifyRecording(const std::string& path,
           now.insert(now.end(), reading.values.begin(), reading.values.end());
         const auto& recorded = samples[next_sample].values;
         ++v.samples;
+        if (now.size() != recorded.size()) {
+          v.identical = false;
+          v.divergent_step = step;
+          v.detail = "the sample at step " + std::to_string(step) + " has " +
+                     std::to_string(now.size()) + " values, recorded " +
+                     std::to_string(recorded.size());
+          return v;
+        }
         for (size_t i = 0; i < now.size() && i < recorded.size(); ++i)
           if (!Same(now[i], recorded[i])) {
             v.identical = false;

@@ -321,7 +321,10 @@ struct Writer::Impl {
 
   void Prepare() {
     insert_keyframe = std::make_unique<Statement>(
-        db, "INSERT INTO keyframes(step, time_s, scene_version, state) VALUES(?,?,?,?)");
+        db,
+        // a later keyframe at the same step (an edit while paused) replaces the earlier one; the
+        // events' keyframe marks tell a replay which events came after the last one
+        "INSERT OR REPLACE INTO keyframes(step, time_s, scene_version, state) VALUES(?,?,?,?)");
     insert_event = std::make_unique<Statement>(
         db, "INSERT INTO events(step, kind, target, vals) VALUES(?,?,?,?)");
     insert_scene = std::make_unique<Statement>(

@@ -61,7 +61,10 @@ Session RecordSession(ModelCore& core, const std::string& file) {
   run(200);
   const auto hand = Read(core, kHand);
   core.Pull("hand", Eigen::Vector3d::Zero(), {hand[0] + 0.2, hand[1], hand[2] + 0.1}, 0);
-  run(150);
+  run(63);
+  // an edit while the pull holds: the pull goes on in the edited scene
+  core.Edit([&](const sgal::Scene& sc) { return sgal::SetMass(sc, "forearm", 1.2); });
+  run(87);
   core.ReleasePull();
   run(62);
   s.hand_at_599 = Read(core, kHand);
@@ -70,6 +73,9 @@ Session RecordSession(ModelCore& core, const std::string& file) {
   via.body = "upper_arm";
   via.position = {0.02, 0, -0.1};
   core.Edit([&](const sgal::Scene& sc) { return sgal::InsertPathPoint(sc, "elbow_flexor", 1, via); });
+  // undone and redone at the same step while paused: three keyframes at step 600, the last kept
+  core.Undo();
+  core.Redo();
   run(400);
   const auto stopped = core.StopRecording();
   EXPECT_GT(stopped.bytes, 100000u);  // the scene's 0.2 MB at least
@@ -124,6 +130,7 @@ TEST_F(ModelRecording, VerifyFindsItIdenticalAndNamesTheFirstDivergence) {
   EXPECT_TRUE(v.identical) << v.detail;
   EXPECT_EQ(v.steps, 963u);
   EXPECT_EQ(v.keyframes, 8u);  // 100 ... 900 but 600, where the edit's keyframe restarts the replay
+  // (the edit at step 450 takes no periodic keyframe's place)
   EXPECT_EQ(v.samples, 963u);
   EXPECT_EQ(told, 1000u);
   // a keyframe changed in its last bit: the first divergence is named there
@@ -155,7 +162,8 @@ TEST_F(ModelRecording, SeekingBackAndForthLandsOnTheRecordedStates) {
   const auto opened = replay.OpenReplay(file_);
   const double dt = 0.001;
   // (at step 600 the edit took place: seeking there gives the state after it)
-  for (const uint64_t step : {650u, 120u, 999u, 599u, 38u, 601u, 599u}) {
+  // 500: after the edit at 450 with the pull still held
+  for (const uint64_t step : {650u, 120u, 999u, 599u, 38u, 601u, 500u, 599u}) {
     const auto status = replay.Seek(opened.start_time + (step - 37) * dt);
     ASSERT_EQ(status.step, step);
     EXPECT_EQ(Read(replay, kHand), session.hand[step - 38]) << "after seeking to step " << step;
@@ -176,6 +184,71 @@ TEST_F(ModelRecording, AForkFromAMiddleKeyframeGoesOnAsTheUninterruptedRun) {
   EXPECT_EQ(Read(fork, kHand), session.hand[380 - 38]);
   // and after the fork the Model takes commands again
   EXPECT_NO_THROW(fork.SetCommands({{"elbow_flexor", 1.0}}));
+}
+
+// balls dropped onto a floor and onto each other: contacts that last across keyframes
+sgal::Scene Balls() {
+  sgal::Scene s;
+  s.name = "balls";
+  s.settings.time_step = 0.001;
+  sgal::Body floor;
+  floor.name = "floor";
+  floor.type = sgal::BodyType::kStatic;
+  floor.shapes.push_back({"plane", sgal::Plane{}, {}});
+  s.bodies.push_back(floor);
+  for (int i = 0; i < 5; ++i) {
+    sgal::Body b;
+    b.name = "ball" + std::to_string(i);
+    b.pose.position = {0.03 * (i % 2), 0.02 * i, 0.06 + 0.11 * i};
+    b.inertia.mass = 0.2;
+    b.inertia.tensor = Eigen::Matrix3d::Identity() * (0.4 * 0.2 * 0.05 * 0.05);
+    b.shapes.push_back({"ball", sgal::Sphere{0.05}, {}});
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
+TEST_F(ModelRecording, AForkWithContactsGoesOnBitForBitPastLaterKeyframes) {
+  ModelCore live;
+  live.LoadScene(Balls(), "balls");
+  live.StartRecording(file_, {});
+  live.StepNow(700);
+  const auto top = Read(live, "balls.ball4.position");
+  live.StopRecording();
+  ModelCore fork;
+  const auto opened = fork.OpenReplay(file_);
+  fork.Seek(opened.start_time + 0.2);  // the keyframe at step 200
+  fork.Fork();
+  fork.StepNow(500);  // past the keyframes at 300 ... 600, as the recorded run reset them
+  EXPECT_EQ(Read(fork, "balls.ball4.position"), top);
+  EXPECT_LT(top[2], 0.5) << "the balls did not come to rest on each other";
+}
+
+// what the Scene Renderer receives (the observer's snapshots) during a replay is the recording
+class Snapshots : public CoreListener {
+ public:
+  void OnScene(std::shared_ptr<const sgal::Scene>, uint64_t) override {}
+  void OnSnapshot(std::shared_ptr<const Snapshot> s) override { last = s; }
+  void OnCleared() override {}
+  std::shared_ptr<const Snapshot> last;
+};
+
+TEST_F(ModelRecording, ObserversOfAReplaySeeTheRecordedPoses) {
+  ModelCore live;
+  const Session session = RecordSession(live, file_);
+  ModelCore replay;
+  replay.OpenReplay(file_);
+  Snapshots observer;
+  replay.AddListener(&observer);
+  const int hand = replay.description()->BodyIndex("hand");
+  for (uint64_t step = 38; step <= 1000; step += 137) {
+    replay.StepNow(step - replay.replay_status().step);
+    ASSERT_TRUE(observer.last);
+    EXPECT_EQ(observer.last->step, step);
+    const Eigen::Vector3d p = observer.last->bodies.at(hand).pose.position;
+    EXPECT_EQ(std::vector<double>({p.x(), p.y(), p.z()}), session.hand[step - 38]) << step;
+  }
+  replay.RemoveListener(&observer);
 }
 
 TEST_F(ModelRecording, AChangedSceneVersionIsRefusedSayingSo) {
