@@ -157,6 +157,7 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   header.keyframe_every = options.keyframe_every;
   header.channels_every = options.channels.empty() ? 0 : options.channels_every;
   header.first_step = loaded_->physics->steps();
+  header.engine = physics_bullet::EngineId();
   for (const auto& id : options.channels) {
     if (!registry_.Contains(id)) throw UnknownId("record: unknown id '" + id + "'", id);
     const daq::ChannelInfo& info = registry_.Info(id);
@@ -396,6 +397,11 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   replay->events = replay->reader->Events(0, last + 1);
   replay->scenes = replay->reader->scenes();
   replay->keyframe_every = replay->reader->header().keyframe_every;
+  const std::string& engine = replay->reader->header().engine;
+  if (!engine.empty() && engine != physics_bullet::EngineId())
+    throw recording::RecordingError(path + " was recorded with " + engine + "; this build runs " +
+                                    physics_bullet::EngineId() +
+                                    ": its replay would not give the recording again");
   const auto lock = Lock();
   RequireIdle();
   if (recorder_session_) EndRecordingLocked("a replay was opened");

@@ -1153,6 +1153,9 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
       in += n;
       t.path.set_wrap_sides(std::move(sides));
     }
+    if (in != end)
+      refuse("the engine state has " + std::to_string(end - in) +
+             " values more than this scene's bodies and tendons hold (a state of another scene)");
   }
 }
 
@@ -1334,6 +1337,12 @@ void BulletScene::SetParameter(const std::string& id, double value) {
 
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options) {
   return std::make_unique<BulletScene>(scene, options);
+}
+
+std::string EngineId() {
+  const int v = btGetVersion();
+  return "bullet " + std::to_string(v / 100) + "." + std::to_string(v % 100) +
+         (sizeof(btScalar) == sizeof(double) ? " double" : " float") + ", state layout 1";
 }
 
 }  // namespace caliper::physics_bullet

@@ -490,6 +490,7 @@ Writer::Writer(const std::string& path, const Header& header, const SceneVersion
       put("keyframe_every", std::to_string(header.keyframe_every));
       put("channels_every", std::to_string(header.channels_every));
       put("first_step", std::to_string(header.first_step));
+      put("engine", header.engine);
       Statement channel(db,
                         "INSERT INTO channels(position, id, unit, rows, cols) VALUES(?,?,?,?,?)");
       for (size_t i = 0; i < header.channels.size(); ++i) {
@@ -612,6 +613,8 @@ struct Reader::Impl {
       header.keyframe_every = static_cast<uint32_t>(std::stoul(get("keyframe_every")));
       header.channels_every = static_cast<uint32_t>(std::stoul(get("channels_every")));
       header.first_step = std::stoull(get("first_step"));
+      for (const auto& kv : meta)
+        if (kv.first == "engine") header.engine = kv.second;
     } catch (const std::logic_error& e) {  // stod/stoul: not a number
       throw Error(std::string("a meta value is not a number (") + e.what() + ")");
     }

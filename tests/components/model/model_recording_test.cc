@@ -276,6 +276,23 @@ TEST_F(ModelRecording, AChangedSceneVersionIsRefusedSayingSo) {
     EXPECT_NE(std::string(e.what()).find(file_), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("does not fit its scene"), std::string::npos) << e.what();
   }
+  // recorded by another engine build: refused before anything is replayed
+  ModelCore live2;
+  const std::string other_file = dir_.path() + "/other_engine.caliper";
+  RecordSession(live2, other_file);
+  ASSERT_EQ(sqlite3_open(other_file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE meta SET value = 'bullet 2.89 double, state layout 1' "
+                             "WHERE key = 'engine'",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  try {
+    replay.OpenReplay(other_file);
+    ADD_FAILURE() << "a recording of another engine was replayed";
+  } catch (const recording::RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("was recorded with bullet 2.89 double"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(ModelRecording, WithoutChannelsTheRecordingStillEndsWhereItStopped) {

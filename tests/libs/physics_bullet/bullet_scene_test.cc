@@ -764,6 +764,9 @@ TEST(BulletSceneDynamicState, RestoredIntoAFreshSceneItGoesOnAsTheOriginal) {
   wrong = saved;
   wrong.actuators[0].push_back(1.0);
   EXPECT_THROW(fresh->RestoreDynamicState(wrong), std::invalid_argument);
+  wrong = saved;
+  wrong.engine.push_back(1.0);  // a state of a scene with more to it
+  EXPECT_THROW(fresh->RestoreDynamicState(wrong), std::invalid_argument);
 }
 
 TEST(BulletSceneDynamicState, APullSwingsThePendulumTowardItsTarget) {

@@ -27,4 +27,8 @@ struct Options {
 /// actuators come before Bullet's step and leave it untouched).
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
 
+/// The engine as recordings name it ("bullet 3.24 float", and the dynamic state's layout): a
+/// replay is exact only on the same.
+std::string EngineId();
+
 }  // namespace caliper::physics_bullet

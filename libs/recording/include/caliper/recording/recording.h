@@ -38,6 +38,8 @@ struct Header {
   uint32_t channels_every = 1;    // steps between channel samples (0: no channels)
   std::vector<Channel> channels;  // sampled, in this order
   uint64_t first_step = 0;        // the step the recording started at
+  std::string engine;             // the engine that ran it (e.g. "bullet 3.24 float"): a replay
+                                  // is exact only with the same ("" = not said)
 };
 
 /// An event that changed the simulation, taking effect before step `step` + 1 (after `step`
