@@ -313,9 +313,21 @@ struct Writer::Impl {
   std::vector<Record> batch;
   uint64_t last_step = 0;
 
+  // records waiting for a disk that does not keep up: beyond this the recording stops rather
+  // than fill the Model's memory (at 1 kHz with a sample and events a step, about 30 s of them)
+  static constexpr size_t kMaxQueued = 100000;
+
   void Push(Record&& record) {
     if (stopped.load(std::memory_order_relaxed)) return;
     std::lock_guard<std::mutex> lock(mutex);
+    if (queue.size() >= kMaxQueued) {
+      error = "recording to " + path + " stopped: the disk did not keep up (" +
+              std::to_string(kMaxQueued) + " records waited to be written); the file holds what " +
+              "came before";
+      stopped = true;
+      queue.clear();
+      return;
+    }
     queue.push_back(std::move(record));
   }
 

@@ -407,6 +407,20 @@ TEST(Recording, SizeLimitStopsTheRecordingAndKeepsWhatWasCommitted) {
   EXPECT_TRUE(r.keyframe_steps().empty());
 }
 
+// a disk that does not keep up (here: a writer that commits only every hour) must not let the
+// queue fill the Model's memory: the recording stops saying why, the caller goes on
+TEST(Recording, ADiskThatDoesNotKeepUpStopsTheRecording) {
+  core::ScratchDirectory dir("recording_test");
+  const std::string path = dir.path() + "/slow.caliper";
+  Writer w(path, ArmHeader(), Scene0(), std::chrono::hours(1));
+  uint64_t step = 0;
+  for (; step < 150000 && w.error().empty(); ++step) w.AddSample(SampleAt(step));
+  EXPECT_NE(w.error().find("the disk did not keep up (100000 records"), std::string::npos)
+      << w.error();
+  EXPECT_LE(step, 100001u);
+  w.AddSample(SampleAt(step));  // a no-op, no throw
+}
+
 double WallSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
