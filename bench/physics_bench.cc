@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -148,5 +149,44 @@ int main(int argc, char** argv) {
   const double off = TimeCaliper(spanning, false);
   std::printf("# step time [us]: tendons pressing on bodies, contact on %.1f, off %.1f\n", on, off);
   Ratio("tendon_contact_on_vs_off", on / off, 2.0);
+
+  // cost growth: the step time of the same tree with more tendons, and of larger trees; the
+  // exponent p of a least-squares fit time = c n^p on log-log axes
+  auto exponent = [](const std::vector<std::pair<double, double>>& points) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [n, t] : points) {
+      const double x = std::log(n), y = std::log(t);
+      sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    const double k = static_cast<double>(points.size());
+    return (k * sxy - sx * sy) / (k * sxx - sx * sx);
+  };
+  std::vector<std::pair<double, double>> by_tendons, by_bodies;
+  // the tendons' share: the step time less that of the same tree without tendons (the bodies,
+  // joints and contacts cost the same at every count and would flatten the fit)
+  TreeOptions bare = contact;
+  bare.tendons = 0;
+  const double without = TimeCaliper(bare, true);
+  std::printf("# step time [us] by tendons (40 bodies, DC motors, floor and self contact): 0: %.1f",
+              without);
+  for (const int n : {10, 40, 80, 160, 320}) {
+    TreeOptions o = contact;
+    o.tendons = n;
+    const double t = TimeCaliper(o, true);
+    by_tendons.emplace_back(n, std::max(t - without, 1e-3));
+    std::printf(" %d: %.1f", n, t);
+  }
+  std::printf("\n# step time [us] by bodies (80 tendons):");
+  for (const int n : {20, 40, 80, 160}) {
+    TreeOptions o = contact;
+    o.bodies = n;
+    by_bodies.emplace_back(n, TimeCaliper(o, true));
+    std::printf(" %d: %.1f", n, by_bodies.back().second);
+  }
+  std::printf("\n# fitted growth exponent by bodies %.2f (information)\n", exponent(by_bodies));
+  std::printf("# the tendons' share [us]:");
+  for (const auto& [n, t] : by_tendons) std::printf(" %.0f: %.1f", n, t);
+  std::printf("\n");
+  Ratio("tendon_cost_growth_exponent", exponent(by_tendons), 1.05);
   return 0;
 }

@@ -1,5 +1,6 @@
 #include "tree_model.h"
 
+#include <algorithm>
 #include <functional>
 #include <sstream>
 
@@ -11,9 +12,6 @@ using Eigen::Vector3d;
 
 constexpr double kRadius = 0.03;   // capsule radius [m]
 constexpr double kSegment = 0.1;   // distance between joints [m]
-constexpr int kSpine = 20;
-constexpr int kArm = 10;
-constexpr int kShoulder = 17;      // spine body the arms hang from
 
 /// One body of the tree: where its centre is, the axis it extends along, its parent, hinge axis.
 struct Link {
@@ -25,9 +23,11 @@ struct Link {
   Vector3d axis;       // hinge axis
 };
 
-std::vector<Link> Links() {
+std::vector<Link> Links(int bodies) {
+  const int spine = bodies / 2, arm = bodies / 4;
+  const int shoulder_body = spine - 3;  // spine body the arms hang from
   std::vector<Link> links;
-  for (int i = 0; i < kSpine; ++i) {
+  for (int i = 0; i < spine; ++i) {
     Link l;
     l.name = "spine" + std::to_string(i);
     l.along = Vector3d::UnitZ();
@@ -38,14 +38,14 @@ std::vector<Link> Links() {
     links.push_back(l);
   }
   for (int side : {-1, 1}) {
-    for (int i = 0; i < kArm; ++i) {
+    for (int i = 0; i < arm; ++i) {
       Link l;
       l.name = std::string(side < 0 ? "left" : "right") + std::to_string(i);
       l.along = Vector3d(side, 0, 0);
-      const Vector3d shoulder = links[kShoulder].centre + Vector3d(side * kRadius, 0, 0);
+      const Vector3d shoulder = links[shoulder_body].centre + Vector3d(side * kRadius, 0, 0);
       l.joint = shoulder + l.along * (kSegment * i);
       l.centre = l.joint + l.along * (kSegment / 2);
-      l.parent = i == 0 ? kShoulder : static_cast<int>(links.size()) - 1;
+      l.parent = i == 0 ? shoulder_body : static_cast<int>(links.size()) - 1;
       l.axis = i % 2 ? Vector3d::UnitZ() : Vector3d::UnitY();
       links.push_back(l);
     }
@@ -62,7 +62,8 @@ struct TendonSpec {
   Vector3d point_a, point_b;  // world positions at rest
 };
 
-std::vector<TendonSpec> Tendons(const std::vector<Link>& links, bool spanning) {
+std::vector<TendonSpec> Tendons(const std::vector<Link>& links, bool spanning, int count) {
+  const int spine = static_cast<int>(links.size()) / 2, arm = static_cast<int>(links.size()) / 4;
   std::vector<TendonSpec> tendons;
   for (size_t c = 1; c < links.size(); ++c) {
     const Link& child = links[c];
@@ -86,11 +87,26 @@ std::vector<TendonSpec> Tendons(const std::vector<Link>& links, bool spanning) {
     TendonSpec t;
     t.name = side ? "right_long" : "left_long";
     t.body_a = 0;
-    t.body_b = kSpine + kArm * side + kArm - 1;
+    t.body_b = spine + arm * side + arm - 1;
     t.point_a = links[0].centre + Vector3d(side ? 0.04 : -0.04, 0, 0);
     t.point_b = links[t.body_b].centre + Vector3d(0, 0, 0.04);
     tendons.push_back(t);
   }
+  // more: the same again on levers turned about each body's axis; fewer: the first ones
+  const std::vector<TendonSpec> base = tendons;
+  for (int copy = 1; static_cast<int>(tendons.size()) < count; ++copy)
+    for (const TendonSpec& b : base) {
+      if (static_cast<int>(tendons.size()) >= count) break;
+      TendonSpec t = b;
+      t.name += "_" + std::to_string(copy);
+      const double turn = 0.35 * copy;  // [rad] about the child's axis
+      const Link& child = links[t.body_b];
+      const Eigen::AngleAxisd r(turn, child.along);
+      t.point_a = links[t.body_a].centre + r * (b.point_a - links[t.body_a].centre);
+      t.point_b = child.centre + r * (b.point_b - child.centre);
+      tendons.push_back(t);
+    }
+  tendons.resize(std::min<size_t>(tendons.size(), static_cast<size_t>(count)));
   return tendons;
 }
 
@@ -103,7 +119,7 @@ Eigen::Quaterniond ZTo(const Vector3d& v) {
 sgal::Scene MakeTree(const TreeOptions& options) {
   sgal::Scene s;
   s.name = "tree40";
-  const auto links = Links();
+  const auto links = Links(options.bodies);
   const uint32_t mask = options.self_contact ? 0xffffffffu : 0x2u;  // 2: the floor's group
   for (const auto& l : links) {
     sgal::Body b;
@@ -143,7 +159,7 @@ sgal::Scene MakeTree(const TreeOptions& options) {
     h.frame_b.orientation = axis;
     s.constraints.push_back(h);
   }
-  for (const auto& t : Tendons(links, options.spanning_tendons)) {
+  for (const auto& t : Tendons(links, options.spanning_tendons, options.tendons)) {
     sgal::Tendon tendon;
     tendon.name = t.name;
     tendon.radius = 0.002;
@@ -164,7 +180,7 @@ sgal::Scene MakeTree(const TreeOptions& options) {
 }
 
 std::string MakeTreeMjcf(const TreeOptions& options) {
-  const auto links = Links();
+  const auto links = Links(options.bodies);
   std::ostringstream x;
   x << "<mujoco model=\"tree40\">\n<option timestep=\"0.001\"/>\n<worldbody>\n";
   if (options.floor) x << "<geom name=\"floor\" type=\"plane\" size=\"10 10 .1\" contype=\"2\" conaffinity=\"1\"/>\n";
@@ -186,7 +202,7 @@ std::string MakeTreeMjcf(const TreeOptions& options) {
       << -half.y() << " " << -half.z() << " " << half.x() << " " << half.y() << " " << half.z()
       << "\" mass=\"0.2\" contype=\"" << (options.self_contact ? 1 : 0) << "\" conaffinity=\""
       << (options.self_contact || options.floor ? 1 : 0) << "\"/>\n";
-    for (const auto& t : Tendons(links, options.spanning_tendons)) {
+    for (const auto& t : Tendons(links, options.spanning_tendons, options.tendons)) {
       for (int end = 0; end < 2; ++end) {
         const int body = end ? t.body_b : t.body_a;
         if (body != i) continue;
@@ -202,11 +218,11 @@ std::string MakeTreeMjcf(const TreeOptions& options) {
   write(0);
   x << "</worldbody>\n<contact>\n";
   x << "</contact>\n<tendon>\n";
-  for (const auto& t : Tendons(links, options.spanning_tendons))
+  for (const auto& t : Tendons(links, options.spanning_tendons, options.tendons))
     x << "<spatial name=\"" << t.name << "\" stiffness=\"0\"><site site=\"" << t.name
       << "_a\"/><site site=\"" << t.name << "_b\"/></spatial>\n";
   x << "</tendon>\n<actuator>\n";
-  for (const auto& t : Tendons(links, options.spanning_tendons))
+  for (const auto& t : Tendons(links, options.spanning_tendons, options.tendons))
     x << "<motor tendon=\"" << t.name << "\" gear=\"-1\" ctrlrange=\"0 50\" ctrllimited=\"true\"/>\n";
   x << "</actuator>\n</mujoco>\n";
   return x.str();

@@ -13,6 +13,8 @@ struct TreeOptions {
   bool self_contact = true;    // bodies collide with each other (not with their hinge neighbours)
   bool spanning_tendons = false;  // tendons cross two joints, over the body between (they press on it)
   std::string actuator_kind = "dc_motor_tendon";
+  int bodies = 40;   // a spine of half of them and two arms of a quarter each (a multiple of 4)
+  int tendons = 80;  // two per joint and two long ones, repeated with other levers or cut short
 };
 
 /// The scene with `actuator_kind` actuators on its 80 tendons.
