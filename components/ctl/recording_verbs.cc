@@ -94,7 +94,7 @@ int RecordingStart(const ModelRef& m, std::vector<std::string>& args) {
   while (TakeOption(args, "--channel", &value)) channels.push_back(value);
   if (TakeOption(args, "--every", &value)) o.channels_every = ParseCount(value, "--every");
   if (TakeOption(args, "--keyframe-every", &value))
-    o.keyframe_every = static_cast<CORBA::ULong>(ParseWhole(value, "--keyframe-every", 1000000ull));
+    o.keyframe_every = static_cast<CORBA::ULong>(ParseWhole(value, "--keyframe-every", 1000ull));
   if (TakeOption(args, "--max-mb", &value)) {
     double mb = 0;
     std::string why;

@@ -25,6 +25,8 @@ namespace caliper::model {
 
 namespace {
 
+constexpr uint32_t kMaxKeyframeEvery = 1000;
+
 // the Model's own log records, into the recording while one runs
 class RecordingAppender : public log4cpp::AppenderSkeleton {
  public:
@@ -142,8 +144,10 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
     throw NotAvailable("already recording to " + recorder_session_->writer->path() +
                        "; stop that first");
   RequireNotReplaying("record");
-  if (options.keyframe_every < 1 || options.keyframe_every > 1000000)
-    throw InvalidValue("keyframe_every must be in [1, 1000000] steps");
+  // a seek re-simulates up to one interval while holding the Model: keep it short
+  if (options.keyframe_every < 1 || options.keyframe_every > kMaxKeyframeEvery)
+    throw InvalidValue("keyframe_every must be in [1, " + std::to_string(kMaxKeyframeEvery) +
+                       "] steps (a seek re-simulates up to one interval)");
   if (!options.channels.empty() && options.channels_every < 1)
     throw InvalidValue("channels_every must be at least 1 step");
   if (options.channels.size() > limits_.ids_per_call)
@@ -232,7 +236,7 @@ void ModelCore::BeforeStepLocked() {
   const uint64_t step = physics.steps();
   if (recorder_session_) {
     Recorder& r = *recorder_session_;
-    if (!r.writer->error().empty()) {
+    if (r.writer->stopped()) {
       // a full disk or a vanished file: the recording ends, the simulation goes on
       logging::Get("model").error("%s", r.writer->error().c_str());
       EndRecordingLocked("write failed");
@@ -397,6 +401,20 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   replay->events = replay->reader->Events(0, last + 1);
   replay->scenes = replay->reader->scenes();
   replay->keyframe_every = replay->reader->header().keyframe_every;
+  // a seek re-simulates from the keyframe before it while holding the Model: a file whose
+  // keyframes lie far apart would hold it that long
+  {
+    uint64_t previous = replay->reader->header().first_step, widest = 0;
+    for (uint64_t k : replay->reader->keyframe_steps()) {
+      widest = std::max(widest, k - std::min(k, previous));
+      previous = k;
+    }
+    widest = std::max(widest, last - std::min(last, previous));
+    if (widest > kMaxKeyframeEvery)
+      throw recording::RecordingError(path + ": its keyframes lie up to " + std::to_string(widest) +
+                                      " steps apart; a replay takes at most " +
+                                      std::to_string(kMaxKeyframeEvery));
+  }
   const std::string& engine = replay->reader->header().engine;
   if (!engine.empty() && engine != physics_bullet::EngineId())
     throw recording::RecordingError(path + " was recorded with " + engine + "; this build runs " +

@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <fstream>
 #include <mutex>
 #include <thread>
@@ -572,6 +573,8 @@ std::string Writer::error() const {
   return impl_->error;
 }
 
+bool Writer::stopped() const { return impl_->stopped.load(std::memory_order_relaxed); }
+
 const std::string& Writer::path() const { return impl_->path; }
 
 uint64_t Writer::bytes_written() const { return impl_->bytes; }
@@ -745,24 +748,40 @@ Keyframe Reader::KeyframeAtOrBefore(uint64_t step) const try {
   throw impl_->Error(e.what());
 }
 
-std::vector<Event> Reader::Events(uint64_t first, uint64_t last) const try {
-  std::vector<Event> out;
-  Statement s(impl_->db,
-              "SELECT step, kind, target, vals FROM events WHERE step >= ? AND step < ? "
-              "ORDER BY seq");
+namespace {
+
+// the rows of `table` with first <= step < last, in `order`: step, then `columns` (the last a
+// `vals` blob of packed doubles), each handed to `row` with its values unpacked; `what` names a
+// row in the message about a malformed blob
+template <class Row>
+void ReadRange(sqlite3* db, const std::string& table, const std::string& columns,
+               const std::string& order, uint64_t first, uint64_t last, const char* what,
+               int vals_column, const std::function<RecordingError(const std::string&)>& error,
+               Row&& row) {
+  Statement s(db, "SELECT step, " + columns + " FROM " + table +
+                      " WHERE step >= ? AND step < ? ORDER BY " + order);
   s.Bind(1, static_cast<int64_t>(first));
   s.Bind(2, static_cast<int64_t>(last));
+  std::vector<double> values;
   while (s.Step()) {
-    Event e;
-    e.step = static_cast<uint64_t>(s.Int(0));
-    e.kind = s.Text(1);
-    e.target = s.Text(2);
-    const std::string vals = s.Blob(3);
-    if (!UnpackDoubles(vals.data(), static_cast<int>(vals.size()), &e.values))
-      throw impl_->Error("the event at step " + std::to_string(e.step) + " has " +
-                         std::to_string(vals.size()) + " bytes of values, not a multiple of 8");
-    out.push_back(std::move(e));
+    const uint64_t step = static_cast<uint64_t>(s.Int(0));
+    const std::string vals = s.Blob(vals_column);
+    if (!UnpackDoubles(vals.data(), static_cast<int>(vals.size()), &values))
+      throw error(std::string("the ") + what + " at step " + std::to_string(step) + " has " +
+                  std::to_string(vals.size()) + " bytes of values, not a multiple of 8");
+    row(s, step, std::move(values));
   }
+}
+
+}  // namespace
+
+std::vector<Event> Reader::Events(uint64_t first, uint64_t last) const try {
+  std::vector<Event> out;
+  ReadRange(impl_->db, "events", "kind, target, vals", "seq", first, last, "event", 3,
+            [&](const std::string& m) { return impl_->Error(m); },
+            [&](Statement& s, uint64_t step, std::vector<double> values) {
+              out.push_back({step, s.Text(1), s.Text(2), std::move(values)});
+            });
   return out;
 } catch (const SqlError& e) {  // SQLite's refusal: name the file
   throw impl_->Error(e.what());
@@ -770,20 +789,11 @@ std::vector<Event> Reader::Events(uint64_t first, uint64_t last) const try {
 
 std::vector<Sample> Reader::Samples(uint64_t first, uint64_t last) const try {
   std::vector<Sample> out;
-  Statement s(impl_->db,
-              "SELECT step, time_s, vals FROM samples WHERE step >= ? AND step < ? ORDER BY step");
-  s.Bind(1, static_cast<int64_t>(first));
-  s.Bind(2, static_cast<int64_t>(last));
-  while (s.Step()) {
-    Sample p;
-    p.step = static_cast<uint64_t>(s.Int(0));
-    p.time = s.Real(1);
-    const std::string vals = s.Blob(2);
-    if (!UnpackDoubles(vals.data(), static_cast<int>(vals.size()), &p.values))
-      throw impl_->Error("the sample at step " + std::to_string(p.step) + " has " +
-                         std::to_string(vals.size()) + " bytes of values, not a multiple of 8");
-    out.push_back(std::move(p));
-  }
+  ReadRange(impl_->db, "samples", "time_s, vals", "step", first, last, "sample", 2,
+            [&](const std::string& m) { return impl_->Error(m); },
+            [&](Statement& s, uint64_t step, std::vector<double> values) {
+              out.push_back({step, s.Real(1), std::move(values)});
+            });
   return out;
 } catch (const SqlError& e) {  // SQLite's refusal: name the file
   throw impl_->Error(e.what());

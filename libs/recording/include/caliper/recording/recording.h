@@ -109,6 +109,8 @@ class Writer {
   void Flush();
   /// "" while recording; otherwise why the recording stopped (e.g. "disk full: ...").
   std::string error() const;
+  /// Whether the recording stopped (a failed write): cheap, no lock (for every step).
+  bool stopped() const;
   const std::string& path() const;
   uint64_t bytes_written() const;  // the file's size at the last commit [bytes]
 
