@@ -75,6 +75,16 @@ rtc::ReturnCode ModelComponent::OnInitialize() {
   if (!scene.empty() && runtime_.config().GetBool("model.confine_scene"))
     scene = files.ResolveScene(scene);
   if (!scene.empty()) core_->Load(scene);  // a bad file fails initialisation with its message
+  log_watch_ = std::thread([this] {
+    std::unique_lock<std::mutex> lock(log_watch_mutex_);
+    while (!log_watch_stop_) {
+      lock.unlock();
+      const bool done = ListenToSessionLog();
+      lock.lock();
+      if (done) break;
+      log_watch_wake_.wait_for(lock, std::chrono::seconds(2), [this] { return log_watch_stop_; });
+    }
+  });
   return rtc::ReturnCode::kOk;
 }
 
@@ -93,33 +103,44 @@ rtc::ReturnCode ModelComponent::OnDeactivated() {
 }
 
 rtc::ReturnCode ModelComponent::OnFinalize() {
+  StopLogWatch();  // before the ORB goes
   core_->CancelExperiment();  // the ORB's shutdown waits for calls in progress
   return rtc::ReturnCode::kOk;
 }
 
-void ModelComponent::ListenToSessionLog() {
-  next_log_check_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+bool ModelComponent::ListenToSessionLog() {
   const std::string name = runtime_.config().GetString("log.service");
-  if (name.empty() || name == "none") return;
+  if (name.empty() || name == "none") return true;  // nothing to look for
   try {
     CosNaming::NamingContext_var root =
         rtc::ResolveRoot(runtime_.orb(), runtime_.naming_address());
     Caliper::Logging::LogService_var logger =
         Caliper::Logging::LogService::_narrow(rtc::FindComponent(root, name).object);
-    if (CORBA::is_nil(logger)) return;
+    if (CORBA::is_nil(logger)) return false;
     CORBA::Object_var ref = runtime_.Activate(new SessionLogListener(*core_));
     logger->add_listener(Caliper::Logging::LogListener::_narrow(ref));
     core_->UseSessionLog(true);
-    listening_ = true;
     logging::Get("model").info("recordings take the session log of '%s'", name.c_str());
+    return true;
   } catch (const std::exception&) {
     // no Logging component (yet): the Model's own records go into recordings
   } catch (const CORBA::Exception&) {
   }
+  return false;
 }
 
+void ModelComponent::StopLogWatch() {
+  {
+    std::lock_guard<std::mutex> lock(log_watch_mutex_);
+    log_watch_stop_ = true;
+  }
+  log_watch_wake_.notify_all();
+  if (log_watch_.joinable()) log_watch_.join();
+}
+
+ModelComponent::~ModelComponent() { StopLogWatch(); }
+
 rtc::ReturnCode ModelComponent::OnExecute() {
-  if (!listening_ && std::chrono::steady_clock::now() >= next_log_check_) ListenToSessionLog();
   if (runtime_.context().kind() == rtc::ContextKind::kExternal) {
     core_->Tick();
   } else {

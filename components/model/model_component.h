@@ -10,8 +10,12 @@
 // The execution context drives stepping: PERIODIC ticks advance the simulation by what the
 // real-time factor makes due; an EXTERNAL context steps once per tick (lock-step).
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "caliper/rtc/runtime.h"
 #include "model_core.h"
@@ -21,6 +25,7 @@ namespace caliper::model {
 class ModelComponent : public rtc::Component {
  public:
   explicit ModelComponent(rtc::Runtime& runtime);
+  ~ModelComponent() override;
 
   rtc::ReturnCode OnInitialize() override;
   rtc::ReturnCode OnActivated() override;
@@ -33,14 +38,20 @@ class ModelComponent : public rtc::Component {
 
  private:
   /// Listens to the Logging component (log.service) so that recordings hold the whole
-  /// session's log, every component's records; until then the Model's own records go in.
-  void ListenToSessionLog();
+  /// session's log, every component's records; until then the Model's own records go in. True
+  /// once registered.
+  bool ListenToSessionLog();
+  void StopLogWatch();
 
   rtc::Runtime& runtime_;
   std::unique_ptr<ModelCore> core_;
   bool autostart_;
-  bool listening_ = false;
-  std::chrono::steady_clock::time_point next_log_check_{};
+  // looks for the Logging component every 2 s until found, on a thread of its own (naming
+  // lookups never run on the stepping thread)
+  std::thread log_watch_;
+  std::mutex log_watch_mutex_;
+  std::condition_variable log_watch_wake_;
+  bool log_watch_stop_ = false;
 };
 
 }  // namespace caliper::model

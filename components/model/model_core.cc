@@ -387,6 +387,7 @@ void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded, bool edit) {
 }
 
 void ModelCore::RewindLocked() {
+  fork_reset_every_ = 0;  // a rewound fork is a plain simulation again
   auto fresh = std::make_unique<Loaded>();
   fresh->description = loaded_->description;
   fresh->source = loaded_->source;
@@ -561,7 +562,7 @@ void ModelCore::ApplyPendingLocked() {
   for (const auto& [name, value] : pending_commands_) {
     loaded_->physics->SetCommand(name, value);
     loaded_->commands[name] = value;
-    RecordEventLocked("command", name, {value});
+    if (recorder_session_) RecordEventLocked("command", name, {value});  // no allocation else
   }
   pending_commands_.clear();
 }

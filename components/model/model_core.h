@@ -74,6 +74,7 @@ struct Limits {
   size_t subscribed_values = 100000;     // values of all data subscriptions together
   size_t queued_bytes = size_t{256} << 20;  // batches waiting for slow consumers, in all
   std::chrono::milliseconds pull_lease{2000};  // a pull not renewed for this long ends
+  uint64_t recording_bytes = uint64_t{4} << 30;  // the largest recording file (a client's 0 = this)
 };
 
 /// Wall time a step request or an experiment holds the lock before letting other calls in.

@@ -150,6 +150,10 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
                        "] steps (a seek re-simulates up to one interval)");
   if (!options.channels.empty() && options.channels_every < 1)
     throw InvalidValue("channels_every must be at least 1 step");
+  // the disk a client may fill: bounded by the Model, whatever the client asks
+  if (options.max_bytes > limits_.recording_bytes)
+    throw InvalidValue("max_bytes " + std::to_string(options.max_bytes) + ": a recording takes at "
+                       "most " + std::to_string(limits_.recording_bytes) + " bytes");
   if (options.channels.size() > limits_.ids_per_call)
     throw InvalidValue(std::to_string(options.channels.size()) + " channels; a recording takes at "
                        "most " + std::to_string(limits_.ids_per_call));
@@ -179,7 +183,9 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   header.scene_file_name = scene.file_name;
   r->writer = std::make_unique<recording::Writer>(path, header, scene,
                                                   std::chrono::milliseconds(500),
-                                                  options.max_bytes);
+                                                  options.max_bytes != 0
+                                                      ? options.max_bytes
+                                                      : limits_.recording_bytes);
   r->first_step = header.first_step;
   recorder_session_ = std::move(r);
   last_recording_error_.clear();
@@ -450,8 +456,9 @@ ModelCore::ReplayStatus ModelCore::Seek(double time_s) {
   const ReplayStatus now = ReplayStatusLocked();
   const double dt = replay_->reader->header().time_step;
   const double clamped = std::min(std::max(time_s, now.start_time), now.end_time);
-  const uint64_t target =
-      now.first_step + static_cast<uint64_t>(std::llround((clamped - now.start_time) / dt));
+  const uint64_t target = std::min(
+      now.last_step,
+      now.first_step + static_cast<uint64_t>(std::llround((clamped - now.start_time) / dt)));
   const RunState keep = state_;
   // from the current state when the target lies ahead within a keyframe interval, else from the
   // keyframe at or before it
@@ -525,7 +532,7 @@ std::string Difference(const sgal::DynamicState& got, const sgal::DynamicState& 
   if (got.engine.size() != recorded.engine.size())
     return "the engine state has " + std::to_string(got.engine.size()) + " values, recorded " +
            std::to_string(recorded.engine.size());
-  constexpr size_t kPerBody = 36;  // two transforms, four velocities (BulletScene)
+  constexpr size_t kPerBody = physics_bullet::kEngineValuesPerBody;
   static const char* const kParts[] = {"orientation", "orientation", "orientation",
                                        "orientation", "orientation", "orientation",
                                        "orientation", "orientation", "orientation",

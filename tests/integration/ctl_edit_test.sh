@@ -88,7 +88,7 @@ ctl edit add-tendon strap upper_arm 0.03 0 -0.05 forearm 0.03 0 -0.05 ligament s
 ctl motor | grep -q "strap_ligament *ligament *strap" && pass "the new ligament is an actuator" ||
   fail "the new ligament is not listed"
 ctl edit mass forearm 0.8 >/dev/null 2>&1 || fail "mass"
-ctl get ecce_arm.forearm.mass | grep -q "0.8" && pass "forearm mass 0.8 kg" || fail "mass not read back"
+ctl get ecce_arm.forearm.mass | awk '$3 == 0.8 {found = 1} END {exit !found}' && pass "forearm mass 0.8 kg" || fail "mass not read back"
 ctl edit shapes forearm >"$WORK/shapes" 2>&1
 dims=$(awk 'NR == 1 {print $3, $4, $5, $6}' "$WORK/shapes")
 ctl edit shape forearm 0 0.05 0.3 >/dev/null 2>&1 || fail "shape ($dims)"

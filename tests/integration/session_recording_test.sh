@@ -75,7 +75,8 @@ ctl replay "$F/run.sqlite" >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "repla
 grep -q "^time / end \[s\]  *0 / 10$" "$WORK/open" && pass "replay opened at 0 of 10 s" ||
   { cat "$WORK/open"; fail "replay status after open"; }
 if ctl motor elbow_flexor 1 >"$WORK/out" 2>&1; then fail "a command during a replay was accepted"
-else pass "command refused while replaying: $(cut -c1-90 "$WORK/out")"; fi
+elif grep -q "replays .*fork" "$WORK/out"; then pass "command refused while replaying: $(cut -c1-90 "$WORK/out")"
+else cat "$WORK/out"; fail "the refusal does not say the Model replays"; fi
 
 # the DAQ recorder while stepping through the replay: the recorded values, bit for bit
 ctl record $CH1 $CH2 --csv "$WORK/daq.csv" --duration 1.5 >/dev/null 2>"$WORK/daq.err" &

@@ -1012,7 +1012,8 @@ btVector3 TakeVector(const double*& in) {
   return v;
 }
 
-constexpr size_t kBodyEngineValues = 2 * 12 + 4 * 3;  // two transforms, four velocities
+constexpr size_t kBodyEngineValues = kEngineValuesPerBody;
+static_assert(kBodyEngineValues == 2 * 12 + 4 * 3, "two transforms, four velocities");
 
 }  // namespace
 

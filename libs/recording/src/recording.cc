@@ -420,7 +420,9 @@ struct Writer::Impl {
         s->Reset();
       if (!sqlite3_get_autocommit(db)) sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
       std::string why;
-      if (code == SQLITE_FULL && max_bytes > 0)
+      // the file at its limit (within a batch of it), or the disk full before that
+      const uint64_t batch_bytes = uint64_t{8} << 20;
+      if (code == SQLITE_FULL && max_bytes > 0 && bytes + batch_bytes >= max_bytes)
         why = "the file reached its limit of " + std::to_string(max_bytes) +
               " bytes or the disk is full";
       else if (code == SQLITE_FULL)
@@ -633,6 +635,11 @@ struct Reader::Impl {
     } catch (const std::logic_error& e) {  // stod/stoul: not a number
       throw Error(std::string("a meta value is not a number (") + e.what() + ")");
     }
+    // what a replay divides by and steps toward: refused here rather than met there
+    if (!(header.time_step > 0 && header.time_step <= 0.1))
+      throw Error("its time step " + std::to_string(header.time_step) + " s is not in (0, 0.1] s");
+    if (header.keyframe_every < 1)
+      throw Error("its keyframe_every is 0: keyframes at least every step");
     Statement c(db, "SELECT id, unit, rows, cols FROM channels ORDER BY position");
     while (c.Step()) {
       Channel ch;

@@ -336,6 +336,34 @@ TEST_F(ModelRecording, TheLogGoesIntoTheRecording) {
   EXPECT_TRUE(other) << "another component's record";
 }
 
+TEST_F(ModelRecording, BoundsAClientOrAFileCannotLift) {
+  ModelCore core;
+  core.Load(Model("ecce_arm.dae"));
+  ModelCore::RecordOptions wide;
+  wide.keyframe_every = 1001;  // a seek would re-simulate that much holding the Model
+  EXPECT_THROW(core.StartRecording(file_, wide), InvalidValue);
+  ModelCore::RecordOptions huge;
+  huge.max_bytes = Limits{}.recording_bytes + 1;
+  EXPECT_THROW(core.StartRecording(file_, huge), InvalidValue);
+  // a file whose time step or keyframe interval would divide by zero or step without end
+  core.StartRecording(file_, {});
+  core.StepNow(50);
+  core.StopRecording();
+  for (const char* sql : {"UPDATE meta SET value = '0' WHERE key = 'time_step_s'",
+                          "UPDATE meta SET value = 'nan' WHERE key = 'time_step_s'",
+                          "UPDATE meta SET value = '0' WHERE key = 'keyframe_every'"}) {
+    const std::string copy = dir_.path() + "/bad" + std::to_string(std::hash<std::string>{}(sql));
+    std::ifstream in(file_, std::ios::binary);
+    std::ofstream(copy, std::ios::binary) << in.rdbuf();
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(copy.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+    ModelCore replay;
+    EXPECT_THROW(replay.OpenReplay(copy), recording::RecordingError) << sql;
+  }
+}
+
 TEST_F(ModelRecording, AFullDiskEndsTheRecordingAndTheSimulationGoesOn) {
   ModelCore core;
   core.Load(Model("ecce_arm.dae"));

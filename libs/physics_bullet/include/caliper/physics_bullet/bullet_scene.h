@@ -27,6 +27,11 @@ struct Options {
 /// actuators come before Bullet's step and leave it untouched).
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
 
+/// DynamicState::engine holds this many values per body first (the centre-of-mass transform and
+/// the interpolation transform, 12 each; linear, angular and the two interpolation velocities,
+/// 3 each), then the tendons' own.
+constexpr size_t kEngineValuesPerBody = 36;
+
 /// The engine as recordings name it ("bullet 3.24 float", and the dynamic state's layout): a
 /// replay is exact only on the same.
 std::string EngineId();
