@@ -40,11 +40,19 @@ class TendonActuator {
  public:
   virtual ~TendonActuator() = default;
 
-  /// Sets the internal state for a tendon path of this length at rest (t = 0).
+  /// Sets the internal state for a tendon path of this length at rest (t = 0); tension() is then
+  /// the tension at rest at that length, which the engine applies through its first step.
   virtual void Reset(double path_length) = 0;
 
-  /// Advances the internal state by dt [s], the path length [m] and lengthening speed [m/s] held
-  /// over the step; returns the tension [N] (>= 0) to apply along the path for this step.
+  /// Advances the internal state by dt [s] while the path moves: it is path_length [m] at the
+  /// start of the step and lengthens at path_speed [m/s] through it (path_length + path_speed dt
+  /// at the end). Returns the tension [N] (>= 0) at the END of the step.
+  ///
+  /// The engine couples actuators and bodies in Stormer-Verlet order, second order in dt: the
+  /// bodies advance over a step on the tension at its start (the last Step's result), then each
+  /// actuator advances over the same step on the path the bodies took. So that the whole stays
+  /// second order, a kind integrates its states at least to second order with the path length at
+  /// each stage's own time, not held at its start value.
   virtual double Step(double path_length, double path_speed, double dt) = 0;
 
   /// The tension of the last Step [N].
