@@ -91,20 +91,46 @@ void Ratio(const char* name, double value, double target) {
   std::fflush(stdout);
 }
 
+/// One Caliper case alone (for profiling): its step time, no ratio. False for an unknown name.
+bool TimeOnly(const std::string& name) {
+  TreeOptions o;  // floor and self contact
+  bool contact = true;
+  if (name == "tree_free" || name == "spanning_on" || name == "spanning_off") {
+    o.floor = false;
+    o.self_contact = false;
+  }
+  if (name == "spanning_on" || name == "spanning_off") o.spanning_tendons = true;
+  if (name == "spanning_off") contact = false;
+  if (name != "tree_contact" && name != "tree_free" && name != "spanning_on" &&
+      name != "spanning_off")
+    return false;
+  std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimeCaliper(o, contact));
+  return true;
+}
+
 }  // namespace
 }  // namespace caliper::bench
 
 int main(int argc, char** argv) {
   using namespace caliper;
   using namespace caliper::bench;
+  std::string only;  // one case to time alone
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else {
-      std::printf("Usage: physics_bench [--steps N] [--repeats R]\n"
-                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms; medians of R runs of N steps.\n");
+      std::printf("Usage: physics_bench [--steps N] [--repeats R] [--only CASE]\n"
+                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms; medians of R runs of N steps.\n"
+                  "--only times one Caliper case (for profiling): tree_contact, tree_free,\n"
+                  "spanning_on, spanning_off.\n");
       return std::strcmp(argv[i], "--help") ? 2 : 0;
     }
+  }
+  if (!only.empty()) {
+    if (TimeOnly(only)) return 0;
+    std::fprintf(stderr, "physics_bench: unknown case '%s' for --only\n", only.c_str());
+    return 2;
   }
   TreeOptions contact;  // floor and self contact
   TreeOptions free;
