@@ -32,6 +32,11 @@
 // tendon_length, tendon_strain; mujoco adds max_isometric_force and optimal_fiber_length (L0),
 // read-only.
 
+#include <array>
+#include <cstddef>
+#include <utility>
+#include <vector>
+
 namespace caliper::actuators {
 
 // ---------------------------------------------------------------------------------------------
@@ -138,6 +143,101 @@ double MujocoNormalizedLength(double length, double lengthrange_lo, double lengt
 double MujocoForceScale(double force, double scale, double acc0);
 
 // ---------------------------------------------------------------------------------------------
+// Millard 2012 (OpenSim's Millard2012EquilibriumMuscle; Millard et al. 2013, J Biomech Eng
+// 135(2)): every curve is a chain of C2-continuous quintic Bezier "corners", linear outside.
+
+/// Curve parameters of OpenSim's ActiveForceLengthCurve, ForceVelocityCurve,
+/// FiberForceLengthCurve and TendonForceLengthCurve; the defaults are OpenSim's. OpenSim derives
+/// an unset stiffness from its strain (fibre 2 / strain, tendon 1.375 / strain): change both.
+struct MillardCurveParameters {
+  // active force-length, on the normalised fibre length [-]
+  double min_norm_active_fiber_length = 0.4441;  // left shoulder (value minimum_value) [-]
+  double transition_norm_fiber_length = 0.73;    // steep to shallow ascending limb [-]
+  double max_norm_active_fiber_length = 1.8123;  // right shoulder (value minimum_value) [-]
+  double shallow_ascending_slope = 0.8616;       // [-]
+  double minimum_value = 0.1;                    // [-]
+  // force-velocity, on the normalised fibre velocity (lengthening > 0, -1 at vmax) [-]
+  double concentric_slope_at_vmax = 0;                // [-]
+  double concentric_slope_near_vmax = 0.25;           // at -0.9 [-]
+  double isometric_slope = 5;                         // at 0 [-]
+  double eccentric_slope_at_vmax = 0;                 // [-]
+  double eccentric_slope_near_vmax = 0.15;            // at 0.9 [-]
+  double max_eccentric_velocity_force_multiplier = 1.4;  // value at +1 [-]
+  double concentric_curviness = 0.6;                  // 0 (sharp) .. 1 (round) [-]
+  double eccentric_curviness = 0.9;                   // [-]
+  // passive fibre force-length, on the fibre strain (normalised length - 1) [-]
+  double fiber_strain_at_zero_force = 0;                  // [-]
+  double fiber_strain_at_one_norm_force = 0.7;            // [-]
+  double fiber_stiffness_at_low_force = 0.2;              // [-]
+  double fiber_stiffness_at_one_norm_force = 2.0 / 0.7;   // [-]
+  double fiber_curviness = 0.75;                          // [-]
+  // tendon force-length, on the tendon strain (length / slack length - 1) [-]
+  double tendon_strain_at_one_norm_force = 0.049;             // [-]
+  double tendon_stiffness_at_one_norm_force = 1.375 / 0.049;  // [-]
+  double tendon_norm_force_at_toe_end = 2.0 / 3.0;            // [-]
+  double tendon_curviness = 0.5;                              // [-]
+};
+
+/// A curve y(x) made of quintic Bezier segments joined with equal value, slope and curvature,
+/// extended by straight lines before the first and after the last segment. Evaluating at x
+/// solves the segment's Bezier parameter by safeguarded Newton from a sampled start.
+class MillardCurve {
+ public:
+  /// Control points of one segment (x increasing).
+  struct Segment {
+    std::array<double, 6> x{}, y{};
+  };
+  MillardCurve() = default;
+  /// Throws std::invalid_argument when there is no segment or x does not increase.
+  explicit MillardCurve(std::vector<Segment> segments);
+
+  double Value(double x) const;
+  double Slope(double x) const;            // dy/dx
+  double SecondDerivative(double x) const;  // d2y/dx2
+  /// Value and slope together (one parameter solve).
+  std::pair<double, double> ValueAndSlope(double x) const;
+
+  /// A root x of weight * y(x) + damping * x = target for a non-decreasing curve, weight and
+  /// damping >= 0 (the damped force-velocity balance; weight 1, damping 0 is the inverse
+  /// curve), with y and dy/dx there. NaN x when no x gives target (flat ends, damping 0).
+  struct Solution {
+    double x = 0, y = 0, slope = 0;
+  };
+  Solution SolveAffine(double weight, double damping, double target) const;
+  /// The inverse x(y) of an increasing curve (NaN beyond a flat end).
+  double Inverse(double y) const { return SolveAffine(1, 0, y).x; }
+
+  double x_begin() const { return poly_.front().x[0]; }
+  double x_end() const { return x_end_; }
+  const std::vector<Segment>& segments() const { return segments_; }
+
+ private:
+  struct Poly {
+    std::array<double, 6> x{}, y{};  // power-basis coefficients in u
+    std::array<double, 9> xs{};      // x at u = k / 8 (start of the parameter solve)
+  };
+  std::pair<std::size_t, double> Locate(double x) const;  // segment and its parameter u
+  std::vector<Segment> segments_;
+  std::vector<Poly> poly_;
+  double x_end_ = 0, y_begin_ = 0, y_end_ = 0, slope_begin_ = 0, slope_end_ = 0;
+};
+
+/// One corner as OpenSim's SegmentedQuinticBezierToolkit builds it: from (x0, y0) with slope
+/// dydx0 to (x1, y1) with slope dydx1, the inner control points pulled towards the lines'
+/// intersection by 0.1 + 0.8 curviness. Throws std::invalid_argument unless the points and
+/// slopes make a C-shaped corner (x1 > x0, the intersection nearer each end than they are).
+MillardCurve::Segment MillardCorner(double x0, double y0, double dydx0, double x1, double y1,
+                                    double dydx1, double curviness);
+
+/// The four curves, each throwing std::invalid_argument naming the parameter out of range.
+MillardCurve MillardActiveForceLengthCurve(const MillardCurveParameters& p = {});
+MillardCurve MillardForceVelocityCurve(const MillardCurveParameters& p = {});
+/// On the normalised fibre length (1 + strain).
+MillardCurve MillardFiberForceLengthCurve(const MillardCurveParameters& p = {});
+/// On the normalised tendon length (1 + strain).
+MillardCurve MillardTendonForceLengthCurve(const MillardCurveParameters& p = {});
+
+// ---------------------------------------------------------------------------------------------
 // Parameter sets of the kind hill_muscle
 
 /// options["curves"] = "thelen2003". Names in the actuator description are the field names.
@@ -174,9 +274,79 @@ struct MujocoMuscleParameters {
   double tau_deact = 0.04;    // [s]
 };
 
+/// options["curves"] = "millard2012". Names in the actuator description are the field names.
+struct MillardMuscleParameters {
+  double max_isometric_force = 1000;                    // F0 [N]
+  double optimal_fiber_length = 0.1;                    // [m] (required in a description)
+  double tendon_slack_length = 0.2;                     // [m] (required in a description)
+  double pennation_angle = 0;                           // at optimal fibre length [rad]
+  double max_contraction_velocity = 10;                 // [optimal fibre lengths / s]
+  double activation_time_constant = 0.010;              // [s]
+  double deactivation_time_constant = 0.040;            // [s]
+  double minimum_activation = 0.01;                     // [-]
+  double maximum_pennation_angle = 1.4706289056333368;  // acos(0.1) [rad]
+  double fiber_damping = 0.1;  // beta: F0 beta v / (vmax lopt) in the fibre [-]
+  MillardCurveParameters curves;  // by the field names of MillardCurveParameters
+};
+
 /// Throws std::invalid_argument naming the first parameter out of range (and the one it
 /// conflicts with).
 void Validate(const ThelenMuscleParameters& p, bool elastic_tendon);
 void Validate(const MujocoMuscleParameters& p);
+/// Also builds the curves (their own checks); fiber_damping = 0 needs an invertible
+/// force-velocity curve (slopes at vmax > 0), minimum_activation > 0 and minimum_value > 0.
+void Validate(const MillardMuscleParameters& p, bool elastic_tendon);
+
+/// The state-free part of the Millard muscle, curves built once: the forces of a fibre state.
+/// Damped equilibrium (Millard 2013): F0 fse = F0 (a fal fv(v) + fpe + beta v) cos(pennation),
+/// v the normalised fibre velocity; with an elastic tendon it gives v for a fibre length.
+class MillardFiberModel {
+ public:
+  /// Forces and kinematics of one state.
+  struct State {
+    double fiber_length = 0;          // [m]
+    double fiber_velocity = 0;        // [m/s]
+    double norm_fiber_length = 0;     // [-]
+    double norm_fiber_velocity = 0;   // [-]
+    double cos_pennation = 1;         // [-]
+    double tendon_length = 0;         // [m]
+    double tendon_strain = 0;         // [-]
+    double active_force_length = 0;   // fal [-]
+    double force_velocity = 1;        // fv [-]
+    double passive_force_length = 0;  // fpe [-]
+    double active_fiber_force = 0;    // F0 a fal fv [N]
+    double passive_force = 0;         // F0 (fpe + beta v), elastic and damping [N]
+    double tendon_force = 0;          // F0 fse; the rigid tendon's is the fibres' along it [N]
+    double tension = 0;               // [N], >= 0
+  };
+
+  /// p must be valid (Validate).
+  explicit MillardFiberModel(const MillardMuscleParameters& p);
+
+  const MillardMuscleParameters& parameters() const { return p_; }
+  double height() const { return height_; }  // optimal_fiber_length sin(pennation_angle) [m]
+  /// The shortest fibre: the longer of min_norm_active_fiber_length lopt and the height over
+  /// sin(maximum_pennation_angle) [m].
+  double minimum_fiber_length() const { return minimum_fiber_length_; }
+
+  /// Rigid tendon: the fibres take the path minus the slack tendon.
+  State Rigid(double path_length, double path_speed, double activation) const;
+  /// Elastic tendon, fibre length lm [m] (>= minimum_fiber_length()): velocity from the balance.
+  State Elastic(double fiber_length, double path_length, double activation) const;
+  /// The fibre velocity [m/s] of the balance at lm and its derivative by lm [1/s].
+  std::pair<double, double> FiberVelocity(double fiber_length, double path_length,
+                                          double activation) const;
+  /// Isometric excess a fal + fpe - fse / cos [-] at lm, and its derivative by lm [1/m]: zero at
+  /// the equilibrium of a fibre at rest.
+  std::pair<double, double> IsometricExcess(double fiber_length, double path_length,
+                                            double activation) const;
+
+ private:
+  struct Terms;
+  Terms TermsAt(double lm, double path_length) const;
+  MillardMuscleParameters p_;
+  MillardCurve fal_, fv_, fpe_, fse_;
+  double height_ = 0, minimum_fiber_length_ = 0;
+};
 
 }  // namespace caliper::actuators
