@@ -63,7 +63,9 @@ void RequireFinite(const std::string& prefix, const char* what, double value) {
 }
 
 // the tendon seen from the spool: an inextensible line paid in by the spool, in series with the
-// elastic element, along a path of fixed length over one step
+// elastic element, along a path that lengthens at a constant speed through the step (the
+// actuator contract): each sub-step and stage sees the path length at its own time, so that the
+// motor's second-order integration stays second order with the path
 class TendonSpoolLoad : public SpoolLoad {
  public:
   TendonSpoolLoad(ElasticElement* elastic, const LinearSpringDamper* linear, double path_length,
@@ -79,12 +81,16 @@ class TendonSpoolLoad : public SpoolLoad {
   double LineLength(double spool_angle) const {
     return line_length_ - spool_radius_ * (spool_angle - spool_angle_);
   }
-  double ElasticLength(double spool_angle) const { return path_length_ - LineLength(spool_angle); }
+  // the path length h [s] after the last accepted sub-step [m]
+  double PathLength(double h) const { return path_length_ + path_speed_ * (elapsed_ + h); }
+  double ElasticLength(double spool_angle, double h) const {
+    return PathLength(h) - LineLength(spool_angle);
+  }
   double ElasticSpeed(double spool_speed) const {
     return path_speed_ + spool_radius_ * spool_speed;
   }
   double TorqueAt(double spool_angle, double spool_speed, double h) const override {
-    const double length = ElasticLength(spool_angle);
+    const double length = ElasticLength(spool_angle, h);
     const double speed = ElasticSpeed(spool_speed);
     // the default element without a second virtual call
     return spool_radius_ * (linear_ ? linear_->LinearSpringDamper::Peek(length, speed, h)
@@ -93,7 +99,7 @@ class TendonSpoolLoad : public SpoolLoad {
   double TorqueAlong(double spool_angle, double spool_speed, double h, double angle_per_speed,
                      double* slope, double* low, double* high) const override {
     // the elastic length and speed grow by r_s per radian and per rad/s
-    const double length = ElasticLength(spool_angle);
+    const double length = ElasticLength(spool_angle, h);
     const double speed = ElasticSpeed(spool_speed);
     const double d_length = spool_radius_ * angle_per_speed;
     double d_force;
@@ -106,7 +112,8 @@ class TendonSpoolLoad : public SpoolLoad {
     return spool_radius_ * force;
   }
   void Advance(double spool_angle, double spool_speed, double h) override {
-    force_ = elastic_->Force(ElasticLength(spool_angle), ElasticSpeed(spool_speed), h);
+    force_ = elastic_->Force(ElasticLength(spool_angle, h), ElasticSpeed(spool_speed), h);
+    elapsed_ += h;
   }
   int TorqueSign() const override { return 1; }  // tension only
   double force() const { return force_; }
@@ -114,11 +121,12 @@ class TendonSpoolLoad : public SpoolLoad {
  private:
   ElasticElement* elastic_;
   const LinearSpringDamper* linear_;  // elastic_ when it is the linear element, else null
-  double path_length_;                // [m]
-  double path_speed_;                 // [m/s]
+  double path_length_;                // at the start of the step [m]
+  double path_speed_;                 // through the step [m/s]
   double line_length_;                // free line at the start of the step [m]
   double spool_angle_;                // at the start of the step [rad]
   double spool_radius_;               // [m]
+  double elapsed_ = 0;                // accepted sub-steps since the start of the step [s]
   double force_ = 0;                  // [N]
 };
 
@@ -179,10 +187,11 @@ class DcMotorTendon : public TendonActuator {
     TendonSpoolLoad load(elastic_.get(), linear_, path_length, path_speed, line_length_, angle,
                          motor_.parameters().spool_radius);
     motor_.Step(voltage(), dt, load);
-    path_length_ = path_length;
+    // everything reported is at the end of the step, where the tension is
+    path_length_ = path_length + path_speed * dt;
     path_speed_ = path_speed;
     line_length_ = load.LineLength(motor_.state().spool_angle);
-    elastic_length_ = load.ElasticLength(motor_.state().spool_angle);
+    elastic_length_ = path_length_ - line_length_;
     tension_ = load.force();
     return tension_;
   }
@@ -398,9 +407,10 @@ class Ligament : public TendonActuator {
     RequireFinite(prefix_, "path speed", path_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
-    length_ = path_length;
+    // the tension at the end of the step, where the path has moved to (the actuator contract)
+    length_ = path_length + path_speed * dt;
     speed_ = path_speed;
-    tension_ = spring_->Force(path_length, path_speed, dt);
+    tension_ = spring_->Force(length_, path_speed, dt);
     return tension_;
   }
 
@@ -462,7 +472,7 @@ class Ligament : public TendonActuator {
   std::unique_ptr<LinearSpringDamper> spring_;
   bool rest_from_path_ = false;  // rest length = path length at Reset
   double tension_ = 0;           // [N]
-  double length_ = 0;            // [m]
+  double length_ = 0;            // at the end of the last step [m]
   double speed_ = 0;             // [m/s]
 };
 
