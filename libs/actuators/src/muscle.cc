@@ -40,15 +40,6 @@ double ThelenEccentricFactor(const ThelenCurveParameters& p) {
   return (2 + 2 / p.af) / (p.flen - 1);
 }
 
-double ThelenPassiveSlope(double l, double kpe, double e0) {
-  if (l <= 1) return 0;
-  return kpe / e0 * std::exp(kpe * (l - 1) / e0) / (std::exp(kpe) - 1);
-}
-
-double ThelenActiveSlope(double l, double gamma) {
-  return -2 * (l - 1) / gamma * ThelenActiveForceLength(l, gamma);
-}
-
 // The activation a(h) of da/dt = (u - a) / tau with tau = tau_act (0.5 + 1.5 a) while u > a and
 // tau_deact / (0.5 + 1.5 a) while u < a (the law of ActivationRate for a, u in [0, 1]; a never
 // crosses u), solved exactly, P = 0.5 + 1.5 u:
@@ -521,12 +512,14 @@ class HillMuscle : public TendonActuator {
     // fibre sub-steps of at most 1 ms (activation takes finer ones inside)
     const int n = elastic_ ? FiberSubsteps(dt) : 1;
     const double h = dt / n;
+    double velocity = out_.fiber_velocity;  // predicts the fibre's stage roots
     for (int i = 0; i < n; ++i) {
       const double a0 = activation_;
       activation_ = IntegrateActivation(a0, h);
       if (elastic_) {
         const double l0 = path_length + path_speed * i * h;
-        fiber_length_ = FiberStep(fiber_length_, l0, l0 + path_speed * h, a0, activation_, h);
+        fiber_length_ =
+            FiberStep(fiber_length_, l0, l0 + path_speed * h, a0, activation_, h, &velocity);
       }
     }
     Evaluate(path_length + path_speed * dt, path_speed);
@@ -730,6 +723,24 @@ class HillMuscle : public TendonActuator {
     minimum_fiber_length_ =
         std::max(height_ / std::sin(t.maximum_pennation_angle), 0.01 * t.optimal_fiber_length);
     passive_denominator_ = std::exp(t.curves.kshape_passive) - 1;
+    UpdateThelenElasticConstants();
+  }
+
+  // the constants of the elastic-tendon curves, so that a fibre evaluation in the step's Newton
+  // solves costs one exp() per curve and no divisions by parameters
+  void UpdateThelenElasticConstants() {
+    const ThelenMuscleParameters& t = p_.thelen;
+    const ThelenCurveParameters& c = t.curves;
+    ElasticConstants& k = elastic_constants_;
+    k.toe = ThelenTendonToe(c.fmax_tendon_strain);
+    k.toe_scale = k.toe.toe_force / (std::exp(k.toe.toe_shape) - 1);
+    k.toe_rate = k.toe.toe_shape / k.toe.toe_strain;
+    k.passive_rate = c.kshape_passive / c.fmax_muscle_strain;
+    k.inv_active_shape = 1 / c.kshape_active;
+    k.inv_optimal = 1 / t.optimal_fiber_length;
+    k.inv_slack = 1 / t.tendon_slack_length;
+    k.eccentric = ThelenEccentricFactor(c);
+    k.velocity_scale = t.max_contraction_velocity * t.optimal_fiber_length;
   }
 
   double Height() const { return height_; }  // optimal_fiber_length sin(pennation_angle) [m]
@@ -752,39 +763,82 @@ class HillMuscle : public TendonActuator {
     double dfv = 0;                             // [1/m]
   };
 
+  // the curves of ThelenTendonForceStrain, ThelenActiveForceLength, PassiveForceLength and their
+  // slopes, each pair from one exp() with the constants of UpdateThelenElasticConstants
   Balance BalanceAt(double lm, double path_length, double a) const {
-    const ThelenMuscleParameters& t = p_.thelen;
+    const ElasticConstants& k = elastic_constants_;
     const double h = Height();
-    const double along = std::sqrt(std::max(lm * lm - h * h, 0.0));
+    const double along = h > 0 ? std::sqrt(std::max(lm * lm - h * h, 0.0)) : lm;
     Balance b;
     b.cos = along / lm;
-    const double strain = (path_length - along) / t.tendon_slack_length - 1;
-    const double l = lm / t.optimal_fiber_length;
-    b.fse = ThelenTendonForceStrain(strain, t.curves.fmax_tendon_strain);
-    b.fal = ThelenActiveForceLength(l, t.curves.kshape_active);
-    b.fpe = PassiveForceLength(l);
+    const double strain = (path_length - along) * k.inv_slack - 1;
+    double stiffness = 0;  // d fse / d strain [-]
+    if (strain > k.toe.toe_strain) {
+      b.fse = k.toe.linear_stiffness * (strain - k.toe.toe_strain) + k.toe.toe_force;
+      stiffness = k.toe.linear_stiffness;
+    } else if (strain > 0) {
+      const double e = std::exp(k.toe_rate * strain);
+      b.fse = k.toe_scale * (e - 1);
+      stiffness = k.toe_scale * k.toe_rate * e;
+    }
+    const double l = lm * k.inv_optimal;
+    const double stretch = l - 1;
+    b.fal = std::exp(-stretch * stretch * k.inv_active_shape);
+    const double dfal = -2 * stretch * k.inv_active_shape * b.fal;  // by l
+    double dfpe = 0;                                                // by l
+    if (stretch > 0) {
+      const double e = std::exp(k.passive_rate * stretch);
+      b.fpe = (e - 1) / passive_denominator_;
+      dfpe = k.passive_rate * e / passive_denominator_;
+    }
     const double cos = std::max(b.cos, 1e-12);
-    b.num = b.fse / cos - b.fpe;
+    const double inv_cos = 1 / cos;
+    b.num = b.fse * inv_cos - b.fpe;
     b.den = std::max(a * b.fal, 1e-12);
-    b.fv = b.num / b.den;
-    const double dfse = ThelenTendonStiffness(strain, t.curves.fmax_tendon_strain) /
-                        t.tendon_slack_length * (-1 / cos);
-    const double dcos = h * h / (lm * lm * lm * cos);
-    b.dnum = dfse / cos - b.fse * dcos / (cos * cos) -
-             ThelenPassiveSlope(l, t.curves.kshape_passive, t.curves.fmax_muscle_strain) /
-                 t.optimal_fiber_length;
-    b.dden = a * ThelenActiveSlope(l, t.curves.kshape_active) / t.optimal_fiber_length;
-    b.dfv = (b.dnum * b.den - b.num * b.dden) / (b.den * b.den);
+    const double inv_den = 1 / b.den;
+    b.fv = b.num * inv_den;
+    const double dfse = -stiffness * k.inv_slack * inv_cos;
+    const double dcos = h > 0 ? h * h / (lm * lm * lm * cos) : 0.0;
+    b.dnum = (dfse - b.fse * dcos * inv_cos) * inv_cos - dfpe * k.inv_optimal;
+    b.dden = a * dfal * k.inv_optimal;
+    b.dfv = (b.dnum - b.fv * b.dden) * inv_den;
     return b;
+  }
+
+  // ThelenForceVelocityInverse and its slope together, with the cached eccentric factor: the
+  // normalised fibre velocity [-] at force-velocity multiplier fv and its derivative by fv
+  std::pair<double, double> InverseForceVelocity(double fv, double a) const {
+    const ThelenCurveParameters& p = p_.thelen.curves;
+    const double k = ThelenSpeedLimit(a);
+    const double c = elastic_constants_.eccentric;
+    if (fv <= 0) {
+      const double slope = k * (1 + 1 / p.af);
+      return {-k + slope * fv, slope};
+    }
+    if (fv <= 1) {
+      const double d = 1 / (1 + fv / p.af);
+      return {k * (fv - 1) * d, k * (1 + 1 / p.af) * d * d};
+    }
+    const double fv_thr = p.fv_linear_extrap_threshold * p.flen;
+    if (fv < fv_thr) {
+      const double d = 1 / (c * (p.flen - fv));
+      return {k * (fv - 1) * d, k * (p.flen - 1) * d * d * c};
+    }
+    const double d = 1 / (c * (p.flen - fv_thr));
+    const double slope = k * (p.flen - 1) * d * d * c;
+    return {k * (fv_thr - 1) * d + slope * (fv - fv_thr), slope};
+  }
+
+  // fibre velocity [m/s] of the balance b at activation a, and its derivative by lm [1/s]
+  std::pair<double, double> FiberVelocityOf(const Balance& b, double a) const {
+    const auto [v, dv] = InverseForceVelocity(b.fv, a);
+    const double scale = elastic_constants_.velocity_scale;
+    return {v * scale, dv * b.dfv * scale};
   }
 
   // fibre velocity [m/s] from the force balance, and its derivative by lm [1/s]
   std::pair<double, double> FiberVelocity(double lm, double path_length, double a) const {
-    const ThelenMuscleParameters& t = p_.thelen;
-    const Balance b = BalanceAt(lm, path_length, a);
-    const double scale = t.max_contraction_velocity * t.optimal_fiber_length;
-    return {ThelenForceVelocityInverse(b.fv, a, t.curves) * scale,
-            ThelenForceVelocityInverseSlope(b.fv, a, t.curves) * b.dfv * scale};
+    return FiberVelocityOf(BalanceAt(lm, path_length, a), a);
   }
 
   // x with x = base + c g(x): root of R(x) = x - base - c g(x) above the shortest fibre
@@ -800,13 +854,41 @@ class HillMuscle : public TendonActuator {
     return SafeNewton(residual, lo, hi, std::max(base, lo), 1e-13 * p_.thelen.optimal_fiber_length);
   }
 
+  // SolveStage from a predicted root: plain Newton steps, which along a smooth path converge
+  // quadratically in two or three evaluations; the bracketed SolveStage when a step would leave
+  // the fibres' range, the residual's slope is not positive or 6 steps do not converge. The last
+  // correction is below 1e-9 optimal fibre lengths, so the root is within the square of that
+  // times the curvature: far below the 1e-13 of the bracketed solve.
+  double SolveStageFrom(double guess, double base, double c, double path_length, double a) const {
+    const double lo = MinimumFiberLength();
+    const double tol = 1e-9 * p_.thelen.optimal_fiber_length;
+    double x = guess;
+    for (int i = 0; i < 6 && x > lo && std::isfinite(x); ++i) {
+      const auto [g, dg] = FiberVelocity(x, path_length, a);
+      const double slope = 1 - c * dg;
+      if (!(slope > 0)) break;
+      const double dx = (x - base - c * g) / slope;
+      x -= dx;
+      if (std::abs(dx) < tol && x > lo) return x;
+    }
+    return SolveStage(base, c, path_length, a);
+  }
+
   // two-stage L-stable SDIRK (second order, stiffly accurate) over h; the path moves linearly
-  // from l0 to l1 and the activation from a0 to a1
-  double FiberStep(double lm, double l0, double l1, double a0, double a1, double h) const {
+  // from l0 to l1 and the activation from a0 to a1. *velocity [m/s]: in, the fibre velocity at
+  // the start (a guess: it only predicts the stage roots); out, the last stage's slope (the
+  // fibre velocity at the end)
+  double FiberStep(double lm, double l0, double l1, double a0, double a1, double h,
+                   double* velocity) const {
     const double gamma = 1 - 1 / std::sqrt(2.0);
-    const double x1 = SolveStage(lm, gamma * h, l0 + gamma * (l1 - l0), a0 + gamma * (a1 - a0));
+    const double x1 = SolveStageFrom(lm + gamma * h * *velocity, lm, gamma * h,
+                                     l0 + gamma * (l1 - l0), a0 + gamma * (a1 - a0));
     const double k1 = (x1 - lm) / (gamma * h);
-    return SolveStage(lm + (1 - gamma) * h * k1, gamma * h, l1, a1);
+    const double base = lm + (1 - gamma) * h * k1;
+    // the second stage predicted from k1 carried over the step
+    const double x2 = SolveStageFrom(lm + h * k1, base, gamma * h, l1, a1);
+    *velocity = (x2 - base) / (gamma * h);
+    return x2;
   }
 
   // the fibre length of zero fibre velocity (fv = 1): tendon force = (a fal + fpe) cos
@@ -880,7 +962,7 @@ class HillMuscle : public TendonActuator {
     o.pennation_cos = Clamp(b.cos, 0, 1);
     o.tendon_length = length - lm * b.cos;
     o.tendon_strain = o.tendon_length / t.tendon_slack_length - 1;
-    o.fiber_velocity = FiberVelocity(lm, length, activation_).first;
+    o.fiber_velocity = FiberVelocityOf(b, activation_).first;
     o.norm_fiber_length = lm / t.optimal_fiber_length;
     o.norm_fiber_velocity =
         o.fiber_velocity / (t.max_contraction_velocity * t.optimal_fiber_length);
@@ -921,6 +1003,19 @@ class HillMuscle : public TendonActuator {
   double excitation_ = 0;            // command u [-], in [0, 1]
   double activation_ = 0;            // [-]
   double fiber_length_ = 0;          // elastic tendon state [m]
+  // the elastic-tendon curve constants (Thelen), once per parameter change
+  struct ElasticConstants {
+    ThelenTendonConstants toe;
+    double toe_scale = 0;         // toe_force / (exp(toe_shape) - 1) [-]
+    double toe_rate = 0;          // toe_shape / toe_strain [-]
+    double passive_rate = 0;      // kshape_passive / fmax_muscle_strain [-]
+    double inv_active_shape = 0;  // 1 / kshape_active [-]
+    double inv_optimal = 0;       // 1 / optimal_fiber_length [1/m]
+    double inv_slack = 0;         // 1 / tendon_slack_length [1/m]
+    double eccentric = 0;         // ThelenEccentricFactor [-]
+    double velocity_scale = 0;    // max_contraction_velocity optimal_fiber_length [m/s]
+  };
+  ElasticConstants elastic_constants_;  // UpdateThelenElasticConstants
   Outputs out_;
 
  public:
