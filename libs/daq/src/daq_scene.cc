@@ -1,27 +1,38 @@
 #include "caliper/daq/daq_scene.h"
 
 #include <stdexcept>
+#include <string>
 
 namespace caliper::daq {
 
+SceneSampler::SceneSampler(const sgal::PhysicsScene& scene)
+    : scene_(scene),
+      body_count_(scene.description().bodies.size()),
+      values_(body_count_ * kValuesPerBody) {}
+
 void SceneSampler::Fetch() {
-  states_ = scene_.BodyStates();
-  rotations_.resize(states_.size());
-  for (size_t i = 0; i < states_.size(); ++i)
-    rotations_[i] = states_[i].pose.orientation.toRotationMatrix();
+  const std::vector<sgal::BodyState> states = scene_.BodyStates();
+  if (states.size() != body_count_)
+    throw std::runtime_error("the scene has " + std::to_string(states.size()) +
+                             " bodies, its DAQ channels were registered for " +
+                             std::to_string(body_count_));
+  for (size_t i = 0; i < body_count_; ++i) {
+    const sgal::BodyState& b = states[i];
+    double* out = values_.data() + i * kValuesPerBody;
+    const Eigen::Quaterniond& q = b.pose.orientation;
+    Eigen::Map<Eigen::Vector3d>(out + kPosition) = b.pose.position;
+    out[kOrientation + 0] = q.w();
+    out[kOrientation + 1] = q.x();
+    out[kOrientation + 2] = q.y();
+    out[kOrientation + 3] = q.z();
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(out + kRotation) =
+        q.toRotationMatrix();
+    Eigen::Map<Eigen::Vector3d>(out + kLinearVelocity) = b.linear_velocity;
+    Eigen::Map<Eigen::Vector3d>(out + kAngularVelocity) = b.angular_velocity;
+  }
   fresh_ = true;
   ++fetches_;
 }
-
-namespace {
-
-void Write3(const Eigen::Vector3d& v, double* out) {
-  out[0] = v.x();
-  out[1] = v.y();
-  out[2] = v.z();
-}
-
-}  // namespace
 
 SceneChannels RegisterScene(Registry& registry, const std::string& model_name,
                             sgal::PhysicsScene& scene) {
@@ -63,49 +74,35 @@ SceneChannels RegisterScene(Registry& registry, const std::string& model_name,
     add(std::move(info), std::move(get), std::move(set));
   }
 
-  // per body: pose and velocities from the per-step cache
+  // per body: pose and velocities read in place from the per-step cache
   const auto& bodies = scene.description().bodies;
   for (size_t i = 0; i < bodies.size(); ++i) {
     const std::string base = prefix + bodies[i].name;
-    SceneSampler* sampler = result.sampler.get();
-    std::shared_ptr<SceneSampler> keep = result.sampler;
-    auto channel = [&](const char* field, const char* unit, Shape shape, const char* what) {
+    const double* values = result.sampler->values(i);
+    auto channel = [&](const char* field, const char* unit, Shape shape, const char* what,
+                       size_t offset) {
       ChannelInfo info;
       info.id = base + "." + field;
       info.unit = unit;
       info.shape = shape;
       info.description = std::string(what) + " of body " + bodies[i].name;
-      return info;
+      if (registry.Contains(info.id)) {
+        result.skipped.push_back(info.id);
+        return;
+      }
+      result.ids.push_back(info.id);
+      registry.Add(std::move(info), Source{result.sampler, values + offset});
     };
-    add(
-        channel("position", "m", Shape::Vector(3), "world position of the frame origin"),
-        [keep, sampler, i](double* out) { Write3(sampler->body(i).pose.position, out); }, nullptr);
-    add(
-        channel("orientation", "", Shape::Vector(4), "orientation quaternion w x y z"),
-        [keep, sampler, i](double* out) {
-          const Eigen::Quaterniond& q = sampler->body(i).pose.orientation;
-          out[0] = q.w();
-          out[1] = q.x();
-          out[2] = q.y();
-          out[3] = q.z();
-        },
-        nullptr);
-    add(
-        channel("rotation", "", Shape::Matrix(3, 3), "rotation matrix (body to world, row-major)"),
-        [keep, sampler, i](double* out) {
-          const Eigen::Matrix3d& r = sampler->rotation(i);
-          for (int row = 0; row < 3; ++row)
-            for (int col = 0; col < 3; ++col) out[row * 3 + col] = r(row, col);
-        },
-        nullptr);
-    add(
-        channel("linear_velocity", "m/s", Shape::Vector(3), "world velocity of the frame origin"),
-        [keep, sampler, i](double* out) { Write3(sampler->body(i).linear_velocity, out); },
-        nullptr);
-    add(
-        channel("angular_velocity", "rad/s", Shape::Vector(3), "world angular velocity"),
-        [keep, sampler, i](double* out) { Write3(sampler->body(i).angular_velocity, out); },
-        nullptr);
+    channel("position", "m", Shape::Vector(3), "world position of the frame origin",
+            SceneSampler::kPosition);
+    channel("orientation", "", Shape::Vector(4), "orientation quaternion w x y z",
+            SceneSampler::kOrientation);
+    channel("rotation", "", Shape::Matrix(3, 3), "rotation matrix (body to world, row-major)",
+            SceneSampler::kRotation);
+    channel("linear_velocity", "m/s", Shape::Vector(3), "world velocity of the frame origin",
+            SceneSampler::kLinearVelocity);
+    channel("angular_velocity", "rad/s", Shape::Vector(3), "world angular velocity",
+            SceneSampler::kAngularVelocity);
   }
   return result;
 }

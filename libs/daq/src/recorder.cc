@@ -77,6 +77,23 @@ struct Recorder::Queue {
   bool closed = false;
 };
 
+namespace {
+
+/// One part of filling a sample, in column order. Resolved whenever the registry changes, so
+/// that a sample does no lookup, and no call per channel for channels read in place: neighbouring
+/// columns whose values lie next to each other in one block are copied in one go.
+struct Op {
+  enum Kind : uint8_t { kCopy, kGet, kNaN };
+  Kind kind = kNaN;
+  uint32_t column = 0;             // the (first) column it fills, for error messages
+  uint32_t block = 0;              // kCopy: index into Subscription::blocks
+  size_t count = 0;                // doubles it appends
+  const double* values = nullptr;  // kCopy: where they are
+  const Getter* getter = nullptr;  // kGet
+};
+
+}  // namespace
+
 /// The simulation-thread state of one subscription.
 struct Recorder::Subscription {
   SubscriptionId id = 0;
@@ -84,6 +101,11 @@ struct Recorder::Subscription {
   uint64_t every_n_steps = 1;
   size_t batch_steps = 1;
   std::vector<Handle> handles;  // per column; meaningless for stale columns
+  // how to fill a sample: valid only while the registry's version is the one they were
+  // resolved at (OnStep re-resolves first when it changed)
+  std::vector<Op> ops;
+  std::vector<SourceBlock*> blocks;       // distinct blocks of the kCopy ops, updated per sample
+  std::vector<std::string> block_errors;  // per block: why its update failed this sample, or ""
   std::shared_ptr<const std::vector<Column>> columns;
   size_t values_per_sample = 0;
   bool started = false;    // has taken a sample
@@ -162,19 +184,56 @@ void Recorder::Resolve(Subscription& s, bool initial) {
     c.offset = offset;
     offset += c.shape.size();
   }
-  if (!initial) {
-    bool same = true;
-    for (size_t i = 0; i < columns->size() && same; ++i) {
-      const Column &a = (*columns)[i], &b = (*s.columns)[i];
-      same = a.unit == b.unit && a.shape == b.shape && a.stale == b.stale;
-    }
-    if (same) return;
-    // a batch has one layout: hand out what was sampled with the old one
-    Emit(s);
-    ++s.layout;
+  bool same = !initial;
+  for (size_t i = 0; i < columns->size() && same; ++i) {
+    const Column &a = (*columns)[i], &b = (*s.columns)[i];
+    same = a.unit == b.unit && a.shape == b.shape && a.stale == b.stale;
   }
-  s.columns = std::move(columns);
-  s.values_per_sample = offset;
+  if (!same) {
+    // a batch has one layout: hand out what was sampled with the old one
+    if (!initial) {
+      Emit(s);
+      ++s.layout;
+    }
+    s.columns = std::move(columns);
+    s.values_per_sample = offset;
+  }
+  Plan(s);
+}
+
+void Recorder::Plan(Subscription& s) {
+  s.ops.clear();
+  s.blocks.clear();
+  const std::vector<Column>& columns = *s.columns;
+  for (size_t i = 0; i < columns.size(); ++i) {
+    Op op;
+    op.column = static_cast<uint32_t>(i);
+    op.count = columns[i].shape.size();
+    if (!columns[i].stale) {
+      const Access a = registry_.Resolved(s.handles[i]);
+      if (a.block) {
+        op.kind = Op::kCopy;
+        op.values = a.values;
+        const auto it = std::find(s.blocks.begin(), s.blocks.end(), a.block);
+        op.block = static_cast<uint32_t>(it - s.blocks.begin());
+        if (it == s.blocks.end()) s.blocks.push_back(a.block);
+      } else {
+        op.kind = Op::kGet;
+        op.getter = a.getter;
+      }
+    }
+    if (!s.ops.empty()) {
+      Op& last = s.ops.back();
+      const bool adjacent_copy = op.kind == Op::kCopy && last.kind == Op::kCopy &&
+                                 last.block == op.block && last.values + last.count == op.values;
+      if (adjacent_copy || (op.kind == Op::kNaN && last.kind == Op::kNaN)) {
+        last.count += op.count;
+        continue;
+      }
+    }
+    s.ops.push_back(op);
+  }
+  s.block_errors.assign(s.blocks.size(), std::string());
 }
 
 void Recorder::Sample(Subscription& s, uint64_t step, double sim_time) {
@@ -190,21 +249,43 @@ void Recorder::Sample(Subscription& s, uint64_t step, double sim_time) {
     b.data.reserve(s.batch_steps * s.values_per_sample);
   }
   b.times.push_back(sim_time);
-  const size_t base = b.data.size();
-  b.data.resize(base + s.values_per_sample);
-  double* out = b.data.data() + base;
-  const std::vector<Column>& columns = *s.columns;
-  for (size_t i = 0; i < columns.size(); ++i) {
-    const Column& c = columns[i];
-    if (c.stale) {
-      std::fill_n(out + c.offset, c.shape.size(), kNaN);
-      continue;
-    }
+  bool block_failed = false;
+  for (size_t k = 0; k < s.blocks.size(); ++k) {
     try {
-      registry_.Read(s.handles[i], out + c.offset);
+      s.blocks[k]->Update();
+      if (!s.block_errors[k].empty()) s.block_errors[k].clear();
     } catch (const std::exception& e) {
-      std::fill_n(out + c.offset, c.shape.size(), kNaN);
-      s.last_error = c.id + ": " + e.what();
+      s.block_errors[k] = e.what();
+      block_failed = true;
+    }
+  }
+  // appended op by op (the capacity was reserved for the batch): no zero-fill before the copy
+  std::vector<double>& data = b.data;
+  const std::vector<Column>& columns = *s.columns;
+  for (const Op& op : s.ops) {
+    switch (op.kind) {
+      case Op::kCopy:
+        if (block_failed && !s.block_errors[op.block].empty()) {
+          data.insert(data.end(), op.count, kNaN);
+          s.last_error = columns[op.column].id + ": " + s.block_errors[op.block];
+        } else {
+          data.insert(data.end(), op.values, op.values + op.count);
+        }
+        break;
+      case Op::kGet: {
+        const size_t at = data.size();
+        data.resize(at + op.count);
+        try {
+          (*op.getter)(data.data() + at);
+        } catch (const std::exception& e) {
+          std::fill_n(data.data() + at, op.count, kNaN);
+          s.last_error = columns[op.column].id + ": " + e.what();
+        }
+        break;
+      }
+      case Op::kNaN:
+        data.insert(data.end(), op.count, kNaN);
+        break;
     }
   }
   ++b.step_count;

@@ -46,6 +46,29 @@ Handle Registry::Add(ChannelInfo info, Getter getter, Setter setter) {
   return {slot, s.generation};
 }
 
+Handle Registry::Add(ChannelInfo info, Source source, Setter setter) {
+  if (!source.block || !source.values)
+    throw std::invalid_argument(info.id + ": source without a block or values");
+  SourceBlock* block = source.block.get();
+  const double* values = source.values;
+  const size_t n = info.shape.size();
+  // the same values through a getter, for reads by id or handle; the slot's source keeps the
+  // block alive as long as the getter
+  Getter getter = [block, values, n](double* out) {
+    block->Update();
+    std::copy_n(values, n, out);
+  };
+  const Handle h = Add(std::move(info), std::move(getter), std::move(setter));
+  slots_[h.slot].source = std::move(source);
+  return h;
+}
+
+Access Registry::Resolved(Handle handle) const {
+  if (!Valid(handle)) ThrowStale(handle);
+  const Slot& s = slots_[handle.slot];
+  return {&s.getter, s.source.block.get(), s.source.values, s.info.shape.size()};
+}
+
 void Registry::Release(uint32_t slot) {
   Slot& s = slots_[slot];
   s.live = false;
@@ -53,6 +76,7 @@ void Registry::Release(uint32_t slot) {
   // drop the functors now: they may hold references into a scene that is going away
   s.getter = nullptr;
   s.setter = nullptr;
+  s.source = Source();
   free_.push_back(slot);
 }
 

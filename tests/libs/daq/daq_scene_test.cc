@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "caliper/daq/recorder.h"
 #include "caliper/physics_bullet/bullet_scene.h"
@@ -114,9 +116,10 @@ TEST_F(Fixture, RegistersEveryParameterAndTheBodyQuantities) {
 TEST_F(Fixture, ValuesAgreeWithTheScene) {
   Step(300);
   const sgal::BodyState state = scene->BodyStates()[0];
-  const auto r = registry.Sample({"pend.bob.position", "pend.bob.orientation", "pend.bob.rotation",
-                                  "pend.bob.linear_velocity", "pend.bob.angular_velocity",
-                                  "pend.pivot.position", "pend.cord.tendon.length", "pend.motor.current"});
+  const auto r =
+      registry.Sample({"pend.bob.position", "pend.bob.orientation", "pend.bob.rotation",
+                       "pend.bob.linear_velocity", "pend.bob.angular_velocity",
+                       "pend.pivot.position", "pend.cord.tendon.length", "pend.motor.current"});
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(r[0].values[i], state.pose.position[i]);
     EXPECT_EQ(r[3].values[i], state.linear_velocity[i]);
@@ -147,6 +150,85 @@ TEST_F(Fixture, FetchesBodyStatesOncePerSampledStep) {
   registry.Read(handles[0], buffer);
   registry.Read(handles[1], buffer);
   EXPECT_EQ(channels.sampler->fetches(), 2u);
+}
+
+TEST_F(Fixture, ABodysChannelsAreReadInPlaceFromTheSampler) {
+  // in channel order, next to each other: a recorder copies a body's five channels in one go
+  const double* at = nullptr;
+  for (const char* field :
+       {"position", "orientation", "rotation", "linear_velocity", "angular_velocity"}) {
+    const Access a = registry.Resolved(registry.Resolve(std::string("pend.bob.") + field));
+    EXPECT_EQ(a.block, channels.sampler.get()) << field;
+    if (at) {
+      EXPECT_EQ(a.values, at) << field;
+    }
+    at = a.values + a.size;
+  }
+  EXPECT_EQ(at, channels.sampler->values(0) + SceneSampler::kValuesPerBody);
+}
+
+TEST(DaqScene, RecordsTendonsAtTheSameInstantAsTheBodies) {
+  // sampled after Step(): the cord's length is the distance from its anchor to the bob where
+  // the bob is now (a length from before the step would be one step's motion off)
+  sgal::Scene taut = Pendulum();
+  taut.actuators[0].parameters = {
+      {"stiffness", 5000}, {"damping", 10}, {"rest_length", 0.1}, {"pretension", 9}};
+  auto scene = physics_bullet::MakeScene(taut);
+  Registry registry;
+  const SceneChannels channels = RegisterScene(registry, "pend", *scene);
+  Recorder recorder(registry);
+  SubscriptionOptions options;
+  options.ids = {"pend.bob.position", "pend.cord.tendon.length", "pend.cord.tendon.speed",
+                 "pend.cord.tendon.tension"};
+  options.batch_steps = 200;
+  const SubscriptionId id = recorder.Subscribe(options);
+  std::vector<sgal::TendonState> tendons;
+  for (int i = 0; i < 200; ++i) {
+    scene->Step();
+    channels.sampler->Refresh();
+    recorder.OnStep(scene->steps(), scene->time());
+    tendons.push_back(scene->TendonStates()[0]);
+  }
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 1u);
+  const Batch& b = batches[0];
+  const Vector3d anchor(-0.5, 0, -0.5);
+  double largest_step_m = 0;
+  for (size_t k = 0; k < b.step_count; ++k) {
+    const double* v = b.data.data() + k * b.values_per_sample;
+    const Vector3d bob(v[0], v[1], v[2]);
+    EXPECT_NEAR(v[3], (bob - anchor).norm(), 1e-6) << "sample " << k;
+    EXPECT_EQ(v[3], tendons[k].length) << "sample " << k;
+    EXPECT_EQ(v[4], tendons[k].speed) << "sample " << k;
+    EXPECT_EQ(v[5], tendons[k].tension) << "sample " << k;
+    if (k > 0) largest_step_m = std::max(largest_step_m, std::abs(v[3] - tendons[k - 1].length));
+  }
+  EXPECT_GT(largest_step_m, 1e-5) << "the cord moves enough per step to tell a stale length";
+  const auto tensions = b.Values("pend.cord.tendon.tension");
+  EXPECT_GT(*std::max_element(tensions.begin(), tensions.end()), 1.0) << "taut for a while";
+}
+
+TEST_F(Fixture, AReloadedSceneIsNeverReadThroughItsOldSampler) {
+  Recorder recorder(registry);
+  SubscriptionOptions options;
+  options.ids = {"pend.bob.position", "pend.bob.rotation", "pend.pivot.position"};
+  options.batch_steps = 1;
+  const SubscriptionId id = recorder.Subscribe(options);
+  Step(1);
+  recorder.OnStep(scene->steps(), scene->time());
+  const std::weak_ptr<SceneSampler> old_sampler = channels.sampler;
+  // as the Model reloads: channels out, then the old scene and its sampler freed
+  registry.Clear();
+  channels = SceneChannels();
+  scene.reset();
+  EXPECT_TRUE(old_sampler.expired()) << "nothing keeps the old sampler (and its scene) alive";
+  recorder.OnStep(2, 0.002);
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 2u);
+  for (double v : batches[1].data) EXPECT_TRUE(std::isnan(v));
+  EXPECT_EQ(recorder.Stats(id).stale.size(), 3u);
+  Handle gone;
+  EXPECT_FALSE(registry.TryResolve("pend.bob.position", &gone));
 }
 
 TEST_F(Fixture, WritesReachTheSceneAndRefusalsCarryItsReason) {

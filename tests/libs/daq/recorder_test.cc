@@ -6,6 +6,8 @@
 
 #include <atomic>
 #include <cmath>
+#include <memory>
+#include <stdexcept>
 #include <thread>
 
 namespace caliper::daq {
@@ -202,6 +204,80 @@ TEST_F(Fixture, AFailingGetterGivesNaNAndIsReported) {
   EXPECT_TRUE(std::isnan(batches[0].data[0]));
   EXPECT_EQ(batches[0].data[1], 1.0);
   EXPECT_EQ(recorder.Stats(id).last_error, "m.bad: engine said no");
+}
+
+/// Values read in place: Update() sets value k to 100 * step + k and counts the updates.
+struct StepBlock : SourceBlock {
+  explicit StepBlock(const uint64_t& step_) : step(step_) {}
+  void Update() override {
+    ++updates;
+    if (counter) ++*counter;
+    if (fail) throw std::runtime_error("no states");
+    for (size_t k = 0; k < 6; ++k) values[k] = 100.0 * static_cast<double>(step) + k;
+  }
+  const uint64_t& step;
+  double values[6] = {};
+  int updates = 0;
+  int* counter = nullptr;  // counts the updates too, beyond the block's life
+  bool fail = false;
+};
+
+TEST_F(Fixture, CopiesChannelsReadInPlaceBesideGetterChannels) {
+  auto block = std::make_shared<StepBlock>(step);
+  registry.Add({"b.p", "m", Shape::Vector(3), false, false, "values 0-2"},
+               Source{block, block->values});
+  registry.Add({"b.q", "", Shape::Vector(2), false, false, "values 3-4"},
+               Source{block, block->values + 3});
+  registry.Add({"b.r", "", Shape::Scalar(), false, false, "value 5"},
+               Source{block, block->values + 5});
+  // q and r lie next to each other in the block, p before them and m.x between
+  const SubscriptionId id = recorder.Subscribe(Options({"b.q", "b.r", "m.x", "b.p"}, 1, 2));
+  RunTo(2);
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 1u);
+  EXPECT_EQ(batches[0].values_per_sample, 7u);
+  EXPECT_EQ(batches[0].data, (std::vector<double>{103, 104, 105, 1, 100, 101, 102,  //
+                                                  203, 204, 205, 2, 200, 201, 202}));
+  EXPECT_EQ(block->updates, 2) << "one update per sample, whatever the number of channels";
+}
+
+TEST_F(Fixture, ABlockThatFailsToUpdateGivesNaNForItsColumnsOnly) {
+  auto block = std::make_shared<StepBlock>(step);
+  registry.Add({"b.p", "m", Shape::Vector(3), false, false, "values 0-2"},
+               Source{block, block->values});
+  const SubscriptionId id = recorder.Subscribe(Options({"m.x", "b.p"}, 1, 1));
+  block->fail = true;
+  RunTo(1);
+  block->fail = false;
+  RunTo(2);
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 2u);
+  EXPECT_EQ(batches[0].data[0], 1.0);
+  for (double v : batches[0].Values("b.p")) EXPECT_TRUE(std::isnan(v));
+  EXPECT_EQ(batches[1].data, (std::vector<double>{2, 200, 201, 202}));
+  EXPECT_EQ(recorder.Stats(id).last_error, "b.p: no states");
+}
+
+TEST_F(Fixture, AChannelReadInPlaceIsNeverReadAfterItIsRemoved) {
+  auto block = std::make_shared<StepBlock>(step);
+  int updates = 0;
+  block->counter = &updates;
+  const std::weak_ptr<StepBlock> watch = block;
+  registry.Add({"b.p", "m", Shape::Vector(3), false, false, "values 0-2"},
+               Source{block, block->values});
+  const SubscriptionId id = recorder.Subscribe(Options({"b.p", "m.x"}, 1, 1));
+  RunTo(1);
+  // the owner goes (as a scene does on a reload): removed from the registry, then freed
+  registry.Remove("b.p");
+  block.reset();
+  EXPECT_TRUE(watch.expired()) << "the recorder keeps no reference to a removed block";
+  RunTo(3);
+  EXPECT_EQ(updates, 1) << "updated for step 1 only";
+  const auto batches = recorder.TakeBatches(id);
+  ASSERT_EQ(batches.size(), 3u);
+  for (double v : batches[2].Values("b.p")) EXPECT_TRUE(std::isnan(v));
+  EXPECT_EQ(batches[2].Values("m.x"), std::vector<double>{3});
+  EXPECT_EQ(recorder.Stats(id).stale, std::vector<std::string>{"b.p"});
 }
 
 TEST_F(Fixture, AResetStartsANewBatch) {

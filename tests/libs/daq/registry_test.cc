@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 
 namespace caliper::daq {
 namespace {
@@ -271,6 +272,69 @@ TEST_F(Fixture, SetsThroughAHandle) {
   registry.Set(h, &v, 1);
   EXPECT_EQ(commands["wrist"], 2.5);
   ExpectThrowsWith<InvalidValue>([&] { registry.Set(h, &v, 2); }, "got 2");
+}
+
+/// Two values read in place; counts its updates.
+struct PairBlock : SourceBlock {
+  void Update() override {
+    ++updates;
+    values[0] = 10.0 * updates;
+    values[1] = 10.0 * updates + 1;
+  }
+  double values[2] = {};
+  int updates = 0;
+};
+
+TEST(Registry, ReadsAChannelAddedWithASourceInPlace) {
+  Registry registry;
+  auto block = std::make_shared<PairBlock>();
+  const Handle h =
+      registry.Add(Info("b.pair", "m", Shape::Vector(2)), Source{block, block->values});
+  EXPECT_FALSE(registry.Info(h).writable);
+  double out[2] = {};
+  registry.Read(h, out);
+  EXPECT_EQ(out[0], 10.0) << "a read updates the block first";
+  EXPECT_EQ(out[1], 11.0);
+  EXPECT_EQ(registry.Get("b.pair"), (std::vector<double>{20, 21}));
+
+  const Access a = registry.Resolved(h);
+  EXPECT_EQ(a.block, block.get());
+  EXPECT_EQ(a.values, block->values);
+  EXPECT_EQ(a.size, 2u);
+  ASSERT_NE(a.getter, nullptr);
+
+  registry.Remove("b.pair");
+  EXPECT_EQ(block.use_count(), 1) << "the registry lets go of a removed channel's block";
+  ExpectThrowsWith<UnknownId>([&] { registry.Resolved(h); }, "unknown id 'b.pair'");
+  ExpectThrowsWith<UnknownId>([&] { registry.Read(h, out); }, "unknown id 'b.pair'");
+}
+
+TEST(Registry, ResolvesAGetterChannelToItsGetter) {
+  Registry registry;
+  const Handle h = registry.Add(Info("g.x", "m"), [](double* out) { out[0] = 7; });
+  const Access a = registry.Resolved(h);
+  EXPECT_EQ(a.block, nullptr);
+  EXPECT_EQ(a.values, nullptr);
+  EXPECT_EQ(a.size, 1u);
+  double out = 0;
+  (*a.getter)(&out);
+  EXPECT_EQ(out, 7.0);
+}
+
+TEST(Registry, RejectsASourceWithoutBlockOrValues) {
+  Registry registry;
+  auto block = std::make_shared<PairBlock>();
+  ExpectThrowsWith<std::invalid_argument>(
+      [&] {
+        registry.Add(Info("b.none", "m"), Source{nullptr, block->values});
+      },
+      "b.none: source without a block or values");
+  ExpectThrowsWith<std::invalid_argument>(
+      [&] {
+        registry.Add(Info("b.none", "m"), Source{block, nullptr});
+      },
+      "b.none: source without a block or values");
+  EXPECT_EQ(registry.size(), 0u);
 }
 
 }  // namespace

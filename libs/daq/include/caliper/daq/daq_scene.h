@@ -13,29 +13,39 @@
 
 namespace caliper::daq {
 
-/// A per-step cache of a scene's body states, shared by the body getters: however many body
-/// channels are read in a step, PhysicsScene::BodyStates() runs at most once. Lives on the
-/// simulation thread, like the registry.
-class SceneSampler {
+/// A per-step cache of a scene's body states, laid out as the body channels read them, shared
+/// by those channels: however many are read in a step, PhysicsScene::BodyStates() runs at most
+/// once, and a recorder copies neighbouring channels' values in one go (see Source). Lives on
+/// the simulation thread, like the registry.
+class SceneSampler : public SourceBlock {
  public:
-  /// `scene` must outlive the sampler and the channels that use it.
-  explicit SceneSampler(const sgal::PhysicsScene& scene) : scene_(scene) {}
+  /// Offsets of a body's quantities within its kValuesPerBody values, in the order of its
+  /// channels: position (3), orientation quaternion w x y z (4), rotation matrix row-major (9),
+  /// linear velocity (3), angular velocity (3).
+  static constexpr size_t kPosition = 0;
+  static constexpr size_t kOrientation = 3;
+  static constexpr size_t kRotation = 7;
+  static constexpr size_t kLinearVelocity = 16;
+  static constexpr size_t kAngularVelocity = 19;
+  static constexpr size_t kValuesPerBody = 22;
+
+  /// `scene` must outlive the sampler and the channels that use it; its number of bodies is
+  /// taken now (a scene with another number of bodies needs a new sampler).
+  explicit SceneSampler(const sgal::PhysicsScene& scene);
 
   /// Marks the cache out of date: call after every step (and after anything that moves bodies,
   /// e.g. a reset). The states are fetched again on the next read, so that a step nobody samples
   /// costs nothing.
   void Refresh() { fresh_ = false; }
+  /// Fetches the states when out of date. Throws std::runtime_error when the scene no longer has
+  /// the number of bodies it had when the sampler was made.
+  void Update() override {
+    if (!fresh_) Fetch();
+  }
 
-  /// The state of body `index` (description().bodies order) at the current step.
-  const sgal::BodyState& body(size_t index) {
-    if (!fresh_) Fetch();
-    return states_[index];
-  }
-  /// Body `index`'s rotation matrix (body to world) at the current step.
-  const Eigen::Matrix3d& rotation(size_t index) {
-    if (!fresh_) Fetch();
-    return rotations_[index];
-  }
+  /// The kValuesPerBody values of body `index` (description().bodies order); at a fixed address
+  /// for the sampler's lifetime, up to date after Update().
+  const double* values(size_t index) const { return values_.data() + index * kValuesPerBody; }
   /// How many times the states were fetched from the scene.
   uint64_t fetches() const { return fetches_; }
 
@@ -43,10 +53,10 @@ class SceneSampler {
   void Fetch();
 
   const sgal::PhysicsScene& scene_;
+  const size_t body_count_;
   bool fresh_ = false;
   uint64_t fetches_ = 0;
-  std::vector<sgal::BodyState> states_;
-  std::vector<Eigen::Matrix3d> rotations_;
+  std::vector<double> values_;  // body_count_ * kValuesPerBody, never resized
 };
 
 /// What RegisterScene did.

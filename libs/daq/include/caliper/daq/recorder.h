@@ -134,6 +134,7 @@ class Recorder {
   std::shared_ptr<Queue> FindQueue(SubscriptionId id) const;
   Subscription& Find(SubscriptionId id);
   void Resolve(Subscription& s, bool initial);
+  void Plan(Subscription& s);
   void Sample(Subscription& s, uint64_t step, double sim_time);
   void Emit(Subscription& s);
 

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -80,6 +81,34 @@ using Getter = std::function<void(double* out)>;
 /// std::invalid_argument with a reason; Registry::Set turns it into InvalidValue.
 using Setter = std::function<void(const double* values)>;
 
+/// Values that a group of channels reads in place (e.g. a per-step cache of every body's pose):
+/// a reader that copies many channels per step updates each block once and then copies the
+/// values, with no call per channel. Lives on the simulation thread, like the registry.
+class SourceBlock {
+ public:
+  virtual ~SourceBlock() = default;
+  /// Brings the block's values up to date; called before any of its values are read. Must be
+  /// cheap when called again with nothing changed (several channels of a block are read per step).
+  virtual void Update() = 0;
+};
+
+/// Where a channel added with a source keeps its values: `shape.size()` doubles at `values`,
+/// up to date after `block->Update()`, valid (at the same address) as long as `block` lives.
+struct Source {
+  std::shared_ptr<SourceBlock> block;
+  const double* values = nullptr;
+};
+
+/// How to read a resolved channel without a lookup, for a reader that copies many channels per
+/// step (the recorder). Valid only while Registry::version() stays the same: any Add, Remove or
+/// Clear may move or free what it points to, so re-resolve when the version changed.
+struct Access {
+  const Getter* getter = nullptr;  // always set
+  SourceBlock* block = nullptr;    // set for a channel added with a Source: call Update() first,
+  const double* values = nullptr;  // then read its `size` doubles at `values`
+  size_t size = 0;                 // shape.size()
+};
+
 /// A pre-resolved channel: reading through it does no string hashing. A handle goes stale when
 /// its channel is removed (also when the same id is registered again); using a stale handle
 /// throws UnknownId, Valid() tells beforehand.
@@ -106,6 +135,10 @@ class Registry {
   /// given. Throws std::invalid_argument for an empty or duplicate id, an empty shape or a
   /// missing getter.
   Handle Add(ChannelInfo info, Getter getter, Setter setter = nullptr);
+  /// Registers a channel whose values are read in place from `source` (see Access); reading it
+  /// by handle or id works as for a getter. Throws std::invalid_argument as Add above, and for a
+  /// source without a block or values.
+  Handle Add(ChannelInfo info, Source source, Setter setter = nullptr);
   /// Removes a channel; false when there was none. Its handles go stale.
   bool Remove(const std::string& id);
   /// Removes every channel whose id matches the glob `pattern`; returns how many.
@@ -142,6 +175,9 @@ class Registry {
     if (!Valid(handle)) ThrowStale(handle);
     slots_[handle.slot].getter(out);
   }
+  /// The channel's getter, or its values in place when it was added with a Source; valid until
+  /// version() changes. Throws UnknownId for a stale handle.
+  Access Resolved(Handle handle) const;
   /// The current value of one channel. Throws UnknownId.
   std::vector<double> Get(const std::string& id) const;
   /// The current values of `ids`, in order. Throws UnknownId for the first unknown id before
@@ -159,6 +195,7 @@ class Registry {
     ChannelInfo info;
     Getter getter;
     Setter setter;
+    Source source;  // block and values when added with a Source
     uint32_t generation = 0;
     bool live = false;
   };
