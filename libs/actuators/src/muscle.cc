@@ -319,15 +319,16 @@ void Validate(const MujocoMuscleParameters& p) {
 
 namespace {
 
-enum class Curves { kThelen, kMujoco };
+enum class Curves { kThelen, kMujoco, kMillard };
 
 struct AllParameters {
   ThelenMuscleParameters thelen;
   MujocoMuscleParameters mujoco;
+  MillardMuscleParameters millard;
   double default_activation = 0;  // [-]
 };
 
-enum class Applies { kBoth, kThelen, kMujoco };
+enum class Applies { kBoth, kThelen, kMujoco, kMillard };  // kBoth: every curve set
 
 struct ParameterEntry {
   const char* name;
@@ -419,16 +420,114 @@ const std::vector<ParameterEntry>& ParameterTable() {
        "activation time constant (mujoco)"},
       {"tau_deact", "s", Applies::kMujoco, false,
        [](P& p) -> double& { return p.mujoco.tau_deact; }, "deactivation time constant (mujoco)"},
+      // millard2012: the names shared with thelen2003 are separate entries (own defaults)
+      {"max_isometric_force", "N", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.max_isometric_force; }, "F0 (millard2012)"},
+      {"optimal_fiber_length", "m", Applies::kMillard, true,
+       [](P& p) -> double& { return p.millard.optimal_fiber_length; },
+       "fibre length of maximum active force (millard2012, required)"},
+      {"tendon_slack_length", "m", Applies::kMillard, true,
+       [](P& p) -> double& { return p.millard.tendon_slack_length; },
+       "tendon length below which it carries no force (millard2012, required)"},
+      {"pennation_angle", "rad", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.pennation_angle; },
+       "pennation at optimal fibre length; constant muscle thickness (millard2012)"},
+      {"max_contraction_velocity", "1/s", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.max_contraction_velocity; },
+       "in optimal fibre lengths per second (millard2012)"},
+      {"activation_time_constant", "s", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.activation_time_constant; }, "(millard2012: 0.010)"},
+      {"deactivation_time_constant", "s", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.deactivation_time_constant; },
+       "(millard2012: 0.040)"},
+      {"minimum_activation", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.minimum_activation; },
+       "lower bound of the activation (millard2012)"},
+      {"maximum_pennation_angle", "rad", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.maximum_pennation_angle; },
+       "sets the shortest fibre with min_norm_active_fiber_length (millard2012)"},
+      {"fiber_damping", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.fiber_damping; },
+       "beta: fibre force F0 beta v / (vmax lopt) (millard2012)"},
+      {"min_norm_active_fiber_length", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.min_norm_active_fiber_length; },
+       "left shoulder of the active force-length curve (millard2012)"},
+      {"transition_norm_fiber_length", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.transition_norm_fiber_length; },
+       "steep to shallow ascending limb (millard2012)"},
+      {"max_norm_active_fiber_length", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.max_norm_active_fiber_length; },
+       "right shoulder of the active force-length curve (millard2012)"},
+      {"shallow_ascending_slope", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.shallow_ascending_slope; },
+       "active force-length slope of the shallow limb (millard2012)"},
+      {"minimum_value", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.minimum_value; },
+       "active force-length value at and beyond the shoulders (millard2012)"},
+      {"concentric_slope_at_vmax", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.concentric_slope_at_vmax; },
+       "force-velocity slope at -vmax (millard2012)"},
+      {"concentric_slope_near_vmax", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.concentric_slope_near_vmax; },
+       "force-velocity slope at -0.9 vmax (millard2012)"},
+      {"isometric_slope", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.isometric_slope; },
+       "force-velocity slope at 0 (millard2012)"},
+      {"eccentric_slope_at_vmax", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.eccentric_slope_at_vmax; },
+       "force-velocity slope at +vmax (millard2012)"},
+      {"eccentric_slope_near_vmax", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.eccentric_slope_near_vmax; },
+       "force-velocity slope at +0.9 vmax (millard2012)"},
+      {"max_eccentric_velocity_force_multiplier", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.max_eccentric_velocity_force_multiplier; },
+       "force-velocity value at +vmax (millard2012)"},
+      {"concentric_curviness", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.concentric_curviness; },
+       "force-velocity bend below 0, 0..1 (millard2012)"},
+      {"eccentric_curviness", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.eccentric_curviness; },
+       "force-velocity bend above 0, 0..1 (millard2012)"},
+      {"fiber_strain_at_zero_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.fiber_strain_at_zero_force; },
+       "passive fibre curve (millard2012)"},
+      {"fiber_strain_at_one_norm_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.fiber_strain_at_one_norm_force; },
+       "passive fibre curve (millard2012)"},
+      {"fiber_stiffness_at_low_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.fiber_stiffness_at_low_force; },
+       "passive fibre curve (millard2012)"},
+      {"fiber_stiffness_at_one_norm_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.fiber_stiffness_at_one_norm_force; },
+       "passive fibre curve; OpenSim's default 2 / strain at one (millard2012)"},
+      {"fiber_curviness", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.fiber_curviness; },
+       "passive fibre curve bend, 0..1 (millard2012)"},
+      {"tendon_strain_at_one_norm_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.tendon_strain_at_one_norm_force; },
+       "tendon curve (millard2012)"},
+      {"tendon_stiffness_at_one_norm_force", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.tendon_stiffness_at_one_norm_force; },
+       "tendon curve; OpenSim's default 1.375 / strain at one (millard2012)"},
+      {"tendon_norm_force_at_toe_end", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.tendon_norm_force_at_toe_end; },
+       "tendon curve (millard2012)"},
+      {"tendon_curviness", "", Applies::kMillard, false,
+       [](P& p) -> double& { return p.millard.curves.tendon_curviness; },
+       "tendon curve bend, 0..1 (millard2012)"},
   };
   return table;
 }
 
 bool AppliesTo(Applies applies, Curves curves) {
   return applies == Applies::kBoth || (applies == Applies::kThelen && curves == Curves::kThelen) ||
-         (applies == Applies::kMujoco && curves == Curves::kMujoco);
+         (applies == Applies::kMujoco && curves == Curves::kMujoco) ||
+         (applies == Applies::kMillard && curves == Curves::kMillard);
 }
 
-const char* CurvesName(Curves c) { return c == Curves::kThelen ? "thelen2003" : "mujoco"; }
+const char* CurvesName(Curves c) {
+  return c == Curves::kThelen ? "thelen2003" : c == Curves::kMujoco ? "mujoco" : "millard2012";
+}
 
 // root of f on [lo, hi] with f(lo) <= 0 <= f(hi); f returns (value, derivative); Newton steps,
 // bisection when a step leaves the bracket or does not halve the error
@@ -488,7 +587,9 @@ class HillMuscle : public TendonActuator {
   void Reset(double path_length) override {
     CheckFinite("path length", path_length);
     activation_ = InitialActivation();
-    if (elastic_) fiber_length_ = EquilibriumFiberLength(path_length, activation_);
+    if (elastic_)
+      fiber_length_ = millard_ ? MillardEquilibrium(path_length, activation_)
+                               : EquilibriumFiberLength(path_length, activation_);
     Evaluate(path_length, 0);
   }
 
@@ -509,6 +610,7 @@ class HillMuscle : public TendonActuator {
       activation_ = Clamp(activation_ + dt * rate, MinimumActivation(), 1);
       return out_.tension;
     }
+    if (millard_ && elastic_) return StepMillardElastic(path_length, path_speed, dt);
     // fibre sub-steps of at most 1 ms (activation takes finer ones inside)
     const int n = elastic_ ? FiberSubsteps(dt) : 1;
     const double h = dt / n;
@@ -567,7 +669,7 @@ class HillMuscle : public TendonActuator {
     q.push_back({"activation", "", true, false});
     q.push_back({"fiber_length", "m", elastic_, false});
     for (const auto& [name, unit] : OutputNames()) q.push_back({name, unit, false, false});
-    if (curves_ == Curves::kThelen) {
+    if (curves_ != Curves::kMujoco) {
       q.push_back({"pennation", "rad", false, false});
       q.push_back({"tendon_length", "m", false, false});
       q.push_back({"tendon_strain", "", false, false});
@@ -595,7 +697,7 @@ class HillMuscle : public TendonActuator {
     if (name == "active_fiber_force") return out_.active_fiber_force;
     if (name == "passive_force") return out_.passive_force;
     if (name == "tension") return out_.tension;
-    if (curves_ == Curves::kThelen) {
+    if (curves_ != Curves::kMujoco) {
       if (name == "pennation")
         return out_.pennation_cos < 0 ? kPi / 2 : std::acos(out_.pennation_cos);
       if (name == "tendon_length") return out_.tendon_length;
@@ -647,6 +749,8 @@ class HillMuscle : public TendonActuator {
             p.default_activation, "must be in [0, 1]");
     if (curves == Curves::kThelen)
       Validate(p.thelen, elastic);
+    else if (curves == Curves::kMillard)
+      Validate(p.millard, elastic);
     else
       Validate(p.mujoco);
   }
@@ -676,6 +780,7 @@ class HillMuscle : public TendonActuator {
   }
 
   double MinimumActivation() const {
+    if (curves_ == Curves::kMillard) return p_.millard.minimum_activation;
     return curves_ == Curves::kThelen ? p_.thelen.minimum_activation : 0.0;
   }
   double InitialActivation() const { return Clamp(p_.default_activation, MinimumActivation(), 1); }
@@ -695,8 +800,12 @@ class HillMuscle : public TendonActuator {
     const double minimum = MinimumActivation();
     const double u = Clamp(excitation_, minimum, 1);
     a = Clamp(a, minimum, 1);
-    const double tau_act = thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act;
-    const double tau_deact = thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact;
+    double tau_act = thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act;
+    double tau_deact = thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact;
+    if (curves_ == Curves::kMillard) {
+      tau_act = p_.millard.activation_time_constant;
+      tau_deact = p_.millard.deactivation_time_constant;
+    }
     return Clamp(ExactActivation(u, a, h, tau_act, tau_deact), minimum, 1);
   }
 
@@ -718,6 +827,7 @@ class HillMuscle : public TendonActuator {
   // what the parameters give, once per change: the fibres' height, the shortest fibre, the
   // passive curve's denominator
   void UpdateDerived() {
+    if (curves_ == Curves::kMillard) millard_ = std::make_unique<MillardFiberModel>(p_.millard);
     const ThelenMuscleParameters& t = p_.thelen;
     height_ = t.optimal_fiber_length * std::sin(t.pennation_angle);
     minimum_fiber_length_ =
@@ -745,7 +855,9 @@ class HillMuscle : public TendonActuator {
 
   double Height() const { return height_; }  // optimal_fiber_length sin(pennation_angle) [m]
 
-  double MinimumFiberLength() const { return minimum_fiber_length_; }  // [m]
+  double MinimumFiberLength() const {  // [m]
+    return millard_ ? millard_->minimum_fiber_length() : minimum_fiber_length_;
+  }
 
   // ThelenPassiveForceLength with the parameters' denominator
   double PassiveForceLength(double l) const {
@@ -912,7 +1024,9 @@ class HillMuscle : public TendonActuator {
   // --- outputs at the end of a step
 
   void Evaluate(double path_length, double path_speed) {
-    if (curves_ == Curves::kMujoco)
+    if (millard_)
+      EvaluateMillard(path_length, path_speed);
+    else if (curves_ == Curves::kMujoco)
       EvaluateMujoco(path_length, path_speed);
     else if (elastic_)
       EvaluateThelenElastic(path_length);
@@ -988,6 +1102,99 @@ class HillMuscle : public TendonActuator {
     o->tension = std::max(0.0, (o->active_fiber_force + o->passive_force) * cos);
   }
 
+  // --- Millard 2012 (millard.cc: the curves and the fibre-tendon balance)
+
+  // the fibre length at rest (fibre velocity 0): a fal + fpe = fse / cos
+  double MillardEquilibrium(double path_length, double a) const {
+    const MillardFiberModel& m = *millard_;
+    const double lo = m.minimum_fiber_length();
+    auto excess = [&](double x) { return m.IsometricExcess(x, path_length, a); };
+    if (excess(lo).first >= 0) return lo;
+    // a fibre that leaves the tendon slack pulls at least what the tendon does (nothing)
+    const double slack = path_length - p_.millard.tendon_slack_length;
+    double hi = std::sqrt(m.height() * m.height() + slack * slack);
+    if (!(hi > lo)) return lo;
+    for (int i = 0; i < 80 && excess(hi).first < 0; ++i) hi = lo + 2 * (hi - lo);
+    return SafeNewton(excess, lo, hi, 0.5 * (lo + hi), 1e-14 * p_.millard.optimal_fiber_length);
+  }
+
+  // the stage equation x = base + c v(x) of the SDIRK below, v the fibre velocity of the balance
+  // at this stage's path length and activation: Newton from the predicted root, the bracketed
+  // solve when a step would leave the fibres' range or 6 steps do not converge
+  double MillardStage(double guess, double base, double c, double path_length, double a) const {
+    const MillardFiberModel& m = *millard_;
+    const double lo = m.minimum_fiber_length();
+    auto residual = [&](double x) {
+      const auto [v, dv] = m.FiberVelocity(x, path_length, a);
+      return std::make_pair(x - base - c * v, 1 - c * dv);
+    };
+    // a correction below 1e-10 optimal lengths leaves an error of its square times the curvature
+    const double tol = 1e-10 * p_.millard.optimal_fiber_length;
+    double x = guess;
+    for (int i = 0; i < 6 && x > lo && std::isfinite(x); ++i) {
+      const auto [r, slope] = residual(x);
+      if (!(slope > 0)) break;
+      const double dx = r / slope;
+      x -= dx;
+      if (std::abs(dx) < tol && x > lo) return x;
+    }
+    if (residual(lo).first >= 0) return lo;
+    double hi = std::max(base, lo * 1.001);
+    for (int i = 0; i < 80 && residual(hi).first < 0; ++i) hi = lo + 2 * (hi - lo);
+    return SafeNewton(residual, lo, hi, std::max(base, lo),
+                      1e-13 * p_.millard.optimal_fiber_length);
+  }
+
+  // elastic tendon: the activation exact, the fibre length by the two-stage L-stable SDIRK
+  // (second order) in sub-steps of <= 1 ms, each stage at its own time's path length and
+  // activation (the path moves linearly through the step)
+  double StepMillardElastic(double path_length, double path_speed, double dt) {
+    const int n = FiberSubsteps(dt);
+    const double h = dt / n;
+    const double gamma = 1 - 1 / std::sqrt(2.0);
+    double lm = std::max(fiber_length_, MinimumFiberLength());
+    double velocity = out_.fiber_velocity;  // predicts the stage roots
+    for (int i = 0; i < n; ++i) {
+      const double a0 = activation_;
+      const double l0 = path_length + path_speed * i * h;
+      const double a_stage = IntegrateActivation(a0, gamma * h);
+      activation_ = IntegrateActivation(a0, h);
+      const double x1 = MillardStage(lm + gamma * h * velocity, lm, gamma * h,
+                                     l0 + gamma * h * path_speed, a_stage);
+      const double k1 = (x1 - lm) / (gamma * h);
+      const double base = lm + (1 - gamma) * h * k1;
+      const double x2 =
+          MillardStage(lm + h * k1, base, gamma * h, l0 + h * path_speed, activation_);
+      velocity = (x2 - base) / (gamma * h);
+      lm = x2;
+    }
+    fiber_length_ = lm;
+    Evaluate(path_length + path_speed * dt, path_speed);
+    return out_.tension;
+  }
+
+  void EvaluateMillard(double path_length, double path_speed) {
+    const MillardFiberModel::State s =
+        elastic_ ? millard_->Elastic(std::max(fiber_length_, MinimumFiberLength()), path_length,
+                                     activation_)
+                 : millard_->Rigid(path_length, path_speed, activation_);
+    Outputs o;
+    o.fiber_length = s.fiber_length;
+    o.fiber_velocity = s.fiber_velocity;
+    o.norm_fiber_length = s.norm_fiber_length;
+    o.norm_fiber_velocity = s.norm_fiber_velocity;
+    o.pennation_cos = s.cos_pennation;
+    o.tendon_length = s.tendon_length;
+    o.tendon_strain = s.tendon_strain;
+    o.active_force_length = s.active_force_length;
+    o.force_velocity = s.force_velocity;
+    o.passive_force_length = s.passive_force_length;
+    o.active_fiber_force = s.active_fiber_force;
+    o.passive_force = s.passive_force;
+    o.tension = s.tension;
+    out_ = o;
+  }
+
   static constexpr std::size_t kOutputValues = sizeof(Outputs) / sizeof(double);
   static_assert(sizeof(Outputs) == kOutputValues * sizeof(double) &&
                     std::is_trivially_copyable_v<Outputs>,
@@ -1017,6 +1224,7 @@ class HillMuscle : public TendonActuator {
   };
   ElasticConstants elastic_constants_;  // UpdateThelenElasticConstants
   Outputs out_;
+  std::unique_ptr<MillardFiberModel> millard_;  // curves=millard2012: curves built per change
 
  public:
   bool mujoco_integrator_ = false;   // options["integrator"] = "mujoco"
@@ -1032,9 +1240,11 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
   if (const auto it = a.options.find("curves"); it != a.options.end()) {
     if (it->second == "mujoco")
       curves = Curves::kMujoco;
+    else if (it->second == "millard2012")
+      curves = Curves::kMillard;
     else if (it->second != "thelen2003")
       throw std::invalid_argument(where + "unknown curves '" + it->second +
-                                  "' (known: thelen2003, mujoco)");
+                                  "' (known: thelen2003, mujoco, millard2012)");
   }
   bool elastic = false;
   if (const auto it = a.options.find("tendon"); it != a.options.end()) {
@@ -1046,20 +1256,24 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
   }
   if (elastic && curves == Curves::kMujoco)
     throw std::invalid_argument(where +
-                                "tendon=elastic needs curves=thelen2003 (MuJoCo's "
+                                "tendon=elastic needs curves=thelen2003 or millard2012 (MuJoCo's "
                                 "muscle has a rigid tendon)");
   AllParameters p;
   std::set<std::string> given;
   for (const auto& [name, value] : a.parameters) given.insert(name);
+  // a name may have one entry per curve set (thelen2003 and millard2012 share names)
+  std::set<std::string> applicable;
+  for (const auto& e : ParameterTable())
+    if (AppliesTo(e.applies, curves)) applicable.insert(e.name);
   for (const auto& e : ParameterTable()) {
     const bool applies = AppliesTo(e.applies, curves);
-    if (given.count(e.name) && !applies)
+    if (given.count(e.name) && !applicable.count(e.name))
       throw std::invalid_argument(where + "parameter '" + e.name +
                                   "' does not apply to curves=" + CurvesName(curves));
     if (applies && e.required && !given.count(e.name))
       throw std::invalid_argument(where + "missing parameter '" + e.name + "' [" + e.unit +
                                   "] needed by curves=" + CurvesName(curves) + ": " + e.help);
-    if (given.count(e.name)) e.ref(p) = a.parameters.at(e.name);
+    if (applies && given.count(e.name)) e.ref(p) = a.parameters.at(e.name);
   }
   try {
     HillMuscle::ValidateAll(p, curves, elastic);
@@ -1071,6 +1285,8 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
     if (it->second == "mujoco") {
       if (elastic)
         throw std::invalid_argument(where + "integrator=mujoco needs a rigid tendon");
+      if (curves == Curves::kMillard)
+        throw std::invalid_argument(where + "integrator=mujoco needs curves=thelen2003 or mujoco");
       muscle->mujoco_integrator_ = true;
     } else if (it->second != "exact") {
       throw std::invalid_argument(where + "unknown integrator '" + it->second +
@@ -1085,8 +1301,15 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
 void RegisterMuscleKinds() {
   std::vector<ParameterSpec> specs;
   AllParameters defaults;
-  for (const auto& e : ParameterTable())
-    specs.push_back({e.name, e.unit, e.ref(defaults), false, e.help});
+  for (const auto& e : ParameterTable()) {
+    // a name shared by two curve sets is one parameter: the first entry's default, both helps
+    const auto same = std::find_if(specs.begin(), specs.end(),
+                                   [&](const ParameterSpec& s) { return s.name == e.name; });
+    if (same == specs.end())
+      specs.push_back({e.name, e.unit, e.ref(defaults), false, e.help});
+    else
+      same->help += "; " + std::string(e.help);
+  }
   RegisterKind("hill_muscle", std::move(specs), MakeHillMuscle);
 }
 

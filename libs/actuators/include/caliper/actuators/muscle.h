@@ -6,13 +6,13 @@
 // isometric force. Thelen's sign convention: shortening velocity is negative.
 //
 // Kind `hill_muscle` (sgal::Actuator, command = excitation u in [0, 1], clamped):
-//   options["curves"] = "thelen2003" (default) | "mujoco"
-//   options["tendon"] = "rigid" (default) | "elastic" (thelen2003 only)
-//   options["integrator"] = "exact" (default) | "mujoco" (rigid tendon only): as MuJoCo's
-//                   mj_step, the force from the activation at the start of the step at the path
-//                   length at its start, then one explicit Euler step of the activation (so that
-//                   MuJoCo models are reproduced step by step)
-//   parameters: ThelenMuscleParameters or MujocoMuscleParameters by their snake_case names, plus
+//   options["curves"] = "thelen2003" (default) | "mujoco" | "millard2012"
+//   options["tendon"] = "rigid" (default) | "elastic" (thelen2003, millard2012)
+//   options["integrator"] = "exact" (default) | "mujoco" (rigid tendon, not millard2012): as
+//                   MuJoCo's mj_step, the force from the activation at the start of the step at
+//                   the path length at its start, then one explicit Euler step of the activation
+//                   (so that MuJoCo models are reproduced step by step)
+//   parameters: Thelen-, Mujoco- or MillardMuscleParameters by their snake_case names, plus
 //   default_activation; a parameter of the other curve set is rejected.
 // Step(path_length, path_speed, dt) lets the path move at path_speed during the step, advances
 // the activation (and, with an elastic tendon, the fibre length) to the end of the step and
@@ -20,7 +20,10 @@
 //   rigid tendon:   F0 (a fal fv + fpe) cos(pennation), fibre length and speed from the path;
 //   elastic tendon: F0 fse(tendon strain), the fibre speed from the force balance through the
 //                   inverse force-velocity curve (as OpenSim's Thelen2003Muscle);
-//   mujoco:         F0 (a FL FV + FP) on MuJoCo's normalised length and speed.
+//   mujoco:         F0 (a FL FV + FP) on MuJoCo's normalised length and speed;
+//   millard2012:    F0 (a fal fv + fpe + beta v) cos along a rigid tendon; with an elastic one,
+//                   F0 fse, the fibre velocity v solving fse = (a fal fv(v) + fpe + beta v) cos
+//                   (Millard's damped equilibrium; beta = fiber_damping, 0 = undamped).
 // Numerics: the activation ODE solved exactly over each step (the excitation held; closed form
 // while falling, Halley's method on the implicit closed form while rising); the fibre length by a
 // two-stage L-stable SDIRK (second order) in sub-steps of <= 1 ms, each stage solved by
@@ -28,9 +31,9 @@
 // Quantities: the parameters (writable, validated), excitation, activation, fiber_length
 // (writable with an elastic tendon), fiber_velocity, normalized_fiber_length,
 // normalized_fiber_velocity, active_force_length, force_velocity, passive_force_length,
-// active_fiber_force [N], passive_force [N], tension [N]; thelen2003 adds pennation,
-// tendon_length, tendon_strain; mujoco adds max_isometric_force and optimal_fiber_length (L0),
-// read-only.
+// active_fiber_force [N], passive_force [N] (millard2012: with the damping), tension [N];
+// thelen2003 and millard2012 add pennation, tendon_length, tendon_strain; mujoco adds
+// max_isometric_force and optimal_fiber_length (L0), read-only.
 
 #include <array>
 #include <cstddef>
@@ -157,20 +160,20 @@ struct MillardCurveParameters {
   double shallow_ascending_slope = 0.8616;       // [-]
   double minimum_value = 0.1;                    // [-]
   // force-velocity, on the normalised fibre velocity (lengthening > 0, -1 at vmax) [-]
-  double concentric_slope_at_vmax = 0;                // [-]
-  double concentric_slope_near_vmax = 0.25;           // at -0.9 [-]
-  double isometric_slope = 5;                         // at 0 [-]
-  double eccentric_slope_at_vmax = 0;                 // [-]
-  double eccentric_slope_near_vmax = 0.15;            // at 0.9 [-]
+  double concentric_slope_at_vmax = 0;                   // [-]
+  double concentric_slope_near_vmax = 0.25;              // at -0.9 [-]
+  double isometric_slope = 5;                            // at 0 [-]
+  double eccentric_slope_at_vmax = 0;                    // [-]
+  double eccentric_slope_near_vmax = 0.15;               // at 0.9 [-]
   double max_eccentric_velocity_force_multiplier = 1.4;  // value at +1 [-]
-  double concentric_curviness = 0.6;                  // 0 (sharp) .. 1 (round) [-]
-  double eccentric_curviness = 0.9;                   // [-]
+  double concentric_curviness = 0.6;                     // 0 (sharp) .. 1 (round) [-]
+  double eccentric_curviness = 0.9;                      // [-]
   // passive fibre force-length, on the fibre strain (normalised length - 1) [-]
-  double fiber_strain_at_zero_force = 0;                  // [-]
-  double fiber_strain_at_one_norm_force = 0.7;            // [-]
-  double fiber_stiffness_at_low_force = 0.2;              // [-]
-  double fiber_stiffness_at_one_norm_force = 2.0 / 0.7;   // [-]
-  double fiber_curviness = 0.75;                          // [-]
+  double fiber_strain_at_zero_force = 0;                 // [-]
+  double fiber_strain_at_one_norm_force = 0.7;           // [-]
+  double fiber_stiffness_at_low_force = 0.2;             // [-]
+  double fiber_stiffness_at_one_norm_force = 2.0 / 0.7;  // [-]
+  double fiber_curviness = 0.75;                         // [-]
   // tendon force-length, on the tendon strain (length / slack length - 1) [-]
   double tendon_strain_at_one_norm_force = 0.049;             // [-]
   double tendon_stiffness_at_one_norm_force = 1.375 / 0.049;  // [-]
@@ -192,7 +195,7 @@ class MillardCurve {
   explicit MillardCurve(std::vector<Segment> segments);
 
   double Value(double x) const;
-  double Slope(double x) const;            // dy/dx
+  double Slope(double x) const;             // dy/dx
   double SecondDerivative(double x) const;  // d2y/dx2
   /// Value and slope together (one parameter solve).
   std::pair<double, double> ValueAndSlope(double x) const;
@@ -285,7 +288,7 @@ struct MillardMuscleParameters {
   double deactivation_time_constant = 0.040;            // [s]
   double minimum_activation = 0.01;                     // [-]
   double maximum_pennation_angle = 1.4706289056333368;  // acos(0.1) [rad]
-  double fiber_damping = 0.1;  // beta: F0 beta v / (vmax lopt) in the fibre [-]
+  double fiber_damping = 0.1;     // beta: F0 beta v / (vmax lopt) in the fibre [-]
   MillardCurveParameters curves;  // by the field names of MillardCurveParameters
 };
 
