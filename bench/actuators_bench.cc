@@ -216,6 +216,17 @@ std::vector<Case> Cases() {
                    1,
                    excitation,
                    500});
+  // Millard 2012 with OpenSim's defaults (damped, compliant tendon): Bezier curves solved per
+  // evaluation; an accuracy line follows as for Thelen's
+  cases.push_back({"hill_millard_elastic_step_ns_per_1ms",
+                   "hill_muscle",
+                   {{"curves", "millard2012"}, {"tendon", "elastic"}},
+                   {{"optimal_fiber_length", 0.1}, {"tendon_slack_length", 0.2}},
+                   0.3,
+                   0.02,
+                   1,
+                   excitation,
+                   0});
   return cases;
 }
 
