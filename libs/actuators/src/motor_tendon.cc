@@ -112,7 +112,11 @@ class TendonSpoolLoad : public SpoolLoad {
     return spool_radius_ * force;
   }
   void Advance(double spool_angle, double spool_speed, double h) override {
-    force_ = elastic_->Force(ElasticLength(spool_angle, h), ElasticSpeed(spool_speed), h);
+    const double length = ElasticLength(spool_angle, h);
+    const double speed = ElasticSpeed(spool_speed);
+    // the linear element is stateless (its Force() is its Peek()): no virtual call
+    force_ = linear_ ? linear_->LinearSpringDamper::Peek(length, speed, h)
+                     : elastic_->Force(length, speed, h);
     elapsed_ += h;
   }
   int TorqueSign() const override { return 1; }  // tension only

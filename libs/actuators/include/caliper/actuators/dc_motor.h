@@ -197,6 +197,7 @@ class DcMotor {
     double h = 0;                    // sub-step [s]
     double c = 0;                    // gamma h [s]
     double inverse_c = 0;            // [1/s]
+    double second_base = 0;          // (1 - gamma) / gamma [-]
     double current_base = 0;         // d(current)/d(base current) [-]
     double current_drive = 0;        // d(current)/d(voltage) [A/V]
     double current_slope = 0;        // d(current)/d(speed) [A s/rad]
