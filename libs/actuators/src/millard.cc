@@ -62,11 +62,15 @@ double SolveParameter(const G& g, double lo, double hi, double u) {
       lo = u;
     else
       hi = u;
-    double next = slope > 0 ? u - value / slope : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    // u in [0, 1]: 1e-15 is near the resolution of a double
-    if (std::abs(next - u) < 1e-15 || hi - lo < 1e-15) return next;
-    u = next;
+    if (slope > 0) {
+      // converging quadratically: after a Newton step below 1e-10 the error in u is of the
+      // order of its square (times the ratio of curvature to slope, small for these corners)
+      const double step = value / slope;
+      if (std::abs(step) < 1e-10) return std::clamp(u - step, lo, hi);
+      u -= step;
+    }
+    if (!(u > lo && u < hi)) u = 0.5 * (lo + hi);
+    if (hi - lo < 1e-15) return u;
   }
   return u;
 }
@@ -86,7 +90,13 @@ MillardCurve::MillardCurve(std::vector<Segment> segments) : segments_(std::move(
     Poly p;
     p.x = PowerBasis(s.x);
     p.y = PowerBasis(s.y);
-    for (int k = 0; k <= 8; ++k) p.xs[k] = Poly0(p.x, k / 8.0);
+    for (int k = 0; k <= kSamples; ++k) {
+      const double u = static_cast<double>(k) / kSamples;
+      p.xs[k] = Poly0(p.x, u);
+      p.ys[k] = Poly0(p.y, u);
+      p.dxs[k] = Poly1(p.x, u);
+      p.dys[k] = Poly1(p.y, u);
+    }
     poly_.push_back(p);
   }
   x_end_ = segments_.back().x[5];
@@ -99,17 +109,52 @@ MillardCurve::MillardCurve(std::vector<Segment> segments) : segments_(std::move(
   slope_end_ = (b.y[5] - b.y[4]) / (b.x[5] - b.x[4]);
 }
 
+template <bool kXOnly>
+double MillardCurve::SolveU(std::size_t i, double w, double d, double target) const {
+  const Poly& p = poly_[i];
+  auto h = [&](int k) { return kXOnly ? p.xs[k] : w * p.ys[k] + d * p.xs[k]; };
+  // the sampled interval holding target, by bisection over the samples
+  int lo = 0, hi = kSamples;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    (h(mid) < target ? lo : hi) = mid;
+  }
+  // start: the cubic Hermite interpolant of the inverse u(h) on that interval (its error is of
+  // the fourth order in the interval), then Newton steps on h(u) - target
+  const double h0 = h(lo), h1 = h(hi);
+  const double du = 1.0 / kSamples;
+  double u = (lo + 0.5) * du;
+  const double span = h1 - h0;
+  const double g0 = kXOnly ? p.dxs[lo] : w * p.dys[lo] + d * p.dxs[lo];
+  const double g1 = kXOnly ? p.dxs[hi] : w * p.dys[hi] + d * p.dxs[hi];
+  if (span > 0 && g0 > 0 && g1 > 0) {
+    const double t = (target - h0) / span;
+    const double m0 = span / g0, m1 = span / g1;  // du/dt at the ends
+    const double t2 = t * t, t3 = t2 * t;
+    u = lo * du + (-2 * t3 + 3 * t2) * du + (t3 - 2 * t2 + t) * m0 + (t3 - t2) * m1;
+    u = std::clamp(u, lo * du, hi * du);
+  }
+  auto g = [&](double v) {
+    if (kXOnly) return std::make_pair(Poly0(p.x, v) - target, Poly1(p.x, v));
+    return std::make_pair(w * Poly0(p.y, v) + d * Poly0(p.x, v) - target,
+                          w * Poly1(p.y, v) + d * Poly1(p.x, v));
+  };
+  // one Halley step from that start: its error is of the order of the cube of the start's
+  // (below 1e-5 here: below 1e-15); the safeguarded Newton solve when the start was poor
+  const auto [value, slope] = g(u);
+  const double curvature = kXOnly ? Poly2(p.x, u) : w * Poly2(p.y, u) + d * Poly2(p.x, u);
+  const double denominator = 2 * slope * slope - value * curvature;
+  if (slope > 0 && denominator > 0) {
+    const double step = 2 * value * slope / denominator;
+    if (std::abs(step) < 1e-5) return std::clamp(u - step, lo * du, hi * du);
+  }
+  return SolveParameter(g, lo * du, hi * du, u);
+}
+
 std::pair<std::size_t, double> MillardCurve::Locate(double x) const {
   std::size_t i = 0;
   while (i + 1 < poly_.size() && x > segments_[i].x[5]) ++i;
-  const Poly& p = poly_[i];
-  // the sampled interval holding x, then Newton on x(u) - x inside it
-  int k = 0;
-  while (k < 7 && x > p.xs[k + 1]) ++k;
-  const double span = p.xs[k + 1] - p.xs[k];
-  const double start = (k + (span > 0 ? (x - p.xs[k]) / span : 0.5)) / 8.0;
-  auto g = [&](double u) { return std::make_pair(Poly0(p.x, u) - x, Poly1(p.x, u)); };
-  return {i, SolveParameter(g, k / 8.0, (k + 1) / 8.0, start)};
+  return {i, SolveU<true>(i, 0, 1, x)};
 }
 
 std::pair<double, double> MillardCurve::ValueAndSlope(double x) const {
@@ -155,14 +200,7 @@ MillardCurve::Solution MillardCurve::SolveAffine(double w, double d, double targ
   std::size_t i = 0;
   while (i + 1 < poly_.size() && target > h(segments_[i].x[5], segments_[i].y[5])) ++i;
   const Poly& p = poly_[i];
-  const double a = h(segments_[i].x[0], segments_[i].y[0]);
-  const double b = h(segments_[i].x[5], segments_[i].y[5]);
-  const double start = b > a ? std::clamp((target - a) / (b - a), 0.0, 1.0) : 0.5;
-  auto g = [&](double u) {
-    return std::make_pair(w * Poly0(p.y, u) + d * Poly0(p.x, u) - target,
-                          w * Poly1(p.y, u) + d * Poly1(p.x, u));
-  };
-  const double u = SolveParameter(g, 0, 1, start);
+  const double u = SolveU<false>(i, w, d, target);
   s.x = Poly0(p.x, u);
   s.y = Poly0(p.y, u);
   s.slope = Poly1(p.y, u) / Poly1(p.x, u);

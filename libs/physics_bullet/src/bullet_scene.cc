@@ -258,6 +258,11 @@ class BulletScene : public sgal::PhysicsScene {
                                             // sized once
   StepStage stage_;                         // what the step is doing (for a fault's message)
   double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
+  // tendon-body contact's buffers, reused by every tendon and step (no allocation per step)
+  actuators::ContactScratch contact_scratch_;
+  std::vector<int> contact_bodies_;  // a broadphase query's answer
+  void QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
+                   std::vector<const actuators::WorldShape*>* out);
   std::vector<ParameterEntry> parameters_;
   std::unordered_map<std::string, int> parameter_index_;
 };
@@ -571,23 +576,39 @@ void BulletScene::RefreshWorldShapes() {
       b.shape_poses.clear();
       for (const auto& shape : b.desc->shapes) b.shape_poses.push_back(shape.pose.ToIsometry());
     }
-    b.world_shapes.resize(b.desc->shapes.size());
-    for (size_t s = 0; s < b.desc->shapes.size(); ++s) {
-      b.world_shapes[s].geometry = &b.desc->shapes[s].geometry;
-      b.world_shapes[s].pose = pose * b.shape_poses[s];
-      b.world_shapes[s].body = static_cast<int>(i);
+    if (b.world_shapes.size() != b.desc->shapes.size()) {
+      // what does not move with the body, once: the geometry and its bounding radius
+      b.world_shapes.resize(b.desc->shapes.size());
+      for (size_t s = 0; s < b.desc->shapes.size(); ++s) {
+        b.world_shapes[s].geometry = &b.desc->shapes[s].geometry;
+        b.world_shapes[s].bounding_radius = sgal::BoundingRadius(b.desc->shapes[s].geometry);
+        b.world_shapes[s].body = static_cast<int>(i);
+      }
     }
+    for (size_t s = 0; s < b.desc->shapes.size(); ++s)
+      b.world_shapes[s].pose = pose * b.shape_poses[s];
   }
 }
 
 struct AabbCollector : public btBroadphaseAabbCallback {
-  std::vector<int> bodies;
+  std::vector<int>* bodies = nullptr;
   bool process(const btBroadphaseProxy* proxy) override {
     const auto* object = static_cast<const btCollisionObject*>(proxy->m_clientObject);
-    if (object != nullptr && object->getUserIndex() >= 0) bodies.push_back(object->getUserIndex());
+    if (object != nullptr && object->getUserIndex() >= 0) bodies->push_back(object->getUserIndex());
     return true;
   }
 };
+
+void BulletScene::QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
+                              std::vector<const actuators::WorldShape*>* out) {
+  contact_bodies_.clear();
+  AabbCollector collector;
+  collector.bodies = &contact_bodies_;
+  broadphase_->aabbTest(ToBt(a.cwiseMin(b) - Vector3d::Constant(pad), scale_),
+                        ToBt(a.cwiseMax(b) + Vector3d::Constant(pad), scale_), collector);
+  for (int body : contact_bodies_)
+    for (const auto& shape : bodies_[body].world_shapes) out->push_back(&shape);
+}
 
 void BulletScene::EvaluateTendons() {
   auto pose = [&](int body) { return body < 0 ? Isometry3d::Identity() : poses_[body]; };
@@ -623,21 +644,17 @@ void BulletScene::EvaluateTendons() {
     t.geometry = t.path.Evaluate(t.world);
     t.contacts = 0;
     if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
-      AabbCollector collector;
-      const actuators::ShapeQuery query = [&](const Vector3d& a, const Vector3d& b, double pad,
-                                              std::vector<actuators::WorldShape>* out) {
-        collector.bodies.clear();
-        broadphase_->aabbTest(ToBt(a.cwiseMin(b) - Vector3d::Constant(pad), scale_),
-                              ToBt(a.cwiseMax(b) + Vector3d::Constant(pad), scale_), collector);
-        for (int body : collector.bodies)
-          out->insert(out->end(), bodies_[body].world_shapes.begin(), bodies_[body].world_shapes.end());
+      // captures only `this`: held inside the std::function, no allocation
+      const actuators::ShapeQuery query = [this](const Vector3d& a, const Vector3d& b, double pad,
+                                                 std::vector<const actuators::WorldShape*>* out) {
+        QueryShapes(a, b, pad, out);
       };
       actuators::ContactOptions contact;
       contact.margin = t.desc->radius;
       contact.detour_reach = detour_reach_;
-      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact);
       if (t.contacts > 0 && t.previous_length >= 0)
         t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
+      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, &contact_scratch_);
     }
   }
 }

@@ -215,10 +215,16 @@ class MillardCurve {
   const std::vector<Segment>& segments() const { return segments_; }
 
  private:
+  static constexpr int kSamples = 32;  // per segment, to start the parameter solve
   struct Poly {
-    std::array<double, 6> x{}, y{};  // power-basis coefficients in u
-    std::array<double, 9> xs{};      // x at u = k / 8 (start of the parameter solve)
+    std::array<double, 6> x{}, y{};                 // power-basis coefficients in u
+    std::array<double, kSamples + 1> xs{}, ys{};    // x, y at u = k / kSamples
+    std::array<double, kSamples + 1> dxs{}, dys{};  // dx/du, dy/du there
   };
+  // the parameter u in segment i where w y(u) + d x(u) = target (non-decreasing in u); kXOnly:
+  // w = 0, d = 1 (x(u) = target) without evaluating y
+  template <bool kXOnly>
+  double SolveU(std::size_t i, double w, double d, double target) const;
   std::pair<std::size_t, double> Locate(double x) const;  // segment and its parameter u
   std::vector<Segment> segments_;
   std::vector<Poly> poly_;
