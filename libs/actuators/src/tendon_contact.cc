@@ -21,7 +21,8 @@ bool Slab(double p, double d, double lo_s, double hi_s, double* lo, double* hi) 
   return *lo <= *hi;
 }
 
-Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p, const Eigen::Vector3d& d) {
+Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p,
+                     const Eigen::Vector3d& d) {
   double lo = 0, hi = 1;
   for (int i = 0; i < 3; ++i)
     if (!Slab(p[i], d[i], -half[i], half[i], &lo, &hi)) return std::nullopt;
@@ -88,9 +89,10 @@ Eigen::Vector3d MeshHalfExtents(const sgal::Mesh* mesh, Eigen::Vector3d* center)
 
 Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                        double margin) {
-  const Eigen::Isometry3d inv = shape.pose.inverse();
-  const Eigen::Vector3d p = inv * a;
-  const Eigen::Vector3d d = inv.linear() * (b - a);
+  // into the shape's frame by the transposed rotation: no inverse, no 4x4 products
+  const auto rotation = shape.pose.linear();
+  const Eigen::Vector3d p = rotation.transpose() * (a - shape.pose.translation());
+  const Eigen::Vector3d d = rotation.transpose() * (b - a);
   return std::visit(
       [&](const auto& g) -> Interval {
         using T = std::decay_t<decltype(g)>;
@@ -101,8 +103,13 @@ Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const 
         } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
           const double r = g.radius + margin, h = g.length / 2;
           Interval i = CylinderInterval(r, h, p, d);
-          i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d));
-          return Union(i, SphereInterval(Eigen::Vector3d(0, 0, -h), r, p, d));
+          // a cap's ball adds to the cylinder and the other ball only beyond its end plane: a
+          // segment that stays short of that plane needs no test against it
+          const double z0 = p.z(), z1 = p.z() + d.z();
+          if (std::max(z0, z1) > h) i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d));
+          if (std::min(z0, z1) < -h)
+            i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, -h), r, p, d));
+          return i;
         } else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>) {
           return CylinderInterval(g.radius + margin, g.length / 2 + margin, p, d);
         } else if constexpr (std::is_same_v<T, sgal::Plane>) {
@@ -124,52 +131,92 @@ Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const 
 
 namespace {
 
-/// Where the ray from `from` along unit `dir` leaves the shape (grown by margin); `from` inside.
-Eigen::Vector3d ExitPoint(const WorldShape& shape, const Eigen::Vector3d& from,
-                          const Eigen::Vector3d& dir, double margin, double reach) {
-  const auto inside = SegmentInside(shape, from, from + dir * reach, margin);
-  const double t = inside ? inside->second : 0.0;
-  return from + dir * (t * reach + 1e-9);
-}
-
 struct Crossing {
   double t_in = 1, t_out = 0;
   const WorldShape* shape = nullptr;
+  double distance = 0;  // of the shape's origin from the routed segment being bent [m]
 };
 
-/// Whether the segment a-b passes within `reach` of point c.
-bool Near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, double reach) {
-  if (!std::isfinite(reach)) return true;
-  const Eigen::Vector3d ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((c - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - c).squaredNorm() <= reach * reach;
-}
+using Candidate = ContactScratch::Candidate;
 
 /// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body.
 Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                       const std::vector<WorldShape>& shapes, int exclude_a, int exclude_b,
+                       const std::vector<Candidate>& candidates, int exclude_a, int exclude_b,
                        double margin) {
   Crossing best;
   double best_len = 0;
-  for (const auto& s : shapes) {
+  const Eigen::Vector3d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  // the ball around the segment: a cheap first test that rejects most shapes of a short piece
+  const Eigen::Vector3d mid = (a + b) / 2;
+  const double half_length = std::sqrt(l2) / 2 * (1 + 1e-9) + 1e-12;
+  for (const Candidate& s : candidates) {
     if (s.body == exclude_a || s.body == exclude_b) continue;
-    if (!Near(a, b, s.pose.translation(), sgal::BoundingRadius(*s.geometry) + margin)) continue;
-    const auto i = SegmentInside(s, a, b, margin);
+    const double ball = s.reach + half_length;
+    if ((s.centre - mid).squaredNorm() > ball * ball) continue;
+    // only shapes whose bounding ball (grown by the margin) comes near the segment are tested
+    const double t = l2 > 0 ? std::clamp((s.centre - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    if (!((a + t * ab - s.centre).squaredNorm() <= s.reach2)) continue;
+    const auto i = SegmentInside(*s.shape, a, b, margin);
     if (!i || i->second - i->first <= 1e-9) continue;
     if (i->second - i->first > best_len) {
       best_len = i->second - i->first;
-      best = {i->first, i->second, &s};
+      best = {i->first, i->second, s.shape, s.distance};
     }
   }
   return best;
 }
 
-void Refine(const PathPoint& a, const PathPoint& b, const std::vector<WorldShape>& candidates,
-            const ContactOptions& options, int depth, std::vector<PathPoint>* out) {
+/// How far from its origin a point on the shape grown by `margin` can lie [m]: a bound on where a
+/// detour point put on its surface goes.
+double SurfaceReach(const WorldShape& shape, double margin) {
+  return std::visit(
+      [&](const auto& g) -> double {
+        using T = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<T, sgal::Box>) {
+          return (g.size / 2 + Eigen::Vector3d::Constant(margin)).norm();
+        } else if constexpr (std::is_same_v<T, sgal::Sphere>) {
+          return g.radius + margin;
+        } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
+          return g.radius + g.length / 2 + margin;
+        } else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>) {
+          return std::hypot(g.radius + margin, g.length / 2 + margin);
+        } else if constexpr (std::is_same_v<T, sgal::Plane>) {
+          return kInf;
+        } else {
+          // taken by their local bounding box, whose corners lie within sqrt(3) times the
+          // farthest vertex
+          const double radius = shape.bounding_radius >= 0 ? shape.bounding_radius
+                                                           : sgal::BoundingRadius(*shape.geometry);
+          return std::sqrt(3.0) * (radius + margin);
+        }
+      },
+      *shape.geometry);
+}
+
+/// One routed segment being bent. Every detour point lies within `rho` of the routed segment, so
+/// a shape can come near a piece of the bent path only if it comes within its reach plus `rho`
+/// of the routed segment: `near` holds those, in the query's order, and grows with `rho`.
+struct Bend {
+  const std::vector<Candidate>* candidates;
+  std::vector<Candidate>* near;
+  double rho = 0;  // [m]
+  const ContactOptions* options;
+  std::vector<PathPoint>* out;
+
+  void Select() {
+    near->clear();
+    // a little slack for rounding: keeping one shape too many changes nothing
+    for (const Candidate& c : *candidates)
+      if (c.distance <= (c.reach + rho) * (1 + 1e-9) + 1e-12) near->push_back(c);
+  }
+};
+
+void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (depth <= 0) return;
+  const ContactOptions& options = *bend->options;
   // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
-  const Crossing c = FirstCrossing(a.position, b.position, candidates, a.contact ? -2 : a.body,
+  const Crossing c = FirstCrossing(a.position, b.position, *bend->near, a.contact ? -2 : a.body,
                                    b.contact ? -2 : b.body, options.margin);
   if (c.shape == nullptr) return;
   const WorldShape& shape = *c.shape;
@@ -189,34 +236,67 @@ void Refine(const PathPoint& a, const PathPoint& b, const std::vector<WorldShape
     if (away.norm() < 1e-9) away = u.unitOrthogonal();  // through the centre: any perpendicular
   }
   away.normalize();
+  // where the ray from the middle of the chord along `away` leaves the shape (grown by margin)
   const double reach = 10 * len + 1.0;
   const auto exit = SegmentInside(shape, mid, mid + away * reach, options.margin);
   if (exit && exit->second >= 1.0) return;  // no way out along that direction: leave it straight
   PathPoint q;
-  q.position = ExitPoint(shape, mid, away, options.margin, reach);
+  q.position = mid + away * ((exit ? exit->second : 0.0) * reach + 1e-9);
   q.body = shape.body;
   q.contact = true;
-  Refine(a, q, candidates, options, depth - 1, out);
-  out->push_back(q);
-  Refine(q, b, candidates, options, depth - 1, out);
+  // the new point lies on the shape's surface: widen the shapes the pieces can come near
+  const double rho = c.distance + SurfaceReach(shape, options.margin) + 1e-9;
+  if (rho > bend->rho) {
+    bend->rho = rho;
+    bend->Select();
+  }
+  Refine(a, q, bend, depth - 1);
+  bend->out->push_back(q);
+  Refine(q, b, bend, depth - 1);
 }
 
 }  // namespace
 
 int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options) {
+  ContactScratch scratch;
+  return WrapAroundBodies(path, query, options, &scratch);
+}
+
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
+                     ContactScratch* scratch) {
   if (path->points.size() < 2) return 0;
-  std::vector<PathPoint> out;
-  out.reserve(path->points.size() * 2);
-  std::vector<WorldShape> scratch;
+  std::vector<PathPoint>& out = scratch->points;
+  out.clear();
+  std::vector<const WorldShape*>& shapes = scratch->shapes;
+  std::vector<Candidate>& candidates = scratch->candidates;
+  Bend bend;
+  bend.candidates = &candidates;
+  bend.near = &scratch->near;
+  bend.options = &options;
+  bend.out = &out;
   int inserted = 0;
   for (size_t i = 0; i + 1 < path->points.size(); ++i) {
     const PathPoint& a = path->points[i];
     const PathPoint& b = path->points[i + 1];
     out.push_back(a);
     const size_t before = out.size();
-    scratch.clear();
-    query(a.position, b.position, options.margin + options.detour_reach, &scratch);
-    Refine(a, b, scratch, options, options.max_depth, &out);
+    shapes.clear();
+    query(a.position, b.position, options.margin + options.detour_reach, &shapes);
+    candidates.clear();
+    const Eigen::Vector3d ab = b.position - a.position;
+    const double l2 = ab.squaredNorm();
+    for (const WorldShape* shape : shapes) {
+      const double radius = shape->bounding_radius >= 0 ? shape->bounding_radius
+                                                        : sgal::BoundingRadius(*shape->geometry);
+      const double reach = radius + options.margin;
+      const Eigen::Vector3d centre = shape->pose.translation();
+      const double t = l2 > 0 ? std::clamp((centre - a.position).dot(ab) / l2, 0.0, 1.0) : 0.0;
+      const double distance = (a.position + t * ab - centre).norm();
+      candidates.push_back({centre, reach * reach, reach, distance, shape->body, shape});
+    }
+    bend.rho = 0;
+    bend.Select();
+    Refine(a, b, &bend, options.max_depth);
     inserted += static_cast<int>(out.size() - before);
   }
   out.push_back(path->points.back());
@@ -228,7 +308,8 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
   for (size_t i = 0; i + 1 < out.size(); ++i)
     bent += (out[i + 1].position - out[i].position).norm();
   path->length += bent - straight;
-  path->points = std::move(out);
+  // the straight path's buffer becomes the next call's
+  std::swap(path->points, out);
   return inserted;
 }
 

@@ -52,9 +52,8 @@ TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
   PathGeometry path;
   path.points = {{Vector3d(-d, 0, 0), -1}, {Vector3d(d, 0, 0), -1}};
   path.length = 2 * d;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
-    out->push_back(shape);
-  };
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) { out->push_back(&shape); };
   ContactOptions options;
   options.margin = 0;
   options.max_depth = 5;
@@ -84,9 +83,12 @@ TEST(WrapAroundBodies, LeavesSegmentsAloneThatMissOrEndOnTheBody) {
   PathGeometry path;
   path.points = {{Vector3d(-1, 0, 0), 3}, {Vector3d(1, 0, 0), -1}};
   path.length = 2;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
-    out->push_back(At(box, Vector3d::Zero(), 3));  // the tendon is fixed to this very body
-    out->push_back(At(box, Vector3d(0, 1, 0), 4));  // beside the path
+  const WorldShape own = At(box, Vector3d::Zero(), 3);      // the tendon is fixed to this very body
+  const WorldShape beside = At(box, Vector3d(0, 1, 0), 4);  // beside the path
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    out->push_back(&own);
+    out->push_back(&beside);
   };
   EXPECT_EQ(WrapAroundBodies(&path, query, {}), 0);
   EXPECT_EQ(path.length, 2);
@@ -96,10 +98,9 @@ TEST(WrapAroundBodies, LiftsAStringOutOfTheFloorAlongItsNormal) {
   const sgal::Geometry floor = sgal::Plane{};
   PathGeometry path;
   path.points = {{Vector3d(-1, 0, 0.1), -1}, {Vector3d(1, 0, 0.1), -1}};
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double, std::vector<WorldShape>* out) {
-    WorldShape s = At(floor, Vector3d(0, 0, 0.3), 7);  // the ground 0.2 m above both ends
-    out->push_back(s);
-  };
+  const WorldShape ground = At(floor, Vector3d(0, 0, 0.3), 7);  // 0.2 m above both ends
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) { out->push_back(&ground); };
   path.length = 2;
   ContactOptions options;
   options.margin = 0;

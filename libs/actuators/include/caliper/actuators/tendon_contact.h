@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <functional>
 #include <optional>
 #include <vector>
@@ -21,20 +20,23 @@ struct WorldShape {
   const sgal::Geometry* geometry = nullptr;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   int body = -1;
+  /// sgal::BoundingRadius of the geometry about the pose's origin [m], infinite for planes; an
+  /// engine sets it once per shape. Negative: not known, computed at each use (slower).
+  double bounding_radius = -1;
 };
 
 /// The part of the segment a + t (b - a), t in [0, 1], inside the shape grown by `margin`, or
 /// nothing. Exact for box, sphere, capsule, cylinder, cone (as its bounding cylinder) and plane;
 /// convex hulls and meshes are taken by their local bounding box.
 std::optional<std::pair<double, double>> SegmentInside(const WorldShape& shape,
-                                                      const Eigen::Vector3d& a,
-                                                      const Eigen::Vector3d& b, double margin);
+                                                       const Eigen::Vector3d& a,
+                                                       const Eigen::Vector3d& b, double margin);
 
-/// Gives the shapes whose bounds come within `pad` of the box around a-b (an engine's
-/// broadphase query).
-using ShapeQuery =
-    std::function<void(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double pad,
-                       std::vector<WorldShape>* out)>;
+/// Appends the shapes whose bounds come within `pad` of the box around a-b (an engine's
+/// broadphase query). The shapes are the engine's, not copies: they must stay in place until
+/// WrapAroundBodies returns.
+using ShapeQuery = std::function<void(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                      double pad, std::vector<const WorldShape*>* out)>;
 
 struct ContactOptions {
   double margin = 0.001;  ///< tendon radius: how far the path stays from surfaces [m]
@@ -49,5 +51,27 @@ struct ContactOptions {
 /// `contact` and carry the body they press on. Returns the number of inserted points; `path`
 /// (points and length) is updated in place.
 int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options);
+
+/// Buffers WrapAroundBodies reuses from call to call, so that a step allocates nothing once they
+/// have grown to the largest path (one per engine is enough: calls do not overlap).
+struct ContactScratch {
+  /// A shape the query gave for one segment, with what the search tests first, packed.
+  struct Candidate {
+    Eigen::Vector3d centre;  ///< the shape's origin in the world [m]
+    double reach2;           ///< (bounding radius + margin)^2 [m^2], infinite for planes
+    double reach;            ///< bounding radius + margin [m]
+    double distance;         ///< from the centre to the routed segment being bent [m]
+    int body;
+    const WorldShape* shape;
+  };
+  std::vector<PathPoint> points;          // the bent path being built
+  std::vector<const WorldShape*> shapes;  // the query's answer for one segment
+  std::vector<Candidate> candidates;      // the same, packed
+  std::vector<Candidate> near;            // those the detours built so far can come near
+};
+
+/// The same, with the caller's buffers. `path->points` and `scratch->points` may be swapped.
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
+                     ContactScratch* scratch);
 
 }  // namespace caliper::actuators
