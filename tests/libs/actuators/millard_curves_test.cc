@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -116,6 +117,36 @@ TEST(MillardCurves, TendonForceLengthHasItsKnots) {
   EXPECT_GT(fse.SecondDerivative(1 + 0.5 * (toe_end - 1)), 0);  // the toe stiffens
   ExpectC2AtJoins(fse);
   ExpectSlopesMatchDifferences(fse, 0.99, 1.07);
+}
+
+// the Bezier of a segment at parameter u, in long double (Bernstein form)
+long double Bernstein(const std::array<double, 6>& p, long double u) {
+  const long double v = 1 - u;
+  const long double c[6] = {v * v * v * v * v,      5 * u * v * v * v * v, 10 * u * u * v * v * v,
+                            10 * u * u * u * v * v, 5 * u * u * u * u * v, u * u * u * u * u};
+  long double sum = 0;
+  for (int k = 0; k < 6; ++k) sum += c[k] * p[k];
+  return sum;
+}
+
+TEST(MillardCurves, ValuesMatchTheBezierSolvedByBisection) {
+  // the evaluation's fast parameter solve against 80 bisections in long double
+  for (const MillardCurve& c : {MillardActiveForceLengthCurve(), MillardForceVelocityCurve(),
+                                MillardFiberForceLengthCurve(), MillardTendonForceLengthCurve()}) {
+    double worst = 0;
+    for (const auto& s : c.segments())
+      for (int i = 0; i <= 997; ++i) {
+        const double x = s.x[0] + (s.x[5] - s.x[0]) * i / 997.0;
+        long double lo = 0, hi = 1;
+        for (int k = 0; k < 80; ++k) {
+          const long double mid = 0.5L * (lo + hi);
+          (Bernstein(s.x, mid) < x ? lo : hi) = mid;
+        }
+        const double y = static_cast<double>(Bernstein(s.y, 0.5L * (lo + hi)));
+        worst = std::max(worst, std::abs(c.Value(x) - y));
+      }
+    EXPECT_LT(worst, 1e-13);
+  }
 }
 
 TEST(MillardCurves, InverseRoundTrips) {
