@@ -57,7 +57,8 @@ class SpoolLoad {
   virtual ~SpoolLoad() = default;
   /// The torque on the spool [N m], positive against positive spool speed, at the end of a
   /// stretch of h [s] from the last accepted sub-step that ends at this spool angle [rad] and
-  /// speed [rad/s]. Must not change the load's state.
+  /// speed [rad/s] (a load that moves with time takes it at that time: the motor calls Advance()
+  /// for every sub-step in order). Must not change the load's state.
   virtual double TorqueAt(double spool_angle, double spool_speed, double h) const = 0;
   /// TorqueAt() on the line an implicit stage of the motor moves along, angle = spool_angle +
   /// angle_per_speed (w - spool_speed), for its Newton iteration: returns the torque at
@@ -103,7 +104,13 @@ class ConstantSpoolLoad : public SpoolLoad {
 /// rad/s of a 10 us reference at the sampled times of the CALIPER-era scenario (1.3e-5 with
 /// 0.1 ms sub-steps, at about 3.5 times the cost); up to about 1/3 ms (three electrical time
 /// constants) the current follows voltage steps to a few mA, from 0.5 ms on it errs by tenths of
-/// an ampere just after them.
+/// an ampere just after them. The cost is that of the stages, each one Newton step on a serial
+/// chain of dependent operations (about 25 ns here): per 1 ms step about 230 ns with the default,
+/// 160 ns with max_substep = 0.5 ms (worst speed error 3.1e-4 rad/s in that scenario) and 90 ns
+/// with 1 ms (2.4e-3 rad/s; still second order in dt on a smoothly moving path).
+/// A load that depends on time (the dc_motor_tendon kind's: its path moves through the step) is
+/// evaluated at each stage's own time, h after the last accepted sub-step, so that the whole
+/// stays second order in the step.
 /// A stage (the current and the angle are linear in the speed) is solved by Newton's method with
 /// its analytic derivative from an extrapolation of the last stage, kept inside the bracket its
 /// residuals give. It stops after the first step whose result provably lies within 1.5e-12 of the
