@@ -39,16 +39,37 @@ struct Recorder::Queue {
 
   /// Appends, dropping the oldest batch when full; never waits for a consumer.
   void Push(Batch&& batch) {
+    Batch old;  // freed after the lock is released
     {
       std::lock_guard<std::mutex> lock(mutex);
       if (batches.size() >= capacity) {
         dropped_samples += batches.front().step_count;
+        old = std::move(batches.front());
         batches.pop_front();
         ++dropped;
+        KeepLocked(old);
       }
       batches.push_back(std::move(batch));
     }
     ready.notify_one();
+  }
+  /// Keeps a batch that was handed out or dropped as the spare whose memory the next batch
+  /// reuses, when there is none yet.
+  void Recycle(Batch&& batch) {
+    std::lock_guard<std::mutex> lock(mutex);
+    KeepLocked(batch);
+  }
+  /// Moves the spare's buffers (emptied, capacity kept) into `batch`; false when there is none.
+  /// Called once per batch, not per sample.
+  bool TakeSpare(Batch* batch) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (spare.data.capacity() == 0) return false;
+    batch->data = std::move(spare.data);
+    batch->times = std::move(spare.times);
+    spare = Batch();
+    batch->data.clear();
+    batch->times.clear();
+    return true;
   }
   std::vector<Batch> Take(size_t max) {
     std::vector<Batch> out;
@@ -75,6 +96,16 @@ struct Recorder::Queue {
   uint64_t dropped = 0;
   uint64_t dropped_samples = 0;
   bool closed = false;
+  // a batch's memory, reused: a fresh multi-megabyte batch costs a page fault per 4 KiB as the
+  // samples fill it, several times the copying itself
+  Batch spare;
+
+ private:
+  void KeepLocked(Batch& batch) {
+    if (spare.data.capacity() != 0 || batch.data.capacity() == 0) return;
+    spare.data = std::move(batch.data);
+    spare.times = std::move(batch.times);
+  }
 };
 
 namespace {
@@ -239,6 +270,7 @@ void Recorder::Plan(Subscription& s) {
 void Recorder::Sample(Subscription& s, uint64_t step, double sim_time) {
   Batch& b = s.pending;
   if (b.step_count == 0) {
+    s.queue->TakeSpare(&b);
     b.subscription = s.id;
     b.first_step = step;
     b.every_n_steps = s.every_n_steps;
@@ -363,6 +395,7 @@ size_t Recorder::Deliver(SubscriptionId id, size_t max) {
     auto one = queue->Take(1);
     if (one.empty()) break;
     queue->consumer(one.front());
+    queue->Recycle(std::move(one.front()));
     ++delivered;
   }
   return delivered;
@@ -381,6 +414,7 @@ size_t Recorder::DeliverAll() {
       auto one = queue->Take(1);
       if (one.empty()) break;
       queue->consumer(one.front());
+      queue->Recycle(std::move(one.front()));
       ++delivered;
     }
   }

@@ -10,6 +10,7 @@
 // step lock) adds, removes, reads and writes channels; getters therefore always see a consistent
 // step.
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -173,7 +174,14 @@ class Registry {
   /// UnknownId for a stale handle.
   void Read(Handle handle, double* out) const {
     if (!Valid(handle)) ThrowStale(handle);
-    slots_[handle.slot].getter(out);
+    const Slot& s = slots_[handle.slot];
+    if (s.source.block) {
+      // in place: no call through the getter
+      s.source.block->Update();
+      std::copy_n(s.source.values, s.info.shape.size(), out);
+    } else {
+      s.getter(out);
+    }
   }
   /// The channel's getter, or its values in place when it was added with a Source; valid until
   /// version() changes. Throws UnknownId for a stale handle.
