@@ -13,8 +13,8 @@
 // - block_hanging_from_muscle.osim (+ _controls.sto): its default state is reproduced (fibre
 //   length) and static equilibrium is checked. Its CMC results (the block's motion under those
 //   excitations) are not in the corpus, so the dynamics cannot be compared.
-// - Tug_of_War_Millard_Iso.osim and Tug_of_War_*.sto: a Millard2012EquilibriumMuscle (curves
-//   not implemented here) and no stored outputs: not reproducible.
+// - Tug_of_War_Millard_Iso.osim and Tug_of_War_*.sto: a Millard2012EquilibriumMuscle and no
+//   stored outputs; its equilibrium and smoothness checks are in millard_muscle_test.cc.
 
 #include "caliper/actuators/muscle.h"
 
