@@ -101,7 +101,7 @@ elif grep -q "faulted" "$WORK/fault"; then pass "oversized shape: $(tail -1 "$WO
 else cat "$WORK/fault"; fail "no fault message"; fi
 ctl edit undo >/dev/null 2>&1 || fail "undo after the fault"
 ctl status | grep -q "PAUSED" && pass "the undo cleared the fault" || { ctl status; fail "still faulted"; }
-ctl step 100 >/dev/null 2>&1 && pass "steps on after the undo" || fail "steps after the undo"
+ctl step 100 >"$WORK/after" 2>&1 && pass "steps on after the undo" || { cat "$WORK/after"; fail "steps after the undo"; }
 ctl edit redo >/dev/null 2>&1 || fail "redo of the shape"
 
 # undo and redo: the history's labels

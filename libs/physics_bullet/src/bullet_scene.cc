@@ -260,7 +260,6 @@ class BulletScene : public sgal::PhysicsScene {
   double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
   // tendon-body contact's buffers, reused by every tendon and step (no allocation per step)
   actuators::ContactScratch contact_scratch_;
-  std::vector<int> contact_bodies_;  // a broadphase query's answer
   void QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
                    std::vector<const actuators::WorldShape*>* out);
   std::vector<ParameterEntry> parameters_;
@@ -564,6 +563,13 @@ void BulletScene::BuildTendons() {
   RefreshWorldShapes();
   EvaluateTendons();
   for (auto& a : actuators_) a.model->Reset(tendons_[a.tendon].geometry.length);
+  // the tensions at rest act through the first step
+  for (auto& t : tendons_) {
+    t.previous_length = t.geometry.length;
+    t.geometry.speed = 0;
+    t.tension = 0;
+    for (int index : t.actuators) t.tension += actuators_[index].model->tension();
+  }
   UpdateJoints();
 }
 
@@ -590,24 +596,22 @@ void BulletScene::RefreshWorldShapes() {
   }
 }
 
-struct AabbCollector : public btBroadphaseAabbCallback {
-  std::vector<int>* bodies = nullptr;
-  bool process(const btBroadphaseProxy* proxy) override {
-    const auto* object = static_cast<const btCollisionObject*>(proxy->m_clientObject);
-    if (object != nullptr && object->getUserIndex() >= 0) bodies->push_back(object->getUserIndex());
-    return true;
-  }
-};
-
+// Every shape whose bounding ball comes within `pad` of the box around a-b, in body order. A scan
+// of the poses of this step rather than Bullet's broadphase: its boxes were computed before the
+// step moved the bodies (and not at all after a state restore), and for a robot's few dozen
+// shapes its tree walk with this padding cost more than the scan.
 void BulletScene::QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
                               std::vector<const actuators::WorldShape*>* out) {
-  contact_bodies_.clear();
-  AabbCollector collector;
-  collector.bodies = &contact_bodies_;
-  broadphase_->aabbTest(ToBt(a.cwiseMin(b) - Vector3d::Constant(pad), scale_),
-                        ToBt(a.cwiseMax(b) + Vector3d::Constant(pad), scale_), collector);
-  for (int body : contact_bodies_)
-    for (const auto& shape : bodies_[body].world_shapes) out->push_back(&shape);
+  const Vector3d lo = a.cwiseMin(b) - Vector3d::Constant(pad);
+  const Vector3d hi = a.cwiseMax(b) + Vector3d::Constant(pad);
+  for (const BodyData& body : bodies_)
+    for (const auto& shape : body.world_shapes) {
+      const auto c = shape.pose.translation();
+      const double r = shape.bounding_radius;  // infinite for planes: always taken
+      if (c.x() >= lo.x() - r && c.x() <= hi.x() + r && c.y() >= lo.y() - r &&
+          c.y() <= hi.y() + r && c.z() >= lo.z() - r && c.z() <= hi.z() + r)
+        out->push_back(&shape);
+    }
 }
 
 void BulletScene::EvaluateTendons() {
@@ -652,8 +656,6 @@ void BulletScene::EvaluateTendons() {
       actuators::ContactOptions contact;
       contact.margin = t.desc->radius;
       contact.detour_reach = detour_reach_;
-      if (t.contacts > 0 && t.previous_length >= 0)
-        t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
       t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, &contact_scratch_);
     }
   }
@@ -860,8 +862,8 @@ void BulletScene::SaveStepState() {
     snapshot_[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
   }
   for (auto& t : tendons_) {
-    // the geometry is evaluated afresh each step: keep the last one by a swap, no copy
-    std::swap(t.geometry, t.saved_geometry);
+    // the geometry the step starts from (a copy into kept capacity: no allocation)
+    t.saved_geometry = t.geometry;
     t.saved_previous_length = t.previous_length;
     t.saved_tension = t.tension;
     t.saved_contacts = t.contacts;
@@ -933,33 +935,17 @@ void BulletScene::Step() {
   // A failing step leaves the scene as it was at its start: bodies, tendons, every actuator's
   // state, time and step count. Bullet's contact cache (warm-start impulses) is not rolled back:
   // after a fault inside stepSimulation or an exploding body, a scene with contacts that steps on
-  // may differ in the last bits from one that never faulted. Faults before it (tendon paths,
-  // actuators) touch nothing in Bullet.
+  // may differ in the last bits from one that never faulted.
+  //
+  // Actuators and bodies take turns in Stormer-Verlet order (second order in dt, see
+  // TendonActuator::Step): the bodies advance on the tendons' tensions and paths at the start of
+  // the step (from the end of the last one), then the paths are evaluated where the bodies went
+  // and each actuator advances along the path's motion over the same step. Tendon length, speed
+  // and tension at the end of a step belong to the same instant as the bodies' poses.
   SaveStepState();
   try {
-    // poses were cached at the end of the last step (or at construction)
-    stage_ = {StepStage::kWorld, -1};
-    RefreshWorldShapes();
-    EvaluateTendons();
-    stage_ = {StepStage::kWorld, -1};
-    UpdateJoints();
-    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
-      TendonData& t = tendons_[ti];
-      t.tension = 0;
-      for (int index : t.actuators) {
-        stage_ = {StepStage::kActuator, index};
-        ActuatorData& a = actuators_[index];
-        const double f = a.model->Step(t.geometry.length, t.geometry.speed, dt_);
-        if (!std::isfinite(f))
-          throw StepFault(Describe(stage_) + ": tension is not finite (" + std::to_string(f) +
-                              ") at t = " + std::to_string(time_ + dt_) +
-                              " s; simulation stopped at t = " + std::to_string(time_) +
-                              " s (step " + std::to_string(steps_) + ")",
-                          a.desc->name, time_ + dt_);
-        t.tension += f;
-      }
-      t.previous_length = t.geometry.length;
-    }
+    // poses, joints and tendon paths were brought up to date at the end of the last step (or at
+    // construction, or a restore)
     ApplyTendonForces();
     stage_ = {StepStage::kWorld, -1};
     ApplyJointSprings();
@@ -970,6 +956,36 @@ void BulletScene::Step() {
     CheckState();
     CacheBodyPoses();
     UpdateJoints();
+    for (auto& t : tendons_) t.previous_length = t.geometry.length;
+    RefreshWorldShapes();
+    EvaluateTendons();
+    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+      TendonData& t = tendons_[ti];
+      // the mean lengthening speed over the step: the path's motion the actuators integrate
+      // along (length at the start + speed * dt is exactly the length at the end)
+      t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
+      t.tension = 0;
+      for (int index : t.actuators) {
+        stage_ = {StepStage::kActuator, index};
+        ActuatorData& a = actuators_[index];
+        const double f = a.model->Step(t.previous_length, t.geometry.speed, dt_);
+        if (!std::isfinite(f))
+          throw StepFault(Describe(stage_) + ": tension is not finite (" + std::to_string(f) +
+                              ") at t = " + std::to_string(time_ + dt_) +
+                              " s; simulation stopped at t = " + std::to_string(time_) +
+                              " s (step " + std::to_string(steps_) + ")",
+                          a.desc->name, time_ + dt_);
+        if (std::abs(f) > options_.max_tension)
+          throw StepFault(Describe(stage_) + ": tension " + std::to_string(f) +
+                              " N beyond the engine's bound of " +
+                              std::to_string(options_.max_tension) + " N (path speed " +
+                              std::to_string(t.geometry.speed) + " m/s) at t = " +
+                              std::to_string(time_ + dt_) + " s; simulation stopped at t = " +
+                              std::to_string(time_) + " s (step " + std::to_string(steps_) + ")",
+                          a.desc->name, time_ + dt_);
+        t.tension += f;
+      }
+    }
   } catch (...) {
     FailStep();
   }
@@ -1143,6 +1159,24 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   time_ = s.time;
   steps_ = s.steps;
   for (size_t j = 0; j < joints_.size(); ++j) joints_[j].position = s.joint_positions[j];
+  // the tendons' part of an exact state: the length at the start of the step that ended here,
+  // and the wrap sides the path goes on from (set before the path is evaluated)
+  std::vector<double> previous(tendons_.size(), -1);
+  if (exact) {
+    const double* end = s.engine.data() + s.engine.size();
+    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+      if (end - in < 2) refuse("the engine state ends before the tendons'");
+      previous[ti] = *in++;
+      const size_t n = static_cast<size_t>(*in++);
+      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
+      std::vector<int> sides(in, in + n);
+      in += n;
+      tendons_[ti].path.set_wrap_sides(std::move(sides));
+    }
+    if (in != end)
+      refuse("the engine state has " + std::to_string(end - in) +
+             " values more than this scene's bodies and tendons hold (a state of another scene)");
+  }
   CacheBodyPoses();
   UpdateJoints();  // counted turns continue from the positions carried over
   RefreshWorldShapes();
@@ -1153,27 +1187,14 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     // passive elements take no command (and refuse one): only what differs is set
     if (s.commands[k] != a.model->command()) a.model->SetCommand(s.commands[k]);
   }
-  // the path's speed comes from the next step's length: no jump from the length before an edit;
-  // the tension reads what the actuators carried over hold
-  for (auto& t : tendons_) {
-    t.previous_length = t.geometry.length;
+  // the tension reads what the actuators carried over hold; the speed is the last step's as an
+  // exact state gives it, else none (no jump from the length before an edit)
+  for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+    TendonData& t = tendons_[ti];
+    t.previous_length = previous[ti] >= 0 ? previous[ti] : t.geometry.length;
+    t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
-  }
-  if (exact) {
-    const double* end = s.engine.data() + s.engine.size();
-    for (auto& t : tendons_) {
-      if (end - in < 2) refuse("the engine state ends before the tendons'");
-      t.previous_length = *in++;
-      const size_t n = static_cast<size_t>(*in++);
-      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
-      std::vector<int> sides(in, in + n);
-      in += n;
-      t.path.set_wrap_sides(std::move(sides));
-    }
-    if (in != end)
-      refuse("the engine state has " + std::to_string(end - in) +
-             " values more than this scene's bodies and tendons hold (a state of another scene)");
   }
 }
 

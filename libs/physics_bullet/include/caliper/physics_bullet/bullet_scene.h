@@ -15,6 +15,9 @@ struct Options {
   /// exploding simulation.
   double max_distance = 1e4;
   double max_speed = 1e3;
+  /// A tendon tension beyond this [N] counts as an exploding actuator (a muscle driven past its
+  /// curves by a path that jumped): the step that computed it faults, before the tension acts.
+  double max_tension = 1e6;
 };
 
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
@@ -22,9 +25,8 @@ struct Options {
 /// bound (solver_iterations outside [1, 10^4], a time step an actuator cannot take in 10^4
 /// sub-steps). A failing Step() puts back the bodies, tendons and actuators (see
 /// sgal::PhysicsScene::Step); Bullet's contact cache (warm-start impulses) is not rolled back, so
-/// after a fault inside Bullet's own step or an exploding body a scene with contacts that steps
-/// on may differ in the last bits from one that never faulted (faults in tendon paths and
-/// actuators come before Bullet's step and leave it untouched).
+/// after a fault a scene with contacts that steps on may differ in the last bits from one that
+/// never faulted.
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
 
 /// DynamicState::engine holds this many values per body first (the centre-of-mass transform and
