@@ -134,22 +134,23 @@ namespace {
 struct Crossing {
   double t_in = 1, t_out = 0;
   const WorldShape* shape = nullptr;
-  double distance = 0;  // of the shape's origin from the routed segment being bent [m]
+  double distance2 = 0;  // squared, of the shape's origin from the routed segment bent [m^2]
 };
 
 using Candidate = ContactScratch::Candidate;
 
 /// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body.
+/// `ab` = b - a, `len` its length.
 Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       const Eigen::Vector3d& ab, double len,
                        const std::vector<Candidate>& candidates, int exclude_a, int exclude_b,
                        double margin) {
   Crossing best;
   double best_len = 0;
-  const Eigen::Vector3d ab = b - a;
   const double l2 = ab.squaredNorm();
   // the ball around the segment: a cheap first test that rejects most shapes of a short piece
   const Eigen::Vector3d mid = (a + b) / 2;
-  const double half_length = std::sqrt(l2) / 2 * (1 + 1e-9) + 1e-12;
+  const double half_length = len / 2 * (1 + 1e-9) + 1e-12;
   for (const Candidate& s : candidates) {
     if (s.body == exclude_a || s.body == exclude_b) continue;
     const double ball = s.reach + half_length;
@@ -161,7 +162,7 @@ Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
     if (!i || i->second - i->first <= 1e-9) continue;
     if (i->second - i->first > best_len) {
       best_len = i->second - i->first;
-      best = {i->first, i->second, s.shape, s.distance};
+      best = {i->first, i->second, s.shape, s.distance2};
     }
   }
   return best;
@@ -207,21 +208,24 @@ struct Bend {
   void Select() {
     near->clear();
     // a little slack for rounding: keeping one shape too many changes nothing
-    for (const Candidate& c : *candidates)
-      if (c.distance <= (c.reach + rho) * (1 + 1e-9) + 1e-12) near->push_back(c);
+    for (const Candidate& c : *candidates) {
+      const double bound = (c.reach + rho) * (1 + 1e-9) + 1e-12;
+      if (c.distance2 <= bound * bound) near->push_back(c);
+    }
   }
 };
 
 void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (depth <= 0) return;
   const ContactOptions& options = *bend->options;
-  // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
-  const Crossing c = FirstCrossing(a.position, b.position, *bend->near, a.contact ? -2 : a.body,
-                                   b.contact ? -2 : b.body, options.margin);
-  if (c.shape == nullptr) return;
-  const WorldShape& shape = *c.shape;
   const Eigen::Vector3d ab = b.position - a.position;
   const double len = ab.norm();
+  // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
+  const Crossing c =
+      FirstCrossing(a.position, b.position, ab, len, *bend->near, a.contact ? -2 : a.body,
+                    b.contact ? -2 : b.body, options.margin);
+  if (c.shape == nullptr) return;
+  const WorldShape& shape = *c.shape;
   if (len < 1e-12) return;
   const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
   const Eigen::Vector3d u = ab / len;
@@ -229,13 +233,18 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (const auto* plane = std::get_if<sgal::Plane>(shape.geometry)) {
     // out of a half-space along its normal
     away = shape.pose.linear() * plane->normal;
+    away.normalize();
   } else {
     // perpendicular to the segment, away from the shape's centre
     const Eigen::Vector3d centre = shape.pose.translation();
     away = (mid - centre) - u * u.dot(mid - centre);
-    if (away.norm() < 1e-9) away = u.unitOrthogonal();  // through the centre: any perpendicular
+    const double norm = away.norm();
+    if (norm < 1e-9) {
+      away = u.unitOrthogonal().normalized();  // through the centre: any perpendicular
+    } else {
+      away /= norm;
+    }
   }
-  away.normalize();
   // where the ray from the middle of the chord along `away` leaves the shape (grown by margin)
   const double reach = 10 * len + 1.0;
   const auto exit = SegmentInside(shape, mid, mid + away * reach, options.margin);
@@ -245,7 +254,7 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   q.body = shape.body;
   q.contact = true;
   // the new point lies on the shape's surface: widen the shapes the pieces can come near
-  const double rho = c.distance + SurfaceReach(shape, options.margin) + 1e-9;
+  const double rho = std::sqrt(c.distance2) + SurfaceReach(shape, options.margin) + 1e-9;
   if (rho > bend->rho) {
     bend->rho = rho;
     bend->Select();
@@ -291,8 +300,8 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       const double reach = radius + options.margin;
       const Eigen::Vector3d centre = shape->pose.translation();
       const double t = l2 > 0 ? std::clamp((centre - a.position).dot(ab) / l2, 0.0, 1.0) : 0.0;
-      const double distance = (a.position + t * ab - centre).norm();
-      candidates.push_back({centre, reach * reach, reach, distance, shape->body, shape});
+      const double distance2 = (a.position + t * ab - centre).squaredNorm();
+      candidates.push_back({centre, reach * reach, reach, distance2, shape->body, shape});
     }
     bend.rho = 0;
     bend.Select();

@@ -60,7 +60,7 @@ struct ContactScratch {
     Eigen::Vector3d centre;  ///< the shape's origin in the world [m]
     double reach2;           ///< (bounding radius + margin)^2 [m^2], infinite for planes
     double reach;            ///< bounding radius + margin [m]
-    double distance;         ///< from the centre to the routed segment being bent [m]
+    double distance2;        ///< squared distance of the centre from the routed segment [m^2]
     int body;
     const WorldShape* shape;
   };
