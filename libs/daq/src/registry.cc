@@ -40,6 +40,7 @@ Handle Registry::Add(ChannelInfo info, Getter getter, Setter setter) {
   s.info = std::move(info);
   s.getter = std::move(getter);
   s.setter = std::move(setter);
+  s.size = s.info.shape.size();
   s.live = true;
   index_.emplace(s.info.id, slot);
   ++version_;

@@ -178,7 +178,7 @@ class Registry {
     if (s.source.block) {
       // in place: no call through the getter
       s.source.block->Update();
-      std::copy_n(s.source.values, s.info.shape.size(), out);
+      std::copy_n(s.source.values, s.size, out);
     } else {
       s.getter(out);
     }
@@ -200,12 +200,14 @@ class Registry {
 
  private:
   struct Slot {
-    ChannelInfo info;
-    Getter getter;
-    Setter setter;
-    Source source;  // block and values when added with a Source
+    // what Read touches first, on as few cache lines as may be
     uint32_t generation = 0;
     bool live = false;
+    size_t size = 0;  // info.shape.size()
+    Source source;    // block and values when added with a Source
+    Getter getter;
+    Setter setter;
+    ChannelInfo info;
   };
   [[noreturn]] void ThrowStale(Handle handle) const;
   void Release(uint32_t slot);
