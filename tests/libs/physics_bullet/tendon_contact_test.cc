@@ -113,6 +113,67 @@ TEST(WrapAroundBodies, LiftsAStringOutOfTheFloorAlongItsNormal) {
   EXPECT_LT(path.length, 3.0) << "a detour of sensible length, not off to infinity";
 }
 
+TEST(WrapAroundBodies, BendsAroundAShapeOnlyItsDetourComesNear) {
+  // the string cuts the big ball; the detour over it passes through a small ball that lies
+  // beyond the small ball's reach of the straight string
+  const sgal::Geometry big = sgal::Sphere{0.2}, small = sgal::Sphere{0.03};
+  const WorldShape ball = At(big, Vector3d(0, -0.05, 0), 1);
+  const WorldShape pebble = At(small, Vector3d(-0.5, 0.075, 0), 2);
+  ASSERT_FALSE(SegmentInside(pebble, Vector3d(-1, 0, 0), Vector3d(1, 0, 0), 0.01))
+      << "the straight string must miss the pebble for this test to mean anything";
+  PathGeometry path;
+  path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
+  path.length = 2;
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    out->push_back(&ball);
+    out->push_back(&pebble);
+  };
+  ContactOptions options;
+  options.margin = 0.001;
+  options.max_depth = 5;
+  EXPECT_GT(WrapAroundBodies(&path, query, options), 0);
+  bool on_pebble = false;
+  for (const auto& p : path.points) on_pebble |= p.contact && p.body == 2;
+  EXPECT_TRUE(on_pebble) << "no detour point on the pebble";
+  for (size_t i = 0; i + 1 < path.points.size(); ++i)
+    EXPECT_FALSE(SegmentInside(pebble, path.points[i].position, path.points[i + 1].position, -1e-3))
+        << "segment " << i << " cuts through the pebble";
+}
+
+TEST(WrapAroundBodies, GivesTheSameWithReusedBuffers) {
+  // one scratch for several paths in turn, as an engine uses it, against fresh buffers each time
+  const sgal::Geometry sphere = sgal::Sphere{0.2};
+  const sgal::Geometry capsule = sgal::Capsule{0.05, 0.3};
+  const WorldShape ball = At(sphere, Vector3d(0, 0, -0.05), 1);
+  WorldShape rod = At(capsule, Vector3d(0.5, 0.02, 0), 2);
+  rod.pose.linear() = Eigen::AngleAxisd(0.3, Vector3d::UnitY()).toRotationMatrix();
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    out->push_back(&ball);
+    out->push_back(&rod);
+  };
+  ContactScratch scratch;
+  for (int k = 0; k < 4; ++k) {
+    PathGeometry path;
+    path.points = {{Vector3d(-1, 0.01 * k, 0), -1},
+                   {Vector3d(0.2, 0.1, 0.02 * k), -1},
+                   {Vector3d(1, -0.01 * k, 0), -1}};
+    path.length = (path.points[1].position - path.points[0].position).norm() +
+                  (path.points[2].position - path.points[1].position).norm();
+    PathGeometry fresh = path;
+    const int with_scratch = WrapAroundBodies(&path, query, {}, &scratch);
+    EXPECT_EQ(with_scratch, WrapAroundBodies(&fresh, query, {}));
+    EXPECT_GT(with_scratch, 0) << "path " << k << " should press on a body";
+    ASSERT_EQ(path.points.size(), fresh.points.size());
+    for (size_t i = 0; i < path.points.size(); ++i) {
+      EXPECT_EQ(path.points[i].position, fresh.points[i].position);
+      EXPECT_EQ(path.points[i].body, fresh.points[i].body);
+    }
+    EXPECT_EQ(path.length, fresh.length);
+  }
+}
+
 sgal::Scene StringOverBall(bool dynamic_ball) {
   sgal::Scene s;
   s.gravity = Vector3d::Zero();
@@ -151,6 +212,22 @@ TEST(TendonContact, StringPressesOnABallItWouldCutThrough) {
   const Vector3d v = scene->BodyStates()[0].linear_velocity;
   EXPECT_NEAR(-v.z() / dt, expected_force / 1.0, 0.03 * expected_force);
   EXPECT_NEAR(v.x(), 0, 1e-9);
+}
+
+TEST(TendonContact, FindsABodyARestoreMovedOntoTheString) {
+  // the ball starts 5 m away; a restore by body poses puts it under the string: the path is
+  // evaluated at once against where the ball is now
+  testing::RegisterTestKinds();
+  sgal::Scene description = StringOverBall(true);
+  description.bodies[0].pose.position = Vector3d(0, 0, -5);
+  auto scene = physics_bullet::MakeScene(description);
+  ASSERT_EQ(scene->TendonStates()[0].contacts, 0);
+  sgal::DynamicState state = scene->SaveDynamicState();
+  state.engine.clear();  // go by the body poses
+  state.bodies[0].pose.position = Vector3d(0, 0, -0.05);
+  scene->RestoreDynamicState(state);
+  EXPECT_GT(scene->TendonStates()[0].contacts, 0);
+  EXPECT_GT(scene->TendonStates()[0].length, 2.0);
 }
 
 TEST(TendonContact, CanBeSwitchedOffToPassStraightThrough) {
