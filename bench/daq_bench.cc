@@ -2,8 +2,9 @@
 // Model does for a subscription sampled every step. Three cases:
 //   synthetic  1,000 scalar channels reading doubles from memory (the registry's own overhead);
 //   bodies     a Bullet scene of 200 free balls, 5 body channels each (position, orientation,
-//              rotation, linear and angular velocity: 1,000 ids, 4,400 doubles) through the
-//              per-step SceneSampler cache;
+//              rotation, linear and angular velocity: 1,000 ids, 4,400 doubles) read in place
+//              from the per-step SceneSampler cache (the recorder copies neighbouring ids in
+//              one go);
 //   chain      a Bullet chain of 100 hinged links: all 502 scene parameters (each read through
 //              PhysicsScene::GetParameter(id)) plus 498 body channels;
 // plus the recorder's OnStep for a 1,000-id subscription on the bodies scene (sampling + batch
