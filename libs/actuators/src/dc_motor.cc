@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace caliper::actuators {
 
@@ -27,6 +28,14 @@ constexpr double kSpeedTolerance = 1e-12;
 constexpr double kNewtonTolerance = 1.5e-12;
 constexpr double kRoundingStep = 1e-3;
 constexpr int kNewtonIterations = 50;
+// A sub-step longer than kFineSubstep [s] is checked: where the difference between its result and
+// the first-order one from its first stage's slope exceeds kSubstepTolerance [rad/s] (the current's
+// difference counted as the speed it would give over one electrical time constant) it is redone
+// as sub-steps of at most kFineSubstep. That happens just after a jump in the voltage or the load
+// (the electrical transient, ~0.1 ms, and the start of the mechanical one); elsewhere the motion
+// is smooth and long sub-steps are as accurate.
+constexpr double kFineSubstep = 3.4e-4;
+constexpr double kSubstepTolerance = 1e-3;
 // beyond |1000 i w + 10| > 40 the switch is exactly 0 or 1 in rho (tanh is +-1 to the last bit
 // from |500 i w + 5| > 19.1): no exp needed
 constexpr double kSwitchSaturation = 40;
@@ -198,12 +207,20 @@ void DcMotor::set_locked(bool locked) {
 }
 
 void DcMotor::UpdateConstants(double dt) {
+  constants_ = ConstantsFor(dt, parameters_.max_substep);
+  // the refined sub-steps, never more than kMaxSubstepsPerStep in one step
+  const double fine = std::max(kFineSubstep, dt / kMaxSubstepsPerStep);
+  refine_ = constants_.h > fine;
+  if (refine_) fine_ = ConstantsFor(constants_.h, fine);
+}
+
+DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) const {
   const DcMotorParameters& p = parameters_;
-  StageConstants& k = constants_;
+  StageConstants k;
   const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
   const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
   k.dt = dt;
-  k.substeps = static_cast<int>(Substeps(dt, p.max_substep));  // checked by Step()
+  k.substeps = static_cast<int>(Substeps(dt, max_substep));  // checked by Step()
   k.h = dt / k.substeps;
   k.c = kGamma * k.h;
   k.inverse_c = 1 / k.c;
@@ -220,6 +237,8 @@ void DcMotor::UpdateConstants(double dt) {
   k.inverse_rho_driving = 1 / p.efficiency;
   k.inverse_rho_driven = 1 / (p.efficiency + k.spread);
   k.tolerance = kNewtonTolerance / emf;  // of the no-load speed at 1 V [rad/s]
+  k.current_to_speed = p.torque_constant * p.inductance / (p.gear_ratio * inertia() * resistance);
+  return k;
 }
 
 double DcMotor::Exp(double x) const {
@@ -472,7 +491,7 @@ double DcMotor::SolveStageBracketing(const DcMotorState& a, double voltage, doub
   return FindRoot(residual, a.spool_speed, kSpeedTolerance);
 }
 
-void DcMotor::Substep(double voltage, SpoolLoad& load, bool last) {
+bool DcMotor::Substep(double voltage, SpoolLoad& load, bool last, bool check) {
   const double h = constants_.h;
   const double c = constants_.c;
   const DcMotorState y = state_;
@@ -491,6 +510,15 @@ void DcMotor::Substep(double voltage, SpoolLoad& load, bool last) {
   const double slope1 = (w1 - y.spool_speed) * constants_.inverse_c;
   const double w2 = locked_ ? 0.0 : SolveStage(a, voltage, h, y.spool_speed + h * slope1, load);
   const Stage second = StageAt(a, voltage, w2);
+  if (check) {
+    // against the first-order result y + h f(Y1); nothing is changed yet when it is refused
+    const double speed_error = w2 - (y.spool_speed + h * slope1);
+    const double current_error =
+        second.current - (y.current + h * (first.current - y.current) * constants_.inverse_c);
+    if (std::abs(speed_error) > kSubstepTolerance ||
+        std::abs(current_error) * constants_.current_to_speed > kSubstepTolerance)
+      return false;
+  }
   last_acceleration_ = (w2 - a.spool_speed) * constants_.inverse_c;
   state_.current = second.current;
   state_.spool_speed = second.spool_speed;
@@ -498,6 +526,7 @@ void DcMotor::Substep(double voltage, SpoolLoad& load, bool last) {
   applied_voltage_ = second.voltage;
   if (last) load_torque_ = load.TorqueAt(second.spool_angle, w2, h);
   load.Advance(state_.spool_angle, state_.spool_speed, h);
+  return true;
 }
 
 void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
@@ -515,7 +544,15 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
   }
   load_sign_ = load.TorqueSign();
   const int n = constants_.substeps;
-  for (int i = 0; i < n; ++i) Substep(voltage, load, i + 1 == n);
+  for (int i = 0; i < n; ++i) {
+    const bool last = i + 1 == n;
+    if (Substep(voltage, load, last, refine_)) continue;
+    // redone in shorter sub-steps (the stages' constants swapped in for them)
+    std::swap(constants_, fine_);
+    const int m = constants_.substeps;
+    for (int j = 0; j < m; ++j) Substep(voltage, load, last && j + 1 == m, false);
+    std::swap(constants_, fine_);
+  }
 }
 
 void DcMotor::Step(double voltage, double dt, double load_torque) {
