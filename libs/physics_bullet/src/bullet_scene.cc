@@ -260,6 +260,13 @@ class BulletScene : public sgal::PhysicsScene {
   double detour_reach_ = 0.1;  // twice the largest finite shape bounding radius [m]
   // tendon-body contact's buffers, reused by every tendon and step (no allocation per step)
   actuators::ContactScratch contact_scratch_;
+  // every shape's bounding ball at this step's poses, packed for QueryShapes' scan
+  struct ContactBall {
+    double x, y, z;  // centre [m]
+    double radius;   // [m], infinite for planes
+    const actuators::WorldShape* shape;
+  };
+  std::vector<ContactBall> contact_balls_;
   void QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
                    std::vector<const actuators::WorldShape*>* out);
   std::vector<ParameterEntry> parameters_;
@@ -594,6 +601,12 @@ void BulletScene::RefreshWorldShapes() {
     for (size_t s = 0; s < b.desc->shapes.size(); ++s)
       b.world_shapes[s].pose = pose * b.shape_poses[s];
   }
+  contact_balls_.clear();
+  for (const BodyData& b : bodies_)
+    for (const auto& shape : b.world_shapes) {
+      const Vector3d c = shape.pose.translation();
+      contact_balls_.push_back({c.x(), c.y(), c.z(), shape.bounding_radius, &shape});
+    }
 }
 
 // Every shape whose bounding ball comes within `pad` of the box around a-b, in body order. A scan
@@ -604,14 +617,12 @@ void BulletScene::QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
                               std::vector<const actuators::WorldShape*>* out) {
   const Vector3d lo = a.cwiseMin(b) - Vector3d::Constant(pad);
   const Vector3d hi = a.cwiseMax(b) + Vector3d::Constant(pad);
-  for (const BodyData& body : bodies_)
-    for (const auto& shape : body.world_shapes) {
-      const auto c = shape.pose.translation();
-      const double r = shape.bounding_radius;  // infinite for planes: always taken
-      if (c.x() >= lo.x() - r && c.x() <= hi.x() + r && c.y() >= lo.y() - r &&
-          c.y() <= hi.y() + r && c.z() >= lo.z() - r && c.z() <= hi.z() + r)
-        out->push_back(&shape);
-    }
+  for (const ContactBall& c : contact_balls_) {
+    const double r = c.radius;  // infinite for planes: always taken
+    if (c.x >= lo.x() - r && c.x <= hi.x() + r && c.y >= lo.y() - r && c.y <= hi.y() + r &&
+        c.z >= lo.z() - r && c.z <= hi.z() + r)
+      out->push_back(c.shape);
+  }
 }
 
 void BulletScene::EvaluateTendons() {
