@@ -231,13 +231,14 @@ TEST(DcMotor, GearEfficiencyFactorIsTheTanhBlendOfTendonsMd) {
 }
 
 TEST(DcMotor, TheDefaultSubstepsMatchTheFineReferenceCloselyAndShorterOnesCloser) {
-  // the fine-reference comparison of the test above, for the default sub-steps (1/3 ms) and for
-  // the earlier default 0.1 ms: errors reached 1.4e-4 and 1.3e-5 rad/s
+  // the fine-reference comparison of the test above, for the default sub-steps (1 ms, refined
+  // to 1/3 ms after jumps), the earlier defaults 1/3 ms and 0.1 ms: errors reached 1.4e-4,
+  // 1.4e-4 and 1.3e-5 rad/s
   DcMotor fine(Reference());
   const std::vector<double> w_fine = CaliperEraSpeeds(1e-5, fine);
   DcMotorParameters p = Reference();
-  EXPECT_EQ(p.max_substep, 3.4e-4);
-  for (double max_substep : {3.4e-4, 1e-4}) {
+  EXPECT_EQ(p.max_substep, 1e-3);
+  for (double max_substep : {1e-3, 3.4e-4, 1e-4}) {
     p.max_substep = max_substep;
     DcMotor coarse(p);
     const std::vector<double> w_coarse = CaliperEraSpeeds(1e-3, coarse);

@@ -26,8 +26,9 @@ struct DcMotorParameters {
   double bridge_resistance = 0;        // R_bridge: H-bridge resistance in series [ohm]
   double current_limit = 0;            // |i| the driver allows [A]; 0: no limit
   double spool_radius = 0.0045;        // r_s [m]
-  double max_substep = 3.4e-4;         // longest internal integration step [s] (see DcMotor);
-                                       // a step takes at most kMaxSubstepsPerStep of them
+  double max_substep = 1e-3;           // longest internal integration step [s] (see DcMotor:
+                                       // refined to 1/3 ms after jumps); a step takes at most
+                                       // kMaxSubstepsPerStep of them
 
   /// Throws std::invalid_argument naming the first parameter out of range (non-finite values,
   /// non-positive R, L, k_t, k_e, rotor inertia, N, r_s, max_substep, an efficiency outside
@@ -106,14 +107,13 @@ class ConstantSpoolLoad : public SpoolLoad {
 /// redone as sub-steps of at most 1/3 ms (and at least dt / kMaxSubstepsPerStep). That happens
 /// just after a jump in the voltage or the load; elsewhere the motion is smooth and long
 /// sub-steps are as accurate.
-/// The default max_substep, 1/3 ms (3 sub-steps per 1 ms step), keeps the speed within 1.4e-4
-/// rad/s of a 10 us reference at the sampled times of the CALIPER-era scenario (1.3e-5 with
-/// 0.1 ms sub-steps, at about 3.5 times the cost); up to about 1/3 ms (three electrical time
-/// constants) the current follows voltage steps to a few mA. max_substep = 1 ms gives the same
-/// 1.4e-4 rad/s there (0.7 % of its steps refined; 2.4e-3 rad/s without the check) in one
-/// sub-step per smooth step. The cost is that of the stages, each one Newton step on a serial
-/// chain of dependent operations (about 25 ns here): per 1 ms step about 230 ns with 1/3 ms
-/// sub-steps, 90 ns with 1 ms ones.
+/// The default max_substep, 1 ms (one sub-step per smooth 1 ms step), keeps the speed within
+/// 1.4e-4 rad/s of a 10 us reference at the sampled times of the CALIPER-era scenario (0.7 % of
+/// its steps refined; 2.4e-3 rad/s without the check), as 1/3 ms sub-steps throughout do (1.3e-5
+/// with 0.1 ms ones, at about 3.5 times their cost); up to about 1/3 ms (three electrical time
+/// constants) the current follows voltage steps to a few mA. The cost is that of the stages,
+/// each one Newton step on a serial chain of dependent operations (about 25 ns here): per 1 ms
+/// step about 90 ns with the default, 230 ns with 1/3 ms sub-steps throughout.
 /// A load that depends on time (the dc_motor_tendon kind's: its path moves through the step) is
 /// evaluated at each stage's own time, h after the last accepted sub-step, so that the whole
 /// stays second order in the step.
