@@ -104,9 +104,10 @@ class ConstantSpoolLoad : public SpoolLoad {
 /// A sub-step longer than 1/3 ms is checked against the first-order result from its first
 /// stage's slope: where they differ by more than 1e-3 rad/s (the current's difference counted as
 /// the speed it would give over one electrical time constant, k_t L / (N J R) per ampere) it is
-/// redone as sub-steps of at most 1/3 ms (and at least dt / kMaxSubstepsPerStep). That happens
-/// just after a jump in the voltage or the load; elsewhere the motion is smooth and long
-/// sub-steps are as accurate.
+/// redone as sub-steps of at most 1/3 ms (and at least dt / kMaxSubstepsPerStep, so that a step
+/// never costs more than twice kMaxSubstepsPerStep sub-steps). That happens just after a jump in
+/// the voltage or the load; elsewhere the motion is smooth and long sub-steps are as accurate.
+/// The load sees only accepted sub-steps (Advance()), so a refused one leaves no trace.
 /// The default max_substep, 1 ms (one sub-step per smooth 1 ms step), keeps the speed within
 /// 1.4e-4 rad/s of a 10 us reference at the sampled times of the CALIPER-era scenario (0.7 % of
 /// its steps refined; 2.4e-3 rad/s without the check), as 1/3 ms sub-steps throughout do (1.3e-5
