@@ -14,7 +14,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Intersects [lo, hi] with the slab lo_s <= p + t d <= hi_s along one axis.
 bool Slab(double p, double d, double lo_s, double hi_s, double* lo, double* hi) {
   if (std::abs(d) < 1e-15) return p >= lo_s && p <= hi_s;
-  double t0 = (lo_s - p) / d, t1 = (hi_s - p) / d;
+  const double inverse = 1 / d;  // one division, not two
+  double t0 = (lo_s - p) * inverse, t1 = (hi_s - p) * inverse;
   if (t0 > t1) std::swap(t0, t1);
   *lo = std::max(*lo, t0);
   *hi = std::min(*hi, t1);
@@ -35,10 +36,12 @@ Interval SphereInterval(const Eigen::Vector3d& c, double r, const Eigen::Vector3
   const Eigen::Vector3d m = p - c;
   const double A = d.squaredNorm(), B = m.dot(d), C = m.squaredNorm() - r * r;
   if (A < 1e-30) return C <= 0 ? Interval(std::make_pair(0.0, 1.0)) : std::nullopt;
+  // the reciprocal is taken while the root is: the roots wait for a product, not a division
+  const double inverse = 1 / A;
   const double disc = B * B - A * C;
   if (disc <= 0) return std::nullopt;
   const double s = std::sqrt(disc);
-  const double lo = std::max(0.0, (-B - s) / A), hi = std::min(1.0, (-B + s) / A);
+  const double lo = std::max(0.0, (-B - s) * inverse), hi = std::min(1.0, (-B + s) * inverse);
   if (lo > hi) return std::nullopt;
   return std::make_pair(lo, hi);
 }
@@ -54,11 +57,12 @@ Interval CylinderInterval(double r, double half_length, const Eigen::Vector3d& p
   if (A < 1e-30) {
     if (C > 0) return std::nullopt;
   } else {
+    const double inverse = 1 / A;
     const double disc = B * B - A * C;
     if (disc <= 0) return std::nullopt;
     const double s = std::sqrt(disc);
-    lo = std::max(lo, (-B - s) / A);
-    hi = std::min(hi, (-B + s) / A);
+    lo = std::max(lo, (-B - s) * inverse);
+    hi = std::min(hi, (-B + s) * inverse);
   }
   if (lo > hi) return std::nullopt;
   return std::make_pair(lo, hi);
