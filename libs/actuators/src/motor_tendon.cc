@@ -182,9 +182,10 @@ class DcMotorTendon : public TendonActuator {
     if (line_length_ < 0) WarnNegativeLine();
   }
 
-  double Step(double path_length, double path_speed, double dt) override {
+  double Step(double path_length, double path_speed, double dt, double end_speed) override {
     RequireFinite(prefix_, "path length", path_length);
     RequireFinite(prefix_, "path speed", path_speed);
+    RequireFinite(prefix_, "path speed at the end", end_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     const double angle = motor_.state().spool_angle;
@@ -196,7 +197,14 @@ class DcMotorTendon : public TendonActuator {
     path_speed_ = path_speed;
     line_length_ = load.LineLength(motor_.state().spool_angle);
     elastic_length_ = path_length_ - line_length_;
-    tension_ = load.force();
+    // the linear element's damper reads the path's speed at the end, where the tension acts
+    // from (its stateless force, evaluated again); an element with states of its own integrated
+    // them along the mean speed and has no such direct term
+    tension_ = linear_ ? linear_->LinearSpringDamper::Peek(
+                             elastic_length_,
+                             end_speed + motor_.parameters().spool_radius * motor_.state().spool_speed,
+                             dt)
+                       : load.force();
     return tension_;
   }
 
@@ -406,15 +414,17 @@ class Ligament : public TendonActuator {
     tension_ = spring_->Peek(length_, 0, 0);
   }
 
-  double Step(double path_length, double path_speed, double dt) override {
+  double Step(double path_length, double path_speed, double dt, double end_speed) override {
     RequireFinite(prefix_, "path length", path_length);
     RequireFinite(prefix_, "path speed", path_speed);
+    RequireFinite(prefix_, "path speed at the end", end_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
-    // the tension at the end of the step, where the path has moved to (the actuator contract)
+    // the tension at the end of the step, where the path has moved to and moves at end_speed
+    // (the actuator contract; the spring-damper is stateless)
     length_ = path_length + path_speed * dt;
-    speed_ = path_speed;
-    tension_ = spring_->Force(length_, path_speed, dt);
+    speed_ = end_speed;
+    tension_ = spring_->Force(length_, end_speed, dt);
     return tension_;
   }
 

@@ -593,9 +593,10 @@ class HillMuscle : public TendonActuator {
     Evaluate(path_length, 0);
   }
 
-  double Step(double path_length, double path_speed, double dt) override {
+  double Step(double path_length, double path_speed, double dt, double end_speed) override {
     CheckFinite("path length", path_length);
     CheckFinite("path speed", path_speed);
+    CheckFinite("path speed at the end", end_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
     if (mujoco_integrator_) {
@@ -624,7 +625,8 @@ class HillMuscle : public TendonActuator {
             FiberStep(fiber_length_, l0, l0 + path_speed * h, a0, activation_, h, &velocity);
       }
     }
-    Evaluate(path_length + path_speed * dt, path_speed);
+    // a rigid tendon's force-velocity reads the path's speed at the end, where the tension acts
+    Evaluate(path_length + path_speed * dt, end_speed);
     return out_.tension;
   }
 

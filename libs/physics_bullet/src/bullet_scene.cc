@@ -86,14 +86,20 @@ struct TendonData {
   std::vector<actuators::WorldElement> world;  // reused every step
   actuators::TendonPath path;
   actuators::PathGeometry geometry;
+  // at the start of the last step [m]; -1 after a build or an edit, when no step has measured
+  // the path's speed yet (kept so in an exact state, so that a replay knows it too)
   double previous_length = -1;
+  // the last step's mean lengthening speed [m/s] (geometry.speed until the path is evaluated
+  // again), when previous_length says it was measured
+  double mean_speed = 0;
+  bool speed_known = false;
   double tension = 0;
   int contacts = 0;
   std::vector<int> actuators;
   bool has_wraps = false;  // the path keeps a side per wrap from step to step
   // the state at the start of the step, put back when the step fails
   actuators::TendonPath saved_path;       // only when has_wraps
-  actuators::PathGeometry saved_geometry;  // swapped, not copied
+  actuators::PathGeometry saved_geometry;  // copied into kept capacity
   double saved_previous_length = -1;
   double saved_tension = 0;
   int saved_contacts = 0;
@@ -572,7 +578,7 @@ void BulletScene::BuildTendons() {
   for (auto& a : actuators_) a.model->Reset(tendons_[a.tendon].geometry.length);
   // the tensions at rest act through the first step
   for (auto& t : tendons_) {
-    t.previous_length = t.geometry.length;
+    t.previous_length = -1;
     t.geometry.speed = 0;
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
@@ -967,19 +973,28 @@ void BulletScene::Step() {
     CheckState();
     CacheBodyPoses();
     UpdateJoints();
-    for (auto& t : tendons_) t.previous_length = t.geometry.length;
+    for (auto& t : tendons_) {
+      t.speed_known = t.previous_length >= 0;
+      t.previous_length = t.geometry.length;
+      t.mean_speed = t.geometry.speed;
+    }
     RefreshWorldShapes();
     EvaluateTendons();
     for (size_t ti = 0; ti < tendons_.size(); ++ti) {
       TendonData& t = tendons_[ti];
       // the mean lengthening speed over the step: the path's motion the actuators integrate
-      // along (length at the start + speed * dt is exactly the length at the end)
+      // along (length at the start + speed * dt is exactly the length at the end); the speed at
+      // the end, for what reads it directly (dampers, force-velocity), from the last two means
+      // to second order (the mean lags it by half a step)
       t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
+      const double end_speed = t.speed_known
+                                   ? t.geometry.speed + 0.5 * (t.geometry.speed - t.mean_speed)
+                                   : t.geometry.speed;
       t.tension = 0;
       for (int index : t.actuators) {
         stage_ = {StepStage::kActuator, index};
         ActuatorData& a = actuators_[index];
-        const double f = a.model->Step(t.previous_length, t.geometry.speed, dt_);
+        const double f = a.model->Step(t.previous_length, t.geometry.speed, dt_, end_speed);
         if (!std::isfinite(f))
           throw StepFault(Describe(stage_) + ": tension is not finite (" + std::to_string(f) +
                               ") at t = " + std::to_string(time_ + dt_) +
@@ -1202,8 +1217,8 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   // exact state gives it, else none (no jump from the length before an edit)
   for (size_t ti = 0; ti < tendons_.size(); ++ti) {
     TendonData& t = tendons_[ti];
-    t.previous_length = previous[ti] >= 0 ? previous[ti] : t.geometry.length;
-    t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
+    t.previous_length = previous[ti];
+    t.geometry.speed = previous[ti] >= 0 ? (t.geometry.length - t.previous_length) / dt_ : 0;
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
   }

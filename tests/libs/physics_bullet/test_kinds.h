@@ -21,7 +21,7 @@ class ConstantTension : public actuators::TendonActuator {
       : tension_(actuators::ParameterOr(a, "tension", 0)),
         nan_after_(static_cast<int>(actuators::ParameterOr(a, "nan_after", 0))) {}
   void Reset(double) override { steps_ = 0; }
-  double Step(double length, double, double) override {
+  double Step(double length, double, double, double) override {
     last_length_ = length;
     ++steps_;
     if (nan_after_ > 0 && steps_ > nan_after_) return std::numeric_limits<double>::quiet_NaN();
@@ -59,8 +59,8 @@ class FaultyMotor : public actuators::TendonActuator {
     motor_ = actuators::Make(motor);
   }
   void Reset(double length) override { motor_->Reset(length); }
-  double Step(double length, double speed, double dt) override {
-    const double tension = motor_->Step(length, speed, dt);  // the motor has moved on
+  double Step(double length, double speed, double dt, double end_speed) override {
+    const double tension = motor_->Step(length, speed, dt, end_speed);  // the motor has moved on
     switch (static_cast<int>(fail_)) {
       case 1:
         throw std::runtime_error("injected fault");

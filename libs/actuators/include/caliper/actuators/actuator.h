@@ -46,14 +46,21 @@ class TendonActuator {
 
   /// Advances the internal state by dt [s] while the path moves: it is path_length [m] at the
   /// start of the step and lengthens at path_speed [m/s] through it (path_length + path_speed dt
-  /// at the end). Returns the tension [N] (>= 0) at the END of the step.
+  /// at the end). Returns the tension [N] (>= 0) at the END of the step, where the path's
+  /// lengthening speed is end_speed [m/s].
   ///
   /// The engine couples actuators and bodies in Stormer-Verlet order, second order in dt: the
   /// bodies advance over a step on the tension at its start (the last Step's result), then each
   /// actuator advances over the same step on the path the bodies took. So that the whole stays
   /// second order, a kind integrates its states at least to second order with the path length at
-  /// each stage's own time, not held at its start value.
-  virtual double Step(double path_length, double path_speed, double dt) = 0;
+  /// each stage's own time, not held at its start value; and a kind whose tension depends on the
+  /// path's speed directly (a damper in series, a rigid tendon's force-velocity curve) takes
+  /// end_speed for the tension it returns (path_speed, the mean, lags it by half a step).
+  virtual double Step(double path_length, double path_speed, double dt, double end_speed) = 0;
+  /// Step() on a path moving steadily: its speed at the end is its mean speed.
+  double Step(double path_length, double path_speed, double dt) {
+    return Step(path_length, path_speed, dt, path_speed);
+  }
 
   /// The tension of the last Step [N].
   virtual double tension() const = 0;
