@@ -298,12 +298,15 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
     candidates.clear();
     const Eigen::Vector3d ab = b.position - a.position;
     const double l2 = ab.squaredNorm();
+    // the distances only choose which shapes are tested (with slack): a product will do for the
+    // division
+    const double inverse_l2 = l2 > 0 ? 1 / l2 : 0.0;
     for (const WorldShape* shape : shapes) {
       const double radius = shape->bounding_radius >= 0 ? shape->bounding_radius
                                                         : sgal::BoundingRadius(*shape->geometry);
       const double reach = radius + options.margin;
       const Eigen::Vector3d centre = shape->pose.translation();
-      const double t = l2 > 0 ? std::clamp((centre - a.position).dot(ab) / l2, 0.0, 1.0) : 0.0;
+      const double t = std::clamp((centre - a.position).dot(ab) * inverse_l2, 0.0, 1.0);
       const double distance2 = (a.position + t * ab - centre).squaredNorm();
       candidates.push_back({centre, reach * reach, reach, distance2, shape->body, shape});
     }
