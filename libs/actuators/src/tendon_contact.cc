@@ -91,6 +91,20 @@ Eigen::Vector3d MeshHalfExtents(const sgal::Mesh* mesh, Eigen::Vector3d* center)
 
 }  // namespace
 
+void PrepareShape(WorldShape* shape) {
+  shape->bounding_radius = sgal::BoundingRadius(*shape->geometry);
+  shape->mesh_box.reset();
+  const sgal::Mesh* mesh = nullptr;
+  if (const auto* hull = std::get_if<sgal::ConvexHull>(shape->geometry)) mesh = hull->mesh.get();
+  if (const auto* tri = std::get_if<sgal::TriangleMesh>(shape->geometry)) mesh = tri->mesh.get();
+  if (std::holds_alternative<sgal::ConvexHull>(*shape->geometry) ||
+      std::holds_alternative<sgal::TriangleMesh>(*shape->geometry)) {
+    Eigen::Vector3d center;
+    const Eigen::Vector3d half = MeshHalfExtents(mesh, &center);
+    shape->mesh_box = std::make_pair(center, half);
+  }
+}
+
 Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                        double margin) {
   // into the shape's frame by the transposed rotation: no inverse, no 4x4 products
@@ -125,7 +139,9 @@ Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const 
           return da < 0 ? std::make_pair(0.0, t) : std::make_pair(t, 1.0);
         } else {
           Eigen::Vector3d center;
-          const Eigen::Vector3d half = MeshHalfExtents(g.mesh.get(), &center);
+          const Eigen::Vector3d half =
+              shape.mesh_box ? shape.mesh_box->second : MeshHalfExtents(g.mesh.get(), &center);
+          if (shape.mesh_box) center = shape.mesh_box->first;
           if (half.isZero()) return std::nullopt;
           return BoxInterval(half + Eigen::Vector3d::Constant(margin), p - center, d);
         }

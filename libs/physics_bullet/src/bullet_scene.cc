@@ -596,11 +596,11 @@ void BulletScene::RefreshWorldShapes() {
       for (const auto& shape : b.desc->shapes) b.shape_poses.push_back(shape.pose.ToIsometry());
     }
     if (b.world_shapes.size() != b.desc->shapes.size()) {
-      // what does not move with the body, once: the geometry and its bounding radius
+      // what does not move with the body, once: the geometry, its bounding radius and box
       b.world_shapes.resize(b.desc->shapes.size());
       for (size_t s = 0; s < b.desc->shapes.size(); ++s) {
         b.world_shapes[s].geometry = &b.desc->shapes[s].geometry;
-        b.world_shapes[s].bounding_radius = sgal::BoundingRadius(b.desc->shapes[s].geometry);
+        actuators::PrepareShape(&b.world_shapes[s]);
         b.world_shapes[s].body = static_cast<int>(i);
       }
     }

@@ -45,6 +45,35 @@ TEST(SegmentInside, FindsTheChordThroughEachPrimitive) {
   EXPECT_FALSE(SegmentInside(At(sphere, Vector3d(0, 0.6, 0)), a, b, 0));
 }
 
+TEST(SegmentInside, TakesAPreparedMeshByTheSameBox) {
+  // an off-centre tetrahedron: its box is centred at (0.15, 0, 0.05), half extents (0.15, 0.1,
+  // 0.05)
+  auto mesh = std::make_shared<sgal::Mesh>();
+  mesh->vertices = {{0, -0.1f, 0}, {0.3f, 0, 0}, {0, 0.1f, 0}, {0.1f, 0, 0.1f}};
+  mesh->triangles = {{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {0, 2, 3}};
+  const sgal::Geometry hull = sgal::ConvexHull{mesh};
+  WorldShape raw = At(hull, Vector3d(0.2, -0.1, 0.3));
+  raw.pose.linear() = Eigen::AngleAxisd(0.4, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  WorldShape prepared = raw;
+  PrepareShape(&prepared);
+  ASSERT_TRUE(prepared.mesh_box);
+  EXPECT_TRUE(prepared.mesh_box->first.isApprox(Vector3d(0.15, 0, 0.05), 1e-6));
+  EXPECT_TRUE(prepared.mesh_box->second.isApprox(Vector3d(0.15, 0.1, 0.05), 1e-6));
+  EXPECT_NEAR(prepared.bounding_radius, 0.3, 1e-6);
+  int crossings = 0;
+  for (int k = 0; k < 20; ++k) {
+    const Vector3d a(-1, -0.1 + 0.01 * k, 0.3 + 0.005 * k), b(1, -0.1, 0.35 - 0.004 * k);
+    const auto expected = SegmentInside(raw, a, b, 0.002);
+    const auto got = SegmentInside(prepared, a, b, 0.002);
+    ASSERT_EQ(expected.has_value(), got.has_value()) << "segment " << k;
+    if (!got) continue;
+    ++crossings;
+    EXPECT_EQ(got->first, expected->first) << "segment " << k;
+    EXPECT_EQ(got->second, expected->second) << "segment " << k;
+  }
+  EXPECT_GT(crossings, 5) << "most of the segments should pass through the hull's box";
+}
+
 TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
   const double r = 0.2, d = 1.0;
   const sgal::Geometry sphere = sgal::Sphere{r};

@@ -2,7 +2,8 @@
 // Tendons that never pass through the skeleton: where a path segment would cut through a body
 // that is not one of its declared wrap obstacles, the path is bent around the body's surface, as a
 // taut string would be. Stateless and engine-free: an engine supplies the shapes near a segment
-// (from its broadphase), this computes the detour points. SI units.
+// (by a scan of the shapes' bounding balls or a broadphase), this computes the detour points. SI
+// units.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -21,9 +22,16 @@ struct WorldShape {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   int body = -1;
   /// sgal::BoundingRadius of the geometry about the pose's origin [m], infinite for planes; an
-  /// engine sets it once per shape. Negative: not known, computed at each use (slower).
+  /// engine sets it once per shape (PrepareShape). Negative: not known, computed at each use.
   double bounding_radius = -1;
+  /// Convex hulls and meshes: their local bounding box as (centre, half extents) [m], set once
+  /// by PrepareShape; without it each test reads every vertex again.
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> mesh_box;
 };
+
+/// Sets what does not change as the shape moves (bounding radius, a mesh's box), once per shape
+/// after its geometry is set.
+void PrepareShape(WorldShape* shape);
 
 /// The part of the segment a + t (b - a), t in [0, 1], inside the shape grown by `margin`, or
 /// nothing. Exact for box, sphere, capsule, cylinder, cone (as its bounding cylinder) and plane;
