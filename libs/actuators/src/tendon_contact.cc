@@ -240,6 +240,8 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   const ContactOptions& options = *bend->options;
   const Eigen::Vector3d ab = b.position - a.position;
   const double len = ab.norm();
+  // taken now, while the crossing is searched for: the detour direction then waits on a product
+  const double inverse_len = 1 / len;
   // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
   const Crossing c =
       FirstCrossing(a.position, b.position, ab, len, *bend->near, a.contact ? -2 : a.body,
@@ -248,7 +250,7 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   const WorldShape& shape = *c.shape;
   if (len < 1e-12) return;
   const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
-  const Eigen::Vector3d u = ab / len;
+  const Eigen::Vector3d u = ab * inverse_len;
   Eigen::Vector3d away;
   if (const auto* plane = std::get_if<sgal::Plane>(shape.geometry)) {
     // out of a half-space along its normal
