@@ -85,6 +85,28 @@ double TimeMuJoCo(const TreeOptions& tree) {
   return us;
 }
 
+/// The like-for-like case of the raw baseline: ligaments with its springs' law (2000 N/m, 5 N s/m,
+/// slack at 98 % of the starting length, so that every one pulls), no tendon-body contact; the
+/// same forces give the same motion and the same contacts.
+double TimePassive(const TreeOptions& tree) {
+  TreeOptions springs = tree;
+  springs.actuator_kind = "ligament";
+  std::unique_ptr<sgal::PhysicsScene> plain;
+  sgal::Scene description = MakeTree(springs);
+  for (auto& a : description.actuators) a.parameters["stiffness"] = 2000;
+  const auto start = physics_bullet::MakeScene(description)->TendonStates();
+  for (auto& a : description.actuators)
+    for (size_t t = 0; t < description.tendons.size(); ++t)
+      if (description.tendons[t].name == a.tendon) {
+        a.parameters["damping"] = 5;
+        a.parameters["rest_length"] = 0.98 * start[t].length;
+      }
+  physics_bullet::Options no_contact;
+  no_contact.tendon_body_contact = false;
+  return Time([&] { plain = physics_bullet::MakeScene(description, no_contact); },
+              [&] { plain->Step(); });
+}
+
 void Ratio(const char* name, double value, double target) {
   std::printf("RATIO %s %.3f (target %.2f)%s\n", name, value, target,
               value <= target ? "" : "  <- above target");
@@ -101,8 +123,17 @@ bool TimeOnly(const std::string& name) {
   }
   if (name == "spanning_on" || name == "spanning_off") o.spanning_tendons = true;
   if (name == "spanning_off") contact = false;
+  if (name == "tree_bare") o.tendons = 0;
+  if (name == "passive") {
+    std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimePassive(o));
+    return true;
+  }
+  if (name == "raw_bullet") {
+    std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimeRawBullet(o));
+    return true;
+  }
   if (name != "tree_contact" && name != "tree_free" && name != "spanning_on" &&
-      name != "spanning_off")
+      name != "spanning_off" && name != "tree_bare")
     return false;
   std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimeCaliper(o, contact));
   return true;
@@ -122,8 +153,9 @@ int main(int argc, char** argv) {
     else {
       std::printf("Usage: physics_bench [--steps N] [--repeats R] [--only CASE]\n"
                   "40-body tree, 39 hinges, 80 tendons, dt = 1 ms; medians of R runs of N steps.\n"
-                  "--only times one Caliper case (for profiling): tree_contact, tree_free,\n"
-                  "spanning_on, spanning_off.\n");
+                  "--only times one case (for profiling): tree_contact, tree_free,\n"
+                  "spanning_on, spanning_off, tree_bare (no tendons), passive (ligaments, no tendon\n"
+                  "contact), raw_bullet.\n");
       return std::strcmp(argv[i], "--help") ? 2 : 0;
     }
   }
@@ -144,16 +176,7 @@ int main(int argc, char** argv) {
   Ratio("caliper_vs_raw_bullet", caliper_contact / raw_contact, 1.15);
 
   // like for like with the baseline's plain springs: passive tendons, no tendon-body contact
-  TreeOptions springs = contact;
-  springs.actuator_kind = "ligament";
-  std::unique_ptr<sgal::PhysicsScene> plain;
-  sgal::Scene plain_description = MakeTree(springs);
-  for (auto& a : plain_description.actuators) a.parameters["stiffness"] = 2000;
-  physics_bullet::Options no_contact;
-  no_contact.tendon_body_contact = false;
-  const double caliper_springs = Time(
-      [&] { plain = physics_bullet::MakeScene(plain_description, no_contact); },
-      [&] { plain->Step(); });
+  const double caliper_springs = TimePassive(contact);
   std::printf("# step time [us]: Caliper with 80 passive tendons and no tendon contact %.1f "
               "(information: the cost of the DC motors and of tendon contact is the rest)\n",
               caliper_springs);

@@ -264,10 +264,19 @@ void CheckElements(const std::vector<WorldElement>& elements) {
 }  // namespace
 
 PathGeometry TendonPath::Evaluate(const std::vector<WorldElement>& elements) {
+  PathGeometry path;
+  Evaluate(elements, &path);
+  return path;
+}
+
+void TendonPath::Evaluate(const std::vector<WorldElement>& elements, PathGeometry* out) {
   CheckElements(elements);
   if (wrap_side_.size() != elements.size()) wrap_side_.assign(elements.size(), 0);
 
-  PathGeometry path;
+  PathGeometry& path = *out;
+  path.points.clear();
+  path.length = 0;
+  path.speed = 0;
   path.points.reserve(elements.size() + 16);
   // velocity of every path point, and whether the piece after it runs along an obstacle surface
   // (scratch kept between calls: this runs for every tendon in every step)
@@ -311,17 +320,24 @@ PathGeometry TendonPath::Evaluate(const std::vector<WorldElement>& elements) {
     path.length += len;
     if (len > kTiny) path.speed += d.dot(velocity[k + 1] - velocity[k]) / len;
   }
-  return path;
 }
 
 std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {
+  std::vector<PointForce> forces;
+  PathForces(path, tension, &forces);
+  return forces;
+}
+
+void PathForces(const PathGeometry& path, double tension, std::vector<PointForce>* out) {
   const size_t n = path.points.size();
-  std::vector<PointForce> forces(n);
+  std::vector<PointForce>& forces = *out;
+  forces.resize(n);
   for (size_t k = 0; k < n; ++k) {
     forces[k].body = path.points[k].body;
     forces[k].position = path.points[k].position;
+    forces[k].force.setZero();
   }
-  if (n < 2) return forces;
+  if (n < 2) return;
 
   thread_local std::vector<Vector3d> unit;
   unit.assign(n - 1, Vector3d::Zero());
@@ -346,7 +362,6 @@ std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {
     forces[k].force += t * unit[k];
     forces[k + 1].force -= t * unit[k];
   }
-  return forces;
 }
 
 }  // namespace caliper::actuators

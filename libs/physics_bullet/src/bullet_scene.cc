@@ -99,10 +99,9 @@ struct TendonData {
   bool has_wraps = false;  // the path keeps a side per wrap from step to step
   // the state at the start of the step, put back when the step fails
   actuators::TendonPath saved_path;       // only when has_wraps
-  actuators::PathGeometry saved_geometry;  // copied into kept capacity
+  double saved_speed = 0;
   double saved_previous_length = -1;
   double saved_tension = 0;
-  int saved_contacts = 0;
 };
 
 /// A coupling q_follower = ratio * q_leader + offset held by a stiff, critically damped
@@ -255,7 +254,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
   std::vector<Isometry3d> poses_;        // body frames this step [m]
-  std::vector<sgal::Pose> body_poses_;   // the same as poses [m]
+  std::vector<actuators::PointForce> forces_;  // a tendon's forces, storage kept between steps
   std::vector<Vector3d> coms_;           // centres of mass this step [m]
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
@@ -442,22 +441,23 @@ void BulletScene::BuildBody(size_t index) {
 void BulletScene::CacheBodyPoses() {
   const size_t n = bodies_.size();
   poses_.resize(n);
-  body_poses_.resize(n);
   coms_.resize(n);
   velocities_.resize(n);
   spins_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const btRigidBody& rb = *bodies_[i].rigid;
     const btTransform& t = rb.getCenterOfMassTransform();
-    const btQuaternion q = t.getRotation();
-    const Eigen::Quaterniond com_rotation(q.w(), q.x(), q.y(), q.z());
+    const btMatrix3x3& basis = t.getBasis();
+    Eigen::Matrix3d com_rotation;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) com_rotation(r, c) = basis[r][c];
     const Vector3d com = FromBt(t.getOrigin(), scale_);
     const Isometry3d& com_in_body = bodies_[i].com_in_body;
-    // body frame = com frame * inverse(com in body)
-    sgal::Pose& pose = body_poses_[i];
-    pose.orientation = (com_rotation * Eigen::Quaterniond(com_in_body.linear()).conjugate()).normalized();
-    pose.position = com - pose.orientation * com_in_body.translation();
-    poses_[i] = pose.ToIsometry();
+    // body frame = com frame * inverse(com in body), in matrices (no quaternion round trip on
+    // the path every tendon and joint reads)
+    Isometry3d& frame = poses_[i];
+    frame.linear().noalias() = com_rotation * com_in_body.linear().transpose();
+    frame.translation() = com - frame.linear() * com_in_body.translation();
     coms_[i] = com;
     velocities_[i] = FromBt(rb.getLinearVelocity(), scale_);
     spins_[i] = FromBt(rb.getAngularVelocity());
@@ -632,11 +632,10 @@ void BulletScene::QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
 }
 
 void BulletScene::EvaluateTendons() {
-  auto pose = [&](int body) { return body < 0 ? Isometry3d::Identity() : poses_[body]; };
-  auto velocity = [&](int body, const Vector3d& p) -> Vector3d {
-    if (body < 0) return Vector3d::Zero();
-    return velocities_[body] + spins_[body].cross(p - coms_[body]);
-  };
+  // the path's speed is measured from its lengths at the ends of a step (Step): the points'
+  // velocities are not needed
+  static const Isometry3d kWorld = Isometry3d::Identity();
+  auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
   for (size_t ti = 0; ti < tendons_.size(); ++ti) {
     TendonData& t = tendons_[ti];
     stage_ = {StepStage::kTendon, static_cast<int>(ti)};
@@ -649,20 +648,20 @@ void BulletScene::EvaluateTendons() {
       w.body = ref.body;
       if (e.kind == sgal::PathElement::Kind::kPoint) {
         w.point = pose(ref.body) * e.position;
-        w.velocity = velocity(ref.body, w.point);
+        w.velocity.setZero();
         w.friction = e.friction;
       } else {
         const sgal::WrapObstacle* o = ref.obstacle;
-        const Isometry3d body_pose = pose(ref.body);
+        const Isometry3d& body_pose = pose(ref.body);
         w.obstacle.kind = o->kind;
         w.obstacle.pose = body_pose * o->pose.ToIsometry();
         w.obstacle.radius = o->radius;
         w.obstacle.length = o->length;
-        w.velocity = velocity(ref.body, w.obstacle.pose.translation());
+        w.velocity.setZero();
         if (e.side) w.side = body_pose * (*e.side);
       }
     }
-    t.geometry = t.path.Evaluate(t.world);
+    t.path.Evaluate(t.world, &t.geometry);
     t.contacts = 0;
     if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
       // captures only `this`: held inside the std::function, no allocation
@@ -683,7 +682,8 @@ void BulletScene::ApplyTendonForces() {
     const TendonData& t = tendons_[ti];
     if (t.tension <= 0) continue;
     stage_ = {StepStage::kTendon, static_cast<int>(ti)};
-    for (const auto& f : actuators::PathForces(t.geometry, t.tension)) {
+    actuators::PathForces(t.geometry, t.tension, &forces_);
+    for (const auto& f : forces_) {
       if (f.body < 0 || scene_.bodies[f.body].type != sgal::BodyType::kDynamic) continue;
       bodies_[f.body].rigid->applyForce(ToBt(f.force, scale_), ToBt(f.position - coms_[f.body], scale_));
     }
@@ -691,7 +691,8 @@ void BulletScene::ApplyTendonForces() {
 }
 
 void BulletScene::UpdateJoints() {
-  auto pose = [&](int body) { return body < 0 ? Isometry3d::Identity() : poses_[body]; };
+  static const Isometry3d kWorld = Isometry3d::Identity();
+  auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
   auto spin = [&](int body) { return body < 0 ? Vector3d::Zero() : spins_[body]; };
   auto velocity = [&](int body, const Vector3d& p) -> Vector3d {
     if (body < 0) return Vector3d::Zero();
@@ -700,22 +701,28 @@ void BulletScene::UpdateJoints() {
   for (auto& j : joints_) {
     const sgal::Constraint& c = *j.desc;
     if (c.kind != sgal::ConstraintKind::kHinge && c.kind != sgal::ConstraintKind::kSlider) continue;
-    const Isometry3d fa = pose(j.body_a) * j.frame_a;
-    const Isometry3d fb = pose(j.body_b) * j.frame_b;
-    const Vector3d axis = fb.linear().col(2);
+    const Isometry3d& pa = pose(j.body_a);
+    const Isometry3d& pb = pose(j.body_b);
+    // the joint frames' axes in the world, only those read (body rotation times frame axis)
+    const Vector3d axis = pb.linear() * j.frame_b.linear().col(2);
     j.axis = axis;
     if (c.kind == sgal::ConstraintKind::kHinge) {
-      // rotation of body_a's joint frame relative to body_b's (the parent's), about z
-      const Eigen::Matrix3d rel = fb.linear().transpose() * fa.linear();
+      // rotation of body_a's joint frame relative to body_b's (the parent's), about z: the
+      // angle of a's x axis in b's x-y plane
+      const Vector3d xa = pa.linear() * j.frame_a.linear().col(0);
+      const double cos = xa.dot(pb.linear() * j.frame_b.linear().col(0));
+      const double sin = xa.dot(pb.linear() * j.frame_b.linear().col(1));
       // whole turns counted: the branch of the angle nearest the last position (a hinge turns
       // far less than half a turn in a step), so that a continuous joint, a multi-turn limit
       // (a UR5's +-2 pi) and a coupling's leader read on past +-pi instead of jumping
-      j.position += std::remainder(std::atan2(rel(1, 0), rel(0, 0)) - j.position, 2 * M_PI);
+      const double turn = std::atan2(sin, cos) - j.position;
+      j.position += turn - 2 * M_PI * std::nearbyint(turn * (0.5 / M_PI));
       j.velocity = axis.dot(spin(j.body_a) - spin(j.body_b));
     } else {
-      j.position = axis.dot(fa.translation() - fb.translation());
-      j.velocity = axis.dot(velocity(j.body_a, fa.translation()) -
-                            velocity(j.body_b, fa.translation()));
+      const Vector3d at_a = pa * j.frame_a.translation();
+      const Vector3d at_b = pb * j.frame_b.translation();
+      j.position = axis.dot(at_a - at_b);
+      j.velocity = axis.dot(velocity(j.body_a, at_a) - velocity(j.body_b, at_a));
     }
   }
 }
@@ -879,11 +886,11 @@ void BulletScene::SaveStepState() {
     snapshot_[i] = {rb.getCenterOfMassTransform(), rb.getLinearVelocity(), rb.getAngularVelocity()};
   }
   for (auto& t : tendons_) {
-    // the geometry the step starts from (a copy into kept capacity: no allocation)
-    t.saved_geometry = t.geometry;
+    // the geometry is a function of the poses and wrap sides: a failed step evaluates it again
+    // rather than every step copying it
+    t.saved_speed = t.geometry.speed;
     t.saved_previous_length = t.previous_length;
     t.saved_tension = t.tension;
-    t.saved_contacts = t.contacts;
   }
   for (const auto& a : actuators_) a.model->SaveState(actuator_states_.data() + a.state_offset);
 }
@@ -899,15 +906,18 @@ void BulletScene::RestoreStepState() {
     rb.clearForces();
   }
   for (auto& t : tendons_) {
-    std::swap(t.geometry, t.saved_geometry);
     if (t.has_wraps) t.path = t.saved_path;
     t.previous_length = t.saved_previous_length;
     t.tension = t.saved_tension;
-    t.contacts = t.saved_contacts;
   }
   for (auto& a : actuators_) a.model->RestoreState(actuator_states_.data() + a.state_offset);
   CacheBodyPoses();
   UpdateJoints();
+  // the paths where the step started, as the last step's end evaluated them (the same poses and
+  // wrap sides give the same bits)
+  RefreshWorldShapes();
+  EvaluateTendons();
+  for (auto& t : tendons_) t.geometry.speed = t.saved_speed;
 }
 
 std::string BulletScene::Describe(const StepStage& stage) const {
@@ -925,7 +935,9 @@ std::string BulletScene::Describe(const StepStage& stage) const {
 }
 
 void BulletScene::FailStep() {
-  // called while an exception is handled: back to the start of the step, then say why
+  // called while an exception is handled: back to the start of the step, then say why (the
+  // stage that failed, kept: putting the step back evaluates the paths again)
+  const StepStage failed = stage_;
   std::string what;
   try {
     throw;
@@ -936,6 +948,7 @@ void BulletScene::FailStep() {
     what = CurrentException();
   }
   RestoreStepState();
+  stage_ = failed;
   const std::string element = stage_.kind == StepStage::kActuator
                                   ? actuators_[stage_.index].desc->name
                                   : stage_.kind == StepStage::kTendon
@@ -1225,11 +1238,21 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
 }
 
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {
+  // through Bullet's own quaternion of each body (not the matrices the step reads), so that a
+  // state read here and restored (an edit, a rewind) gives back the same poses to 1e-12 m
   std::vector<sgal::BodyState> states(bodies_.size());
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    states[i].pose = body_poses_[i];
+    const btTransform& t = bodies_[i].rigid->getCenterOfMassTransform();
+    const btQuaternion q = t.getRotation();
+    const Eigen::Quaterniond com_rotation(q.w(), q.x(), q.y(), q.z());
+    const Isometry3d& com_in_body = bodies_[i].com_in_body;
+    // body frame = com frame * inverse(com in body)
+    sgal::Pose& pose = states[i].pose;
+    pose.orientation =
+        (com_rotation * Eigen::Quaterniond(com_in_body.linear()).conjugate()).normalized();
+    pose.position = coms_[i] - pose.orientation * com_in_body.translation();
     states[i].angular_velocity = spins_[i];
-    states[i].linear_velocity = velocities_[i] + spins_[i].cross(body_poses_[i].position - coms_[i]);
+    states[i].linear_velocity = velocities_[i] + spins_[i].cross(pose.position - coms_[i]);
   }
   return states;
 }

@@ -60,6 +60,9 @@ class TendonPath {
  public:
   /// Path through the elements (points, with wraps between two points).
   PathGeometry Evaluate(const std::vector<WorldElement>& elements);
+  /// The same into *path, reusing its storage (no allocation once it has grown: the engine's
+  /// every step).
+  void Evaluate(const std::vector<WorldElement>& elements, PathGeometry* path);
   /// The side each wrap took at the last evaluation (the state carried from step to step).
   const std::vector<int>& wrap_sides() const { return wrap_side_; }
   void set_wrap_sides(std::vector<int> sides) { wrap_side_ = std::move(sides); }
@@ -74,5 +77,7 @@ class TendonPath {
 /// (`speed` > 0: the tendon is pulled out toward the first point). Forces on the world (-1)
 /// are included too, so that all forces sum to zero when no friction acts.
 std::vector<PointForce> PathForces(const PathGeometry& path, double tension);
+/// The same into *forces, reusing its storage.
+void PathForces(const PathGeometry& path, double tension, std::vector<PointForce>* forces);
 
 }  // namespace caliper::actuators
