@@ -197,14 +197,15 @@ class DcMotorTendon : public TendonActuator {
     path_speed_ = path_speed;
     line_length_ = load.LineLength(motor_.state().spool_angle);
     elastic_length_ = path_length_ - line_length_;
-    // the linear element's damper reads the path's speed at the end, where the tension acts
-    // from (its stateless force, evaluated again); an element with states of its own integrated
-    // them along the mean speed and has no such direct term
-    tension_ = linear_ ? linear_->LinearSpringDamper::Peek(
-                             elastic_length_,
-                             end_speed + motor_.parameters().spool_radius * motor_.state().spool_speed,
-                             dt)
-                       : load.force();
+    // a stateless element's damper (linear, polynomial, table) reads the path's speed at the
+    // end, where the tension acts from (its force evaluated again); an element with states of
+    // its own (zener) integrated them along the mean speed and has no such direct term
+    const double spool_line_speed =
+        motor_.parameters().spool_radius * motor_.state().spool_speed;  // [m/s]
+    tension_ = linear_ ? linear_->LinearSpringDamper::Peek(elastic_length_,
+                                                           end_speed + spool_line_speed, dt)
+               : elastic_state_ == 0 ? elastic_->Peek(elastic_length_, end_speed + spool_line_speed, dt)
+                                     : load.force();
     return tension_;
   }
 

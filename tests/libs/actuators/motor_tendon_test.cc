@@ -175,6 +175,41 @@ TEST(DcMotorTendon, WithAZenerElementStallsAtTheSameTension) {
   EXPECT_NEAR(motor->Get("stress"), stall / 1e-3, 0.005 * stall / 1e-3);
 }
 
+TEST(DcMotorTendon, AStatelessElementsDamperReadsThePathsSpeedAtTheEnd) {
+  // the tension returned acts from the end of the step: a series damper there reads the path's
+  // speed at the end (the engine's second-order estimate), not the step's mean; the states, and
+  // so the spring's stretch, integrate along the mean either way
+  for (const std::string elastic : {"linear", "polynomial", "table"}) {
+    SCOPED_TRACE(elastic);
+    sgal::Actuator a = Motor();
+    a.options["elastic"] = elastic;
+    a.parameters["damping"] = 5;  // [N s/m]
+    a.parameters["rest_length"] = 0.05;
+    a.parameters["pretension"] = 20;
+    if (elastic == "polynomial") a.parameters["poly_c1"] = 3000, a.parameters["poly_c2"] = 1e5;
+    if (elastic == "table") a.options["elastic_table"] = "0.01 30; 0.02 80";
+    if (elastic == "linear") a.parameters["stiffness"] = 3000;
+    auto mean = Make(a), end = Make(a);
+    for (auto* m : {mean.get(), end.get()}) {
+      m->Reset(0.3);
+      m->SetCommand(1.0);
+    }
+    const double f_mean = mean->Step(0.3, 0.01, 1e-3, 0.01);
+    const double f_end = end->Step(0.3, 0.01, 1e-3, 0.03);
+    EXPECT_NEAR(f_end - f_mean, 5 * 0.02, 1e-9) << "damping x (end speed - mean speed)";
+    EXPECT_EQ(mean->Get("spool_angle"), end->Get("spool_angle")) << "states along the mean";
+  }
+  // an element with states of its own integrated them along the mean: the end speed changes
+  // nothing
+  sgal::Actuator z = Motor();
+  z.options["elastic"] = "zener";
+  z.parameters["zener_area"] = 1e-3;
+  z.parameters["rest_length"] = 0.05;
+  auto mean = Make(z), end = Make(z);
+  for (auto* m : {mean.get(), end.get()}) m->Reset(0.3);
+  EXPECT_EQ(mean->Step(0.3, 0.01, 1e-3, 0.01), end->Step(0.3, 0.01, 1e-3, 0.03));
+}
+
 TEST(DcMotorTendon, DutyInputScalesTheSupplyVoltage) {
   sgal::Actuator a = Motor();
   a.options["input"] = "duty";
