@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -181,7 +182,10 @@ TEST(BulletScene, TendonTensionHoldsAHangingBallAgainstGravity) {
   EXPECT_NEAR(scene->BodyStates()[0].linear_velocity.z(), kG * 0.1, 0.001 * kG * 0.1);
 }
 
-TEST(BulletScene, NonFiniteTensionStopsTheStepNamingTheActuator) {
+/// A 1 kg ball hanging on a rope from the origin, pulled by the test kind test_constant_tension
+/// named `actuator` with these parameters.
+sgal::Scene BallOnRope(const std::string& actuator,
+                       const std::map<std::string, double>& parameters) {
   testing::RegisterTestKinds();
   sgal::Scene s;
   s.bodies.push_back(Ball("ball", Vector3d(0, 0, -0.5), 1.0, 0.05));
@@ -191,8 +195,12 @@ TEST(BulletScene, NonFiniteTensionStopsTheStepNamingTheActuator) {
   bottom.body = "ball";
   t.path = {top, bottom};
   s.tendons.push_back(t);
-  s.actuators.push_back({"faulty", "test_constant_tension", "rope", {{"nan_after", 10}}, {}});
-  auto scene = MakeScene(s);
+  s.actuators.push_back({actuator, "test_constant_tension", "rope", parameters, {}});
+  return s;
+}
+
+TEST(BulletScene, NonFiniteTensionStopsTheStepNamingTheActuator) {
+  auto scene = MakeScene(BallOnRope("faulty", {{"nan_after", 10}}));
   for (int i = 0; i < 10; ++i) scene->Step();
   const auto before = scene->BodyStates()[0];
   try {
@@ -214,19 +222,9 @@ TEST(BulletScene, ATensionBeyondTheBoundStopsTheStepBeforeItActs) {
   // a tension computed at the end of a step acts through the next one: a wild one (a muscle
   // driven past its curves by a path that jumped) faults the step that made it, so that a rewind
   // or an undo does not carry it on
-  testing::RegisterTestKinds();
-  sgal::Scene s;
-  s.bodies.push_back(Ball("ball", Vector3d(0, 0, -0.5), 1.0, 0.05));
-  sgal::Tendon t;
-  t.name = "rope";
-  sgal::PathElement top, bottom;
-  bottom.body = "ball";
-  t.path = {top, bottom};
-  s.tendons.push_back(t);
-  s.actuators.push_back({"wild", "test_constant_tension", "rope", {{"tension", 1}}, {}});
   Options options;
   options.max_tension = 1e5;
-  auto scene = MakeScene(s, options);
+  auto scene = MakeScene(BallOnRope("wild", {{"tension", 1}}), options);
   for (int i = 0; i < 10; ++i) scene->Step();
   const auto before = scene->BodyStates()[0];
   scene->SetCommand("wild", 2e5);
