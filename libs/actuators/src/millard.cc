@@ -498,17 +498,31 @@ MillardFiberModel::State MillardFiberModel::Rigid(double path_length, double pat
   const double lopt = p_.optimal_fiber_length;
   const double f0 = p_.max_isometric_force;
   State s;
-  s.tendon_length = p_.tendon_slack_length;
-  const double along = std::max(path_length - p_.tendon_slack_length, 0.0);
-  s.fiber_length = std::sqrt(height_ * height_ + along * along);
-  // a fibre shorter than its height (or none) pulls nothing along the path
-  s.cos_pennation = s.fiber_length > 0 ? along / s.fiber_length : 0.0;
-  s.fiber_velocity = s.cos_pennation * path_speed;
+  const double lts = p_.tendon_slack_length;
+  const double along = std::max(path_length - lts, 0.0);
+  // OpenSim's clamp: the fibre never shorter than minimum_fiber_length(); a path too short for
+  // it leaves the tendon slack (shorter than its slack length, buckled)
+  s.fiber_length = std::max(std::sqrt(height_ * height_ + along * along), minimum_fiber_length_);
+  const double along_clamped =
+      std::sqrt(std::max(s.fiber_length * s.fiber_length - height_ * height_, 0.0));
+  s.cos_pennation = along_clamped / s.fiber_length;
+  s.tendon_length = path_length - along_clamped;
+  // a buckled tendon moves, the fibre does not
+  const bool buckled = s.tendon_length < lts - 1e-12 * lts;
+  s.fiber_velocity = buckled ? 0.0 : s.cos_pennation * path_speed;
   s.norm_fiber_length = s.fiber_length / lopt;
-  s.norm_fiber_velocity = s.fiber_velocity / (p_.max_contraction_velocity * lopt);
   s.active_force_length = fal_.Value(s.norm_fiber_length);
-  s.force_velocity = fv_.Value(s.norm_fiber_velocity);
   s.passive_force_length = fpe_.Value(s.norm_fiber_length);
+  // clamped (at the minimum and not lengthening): at rest (fv = 1) and no fibre force, as
+  // OpenSim's isFiberStateClamped; it leaves the minimum as soon as the path lengthens it
+  if (s.fiber_length <= minimum_fiber_length_ && s.fiber_velocity <= 0) {
+    s.fiber_velocity = 0;
+    s.norm_fiber_velocity = 0;
+    s.force_velocity = 1;
+    return s;  // active, passive, tendon force and tension 0
+  }
+  s.norm_fiber_velocity = s.fiber_velocity / (p_.max_contraction_velocity * lopt);
+  s.force_velocity = fv_.Value(s.norm_fiber_velocity);
   s.active_fiber_force = f0 * a * s.active_force_length * s.force_velocity;
   s.passive_force = f0 * (s.passive_force_length + p_.fiber_damping * s.norm_fiber_velocity);
   s.tendon_force = (s.active_fiber_force + s.passive_force) * s.cos_pennation;

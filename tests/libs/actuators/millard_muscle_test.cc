@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -243,10 +245,15 @@ MillardMuscleParameters AsStruct(const std::map<std::string, double>& p) {
 }
 
 // Drives the model's muscle along the block motion of a testAnalyzeTool input at 1 ms steps
-// (activation from the file's column when it has one, else the model's default), and checks at
-// every stored state: the equilibrium (tendon force = fibre force along the tendon), the fibre
+// (activation from the file's column when it has one, else `activation`), and checks at every
+// stored state: the equilibrium (tendon force = fibre force along the tendon), the fibre
 // velocity against the fibre length's change, and a bounded second difference of the force.
-void CheckTugOfWarInput(const std::string& input) {
+// Then, as testAnalyzeTool does, a fresh muscle per stored row, Reset at that row's path length
+// and activation (the equilibrium solved from scratch, not carried from the previous state):
+// balanced to sqrt(eps) F0, the fibre no shorter than its minimum, the force smooth over rows.
+// min_range_n: how much the input must change the integrated force [N].
+void CheckTugOfWarInput(const std::string& input, double activation, double minimum_activation,
+                        double min_range_n) {
   const TugOfWar tug = ReadTugOfWar(Reference("opensim/Tug_of_War_Millard_Iso.osim"));
   ASSERT_TRUE(tug.elastic);
   const Storage s = ReadStorage(Reference("opensim/" + input));
@@ -254,16 +261,18 @@ void CheckTugOfWarInput(const std::string& input) {
   int act = -1;
   for (size_t i = 0; i < s.columns.size(); ++i)
     if (s.columns[i] == "LeftMuscle.activation") act = static_cast<int>(i);
-  const MillardMuscleParameters p = AsStruct(tug.parameters);
-  const double a_min = tug.parameters.at("minimum_activation");
+  auto tug_parameters = tug.parameters;
+  tug_parameters["minimum_activation"] = minimum_activation;
+  const MillardMuscleParameters p = AsStruct(tug_parameters);
+  const double a_min = minimum_activation;
   auto activation_at = [&](size_t row, double fraction) {
-    if (act < 0) return tug.default_activation;
+    if (act < 0) return std::max(a_min, activation);
     const double a0 = s.rows[row][act];
     const double a1 = s.rows[std::min(row + 1, s.rows.size() - 1)][act];
     return std::max(a_min, a0 + fraction * (a1 - a0));
   };
   // Reset puts the activation at default_activation: the file's first one
-  auto parameters = tug.parameters;
+  auto parameters = tug_parameters;
   parameters["default_activation"] = activation_at(0, 0);
   auto m = MakeMuscle({{"curves", "millard2012"}, {"tendon", "elastic"}}, parameters);
   m->SetCommand(activation_at(0, 0));
@@ -319,22 +328,71 @@ void CheckTugOfWarInput(const std::string& input) {
   for (size_t i = 1; i + 1 < force.size(); ++i)
     worst_second = std::max(worst_second, std::abs(force[i + 1] - 2 * force[i] + force[i - 1]));
   const auto [lo, hi] = std::minmax_element(force.begin(), force.end());
-  EXPECT_GT(*hi - *lo, 0.05 * p.max_isometric_force) << "the input should change the force";
+  EXPECT_GT(*hi - *lo, min_range_n) << "the input should change the force";
   EXPECT_LT(worst_second, 0.01 * (*hi - *lo)) << "force not smooth";
+
+  // independent equilibria, one fresh muscle per stored row
+  const double tolerance =
+      std::sqrt(std::numeric_limits<double>::epsilon()) * p.max_isometric_force;
+  // the shortest fibre: the active curve's left shoulder, or the height at maximum pennation
+  const double minimum_fibre_length = std::max(
+      p.curves.min_norm_active_fiber_length * p.optimal_fiber_length,
+      p.optimal_fiber_length * std::sin(p.pennation_angle) / std::sin(p.maximum_pennation_angle));
+  std::vector<double> fresh_force;
+  double worst_fresh_balance = 0;
+  int at_minimum = 0;
+  for (size_t r = 0; r < s.rows.size(); ++r) {
+    auto row_parameters = tug_parameters;
+    row_parameters["default_activation"] = activation_at(r, 0);
+    auto fresh = MakeMuscle({{"curves", "millard2012"}, {"tendon", "elastic"}}, row_parameters);
+    fresh->Reset(tug.PathLength(s.rows[r][tz]));
+    EXPECT_NEAR(fresh->Get("activation"), activation_at(r, 0), 0) << "row " << r;
+    EXPECT_NEAR(fresh->Get("fiber_velocity"), 0, 1e-9) << "row " << r;
+    const Balance b = BalanceOf(*fresh, p);
+    EXPECT_NEAR(b.tendon, b.fibre, tolerance) << "row " << r;
+    worst_fresh_balance = std::max(worst_fresh_balance, std::abs(b.tendon - b.fibre));
+    EXPECT_GE(fresh->Get("fiber_length"), minimum_fibre_length) << "row " << r;
+    if (fresh->Get("fiber_length") <= minimum_fibre_length * (1 + 1e-12)) ++at_minimum;
+    fresh_force.push_back(fresh->tension());
+  }
+  double worst_fresh_second = 0;
+  for (size_t i = 1; i + 1 < fresh_force.size(); ++i)
+    worst_fresh_second = std::max(
+        worst_fresh_second, std::abs(fresh_force[i + 1] - 2 * fresh_force[i] + fresh_force[i - 1]));
+  const auto [flo, fhi] = std::minmax_element(fresh_force.begin(), fresh_force.end());
+  EXPECT_GT(*fhi - *flo, min_range_n) << "the input should change the equilibrium force";
+  // rows are 1 mm of path apart (3 % of the optimal fibre length): the active curve's
+  // shoulders bend the equilibrium force by ~1.1 % of its range per row (21 N at activation 1);
+  // a wrong root or a jump between neighbouring solves exceeds 2 %
+  EXPECT_LT(worst_fresh_second, 0.02 * (*fhi - *flo)) << "equilibrium force not smooth";
+  // the short end of the input leaves the tendon slack and the fibre at its minimum
+  EXPECT_GT(at_minimum, 0);
+
   std::ostringstream numbers;
   numbers << std::scientific << "balance " << worst_balance << " N, rate " << worst_rate
-          << ", second difference " << worst_second << " N of a range " << *hi - *lo << " N";
+          << ", second difference " << worst_second << " N of a range " << *hi - *lo
+          << " N; fresh equilibria: balance " << worst_fresh_balance << " N, second difference "
+          << worst_fresh_second << " N of a range " << *fhi - *flo << " N, " << at_minimum
+          << " rows at the minimum fibre length";
   ::testing::Test::RecordProperty("worst", numbers.str());
+  std::cout << input << " activation " << activation << ": " << numbers.str() << "\n";
+}
+
+// upstream's three cases: constant velocity at activation 0.01 (passive fibres only) and 1, and
+// the activation ramp from 0 with minimum_activation 0 (allowed with fibre damping)
+TEST(MillardMuscle, TugOfWarConstantVelocityPassiveHoldsEquilibriumAndIsSmooth) {
+  CALIPER_REQUIRE_CORPUS();
+  CheckTugOfWarInput("Tug_of_War_ConstantVelocity.sto", 0.01, 0.01, 0.05 * 1000);
 }
 
 TEST(MillardMuscle, TugOfWarConstantVelocityHoldsEquilibriumAndIsSmooth) {
   CALIPER_REQUIRE_CORPUS();
-  CheckTugOfWarInput("Tug_of_War_ConstantVelocity.sto");
+  CheckTugOfWarInput("Tug_of_War_ConstantVelocity.sto", 1.0, 0.01, 0.05 * 1000);
 }
 
 TEST(MillardMuscle, TugOfWarRampActivationHoldsEquilibriumAndIsSmooth) {
   CALIPER_REQUIRE_CORPUS();
-  CheckTugOfWarInput("Tug_of_War_ConstantVelocity_RampActivation.sto");
+  CheckTugOfWarInput("Tug_of_War_ConstantVelocity_RampActivation.sto", 0.0, 0.0, 0.05 * 1000);
 }
 
 const std::map<std::string, double> kMuscle = {{"optimal_fiber_length", 0.1},
@@ -410,6 +468,38 @@ TEST(MillardMuscle, DampingActsOnlyWhileTheFibreMoves) {
     for (size_t i = 0; i < fd.size(); ++i) differ = std::max(differ, std::abs(fd[i] - fu[i]));
     EXPECT_GT(differ, 1.0) << "N";
     EXPECT_LT(differ, 0.2 * 1000) << "N";
+  }
+}
+
+TEST(MillardMuscle, RigidFibreClampedAtItsMinimumLength) {
+  // kMuscle: lopt 0.1 m, slack 0.2 m, pennation 0.2 rad; the shortest fibre is the active
+  // curve's left shoulder, 0.4441 lopt (the height over sin(maximum pennation) is 0.020 m)
+  auto m = MakeMuscle({{"curves", "millard2012"}, {"tendon", "rigid"}}, kMuscle);
+  const double minimum = 0.4441 * 0.1;
+  const double height = 0.1 * std::sin(0.2);
+  const double along_at_minimum = std::sqrt(minimum * minimum - height * height);
+  m->Reset(0.3);
+  // 0.03 m of path beyond the slack tendon: the fibre would be 0.036 m, below its minimum
+  for (const double speed : {-0.1, 0.0, 0.1}) {
+    SCOPED_TRACE(speed);
+    m->Step(0.23, speed, 1e-3);
+    EXPECT_NEAR(m->Get("fiber_length"), minimum, 1e-15);
+    EXPECT_EQ(m->Get("fiber_velocity"), 0);
+    EXPECT_EQ(m->Get("force_velocity"), 1);
+    EXPECT_EQ(m->Get("active_fiber_force"), 0);
+    EXPECT_EQ(m->tension(), 0);
+    // the tendon buckles: shorter than its slack length by what the fibre cannot give
+    EXPECT_NEAR(m->Get("tendon_length"), 0.23 + speed * 1e-3 - along_at_minimum, 1e-15);
+  }
+  // 0.1 mm of path above it the fibre follows the path again and pulls, either way it moves
+  // (a fal F0 fv cos, fal >= minimum_value 0.1): the clamp holds only at the minimum
+  const double above = 0.2 + along_at_minimum + 1e-4;
+  for (const double speed : {-0.1, 0.1}) {
+    SCOPED_TRACE(speed);
+    m->Step(above, 0, 1e-3, speed);
+    EXPECT_GT(m->Get("fiber_length"), minimum);
+    EXPECT_NEAR(m->Get("fiber_velocity"), speed * std::cos(m->Get("pennation")), 1e-12);
+    EXPECT_GT(m->tension(), 0.5 * 0.1 * 1000 * 0.1);
   }
 }
 

@@ -1,6 +1,7 @@
-// The hill_muscle Thelen2003 elastic-tendon step (fibre length by a two-stage SDIRK whose stage
-// roots Newton finds from a prediction): its order against fine steps along the path the
-// actuator contract describes, and results that do not depend on the prediction.
+// The hill_muscle elastic-tendon step (fibre length by a two-stage SDIRK whose stage roots Newton
+// finds from a prediction; Thelen2003, and Millard2012 for the prediction's independence): its
+// order against fine steps along the path the actuator contract describes, and results that do not
+// depend on the prediction.
 
 #include <gtest/gtest.h>
 
@@ -19,12 +20,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::unique_ptr<TendonActuator> MakeElastic(std::map<std::string, double> parameters = {}) {
+std::unique_ptr<TendonActuator> MakeElastic(std::map<std::string, double> parameters = {},
+                                            const std::string& curves = "thelen2003") {
   sgal::Actuator a;
   a.name = "m";
   a.kind = "hill_muscle";
   a.tendon = "t";
-  a.options = {{"curves", "thelen2003"}, {"tendon", "elastic"}};
+  a.options = {{"curves", curves}, {"tendon", "elastic"}};
   a.parameters = {{"optimal_fiber_length", 0.1}, {"tendon_slack_length", 0.2}};
   for (const auto& [name, value] : parameters) a.parameters[name] = value;
   return Make(a);
@@ -86,17 +88,18 @@ TEST(HillMuscleElasticStep, ConvergesWithSecondOrderAlongAMovingPathAndActivatio
 // solve. One comes from rest, the other from a fast stretch, and the fibre is put where it is far
 // from the force balance, so that the prediction is poor; on the short path the tendon is slack
 // and the fibre shortens to its shortest length (where Newton hands over to the bracketed solve).
-TEST(HillMuscleElasticStep, TheNextStepDoesNotDependOnThePrediction) {
-  const double fiber_lengths[] = {0.0015, 0.06, 0.1, 0.13};  // [m] (the shortest: 0.001 m)
+// Both stepping schemes: Thelen2003's and Millard2012's (its own stage solve, damped fibres).
+void CheckTheNextStepDoesNotDependOnThePrediction(const std::string& curves,
+                                                  const std::vector<double>& fiber_lengths) {
   const double speeds[] = {-1.5, 0, 0.4};  // path speed of the compared step [m/s]
   const double paths[] = {0.15, 0.3};      // path length of the compared step [m]
   for (const double path : paths)
     for (const double fiber : fiber_lengths)
       for (const double speed : speeds) {
-        SCOPED_TRACE("path " + std::to_string(path) + " m, fibre " + std::to_string(fiber) +
-                     " m, path speed " + std::to_string(speed) + " m/s");
-        auto rest = MakeElastic();
-        auto moving = MakeElastic();
+        SCOPED_TRACE(curves + ": path " + std::to_string(path) + " m, fibre " +
+                     std::to_string(fiber) + " m, path speed " + std::to_string(speed) + " m/s");
+        auto rest = MakeElastic({}, curves);
+        auto moving = MakeElastic({}, curves);
         rest->SetCommand(0.7);
         moving->SetCommand(0.7);
         rest->Reset(0.3);
@@ -116,6 +119,16 @@ TEST(HillMuscleElasticStep, TheNextStepDoesNotDependOnThePrediction) {
         EXPECT_NEAR(tension_rest, tension_moving, 1e-8);
         EXPECT_NEAR(rest->Get("fiber_velocity"), moving->Get("fiber_velocity"), 1e-8);
       }
+}
+
+TEST(HillMuscleElasticStep, TheNextStepDoesNotDependOnThePrediction) {
+  // [m] (lopt 0.1 m; Thelen's shortest fibre: 0.001 m)
+  CheckTheNextStepDoesNotDependOnThePrediction("thelen2003", {0.0015, 0.06, 0.1, 0.13});
+}
+
+TEST(HillMuscleElasticStep, TheNextStepDoesNotDependOnThePredictionMillard) {
+  // [m] (Millard's shortest fibre: the active curve's shoulder, 0.4441 lopt = 0.04441 m)
+  CheckTheNextStepDoesNotDependOnThePrediction("millard2012", {0.04442, 0.06, 0.1, 0.13});
 }
 
 // A tendon a hundred times stiffer than Thelen's (stretch 4e-4 of its slack length at F0) along a

@@ -339,7 +339,9 @@ class MillardFiberModel {
   /// sin(maximum_pennation_angle) [m].
   double minimum_fiber_length() const { return minimum_fiber_length_; }
 
-  /// Rigid tendon: the fibres take the path minus the slack tendon.
+  /// Rigid tendon: the fibres take the path minus the slack tendon, never shorter than
+  /// minimum_fiber_length(); there and not lengthening (OpenSim's clamp): velocity 0, fv = 1,
+  /// no fibre force (the tendon buckles, shorter than its slack length).
   State Rigid(double path_length, double path_speed, double activation) const;
   /// Elastic tendon, fibre length lm [m] (>= minimum_fiber_length()): velocity from the balance.
   State Elastic(double fiber_length, double path_length, double activation) const;
