@@ -580,7 +580,8 @@ class HillMuscle : public TendonActuator {
   HillMuscle(std::string name, Curves curves, bool elastic, const AllParameters& p)
       : name_(std::move(name)), curves_(curves), elastic_(elastic), p_(p) {
     activation_ = InitialActivation();
-    fiber_length_ = p_.thelen.optimal_fiber_length;
+    fiber_length_ = curves_ == Curves::kMillard ? p_.millard.optimal_fiber_length
+                                                : p_.thelen.optimal_fiber_length;
     UpdateDerived();
   }
 
