@@ -9,6 +9,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "caliper/actuators/muscle.h"
 
@@ -117,6 +118,59 @@ TEST(MillardCurves, TendonForceLengthHasItsKnots) {
   EXPECT_GT(fse.SecondDerivative(1 + 0.5 * (toe_end - 1)), 0);  // the toe stiffens
   ExpectC2AtJoins(fse);
   ExpectSlopesMatchDifferences(fse, 0.99, 1.07);
+}
+
+// The construction points pinned to 1e-12, as literal numbers worked out by hand from OpenSim's
+// SmoothSegmentedFunctionFactory with the default parameters, so that a wrong constant in
+// millard.cc fails here even where the curve keeps its knots' values and slopes.
+void ExpectJoins(const MillardCurve& c, const std::vector<std::array<double, 2>>& joins) {
+  const auto& s = c.segments();
+  ASSERT_EQ(s.size() + 1, joins.size());
+  for (size_t i = 0; i < joins.size(); ++i) {
+    SCOPED_TRACE("join " + std::to_string(i));
+    const auto& [x, y] = i < s.size() ? std::array<double, 2>{s[i].x[0], s[i].y[0]}
+                                      : std::array<double, 2>{s[i - 1].x[5], s[i - 1].y[5]};
+    EXPECT_NEAR(x, joins[i][0], 1e-12);
+    EXPECT_NEAR(y, joins[i][1], 1e-12);
+    if (i > 0 && i < s.size()) {  // the segments meet
+      EXPECT_EQ(s[i - 1].x[5], s[i].x[0]);
+      EXPECT_EQ(s[i - 1].y[5], s[i].y[0]);
+    }
+  }
+}
+
+TEST(MillardCurves, ConstructionPointsAreOpenSims) {
+  // active force-length: shoulder half-width 0.05, xs = 0.95, y1 = 1 - 0.8616 (0.95 - 0.73)
+  // = 0.810448; x01 = 0.4441 + (0.73 - 0.4441) / 2, y01 = y1 / 2; x1s = 0.73 + (0.95 - 0.73) / 2,
+  // y1s = (1 + y1) / 2; x23 = 1.05 + (1.8123 - 1.05) / 2, y23 = 1/2
+  const MillardCurve fal = MillardActiveForceLengthCurve();
+  ExpectJoins(fal, {{{0.4441, 0.1},
+                     {0.58705, 0.405224},
+                     {0.84, 0.905224},
+                     {1, 1},
+                     {1.43115, 0.5},
+                     {1.8123, 0.1}}});
+  // the first corner's doubled inner point, curviness 1 scaled to 0.9 of the way to where the
+  // flat shoulder y = 0.1 meets the line through (x01, y01) of slope 1.25 y1 / (0.73 - 0.4441)
+  // = 3.5434067855893674: at x = 0.58705 - 0.305224 / 3.5434067855893674 = 0.5009114281483821
+  EXPECT_NEAR(fal.segments()[0].x[1], 0.4441 + 0.9 * (0.5009114281483821 - 0.4441), 1e-12);
+  EXPECT_EQ(fal.segments()[0].x[1], fal.segments()[0].x[2]);
+  EXPECT_NEAR(fal.segments()[0].y[1], 0.1, 1e-12);
+  EXPECT_NEAR(fal.Slope(0.58705), 3.5434067855893674, 1e-9);
+  // force-velocity: (-0.9, (0.25 + 0) / 2 * 0.1), (0.9, 1.4 - (0.15 + 0) / 2 * 0.1)
+  ExpectJoins(MillardForceVelocityCurve(),
+              {{{-1, 0}, {-0.9, 0.0125}, {0, 1}, {0.9, 1.3925}, {1, 1.4}}});
+  // passive fibre: the foot ends at 1 + min(0.1 / (2 / 0.7), 0.1 * 0.7) = 1.035 on the line of
+  // slope 0.2 from 1 + 0.035 / 2: y = 0.2 * 0.0175
+  ExpectJoins(MillardFiberForceLengthCurve(), {{{1, 0}, {1.035, 0.0035}, {1.7, 1}}});
+  // tendon: the toe ends at 1.049 - (1/3) 0.049 / 1.375 = 1.037121212121212 (force 2/3); the
+  // foot at 1 + (toe end - 1) / 10 = 1.0037121212121212; the mid line point at force 1/3 is at
+  // 1.049 - (2/3) 0.049 / 1.375 = 1.0252424242424243, its slope from the foot
+  // (1/3) / (1.0252424242424243 - 1.0037121212121212) = 15.48205489092182; the control point
+  // halfway from the foot to it: x = 1.0144772727272726, y = 1/6
+  const MillardCurve fse = MillardTendonForceLengthCurve();
+  ExpectJoins(fse, {{{1, 0}, {1.0144772727272726, 1.0 / 6}, {1.037121212121212, 2.0 / 3}}});
+  EXPECT_NEAR(fse.Slope(1.0144772727272726), 15.48205489092182, 1e-9);
 }
 
 // the Bezier of a segment at parameter u, in long double (Bernstein form)
