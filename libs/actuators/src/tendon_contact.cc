@@ -301,7 +301,46 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
 
 int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
                      ContactScratch* scratch) {
+  return WrapAroundBodies(path, query, options, scratch, nullptr, 0.0);
+}
+
+namespace {
+
+// What a clearance proof leaves for rounding [m]: the distances it compares carry errors of a
+// few 1e-16 m per metre of coordinates, so this holds for scenes up to kilometres across.
+constexpr double kClearanceSlack = 1e-9;
+
+/// Whether `memory` proves that the routed segment a-b crosses no shape: every other shape was
+/// farther than its reach by more than the segment's ends and the shapes have moved since, and
+/// no plane cuts it (tested as the search would).
+bool ProvenClear(const ContactMemory& memory, size_t index, const Eigen::Vector3d& a,
+                 const Eigen::Vector3d& b, int exclude_a, int exclude_b, double travel,
+                 double margin) {
+  const ContactMemory::Segment& s = memory.segments[index];
+  if (!(s.clearance > 0) || s.exclude_a != exclude_a || s.exclude_b != exclude_b) return false;
+  // every point of the segment moved no more than the farther of its ends (it stays straight)
+  const double ends = std::sqrt(std::max((a - s.a).squaredNorm(), (b - s.b).squaredNorm()));
+  if (!(ends + (travel - s.travel) + kClearanceSlack < s.clearance)) return false;
+  for (const WorldShape* plane : s.planes) {
+    const auto i = SegmentInside(*plane, a, b, margin);
+    if (i && i->second - i->first > 1e-9) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
+                     ContactScratch* scratch, ContactMemory* memory, double travel) {
   if (path->points.size() < 2) return 0;
+  const size_t segments = path->points.size() - 1;
+  if (memory != nullptr &&
+      (memory->margin != options.margin || memory->segments.size() != segments)) {
+    // another path shape or margin: nothing remembered holds
+    memory->Clear();
+    memory->margin = options.margin;
+    memory->segments.resize(segments);
+  }
   std::vector<PathPoint>& out = scratch->points;
   out.clear();
   std::vector<const WorldShape*>& shapes = scratch->shapes;
@@ -312,13 +351,19 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
   bend.options = &options;
   bend.out = &out;
   int inserted = 0;
-  for (size_t i = 0; i + 1 < path->points.size(); ++i) {
+  for (size_t i = 0; i < segments; ++i) {
     const PathPoint& a = path->points[i];
     const PathPoint& b = path->points[i + 1];
     out.push_back(a);
+    // the bodies the search lets the routed segment touch (as Refine excludes them)
+    const int exclude_a = a.contact ? -2 : a.body, exclude_b = b.contact ? -2 : b.body;
+    if (memory != nullptr && ProvenClear(*memory, i, a.position, b.position, exclude_a, exclude_b,
+                                         travel, options.margin))
+      continue;
     const size_t before = out.size();
     shapes.clear();
-    query(a.position, b.position, options.margin + options.detour_reach, &shapes);
+    const double pad = options.margin + options.detour_reach;
+    query(a.position, b.position, pad, &shapes);
     candidates.clear();
     const Eigen::Vector3d ab = b.position - a.position;
     const double l2 = ab.squaredNorm();
@@ -333,6 +378,26 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       const double t = std::clamp((centre - a.position).dot(ab) * inverse_l2, 0.0, 1.0);
       const double distance2 = (a.position + t * ab - centre).squaredNorm();
       candidates.push_back({centre, reach * reach, reach, distance2, shape->body, shape});
+    }
+    if (memory != nullptr) {
+      // shapes the query left out lie farther than `pad` from the segment's box
+      double clearance = options.detour_reach;
+      ContactMemory::Segment& s = memory->segments[i];
+      s.planes.clear();
+      for (const Candidate& c : candidates) {
+        if (c.body == exclude_a || c.body == exclude_b) continue;
+        if (std::isinf(c.reach)) {
+          s.planes.push_back(c.shape);
+        } else {
+          clearance = std::min(clearance, std::sqrt(c.distance2) - c.reach);
+        }
+      }
+      s.a = a.position;
+      s.b = b.position;
+      s.exclude_a = exclude_a;
+      s.exclude_b = exclude_b;
+      s.clearance = clearance - kClearanceSlack;
+      s.travel = travel;
     }
     bend.rho = 0;
     bend.Select();

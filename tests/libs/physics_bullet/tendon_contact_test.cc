@@ -203,6 +203,174 @@ TEST(WrapAroundBodies, GivesTheSameWithReusedBuffers) {
   }
 }
 
+/// A swinging chain of capsules like the bench tree's spine, a ball flying through it and a
+/// floor; tendons that press on the body between their ends, tendons beside the chain that touch
+/// nothing, and one that ends near the floor. Poses at time `t` [s] from hinge angles of our own.
+struct SwingingChain {
+  static constexpr int kLinks = 10;
+  const sgal::Geometry capsule = sgal::Capsule{0.03, 0.04};
+  const sgal::Geometry sphere = sgal::Sphere{0.04};
+  const sgal::Geometry floor = sgal::Plane{};
+  std::vector<WorldShape> shapes;  // kLinks capsules, the ball, the floor
+  struct Tendon {
+    int body_a, body_b;
+    Vector3d local_a, local_b;  // attachments in the bodies' frames [m]
+  };
+  std::vector<Tendon> tendons;
+  std::vector<Eigen::Isometry3d> frames;
+
+  SwingingChain() {
+    shapes.resize(kLinks + 2);
+    for (int i = 0; i < kLinks; ++i) shapes[i] = At(capsule, Vector3d::Zero(), i);
+    shapes[kLinks] = At(sphere, Vector3d::Zero(), kLinks);
+    shapes[kLinks + 1] = At(floor, Vector3d::Zero(), kLinks + 1);
+    for (auto& s : shapes) PrepareShape(&s);
+    for (int i = 1; i + 1 < kLinks; ++i) {
+      // across the middle body, 0.6 radii off its axis: presses on it
+      tendons.push_back({i - 1, i + 1, Vector3d(0.018, 0, 0), Vector3d(0.018, 0, 0)});
+      // beside the chain, 1.5 radii off: touches nothing while the chain bends gently
+      tendons.push_back({i, i + 1, Vector3d(0, 0.045, 0), Vector3d(0, 0.045, 0)});
+    }
+    // from the base down to just above the floor (within the margin: cuts it at its end)
+    tendons.push_back({0, -1, Vector3d(0.045, 0, 0), Vector3d(0.3, 0, 0.0005)});
+    Place(0);
+  }
+
+  void Place(double t) {
+    frames.assign(kLinks, Eigen::Isometry3d::Identity());
+    Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+    f.translation() = Vector3d(0, 0, 0.05);
+    for (int i = 0; i < kLinks; ++i) {
+      const double angle = 0.25 * std::sin(2 * M_PI * (0.7 + 0.13 * i) * t + i);
+      f = f * Eigen::AngleAxisd(angle, i % 2 ? Vector3d::UnitX() : Vector3d::UnitY());
+      frames[i] = f;
+      frames[i].translation() += f.linear() * Vector3d(0, 0, 0.05);  // the body's centre
+      shapes[i].pose = frames[i];
+      f.translation() += f.linear() * Vector3d(0, 0, 0.1);
+    }
+    // the ball crosses the chain and the tendons beside it along x, 0.35 m up, once a second
+    shapes[kLinks].pose.translation() = Vector3d(0.6 * std::cos(2 * M_PI * 0.5 * t), 0.05, 0.35);
+  }
+
+  PathGeometry Path(const Tendon& tendon) const {
+    auto point = [&](int body, const Vector3d& local) {
+      PathPoint p;
+      p.position = body < 0 ? local : Vector3d(frames[body] * local);
+      p.body = body;
+      return p;
+    };
+    PathGeometry path;
+    path.points = {point(tendon.body_a, tendon.local_a), point(tendon.body_b, tendon.local_b)};
+    path.length = (path.points[1].position - path.points[0].position).norm();
+    return path;
+  }
+};
+
+TEST(WrapAroundBodies, RemembersClearSegmentsWithoutChangingAnyPath) {
+  // the same search with and without a memory, side by side over 1000 steps of 1 ms: every
+  // point and length bit for bit, and most searches of the tendons that touch nothing skipped
+  SwingingChain chain;
+  std::vector<ContactMemory> memories(chain.tendons.size());
+  ContactScratch with_memory, without;
+  int searches = 0, segments = 0, pressing = 0, on_floor = 0, ball_hits = 0;
+  auto query_all = [&](int* count) {
+    return [&chain, count](const Vector3d&, const Vector3d&, double,
+                           std::vector<const WorldShape*>* out) {
+      if (count != nullptr) ++*count;
+      for (const auto& s : chain.shapes) out->push_back(&s);
+    };
+  };
+  const ShapeQuery counted = query_all(&searches), plain = query_all(nullptr);
+  ContactOptions options;
+  options.margin = 0.001;
+  options.detour_reach = 0.1;
+  double travel = 0;
+  std::vector<Vector3d> previous;
+  for (int step = 0; step < 1000; ++step) {
+    chain.Place(step * 0.001);
+    // the engine's odometer: the largest move of a finite shape's origin, summed
+    double moved = 0;
+    for (size_t k = 0; k < chain.shapes.size(); ++k) {
+      const Vector3d c = chain.shapes[k].pose.translation();
+      if (k < previous.size() && std::isfinite(chain.shapes[k].bounding_radius))
+        moved = std::max(moved, (c - previous[k]).norm());
+      if (k >= previous.size()) previous.push_back(c);
+      previous[k] = c;
+    }
+    travel += moved;
+    for (size_t ti = 0; ti < chain.tendons.size(); ++ti) {
+      PathGeometry remembered = chain.Path(chain.tendons[ti]);
+      PathGeometry fresh = remembered;
+      const int n =
+          WrapAroundBodies(&remembered, counted, options, &with_memory, &memories[ti], travel);
+      ASSERT_EQ(n, WrapAroundBodies(&fresh, plain, options, &without)) << "step " << step;
+      ASSERT_EQ(remembered.points.size(), fresh.points.size()) << "step " << step;
+      for (size_t i = 0; i < fresh.points.size(); ++i) {
+        ASSERT_EQ(remembered.points[i].position, fresh.points[i].position)
+            << "step " << step << " tendon " << ti << " point " << i;
+        ASSERT_EQ(remembered.points[i].body, fresh.points[i].body);
+        ASSERT_EQ(remembered.points[i].contact, fresh.points[i].contact);
+      }
+      ASSERT_EQ(remembered.length, fresh.length) << "step " << step << " tendon " << ti;
+      ++segments;
+      if (ti % 2 == 0 && ti + 1 < chain.tendons.size()) pressing += n > 0;
+      if (ti + 1 == chain.tendons.size()) on_floor += n > 0;
+      // the ball on a tendon beside the chain: one the memory may have skipped until then
+      if (ti % 2 == 1)
+        for (const auto& p : fresh.points)
+          ball_hits += p.contact && p.body == SwingingChain::kLinks;
+    }
+  }
+  // what the comparison covered: pressing tendons, the floor and the ball crossing tendons
+  EXPECT_GT(pressing, 0.9 * 1000 * (SwingingChain::kLinks - 2));
+  EXPECT_EQ(on_floor, 1000);
+  EXPECT_GT(ball_hits, 0) << "the ball never met a tendon: the memory was never put to the test";
+  // the 8 pressing tendons and the one on the floor are searched at every step (9000 searches);
+  // of the 8000 segments beside the chain, all but a few in ten are skipped
+  EXPECT_EQ(segments, 17000);
+  EXPECT_LT(searches, 9000 + 800) << searches << " searches of " << segments;
+}
+
+TEST(WrapAroundBodies, SearchesAgainWhenTheMemoryCannotProveTheAnswer) {
+  // a clearance proves nothing for another margin, another routed path, or once the shapes may
+  // have travelled as far as it
+  const sgal::Geometry sphere = sgal::Sphere{0.1};
+  WorldShape ball = At(sphere, Vector3d(0, 0, 0.15), 1);
+  PrepareShape(&ball);
+  int searches = 0;
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    ++searches;
+    out->push_back(&ball);
+  };
+  ContactMemory memory;
+  ContactScratch scratch;
+  auto wrap = [&](double margin, double travel, bool via) {
+    ContactOptions options;
+    options.margin = margin;
+    PathGeometry path;
+    path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
+    if (via) path.points.insert(path.points.begin() + 1, {Vector3d(0, -0.5, 0), -1});
+    path.length = 2;
+    return WrapAroundBodies(&path, query, options, &scratch, &memory, travel);
+  };
+  EXPECT_EQ(wrap(0.01, 0, false), 0);
+  EXPECT_EQ(searches, 1);
+  EXPECT_EQ(wrap(0.01, 0.02, false), 0);
+  EXPECT_EQ(searches, 1) << "0.04 m clear, the shapes moved 0.02 m at most: no search";
+  EXPECT_GT(wrap(0.06, 0.02, false), 0) << "the thicker string touches the ball";
+  EXPECT_EQ(searches, 2);
+  EXPECT_EQ(wrap(0.01, 0.02, false), 0);
+  EXPECT_EQ(searches, 3) << "what the thicker string found says nothing of the thinner";
+  EXPECT_EQ(wrap(0.01, 0.02, true), 0);
+  EXPECT_EQ(searches, 5) << "another routed path: both segments searched";
+  EXPECT_EQ(wrap(0.01, 0.02, false), 0);
+  EXPECT_EQ(searches, 6);
+  ball.pose.translation().z() = 0.1;  // moved 0.05 m: the travel says so
+  EXPECT_GT(wrap(0.01, 0.07, false), 0) << "the ball moved onto the string";
+  EXPECT_EQ(searches, 7);
+}
+
 sgal::Scene StringOverBall(bool dynamic_ball) {
   sgal::Scene s;
   s.gravity = Vector3d::Zero();
@@ -257,6 +425,35 @@ TEST(TendonContact, FindsABodyARestoreMovedOntoTheString) {
   scene->RestoreDynamicState(state);
   EXPECT_GT(scene->TendonStates()[0].contacts, 0);
   EXPECT_GT(scene->TendonStates()[0].length, 2.0);
+}
+
+TEST(TendonContact, NoticesABallRisingIntoAStringItClearedBefore) {
+  // the ball rises from 0.4 m below the string: while it stays clear the engine may skip the
+  // string's search, and it must find the ball at the first step its top reaches the string
+  testing::RegisterTestKinds();
+  sgal::Scene description = StringOverBall(true);
+  description.bodies[0].pose.position = Vector3d(0, 0, -0.5);
+  auto scene = physics_bullet::MakeScene(description);
+  sgal::DynamicState state = scene->SaveDynamicState();
+  state.engine.clear();  // go by the body poses and velocities
+  state.bodies[0].linear_velocity = Vector3d(0, 0, 1);
+  scene->RestoreDynamicState(state);
+  int clear_steps = 0, pressing_steps = 0;
+  for (int step = 0; step < 600; ++step) {
+    scene->Step();
+    const double top = scene->BodyStates()[0].pose.position.z() + 0.1;  // radius 0.1 m
+    const int contacts = scene->TendonStates()[0].contacts;
+    if (std::abs(top) < 1e-6) continue;  // too close to call
+    if (top < 0) {
+      ++clear_steps;
+      ASSERT_EQ(contacts, 0) << "step " << step << ": the ball's top is " << -top << " m below";
+    } else {
+      ++pressing_steps;
+      ASSERT_GT(contacts, 0) << "step " << step << ": the ball's top is " << top << " m above";
+    }
+  }
+  EXPECT_GT(clear_steps, 300);
+  EXPECT_GT(pressing_steps, 50);
 }
 
 TEST(TendonContact, CanBeSwitchedOffToPassStraightThrough) {

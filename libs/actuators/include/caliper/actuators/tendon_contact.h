@@ -82,4 +82,39 @@ struct ContactScratch {
 int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
                      ContactScratch* scratch);
 
+/// What one tendon's last full searches proved, so that a later step can skip a search whose
+/// answer is known: a routed segment that cleared every shape by `clearance` still clears them
+/// all while its ends and the shapes together have moved less than that. One per tendon, kept
+/// by the engine; it never changes a result, only saves work (an empty one is always right).
+struct ContactMemory {
+  struct Segment {
+    Eigen::Vector3d a, b;                ///< the routed ends when the clearance was measured [m]
+    int exclude_a = -3, exclude_b = -3;  ///< the bodies the segment may touch (its ends' bodies)
+    /// How much farther than its bounding ball (grown by the margin) every other shape's origin
+    /// was from the segment, less a rounding allowance [m]; negative when the segment pressed
+    /// on a body or came too near one (nothing is skipped then).
+    double clearance = -1;
+    double travel = 0;  ///< the shapes' travel (see WrapAroundBodies) when measured [m]
+    /// The planes it may touch: no clearance bounds them, they are tested at every step.
+    std::vector<const WorldShape*> planes;
+  };
+  std::vector<Segment> segments;
+  double margin = -1;  ///< the margin the clearances hold for [m]
+  /// Forgets everything (after the shapes were built again or replaced).
+  void Clear() {
+    segments.clear();
+    margin = -1;
+  }
+};
+
+/// The same, skipping the search of every routed segment that `memory` proves clear, and
+/// remembering what the full searches prove. `travel` [m] bounds how far any shape's origin can
+/// have moved: it must never decrease and must grow by at least each shape's displacement
+/// between calls (an engine sums the largest displacement at each refresh of the poses). Planes
+/// (infinite bounding radius) are tested at every call instead. The query must give every
+/// plane and every shape whose bounding ball comes within `pad` of the box around the segment,
+/// as ShapeQuery says, and the shapes must stay in place while the memory holds them.
+int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactOptions& options,
+                     ContactScratch* scratch, ContactMemory* memory, double travel);
+
 }  // namespace caliper::actuators
