@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "caliper/actuators/muscle.h"
+#include "muscle_validation.h"
 
 namespace caliper::actuators {
 
@@ -19,16 +20,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-void Require(bool ok, const std::string& name, double value, const std::string& rule) {
-  if (!ok || !std::isfinite(value))
-    throw std::invalid_argument("parameter '" + name + "' = " + Num(value) + ": " + rule);
-}
+using muscle_detail::Num;
+using muscle_detail::Require;
 
 // polynomial c[0] + c[1] u + ... + c[5] u^5 and its first two derivatives
 double Poly0(const std::array<double, 6>& c, double u) {
@@ -364,28 +357,7 @@ MillardCurve MillardTendonForceLengthCurve(const MillardCurveParameters& p) {
 // parameters
 
 void Validate(const MillardMuscleParameters& p, bool elastic_tendon) {
-  constexpr double kPi = 3.14159265358979323846;
-  Require(p.max_isometric_force >= 0, "max_isometric_force", p.max_isometric_force,
-          "must be >= 0 N");
-  Require(p.optimal_fiber_length > 0, "optimal_fiber_length", p.optimal_fiber_length,
-          "must be > 0 m");
-  if (elastic_tendon)
-    Require(p.tendon_slack_length > 0, "tendon_slack_length", p.tendon_slack_length,
-            "must be > 0 m with an elastic tendon");
-  else
-    Require(p.tendon_slack_length >= 0, "tendon_slack_length", p.tendon_slack_length,
-            "must be >= 0 m");
-  Require(p.maximum_pennation_angle > 0 && p.maximum_pennation_angle < kPi / 2,
-          "maximum_pennation_angle", p.maximum_pennation_angle, "must be in (0, pi/2) rad");
-  Require(p.pennation_angle >= 0 && p.pennation_angle < p.maximum_pennation_angle,
-          "pennation_angle", p.pennation_angle,
-          "must be in [0, maximum_pennation_angle = " + Num(p.maximum_pennation_angle) + ") rad");
-  Require(p.max_contraction_velocity > 0, "max_contraction_velocity", p.max_contraction_velocity,
-          "must be > 0 optimal fibre lengths/s");
-  Require(p.activation_time_constant > 0, "activation_time_constant", p.activation_time_constant,
-          "must be > 0 s");
-  Require(p.deactivation_time_constant > 0, "deactivation_time_constant",
-          p.deactivation_time_constant, "must be > 0 s");
+  muscle_detail::RequireHillCommon(p, elastic_tendon);
   Require(p.minimum_activation >= 0 && p.minimum_activation < 1, "minimum_activation",
           p.minimum_activation, "must be in [0, 1)");
   Require(p.fiber_damping >= 0, "fiber_damping", p.fiber_damping, "must be >= 0");
