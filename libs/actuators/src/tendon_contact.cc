@@ -319,8 +319,17 @@ bool ProvenClear(const ContactMemory& memory, size_t index, const Eigen::Vector3
   const ContactMemory::Segment& s = memory.segments[index];
   if (!(s.clearance > 0) || s.exclude_a != exclude_a || s.exclude_b != exclude_b) return false;
   // every point of the segment moved no more than the farther of its ends (it stays straight)
-  const double ends = std::sqrt(std::max((a - s.a).squaredNorm(), (b - s.b).squaredNorm()));
+  const Eigen::Vector3d da = a - s.a, db = b - s.b;
+  const double ends = std::sqrt(std::max(da.squaredNorm(), db.squaredNorm()));
   if (!(ends + (travel - s.travel) + kClearanceSlack < s.clearance)) return false;
+  // distances do not change when everything moves alike: against the ends' mean move, the
+  // segment's points moved at most half the ends' difference, and a shape what is left of its own
+  const Eigen::Vector3d mean = (da + db) / 2;
+  const double ends_relative = (da - db).norm() / 2;
+  for (const ContactMemory::Segment::Near& n : s.near) {
+    const double shape_relative = (n.shape->pose.translation() - n.centre - mean).norm();
+    if (!(ends_relative + shape_relative + kClearanceSlack < n.clearance)) return false;
+  }
   for (const WorldShape* plane : s.planes) {
     const auto i = SegmentInside(*plane, a, b, margin);
     if (i && i->second - i->first > 1e-9) return false;
@@ -380,17 +389,28 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       candidates.push_back({centre, reach * reach, reach, distance2, shape->body, shape});
     }
     if (memory != nullptr) {
-      // shapes the query left out lie farther than `pad` from the segment's box
+      // shapes the query left out lie farther than `pad` from the segment's box; those it gave
+      // are remembered one by one (a shape's own travel is then enough for it)
       double clearance = options.detour_reach;
       ContactMemory::Segment& s = memory->segments[i];
       s.planes.clear();
+      s.near.clear();
       for (const Candidate& c : candidates) {
         if (c.body == exclude_a || c.body == exclude_b) continue;
         if (std::isinf(c.reach)) {
           s.planes.push_back(c.shape);
         } else {
-          clearance = std::min(clearance, std::sqrt(c.distance2) - c.reach);
+          const double own = std::sqrt(c.distance2) - c.reach - kClearanceSlack;
+          if (own < options.detour_reach) s.near.push_back({c.shape, own, c.centre});
+          clearance = std::min(clearance, own);
         }
+      }
+      // a segment that may touch a shape is searched at every step; otherwise every shape the
+      // query left out, or gave farther than that, clears it by `detour_reach`
+      if (clearance > 0) {
+        clearance = options.detour_reach;
+      } else {
+        s.near.clear();
       }
       s.a = a.position;
       s.b = b.position;

@@ -335,7 +335,7 @@ TEST(WrapAroundBodies, SearchesAgainWhenTheMemoryCannotProveTheAnswer) {
   // a clearance proves nothing for another margin, another routed path, or once the shapes may
   // have travelled as far as it
   const sgal::Geometry sphere = sgal::Sphere{0.1};
-  WorldShape ball = At(sphere, Vector3d(0, 0, 0.15), 1);
+  WorldShape ball = At(sphere, Vector3d(-0.8, 0, 0.15), 1);
   PrepareShape(&ball);
   int searches = 0;
   const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
@@ -345,11 +345,11 @@ TEST(WrapAroundBodies, SearchesAgainWhenTheMemoryCannotProveTheAnswer) {
   };
   ContactMemory memory;
   ContactScratch scratch;
-  auto wrap = [&](double margin, double travel, bool via) {
+  auto wrap = [&](double margin, double travel, bool via, double tilt = 0) {
     ContactOptions options;
     options.margin = margin;
     PathGeometry path;
-    path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
+    path.points = {{Vector3d(-1, 0, tilt), -1}, {Vector3d(1, 0, -tilt), -1}};
     if (via) path.points.insert(path.points.begin() + 1, {Vector3d(0, -0.5, 0), -1});
     path.length = 2;
     return WrapAroundBodies(&path, query, options, &scratch, &memory, travel);
@@ -366,9 +366,14 @@ TEST(WrapAroundBodies, SearchesAgainWhenTheMemoryCannotProveTheAnswer) {
   EXPECT_EQ(searches, 5) << "another routed path: both segments searched";
   EXPECT_EQ(wrap(0.01, 0.02, false), 0);
   EXPECT_EQ(searches, 6);
+  // the ends move opposite ways, their mean not at all: the string turns into the ball
+  EXPECT_GT(wrap(0.01, 0.02, false, 0.07), 0);
+  EXPECT_EQ(searches, 7);
+  EXPECT_EQ(wrap(0.01, 0.02, false), 0);
+  EXPECT_EQ(searches, 8);
   ball.pose.translation().z() = 0.1;  // moved 0.05 m: the travel says so
   EXPECT_GT(wrap(0.01, 0.07, false), 0) << "the ball moved onto the string";
-  EXPECT_EQ(searches, 7);
+  EXPECT_EQ(searches, 9);
 }
 
 sgal::Scene StringOverBall(bool dynamic_ball) {

@@ -90,11 +90,20 @@ struct ContactMemory {
   struct Segment {
     Eigen::Vector3d a, b;                ///< the routed ends when the clearance was measured [m]
     int exclude_a = -3, exclude_b = -3;  ///< the bodies the segment may touch (its ends' bodies)
-    /// How much farther than its bounding ball (grown by the margin) every other shape's origin
+    /// How much farther than its bounding ball (grown by the margin) every shape not in `near`
     /// was from the segment, less a rounding allowance [m]; negative when the segment pressed
-    /// on a body or came too near one (nothing is skipped then).
+    /// on a body (nothing is skipped then).
     double clearance = -1;
     double travel = 0;  ///< the shapes' travel (see WrapAroundBodies) when measured [m]
+    /// The shapes the query gave nearer than `clearance`, with their own clearance and origin
+    /// when measured [m]: they are followed by their own displacement against the segment's (a
+    /// tree that falls or swings as a whole keeps its segments proven), the rest by `travel`.
+    struct Near {
+      const WorldShape* shape;
+      double clearance;
+      Eigen::Vector3d centre;
+    };
+    std::vector<Near> near;
     /// The planes it may touch: no clearance bounds them, they are tested at every step.
     std::vector<const WorldShape*> planes;
   };
