@@ -327,8 +327,11 @@ bool ProvenClear(const ContactMemory& memory, size_t index, const Eigen::Vector3
   const Eigen::Vector3d mean = (da + db) / 2;
   const double ends_relative = (da - db).norm() / 2;
   for (const ContactMemory::Segment::Near& n : s.near) {
-    const double shape_relative = (n.shape->pose.translation() - n.centre - mean).norm();
-    if (!(ends_relative + shape_relative + kClearanceSlack < n.clearance)) return false;
+    // squared, no root per shape: the slack covers the rounding of the square
+    const double room = n.clearance - ends_relative - kClearanceSlack;
+    if (!(room > 0)) return false;
+    if (!((n.shape->pose.translation() - n.centre - mean).squaredNorm() < room * room))
+      return false;
   }
   for (const WorldShape* plane : s.planes) {
     const auto i = SegmentInside(*plane, a, b, margin);
