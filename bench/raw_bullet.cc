@@ -33,22 +33,37 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
   Impl& w = *impl_;
   w.world.setGravity(Bt(s.gravity));
   for (const auto& b : s.bodies) {
-    auto compound = std::make_unique<btCompoundShape>();
+    // like Caliper's scene (like for like): one shape at the identity pose is given to Bullet
+    // directly, any other body gets a compound
+    std::unique_ptr<btCompoundShape> compound;
+    btCollisionShape* collision_shape = nullptr;
     for (const auto& shape : b.shapes) {
       std::unique_ptr<btCollisionShape> child;
       if (const auto* c = std::get_if<sgal::Capsule>(&shape.geometry))
         child = std::make_unique<btCapsuleShapeZ>(c->radius, c->length);
       else
         child = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
-      compound->addChildShape(btTransform(Bt(shape.pose.orientation), Bt(shape.pose.position)),
-                              child.get());
+      const btTransform pose(Bt(shape.pose.orientation), Bt(shape.pose.position));
+      if (b.shapes.size() == 1 && pose.getOrigin().isZero() &&
+          pose.getBasis() == btMatrix3x3::getIdentity()) {
+        collision_shape = child.get();
+      } else {
+        if (!compound) compound = std::make_unique<btCompoundShape>();
+        compound->addChildShape(pose, child.get());
+        collision_shape = compound.get();
+      }
       w.shapes.push_back(std::move(child));
+    }
+    if (!collision_shape) {  // a body without shapes: an empty compound, as in Caliper
+      compound = std::make_unique<btCompoundShape>();
+      collision_shape = compound.get();
     }
     const bool dynamic = b.type == sgal::BodyType::kDynamic;
     const double mass = dynamic ? b.inertia.mass : 0;
     // the tree's tensors are diagonal in the body frame (capsules along x, y or z)
-    const btVector3 inertia = dynamic ? Bt(Eigen::Vector3d(b.inertia.tensor.diagonal())) : btVector3(0, 0, 0);
-    btRigidBody::btRigidBodyConstructionInfo info(mass, nullptr, compound.get(), inertia);
+    const btVector3 inertia =
+        dynamic ? Bt(Eigen::Vector3d(b.inertia.tensor.diagonal())) : btVector3(0, 0, 0);
+    btRigidBody::btRigidBodyConstructionInfo info(mass, nullptr, collision_shape, inertia);
     info.m_startWorldTransform = btTransform(Bt(b.pose.orientation), Bt(b.pose.position));
     auto rb = std::make_unique<btRigidBody>(info);
     rb->setActivationState(DISABLE_DEACTIVATION);
@@ -57,8 +72,9 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
       group |= shape.group;
       mask |= shape.mask;
     }
-    w.world.addRigidBody(rb.get(), static_cast<int>(group & 0x7fff), static_cast<int>(mask & 0x7fff));
-    w.shapes.push_back(std::move(compound));
+    w.world.addRigidBody(rb.get(), static_cast<int>(group & 0x7fff),
+                         static_cast<int>(mask & 0x7fff));
+    if (compound) w.shapes.push_back(std::move(compound));
     w.bodies.push_back(std::move(rb));
   }
   auto body = [&](const std::string& name) { return w.bodies[s.BodyIndex(name)].get(); };

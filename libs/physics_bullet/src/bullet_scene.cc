@@ -54,6 +54,7 @@ btTransform ToBt(const Isometry3d& t, double s) {
 
 struct BodyData {
   const sgal::Body* desc = nullptr;
+  // null when the body's one shape sits at its centre-of-mass frame and Bullet gets it directly
   std::unique_ptr<btCompoundShape> compound;
   std::vector<std::unique_ptr<btCollisionShape>> children;
   std::unique_ptr<btRigidBody> rigid;
@@ -93,13 +94,19 @@ struct TendonData {
   // again), when previous_length says it was measured
   double mean_speed = 0;
   bool speed_known = false;
+  // the lengthening speed at the end of the last step [m/s] (extrapolated from the last two
+  // means): what the tendon's speed channel reports, at the bodies' instant
+  double end_speed = 0;
   double tension = 0;
   int contacts = 0;
+  // what the last contact searches proved (lets a step skip them; never changes a path)
+  actuators::ContactMemory contact_memory;
   std::vector<int> actuators;
   bool has_wraps = false;  // the path keeps a side per wrap from step to step
   // the state at the start of the step, put back when the step fails
   actuators::TendonPath saved_path;       // only when has_wraps
   double saved_speed = 0;
+  double saved_end_speed = 0;
   double saved_previous_length = -1;
   double saved_tension = 0;
 };
@@ -272,6 +279,9 @@ class BulletScene : public sgal::PhysicsScene {
     const actuators::WorldShape* shape;
   };
   std::vector<ContactBall> contact_balls_;
+  // the sum over refreshes of the largest move of a finite shape's origin [m]: bounds how far
+  // any shape went since a tendon's contact memory measured its clearance
+  double contact_travel_ = 0;
   void QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
                    std::vector<const actuators::WorldShape*>* out);
   std::vector<ParameterEntry> parameters_;
@@ -386,23 +396,49 @@ void BulletScene::BuildBody(size_t index) {
   // Bullet wants the body frame at the centre of mass along the principal axes
   btVector3 principal(0, 0, 0);
   if (dynamic) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(desc.inertia.tensor);
-    Eigen::Matrix3d axes = eig.eigenvectors();
-    if (axes.determinant() < 0) axes.col(2) *= -1;
-    data.com_in_body.linear() = axes;
+    const Eigen::Matrix3d& tensor = desc.inertia.tensor;
+    // a body whose one shape sits at the centre of mass in the body's axes, with a tensor
+    // diagonal in them, keeps those axes: Eigen's solver sorts the moments and would turn a
+    // capsule along z needlessly, and then its shape would need a compound. Exact zeros and
+    // poses only, so that every other body keeps the solver's frame (and its numbers)
+    const bool diagonal = tensor(0, 1) == 0 && tensor(0, 2) == 0 && tensor(1, 2) == 0 &&
+                          tensor(1, 0) == 0 && tensor(2, 0) == 0 && tensor(2, 1) == 0;
+    const bool shape_at_com =
+        desc.shapes.size() == 1 && desc.shapes[0].pose.position == desc.inertia.com &&
+        desc.shapes[0].pose.ToIsometry().linear() == Eigen::Matrix3d::Identity();
+    if (diagonal && shape_at_com) {
+      principal = ToBt(Vector3d(tensor.diagonal()), s * s);
+    } else {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor);
+      Eigen::Matrix3d axes = eig.eigenvectors();
+      if (axes.determinant() < 0) axes.col(2) *= -1;
+      data.com_in_body.linear() = axes;
+      principal = ToBt(eig.eigenvalues(), s * s);
+    }
     data.com_in_body.translation() = desc.inertia.com;
-    principal = ToBt(eig.eigenvalues(), s * s);
   }
-  data.compound = std::make_unique<btCompoundShape>();
   const Isometry3d body_to_com = data.com_in_body.inverse();
+  std::vector<btTransform> child_poses;  // in the centre-of-mass frame
   for (const auto& shape : desc.shapes) {
-    auto child = MakeShape(shape.geometry, s, dynamic, "body '" + desc.name + "' shape '" + shape.name + "'");
-    data.compound->addChildShape(ToBt(body_to_com * shape.pose.ToIsometry(), s), child.get());
-    data.children.push_back(std::move(child));
+    data.children.push_back(MakeShape(shape.geometry, s, dynamic,
+                                      "body '" + desc.name + "' shape '" + shape.name + "'"));
+    child_poses.push_back(ToBt(body_to_com * shape.pose.ToIsometry(), s));
+  }
+  // one shape at the identity in Bullet's own (float) numbers collides as itself: a compound
+  // would only add its own collision algorithm and a manifold made and freed every step per pair
+  btCollisionShape* collision_shape = nullptr;
+  if (data.children.size() == 1 && child_poses[0].getOrigin().isZero() &&
+      child_poses[0].getBasis() == btMatrix3x3::getIdentity()) {
+    collision_shape = data.children[0].get();
+  } else {
+    data.compound = std::make_unique<btCompoundShape>();  // also a body without shapes
+    for (size_t k = 0; k < data.children.size(); ++k)
+      data.compound->addChildShape(child_poses[k], data.children[k].get());
+    collision_shape = data.compound.get();
   }
   const double mass = dynamic ? desc.inertia.mass : 0.0;
   btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(mass), nullptr,
-                                                data.compound.get(), principal);
+                                                collision_shape, principal);
   info.m_startWorldTransform = ToBt(desc.pose.ToIsometry() * data.com_in_body, s);
   double friction = 0.5, restitution = 0.0;
   if (!desc.shapes.empty())
@@ -607,12 +643,32 @@ void BulletScene::RefreshWorldShapes() {
     for (size_t s = 0; s < b.desc->shapes.size(); ++s)
       b.world_shapes[s].pose = pose * b.shape_poses[s];
   }
-  contact_balls_.clear();
+  // the balls are rebuilt in the same order: the old one at each index is the same shape's
+  size_t k = 0;
+  bool same_shapes = true;
+  double moved2 = 0;  // the largest squared move of a finite shape's origin [m^2]
   for (const BodyData& b : bodies_)
     for (const auto& shape : b.world_shapes) {
       const Vector3d c = shape.pose.translation();
-      contact_balls_.push_back({c.x(), c.y(), c.z(), shape.bounding_radius, &shape});
+      const ContactBall ball{c.x(), c.y(), c.z(), shape.bounding_radius, &shape};
+      if (k < contact_balls_.size() && contact_balls_[k].shape == &shape) {
+        const ContactBall& old = contact_balls_[k];
+        if (std::isfinite(ball.radius))
+          moved2 = std::max(moved2, (c - Vector3d(old.x, old.y, old.z)).squaredNorm());
+        contact_balls_[k] = ball;
+      } else {
+        same_shapes = false;
+        contact_balls_.resize(k);
+        contact_balls_.push_back(ball);
+      }
+      ++k;
     }
+  same_shapes &= k == contact_balls_.size();
+  contact_balls_.resize(k);
+  contact_travel_ += std::sqrt(moved2);
+  // other shapes than the memories hold: they start again
+  if (!same_shapes)
+    for (auto& t : tendons_) t.contact_memory.Clear();
 }
 
 // Every shape whose bounding ball comes within `pad` of the box around a-b, in body order. A scan
@@ -672,7 +728,8 @@ void BulletScene::EvaluateTendons() {
       actuators::ContactOptions contact;
       contact.margin = t.desc->radius;
       contact.detour_reach = detour_reach_;
-      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, &contact_scratch_);
+      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, &contact_scratch_,
+                                               &t.contact_memory, contact_travel_);
     }
   }
 }
@@ -889,6 +946,7 @@ void BulletScene::SaveStepState() {
     // the geometry is a function of the poses and wrap sides: a failed step evaluates it again
     // rather than every step copying it
     t.saved_speed = t.geometry.speed;
+    t.saved_end_speed = t.end_speed;
     t.saved_previous_length = t.previous_length;
     t.saved_tension = t.tension;
   }
@@ -917,7 +975,10 @@ void BulletScene::RestoreStepState() {
   // wrap sides give the same bits)
   RefreshWorldShapes();
   EvaluateTendons();
-  for (auto& t : tendons_) t.geometry.speed = t.saved_speed;
+  for (auto& t : tendons_) {
+    t.geometry.speed = t.saved_speed;
+    t.end_speed = t.saved_end_speed;
+  }
 }
 
 std::string BulletScene::Describe(const StepStage& stage) const {
@@ -1003,6 +1064,7 @@ void BulletScene::Step() {
       const double end_speed = t.speed_known
                                    ? t.geometry.speed + 0.5 * (t.geometry.speed - t.mean_speed)
                                    : t.geometry.speed;
+      t.end_speed = end_speed;
       t.tension = 0;
       for (int index : t.actuators) {
         stage_ = {StepStage::kActuator, index};
@@ -1106,6 +1168,7 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
   }
   for (const auto& t : tendons_) {
     s.engine.push_back(t.previous_length);
+    s.engine.push_back(t.end_speed);
     s.engine.push_back(static_cast<double>(t.path.wrap_sides().size()));
     for (int side : t.path.wrap_sides()) s.engine.push_back(side);
   }
@@ -1157,7 +1220,7 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
              std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
              std::to_string(s.actuators[k].size()));
   const bool exact = !s.engine.empty();
-  if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 2 * tendons_.size())
+  if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 3 * tendons_.size())
     refuse("the engine state has " + std::to_string(s.engine.size()) + " values, too few for " +
            std::to_string(bodies_.size()) + " bodies");
   const double* in = s.engine.data();
@@ -1201,13 +1264,17 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   // the tendons' part of an exact state: the length at the start of the step that ended here,
   // and the wrap sides the path goes on from (set before the path is evaluated)
   std::vector<double> previous(tendons_.size(), -1);
+  std::vector<double> end_speeds(tendons_.size(), 0);
   if (exact) {
     const double* end = s.engine.data() + s.engine.size();
     for (size_t ti = 0; ti < tendons_.size(); ++ti) {
-      if (end - in < 2) refuse("the engine state ends before the tendons'");
+      if (end - in < 3) refuse("the engine state ends before the tendons'");
       previous[ti] = *in++;
-      const size_t n = static_cast<size_t>(*in++);
-      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
+      end_speeds[ti] = *in++;
+      const double count = *in++;
+      if (!(count >= 0 && count <= static_cast<double>(end - in)))
+        refuse("the engine state ends in a tendon's wraps");
+      const size_t n = static_cast<size_t>(count);
       std::vector<int> sides(in, in + n);
       in += n;
       tendons_[ti].path.set_wrap_sides(std::move(sides));
@@ -1232,6 +1299,7 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     TendonData& t = tendons_[ti];
     t.previous_length = previous[ti];
     t.geometry.speed = previous[ti] >= 0 ? (t.geometry.length - t.previous_length) / dt_ : 0;
+    t.end_speed = end_speeds[ti];
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
   }
@@ -1263,7 +1331,7 @@ std::vector<sgal::TendonState> BulletScene::TendonStates() const {
     const TendonData& t = tendons_[i];
     for (const auto& p : t.geometry.points) states[i].points.push_back(p.position);
     states[i].length = t.geometry.length;
-    states[i].speed = t.geometry.speed;
+    states[i].speed = t.end_speed;
     states[i].tension = t.tension;
     states[i].contacts = t.contacts;
   }
@@ -1311,6 +1379,9 @@ void BulletScene::BuildParameters() {
                                     e.what());
       }
     }
+    // the speed extrapolation assumes equal steps: after a change it starts again
+    if (v != dt_)
+      for (auto& t : tendons_) t.previous_length = -1;
     dt_ = v;
     scene_.settings.time_step = v;
   });
@@ -1364,7 +1435,7 @@ void BulletScene::BuildParameters() {
     const std::string n = t.desc->name + ".tendon.";
     TendonData* td = &t;
     add({n + "length", "m", false, false}, [td] { return td->geometry.length; });
-    add({n + "speed", "m/s", false, false}, [td] { return td->geometry.speed; });
+    add({n + "speed", "m/s", false, false}, [td] { return td->end_speed; });
     add({n + "tension", "N", false, false}, [td] { return td->tension; });
     add({n + "contacts", "", false, false}, [td] { return static_cast<double>(td->contacts); });
   }
@@ -1430,7 +1501,7 @@ std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options 
 std::string EngineId() {
   const int v = btGetVersion();
   return "bullet " + std::to_string(v / 100) + "." + std::to_string(v % 100) +
-         (sizeof(btScalar) == sizeof(double) ? " double" : " float") + ", state layout 1";
+         (sizeof(btScalar) == sizeof(double) ? " double" : " float") + ", state layout 2";
 }
 
 }  // namespace caliper::physics_bullet
