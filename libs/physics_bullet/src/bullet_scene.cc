@@ -67,6 +67,9 @@ struct JointData {
   const sgal::Constraint* desc = nullptr;
   Isometry3d frame_a = Isometry3d::Identity();  // joint frames in the body frames
   Isometry3d frame_b = Isometry3d::Identity();
+  // the frame axes the joint's reading needs, in the body frames: a's x, b's x, y and z
+  Vector3d a_x = Vector3d::UnitX(), b_x = Vector3d::UnitX(), b_y = Vector3d::UnitY(),
+           b_z = Vector3d::UnitZ();
   std::unique_ptr<btTypedConstraint> constraint;
   int body_a = -1, body_b = -1;
   double position = 0;  // [rad] or [m]
@@ -507,6 +510,10 @@ void BulletScene::BuildConstraint(size_t index) {
   j.desc = &c;
   j.frame_a = c.frame_a.ToIsometry();
   j.frame_b = c.frame_b.ToIsometry();
+  j.a_x = j.frame_a.linear().col(0);
+  j.b_x = j.frame_b.linear().col(0);
+  j.b_y = j.frame_b.linear().col(1);
+  j.b_z = j.frame_b.linear().col(2);
   j.body_a = scene_.BodyIndex(c.body_a);
   j.body_b = c.body_b.empty() ? -1 : scene_.BodyIndex(c.body_b);
   btRigidBody& a = *bodies_[j.body_a].rigid;
@@ -761,14 +768,15 @@ void BulletScene::UpdateJoints() {
     const Isometry3d& pa = pose(j.body_a);
     const Isometry3d& pb = pose(j.body_b);
     // the joint frames' axes in the world, only those read (body rotation times frame axis)
-    const Vector3d axis = pb.linear() * j.frame_b.linear().col(2);
+    const Eigen::Matrix3d rb = pb.linear();
+    const Vector3d axis = rb * j.b_z;
     j.axis = axis;
     if (c.kind == sgal::ConstraintKind::kHinge) {
       // rotation of body_a's joint frame relative to body_b's (the parent's), about z: the
-      // angle of a's x axis in b's x-y plane
-      const Vector3d xa = pa.linear() * j.frame_a.linear().col(0);
-      const double cos = xa.dot(pb.linear() * j.frame_b.linear().col(0));
-      const double sin = xa.dot(pb.linear() * j.frame_b.linear().col(1));
+      // angle of a's x axis in b's x-y plane, read in body_b's frame
+      const Vector3d xa = rb.transpose() * (pa.linear() * j.a_x);
+      const double cos = xa.dot(j.b_x);
+      const double sin = xa.dot(j.b_y);
       // whole turns counted: the branch of the angle nearest the last position (a hinge turns
       // far less than half a turn in a step), so that a continuous joint, a multi-turn limit
       // (a UR5's +-2 pi) and a coupling's leader read on past +-pi instead of jumping
@@ -917,9 +925,9 @@ void BulletScene::CheckState() {
     std::string problem;
     if (!p.allFinite() || !v.allFinite() || !w.allFinite()) {
       problem = "non-finite state";
-    } else if (p.norm() > options_.max_distance) {
+    } else if (p.squaredNorm() > options_.max_distance * options_.max_distance) {
       problem = "flew off to " + std::to_string(p.norm()) + " m";
-    } else if (v.norm() > options_.max_speed) {
+    } else if (v.squaredNorm() > options_.max_speed * options_.max_speed) {
       problem = "speed " + std::to_string(v.norm()) + " m/s";
     }
     if (!problem.empty()) {
