@@ -34,7 +34,9 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
   w.world.setGravity(Bt(s.gravity));
   for (const auto& b : s.bodies) {
     // like Caliper's scene (like for like): one shape at the identity pose is given to Bullet
-    // directly, any other body gets a compound
+    // directly, any other body gets a compound. Caliper also asks for the centre of mass at the
+    // shape and a diagonal tensor; the bench trees have both (com 0, tensors diagonal in the body
+    // frame, as the inertia below assumes), so the rule is the same here
     std::unique_ptr<btCompoundShape> compound;
     btCollisionShape* collision_shape = nullptr;
     for (const auto& shape : b.shapes) {

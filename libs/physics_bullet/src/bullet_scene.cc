@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -672,7 +673,11 @@ void BulletScene::RefreshWorldShapes() {
     }
   same_shapes &= k == contact_balls_.size();
   contact_balls_.resize(k);
-  contact_travel_ += std::sqrt(moved2);
+  // rounded up: however large the sum grows, no move is lost to rounding (the memories' proof
+  // rests on it)
+  if (moved2 > 0)
+    contact_travel_ = std::nextafter(contact_travel_ + std::sqrt(moved2),
+                                     std::numeric_limits<double>::infinity());
   // other shapes than the memories hold: they start again
   if (!same_shapes)
     for (auto& t : tendons_) t.contact_memory.Clear();
@@ -1176,6 +1181,7 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
   }
   for (const auto& t : tendons_) {
     s.engine.push_back(t.previous_length);
+    s.engine.push_back(t.geometry.speed);  // the mean, as measured with the step's own dt
     s.engine.push_back(t.end_speed);
     s.engine.push_back(static_cast<double>(t.path.wrap_sides().size()));
     for (int side : t.path.wrap_sides()) s.engine.push_back(side);
@@ -1228,7 +1234,7 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
              std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
              std::to_string(s.actuators[k].size()));
   const bool exact = !s.engine.empty();
-  if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 3 * tendons_.size())
+  if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 4 * tendons_.size())
     refuse("the engine state has " + std::to_string(s.engine.size()) + " values, too few for " +
            std::to_string(bodies_.size()) + " bodies");
   const double* in = s.engine.data();
@@ -1272,19 +1278,29 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   // the tendons' part of an exact state: the length at the start of the step that ended here,
   // and the wrap sides the path goes on from (set before the path is evaluated)
   std::vector<double> previous(tendons_.size(), -1);
+  std::vector<double> mean_speeds(tendons_.size(), 0);
   std::vector<double> end_speeds(tendons_.size(), 0);
   if (exact) {
     const double* end = s.engine.data() + s.engine.size();
     for (size_t ti = 0; ti < tendons_.size(); ++ti) {
-      if (end - in < 3) refuse("the engine state ends before the tendons'");
+      if (end - in < 4) refuse("the engine state ends before the tendons'");
       previous[ti] = *in++;
+      mean_speeds[ti] = *in++;
       end_speeds[ti] = *in++;
       const double count = *in++;
-      if (!(count >= 0 && count <= static_cast<double>(end - in)))
-        refuse("the engine state ends in a tendon's wraps");
+      const size_t elements = tendons_[ti].elements.size();
+      if (!(count == 0 || count == static_cast<double>(elements)))
+        refuse("tendon '" + tendons_[ti].desc->name + "' has " + std::to_string(elements) +
+               " path elements, the engine state gives wrap sides for " + std::to_string(count));
       const size_t n = static_cast<size_t>(count);
-      std::vector<int> sides(in, in + n);
-      in += n;
+      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
+      std::vector<int> sides(n);
+      for (size_t k = 0; k < n; ++k) {
+        const double side = *in++;
+        if (!(side == -1 || side == 0 || side == 1))
+          refuse("tendon '" + tendons_[ti].desc->name + "': a wrap side must be -1, 0 or 1");
+        sides[k] = static_cast<int>(side);
+      }
       tendons_[ti].path.set_wrap_sides(std::move(sides));
     }
     if (in != end)
@@ -1306,7 +1322,7 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   for (size_t ti = 0; ti < tendons_.size(); ++ti) {
     TendonData& t = tendons_[ti];
     t.previous_length = previous[ti];
-    t.geometry.speed = previous[ti] >= 0 ? (t.geometry.length - t.previous_length) / dt_ : 0;
+    t.geometry.speed = previous[ti] >= 0 ? mean_speeds[ti] : 0;
     t.end_speed = end_speeds[ti];
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();

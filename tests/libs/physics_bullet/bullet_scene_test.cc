@@ -803,6 +803,23 @@ TEST(BulletSceneDynamicState, RestoredIntoAFreshSceneItGoesOnAsTheOriginal) {
   wrong = saved;
   wrong.engine.push_back(1.0);  // a state of a scene with more to it
   EXPECT_THROW(fresh->RestoreDynamicState(wrong), std::invalid_argument);
+  // the first tendon's wrap sides (after the one body and the tendon's length and two speeds):
+  // a count that is neither 0 nor its 2 path elements (the path keeps a side per element), or a
+  // side that is not -1, 0 or +1
+  const size_t count = kEngineValuesPerBody + 3;
+  ASSERT_EQ(saved.engine[count], 2.0);
+  wrong = saved;
+  wrong.engine[count] = 1;
+  wrong.engine.erase(wrong.engine.begin() + count + 1);
+  EXPECT_THROW(fresh->RestoreDynamicState(wrong), std::invalid_argument);
+  wrong = saved;
+  wrong.engine[count + 1] = 2;
+  try {
+    fresh->RestoreDynamicState(wrong);
+    ADD_FAILURE() << "a wrap side of 2 was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("must be -1, 0 or 1"), std::string::npos) << e.what();
+  }
 }
 
 TEST(BulletSceneDynamicState, APullSwingsThePendulumTowardItsTarget) {

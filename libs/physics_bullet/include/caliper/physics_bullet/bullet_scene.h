@@ -31,7 +31,9 @@ std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options 
 
 /// DynamicState::engine holds this many values per body first (the centre-of-mass transform and
 /// the interpolation transform, 12 each; linear, angular and the two interpolation velocities,
-/// 3 each), then the tendons' own.
+/// 3 each), then per tendon: the length at the start of the last step (-1: not measured), its mean
+/// and end lengthening speeds, and the wrap sides (their count, 0 or the path's element count,
+/// then -1, 0 or +1 each).
 constexpr size_t kEngineValuesPerBody = 36;
 
 /// The engine as recordings name it ("bullet 3.24 float", and the dynamic state's layout): a
