@@ -18,7 +18,13 @@ free_port() {
 # TLS for omniNames and nameclt, which are not linked with omniORB's SSL transport: it is
 # preloaded, and configured through ORB* environment variables (the key's password too: the
 # environment of a process is readable by its user and root only, its command line by all).
-SSL_TRANSPORT=$(ls /usr/lib/*/libomnisslTP4.so.2 2>/dev/null | head -1)
+# Empty until omniORB is installed (a fresh machine sources this before `deps`): no pipeline here,
+# whose failing `ls` would end the sourcing script under `set -euo pipefail` without a word.
+SSL_TRANSPORT=
+for lib in /usr/lib/*/libomnisslTP4.so.2; do
+  [ -e "$lib" ] && { SSL_TRANSPORT=$lib; break; }
+done
+unset lib
 
 # Finds this host's TLS identity as the components do (transport_security.h); sets TLS_CA,
 # TLS_KEY, TLS_PASS_FILE, or dies saying which launch/caliper certs commands make them.
