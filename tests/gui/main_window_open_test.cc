@@ -56,6 +56,11 @@ class MainWindowOpenTest : public ModelProcessTest {
     options.reconnect_period_ms = 300;
     window_ = std::make_unique<MainWindow>(std::make_unique<ModelLink>(options), 10.0);
     window_->show();
+    // Open is enabled once the window's link has reached the Model (its worker thread): a click
+    // before that does nothing, and no dialog would come up
+    ASSERT_TRUE(WaitInGui(
+        [&] { return window_->findChild<QPushButton*>("open")->isEnabled(); }, seconds(10)))
+        << "the Main Window did not connect to the Model";
   }
 
   /// Clicks Open, and in the dialog that comes up runs `inspect` and chooses `file`.

@@ -25,22 +25,14 @@
 #include "caliper/actuators/actuator.h"
 #include "caliper/actuators/muscle.h"
 #include "corpus.h"
+#include "make_muscle.h"
 
 namespace caliper::actuators {
 namespace {
 
 using caliper::testing::CorpusDir;
 
-std::unique_ptr<TendonActuator> MakeMuscle(std::map<std::string, std::string> options,
-                                           std::map<std::string, double> parameters) {
-  sgal::Actuator a;
-  a.name = "m";
-  a.kind = "hill_muscle";
-  a.tendon = "t";
-  a.options = std::move(options);
-  a.parameters = std::move(parameters);
-  return Make(a);
-}
+using test_support::MakeMuscle;
 
 std::string MakeError(std::map<std::string, std::string> options,
                       std::map<std::string, double> parameters) {

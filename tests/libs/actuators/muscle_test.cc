@@ -32,6 +32,7 @@
 
 #include "caliper/actuators/actuator.h"
 #include "corpus.h"
+#include "make_muscle.h"
 
 namespace caliper::actuators {
 namespace {
@@ -39,16 +40,7 @@ namespace {
 using caliper::testing::CorpusDir;
 using caliper::testing::ReadCsv;
 
-std::unique_ptr<TendonActuator> MakeMuscle(std::map<std::string, std::string> options,
-                                           std::map<std::string, double> parameters) {
-  sgal::Actuator a;
-  a.name = "m";
-  a.kind = "hill_muscle";
-  a.tendon = "t";
-  a.options = std::move(options);
-  a.parameters = std::move(parameters);
-  return Make(a);
-}
+using test_support::MakeMuscle;
 
 std::string Sci(double v) {
   std::ostringstream s;
