@@ -75,8 +75,9 @@ TEST(Arm26Trajectory, FollowsMuJoCoUnderConstantMuscleControls) {
 
 TEST(Arm26Trajectory, MatchesMuJoCoWhenBothStepFinely) {
   // tests/data/arm26_mujoco222_dt0.5ms.csv: MuJoCo 2.2.2 at 0.5 ms (bench/arm26_reference.cc)
-  const CsvTable ref = ReadCsv(std::string(std::getenv("CALIPER_SOURCE_DIR")) +
-                               "/tests/data/arm26_mujoco222_dt0.5ms.csv");
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "CALIPER_SOURCE_DIR is not set: run it through ctest";
+  const CsvTable ref = ReadCsv(std::string(source) + "/tests/data/arm26_mujoco222_dt0.5ms.csv");
   physics_bullet::Options options;
   options.tendon_body_contact = false;
   sgal::Scene arm = MakeArm26();
