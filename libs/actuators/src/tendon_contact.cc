@@ -27,8 +27,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
 Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p,
-                     const Eigen::Vector3d& d) {
-  double lo = 0, hi = 1;
+                     const Eigen::Vector3d& d, double t_max = 1) {
+  double lo = 0, hi = t_max;
   for (int i = 0; i < 3; ++i)
     if (!Slab(p[i], d[i], -half[i], half[i], &lo, &hi)) return std::nullopt;
   return std::make_pair(lo, hi);
@@ -37,16 +37,16 @@ Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p,
 /// Roots of |p + t d - c|^2 = r^2 restricted to [0, 1].
 [[gnu::always_inline]] inline Interval SphereInterval(const Eigen::Vector3d& c, double r,
                                                       const Eigen::Vector3d& p,
-                                                      const Eigen::Vector3d& d) {
+                                                      const Eigen::Vector3d& d, double t_max = 1) {
   const Eigen::Vector3d m = p - c;
   const double A = d.squaredNorm(), B = m.dot(d), C = m.squaredNorm() - r * r;
-  if (A < 1e-30) return C <= 0 ? Interval(std::make_pair(0.0, 1.0)) : std::nullopt;
+  if (A < 1e-30) return C <= 0 ? Interval(std::make_pair(0.0, t_max)) : std::nullopt;
   // the reciprocal is taken while the root is: the roots wait for a product, not a division
   const double inverse = 1 / A;
   const double disc = B * B - A * C;
   if (disc <= 0) return std::nullopt;
   const double s = std::sqrt(disc);
-  const double lo = std::max(0.0, (-B - s) * inverse), hi = std::min(1.0, (-B + s) * inverse);
+  const double lo = std::max(0.0, (-B - s) * inverse), hi = std::min(t_max, (-B + s) * inverse);
   if (lo > hi) return std::nullopt;
   return std::make_pair(lo, hi);
 }
@@ -54,8 +54,9 @@ Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p,
 /// Infinite cylinder about z of radius r, cut to |z| <= half_length.
 [[gnu::always_inline]] inline Interval CylinderInterval(double r, double half_length,
                                                         const Eigen::Vector3d& p,
-                                                        const Eigen::Vector3d& d) {
-  double lo = 0, hi = 1;
+                                                        const Eigen::Vector3d& d,
+                                                        double t_max = 1) {
+  double lo = 0, hi = t_max;
   if (!Slab(p.z(), d.z(), -half_length, half_length, &lo, &hi)) return std::nullopt;
   const double A = d.x() * d.x() + d.y() * d.y();
   const double B = p.x() * d.x() + p.y() * d.y();
@@ -111,48 +112,59 @@ void PrepareShape(WorldShape* shape) {
   }
 }
 
-Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                       double margin) {
-  // into the shape's frame by the transposed rotation: no inverse, no 4x4 products
-  const auto rotation = shape.pose.linear();
-  const Eigen::Vector3d p = rotation.transpose() * (a - shape.pose.translation());
-  const Eigen::Vector3d d = rotation.transpose() * (b - a);
+namespace {
+
+/// SegmentInside in the shape's own frame: the points p + t d, t in [0, t_max].
+Interval LocalInterval(const WorldShape& shape, const Eigen::Vector3d& p, const Eigen::Vector3d& d,
+                       double margin, double t_max = 1) {
   return std::visit(
       [&](const auto& g) -> Interval {
         using T = std::decay_t<decltype(g)>;
         if constexpr (std::is_same_v<T, sgal::Box>) {
-          return BoxInterval(g.size / 2 + Eigen::Vector3d::Constant(margin), p, d);
+          return BoxInterval(g.size / 2 + Eigen::Vector3d::Constant(margin), p, d, t_max);
         } else if constexpr (std::is_same_v<T, sgal::Sphere>) {
-          return SphereInterval(Eigen::Vector3d::Zero(), g.radius + margin, p, d);
+          return SphereInterval(Eigen::Vector3d::Zero(), g.radius + margin, p, d, t_max);
         } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
           const double r = g.radius + margin, h = g.length / 2;
-          Interval i = CylinderInterval(r, h, p, d);
+          Interval i = CylinderInterval(r, h, p, d, t_max);
           // a cap's ball adds to the cylinder and the other ball only beyond its end plane: a
           // segment that stays short of that plane needs no test against it
-          const double z0 = p.z(), z1 = p.z() + d.z();
-          if (std::max(z0, z1) > h) i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d));
+          const double z0 = p.z(), z1 = p.z() + t_max * d.z();
+          if (std::max(z0, z1) > h)
+            i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d, t_max));
           if (std::min(z0, z1) < -h)
-            i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, -h), r, p, d));
+            i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, -h), r, p, d, t_max));
           return i;
         } else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>) {
-          return CylinderInterval(g.radius + margin, g.length / 2 + margin, p, d);
+          return CylinderInterval(g.radius + margin, g.length / 2 + margin, p, d, t_max);
         } else if constexpr (std::is_same_v<T, sgal::Plane>) {
           const double da = g.normal.dot(p) - g.offset - margin;
-          const double db = g.normal.dot(p + d) - g.offset - margin;
+          const double db = g.normal.dot(p + t_max * d) - g.offset - margin;
           if (da >= 0 && db >= 0) return std::nullopt;
-          if (da < 0 && db < 0) return std::make_pair(0.0, 1.0);
-          const double t = da / (da - db);
-          return da < 0 ? std::make_pair(0.0, t) : std::make_pair(t, 1.0);
+          if (da < 0 && db < 0) return std::make_pair(0.0, t_max);
+          const double t = t_max * da / (da - db);
+          return da < 0 ? std::make_pair(0.0, t) : std::make_pair(t, t_max);
         } else {
           Eigen::Vector3d center;
           const Eigen::Vector3d half =
               shape.mesh_box ? shape.mesh_box->second : MeshHalfExtents(g.mesh.get(), &center);
           if (shape.mesh_box) center = shape.mesh_box->first;
           if (half.isZero()) return std::nullopt;
-          return BoxInterval(half + Eigen::Vector3d::Constant(margin), p - center, d);
+          return BoxInterval(half + Eigen::Vector3d::Constant(margin), p - center, d, t_max);
         }
       },
       *shape.geometry);
+}
+
+}  // namespace
+
+Interval SegmentInside(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       double margin) {
+  // into the shape's frame by the transposed rotation: no inverse, no 4x4 products
+  const auto rotation = shape.pose.linear();
+  const Eigen::Vector3d p = rotation.transpose() * (a - shape.pose.translation());
+  const Eigen::Vector3d d = rotation.transpose() * (b - a);
+  return LocalInterval(shape, p, d, margin);
 }
 
 namespace {
@@ -161,34 +173,62 @@ struct Crossing {
   double t_in = 1, t_out = 0;
   const WorldShape* shape = nullptr;
   double distance2 = 0;  // squared, of the shape's origin from the routed segment bent [m^2]
+  Eigen::Vector3d p, d;  // the piece in the shape's frame: p + t d (see LocalInterval)
 };
 
 using Candidate = ContactScratch::Candidate;
 
-/// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body.
-/// `ab` = b - a, `len` its length.
-Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                       const Eigen::Vector3d& ab, double len,
+/// Where the ray m + s w (s >= 0, in the shape's frame) leaves the shape grown by `margin`, as
+/// LocalInterval's end over the whole ray; 0 when it does not start inside. A capsule's exit is
+/// found directly: through its side where the ray leaves the side's infinite cylinder between the
+/// end planes (each cap's ball lies inside that cylinder), else through the cap on that side.
+double RayExit(const WorldShape& shape, const Eigen::Vector3d& m, const Eigen::Vector3d& w,
+               double margin) {
+  if (const auto* capsule = std::get_if<sgal::Capsule>(shape.geometry)) {
+    const double r = capsule->radius + margin, h = capsule->length / 2;
+    const double A = w.x() * w.x() + w.y() * w.y();
+    const double B = m.x() * w.x() + m.y() * w.y();
+    const double C = m.x() * m.x() + m.y() * m.y() - r * r;
+    if (C <= 0 && A >= 1e-30) {  // inside the side's cylinder: one exit from it
+      const double side = (-B + std::sqrt(B * B - A * C)) * (1 / A);
+      const double z = m.z() + side * w.z();
+      const double cap = z > h ? h : z < -h ? -h : 0.0;
+      if (cap == 0.0) return side;
+      const Eigen::Vector3d from = m - Eigen::Vector3d(0, 0, cap);
+      const double A3 = w.squaredNorm(), B3 = from.dot(w), C3 = from.squaredNorm() - r * r;
+      const double disc = B3 * B3 - A3 * C3;
+      if (C3 <= 0 && disc >= 0) return (-B3 + std::sqrt(disc)) * (1 / A3);
+    }
+  }
+  const auto exit = LocalInterval(shape, m, w, margin, kInf);  // anything else, the general way
+  return exit ? exit->second : 0.0;
+}
+
+/// The deepest-cutting crossing of a-b with a shape not fixed to an excluded body. `ab` = b - a,
+/// `l2` its squared length. No root nor division waits before the shapes are filtered.
+Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& ab, double l2,
                        const std::vector<Candidate>& candidates, int exclude_a, int exclude_b,
                        double margin) {
   Crossing best;
   double best_len = 0;
-  const double l2 = ab.squaredNorm();
-  // the ball around the segment: a cheap first test that rejects most shapes of a short piece
-  const Eigen::Vector3d mid = (a + b) / 2;
-  const double half_length = len / 2 * (1 + 1e-9) + 1e-12;
   for (const Candidate& s : candidates) {
     if (s.body == exclude_a || s.body == exclude_b) continue;
-    const double ball = s.reach + half_length;
-    if ((s.centre - mid).squaredNorm() > ball * ball) continue;
-    // only shapes whose bounding ball (grown by the margin) comes near the segment are tested
-    const double t = l2 > 0 ? std::clamp((s.centre - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-    if (!((a + t * ab - s.centre).squaredNorm() <= s.reach2)) continue;
-    const auto i = SegmentInside(*s.shape, a, b, margin);
+    // only shapes whose bounding ball (grown by the margin) comes near the segment are tested;
+    // nothing here waits on the piece's length (a root and a division): its search starts at once
+    const Eigen::Vector3d to_centre = s.centre - a;
+    const double along = to_centre.dot(ab);
+    if (!((to_centre.squaredNorm() - s.reach2) * l2 <= along * along)) continue;  // off the line
+    const double before = std::min(along, 0.0), beyond = std::max(along - l2, 0.0);
+    const double end_reach2 = s.reach2 * l2;
+    if (!(before * before <= end_reach2 && beyond * beyond <= end_reach2)) continue;  // past an end
+    const auto rotation = s.shape->pose.linear();
+    const Eigen::Vector3d p = rotation.transpose() * (-to_centre);
+    const Eigen::Vector3d d = rotation.transpose() * ab;
+    const auto i = LocalInterval(*s.shape, p, d, margin);
     if (!i || i->second - i->first <= 1e-9) continue;
     if (i->second - i->first > best_len) {
       best_len = i->second - i->first;
-      best = {i->first, i->second, s.shape, s.distance2};
+      best = {i->first, i->second, s.shape, s.distance2, p, d};
     }
   }
   return best;
@@ -245,40 +285,45 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (depth <= 0) return;
   const ContactOptions& options = *bend->options;
   const Eigen::Vector3d ab = b.position - a.position;
-  const double len = ab.norm();
-  // taken now, while the crossing is searched for: the detour direction then waits on a product
-  const double inverse_len = 1 / len;
+  const double l2 = ab.squaredNorm();
+  const double len = std::sqrt(l2);
+  const double inverse_l2 = l2 > 0 ? 1 / l2 : 0.0;
   // a segment may touch the bodies its routed ends sit on; points inserted by contact exclude none
-  const Crossing c =
-      FirstCrossing(a.position, b.position, ab, len, *bend->near, a.contact ? -2 : a.body,
-                    b.contact ? -2 : b.body, options.margin);
+  const Crossing c = FirstCrossing(a.position, ab, l2, *bend->near, a.contact ? -2 : a.body,
+                                   b.contact ? -2 : b.body, options.margin);
   if (c.shape == nullptr) return;
   const WorldShape& shape = *c.shape;
   if (len < 1e-12) return;
-  const Eigen::Vector3d mid = a.position + ab * ((c.t_in + c.t_out) / 2);
-  const Eigen::Vector3d u = ab * inverse_len;
-  Eigen::Vector3d away;
+  const double t_mid = (c.t_in + c.t_out) / 2;
+  const Eigen::Vector3d mid = a.position + ab * t_mid;
+  // the detour point: where the ray from the middle of the cut along `away` leaves the shape
+  // (grown by the margin); no way out within `reach`: the piece stays straight
+  const double reach = 10 * len + 1.0;
+  PathPoint q;
   if (const auto* plane = std::get_if<sgal::Plane>(shape.geometry)) {
     // out of a half-space along its normal
-    away = shape.pose.linear() * plane->normal;
+    Eigen::Vector3d away = shape.pose.linear() * plane->normal;
     away.normalize();
+    const auto exit = SegmentInside(shape, mid, mid + away * reach, options.margin);
+    if (exit && exit->second >= 1.0) return;
+    q.position = mid + away * ((exit ? exit->second : 0.0) * reach + 1e-9);
   } else {
-    // perpendicular to the segment, away from the shape's centre
-    const Eigen::Vector3d centre = shape.pose.translation();
-    away = (mid - centre) - u * u.dot(mid - centre);
-    const double norm = away.norm();
-    if (norm < 1e-9) {
-      away = u.unitOrthogonal().normalized();  // through the centre: any perpendicular
-    } else {
-      away /= norm;
+    // perpendicular to the piece, away from the shape's centre (its frame's origin), in the
+    // shape's frame where the cut was found. The ray is followed along the unnormalised
+    // direction, so that the search need not wait for its length (a root and a division)
+    const Eigen::Vector3d mid_local = c.p + c.d * t_mid;
+    Eigen::Vector3d away = mid_local - c.d * (c.d.dot(mid_local) * inverse_l2);
+    double away2 = away.squaredNorm();
+    if (away2 < 1e-18) {  // through the centre: any perpendicular
+      away = c.d.unitOrthogonal().normalized();
+      away2 = 1;
     }
+    const double inverse_norm = 1 / std::sqrt(away2);
+    // the whole ray: an exit beyond `reach` is refused below
+    const double s = RayExit(shape, mid_local, away, options.margin);
+    if (s * s * away2 >= reach * reach) return;
+    q.position = mid + shape.pose.linear() * (away * (s + 1e-9 * inverse_norm));
   }
-  // where the ray from the middle of the chord along `away` leaves the shape (grown by margin)
-  const double reach = 10 * len + 1.0;
-  const auto exit = SegmentInside(shape, mid, mid + away * reach, options.margin);
-  if (exit && exit->second >= 1.0) return;  // no way out along that direction: leave it straight
-  PathPoint q;
-  q.position = mid + away * ((exit ? exit->second : 0.0) * reach + 1e-9);
   q.body = shape.body;
   q.contact = true;
   // the new point lies on the shape's surface: widen the shapes the pieces can come near
@@ -310,6 +355,25 @@ namespace {
 // few 1e-16 m per metre of coordinates, so this holds for scenes up to kilometres across.
 constexpr double kClearanceSlack = 1e-9;
 
+/// Whether the segment a-b cuts the plane's half-space grown by `margin` over more than 1e-9 of
+/// its length, as SegmentInside would say, in the world's frame (no transform of the segment).
+bool PlaneCuts(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+               double margin) {
+  const auto* plane = std::get_if<sgal::Plane>(shape.geometry);
+  if (plane == nullptr) {
+    const auto i = SegmentInside(shape, a, b, margin);
+    return i && i->second - i->first > 1e-9;
+  }
+  const Eigen::Vector3d normal = shape.pose.linear() * plane->normal;
+  const Eigen::Vector3d origin = shape.pose.translation();
+  const double da = normal.dot(a - origin) - plane->offset - margin;
+  const double db = normal.dot(b - origin) - plane->offset - margin;
+  if (da >= 0 && db >= 0) return false;
+  if (da < 0 && db < 0) return true;
+  const double t = da / (da - db);
+  return (da < 0 ? t : 1 - t) > 1e-9;
+}
+
 /// Whether `memory` proves that the routed segment a-b crosses no shape: every other shape was
 /// farther than its reach by more than the segment's ends and the shapes have moved since, and
 /// no plane cuts it (tested as the search would).
@@ -334,8 +398,7 @@ bool ProvenClear(const ContactMemory& memory, size_t index, const Eigen::Vector3
       return false;
   }
   for (const WorldShape* plane : s.planes) {
-    const auto i = SegmentInside(*plane, a, b, margin);
-    if (i && i->second - i->first > 1e-9) return false;
+    if (PlaneCuts(*plane, a, b, margin)) return false;
   }
   return true;
 }
