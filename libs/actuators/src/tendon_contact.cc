@@ -217,10 +217,12 @@ Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& ab, doub
     // nothing here waits on the piece's length (a root and a division): its search starts at once
     const Eigen::Vector3d to_centre = s.centre - a;
     const double along = to_centre.dot(ab);
-    if (!((to_centre.squaredNorm() - s.reach2) * l2 <= along * along)) continue;  // off the line
-    const double before = std::min(along, 0.0), beyond = std::max(along - l2, 0.0);
-    const double end_reach2 = s.reach2 * l2;
-    if (!(before * before <= end_reach2 && beyond * beyond <= end_reach2)) continue;  // past an end
+    const double centre2 = to_centre.squaredNorm();
+    // the centre's squared distance from the segment, compared without dividing by l2
+    const bool close = along <= 0    ? centre2 <= s.reach2
+                       : along >= l2 ? (to_centre - ab).squaredNorm() <= s.reach2
+                                     : (centre2 - s.reach2) * l2 <= along * along;
+    if (!close) continue;
     const auto rotation = s.shape->pose.linear();
     const Eigen::Vector3d p = rotation.transpose() * (-to_centre);
     const Eigen::Vector3d d = rotation.transpose() * ab;
