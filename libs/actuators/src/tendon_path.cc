@@ -339,28 +339,27 @@ void PathForces(const PathGeometry& path, double tension, std::vector<PointForce
   }
   if (n < 2) return;
 
-  thread_local std::vector<Vector3d> unit;
-  unit.assign(n - 1, Vector3d::Zero());
-  for (size_t k = 0; k + 1 < n; ++k) {
-    const Vector3d d = path.points[k + 1].position - path.points[k].position;
-    if (d.norm() > kTiny) unit[k] = d.normalized();
-  }
-
   // capstan: when the path shortens or holds (speed <= 0) the actuator at the first point pulls
   // the tendon through, so tension falls by exp(-mu alpha) past each point with friction; when it
   // lengthens (speed > 0) the tendon is dragged out against the actuator and tension rises by
-  // exp(mu alpha) toward the far end
+  // exp(mu alpha) toward the far end. One pass: each piece's direction, the one before it kept
   const double sign = path.speed > 0 ? 1.0 : -1.0;
   double t = tension;
+  Vector3d before = Vector3d::Zero();  // the last piece's direction (zero for a point)
   for (size_t k = 0; k + 1 < n; ++k) {
+    const Vector3d d = path.points[k + 1].position - path.points[k].position;
+    // one root: d / |d| is what normalized() computes
+    const double length = d.norm();
+    const Vector3d unit = length > kTiny ? Vector3d(d / length) : Vector3d::Zero();
     const double mu = path.points[k].friction;
-    if (k > 0 && mu > 0 && !unit[k - 1].isZero() && !unit[k].isZero()) {
-      const double straight = std::acos(std::clamp(-unit[k - 1].dot(unit[k]), -1.0, 1.0));
+    if (k > 0 && mu > 0 && !before.isZero() && !unit.isZero()) {
+      const double straight = std::acos(std::clamp(-before.dot(unit), -1.0, 1.0));
       const double alpha = kPi - straight;
       t *= std::exp(sign * mu * alpha);
     }
-    forces[k].force += t * unit[k];
-    forces[k + 1].force -= t * unit[k];
+    before = unit;
+    forces[k].force += t * unit;
+    forces[k + 1].force -= t * unit;
   }
 }
 
