@@ -34,6 +34,9 @@ class FailingScene : public sgal::PhysicsScene {
   uint64_t steps() const override { return inner_->steps(); }
   const sgal::Scene& description() const override { return inner_->description(); }
   std::vector<sgal::BodyState> BodyStates() const override { return inner_->BodyStates(); }
+  void ReadBodyStates(std::vector<sgal::BodyState>* out) const override {
+    inner_->ReadBodyStates(out);
+  }
   std::vector<sgal::TendonState> TendonStates() const override { return inner_->TendonStates(); }
   void SetCommand(const std::string& a, double v) override { inner_->SetCommand(a, v); }
   std::vector<sgal::ParameterInfo> Parameters() const override { return inner_->Parameters(); }

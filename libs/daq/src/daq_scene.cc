@@ -11,7 +11,8 @@ SceneSampler::SceneSampler(const sgal::PhysicsScene& scene)
       values_(body_count_ * kValuesPerBody) {}
 
 void SceneSampler::Fetch() {
-  const std::vector<sgal::BodyState> states = scene_.BodyStates();
+  scene_.ReadBodyStates(&states_);
+  const std::vector<sgal::BodyState>& states = states_;
   if (states.size() != body_count_)
     throw std::runtime_error("the scene has " + std::to_string(states.size()) +
                              " bodies, its DAQ channels were registered for " +

@@ -60,6 +60,9 @@ struct BodyData {
   std::vector<std::unique_ptr<btCollisionShape>> children;
   std::unique_ptr<btRigidBody> rigid;
   Isometry3d com_in_body = Isometry3d::Identity();  // principal-axes frame at the com
+  // the inverse of com_in_body's rotation as a quaternion (BodyStates), taken once
+  Eigen::Quaterniond body_in_com_rotation = Eigen::Quaterniond::Identity();
+  bool com_is_body_frame = true;  // com_in_body is the identity: body and Bullet frames coincide
   std::vector<actuators::WorldShape> world_shapes;  // refreshed each step when contact is on
   std::vector<Isometry3d> shape_poses;               // shapes in the body frame
 };
@@ -197,6 +200,7 @@ class BulletScene : public sgal::PhysicsScene {
   uint64_t steps() const override { return steps_; }
   const sgal::Scene& description() const override { return scene_; }
   std::vector<sgal::BodyState> BodyStates() const override;
+  void ReadBodyStates(std::vector<sgal::BodyState>* out) const override;
   std::vector<sgal::TendonState> TendonStates() const override;
   void SetCommand(const std::string& actuator, double value) override;
   std::vector<sgal::ParameterInfo> Parameters() const override;
@@ -421,6 +425,8 @@ void BulletScene::BuildBody(size_t index) {
     }
     data.com_in_body.translation() = desc.inertia.com;
   }
+  data.body_in_com_rotation = Eigen::Quaterniond(data.com_in_body.linear()).conjugate();
+  data.com_is_body_frame = data.com_in_body.matrix() == Eigen::Matrix4d::Identity();
   const Isometry3d body_to_com = data.com_in_body.inverse();
   std::vector<btTransform> child_poses;  // in the centre-of-mass frame
   for (const auto& shape : desc.shapes) {
@@ -1330,23 +1336,33 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
 }
 
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {
+  std::vector<sgal::BodyState> states;
+  ReadBodyStates(&states);
+  return states;
+}
+
+void BulletScene::ReadBodyStates(std::vector<sgal::BodyState>* out) const {
   // through Bullet's own quaternion of each body (not the matrices the step reads), so that a
   // state read here and restored (an edit, a rewind) gives back the same poses to 1e-12 m
-  std::vector<sgal::BodyState> states(bodies_.size());
+  std::vector<sgal::BodyState>& states = *out;
+  states.resize(bodies_.size());
   for (size_t i = 0; i < bodies_.size(); ++i) {
     const btTransform& t = bodies_[i].rigid->getCenterOfMassTransform();
     const btQuaternion q = t.getRotation();
     const Eigen::Quaterniond com_rotation(q.w(), q.x(), q.y(), q.z());
-    const Isometry3d& com_in_body = bodies_[i].com_in_body;
-    // body frame = com frame * inverse(com in body)
     sgal::Pose& pose = states[i].pose;
-    pose.orientation =
-        (com_rotation * Eigen::Quaterniond(com_in_body.linear()).conjugate()).normalized();
-    pose.position = coms_[i] - pose.orientation * com_in_body.translation();
     states[i].angular_velocity = spins_[i];
+    if (bodies_[i].com_is_body_frame) {  // what the general case gives, without its products
+      pose.orientation = com_rotation.normalized();
+      pose.position = coms_[i];
+      states[i].linear_velocity = velocities_[i];
+      continue;
+    }
+    // body frame = com frame * inverse(com in body)
+    pose.orientation = (com_rotation * bodies_[i].body_in_com_rotation).normalized();
+    pose.position = coms_[i] - pose.orientation * bodies_[i].com_in_body.translation();
     states[i].linear_velocity = velocities_[i] + spins_[i].cross(pose.position - coms_[i]);
   }
-  return states;
 }
 
 std::vector<sgal::TendonState> BulletScene::TendonStates() const {

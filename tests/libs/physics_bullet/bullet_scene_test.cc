@@ -64,6 +64,65 @@ double MeasuredPeriod(sgal::PhysicsScene& scene, double duration) {
   return (crossings.back() - crossings.front()) / (crossings.size() - 1);
 }
 
+// Two free bodies drifting and spinning without gravity: a ball whose centre of mass is its
+// origin (its state read without the frame products) and a box whose centre of mass sits off its
+// origin with a tensor off its axes. The states read into a reused buffer are those of
+// BodyStates() bit for bit, and follow the motion: the centre of mass moves on a straight line,
+// the box's origin turns about it.
+TEST(BulletScene, ReadBodyStatesFillsAReusedBufferWithTheStatesOfBodyStates) {
+  sgal::Scene s;
+  s.name = "drift";
+  s.gravity = Vector3d::Zero();
+  sgal::Body ball;
+  ball.name = "ball";
+  ball.inertia.mass = 1;
+  ball.inertia.tensor = Eigen::Matrix3d::Identity() * 0.004;
+  ball.shapes.push_back({"s", sgal::Sphere{0.1}, {}});
+  ball.linear_velocity = Vector3d(0.3, -0.2, 0.1);
+  ball.angular_velocity = Vector3d(0, 0, 2);
+  s.bodies.push_back(ball);
+  sgal::Body box;
+  box.name = "box";
+  box.pose.position = Vector3d(1, 0, 0);
+  box.inertia.mass = 2;
+  box.inertia.com = Vector3d(0.05, 0.02, 0);
+  box.inertia.tensor << 0.02, 0.001, 0, 0.001, 0.03, 0, 0, 0, 0.04;
+  box.shapes.push_back({"b", sgal::Box{Vector3d(0.2, 0.1, 0.1)}, {}});
+  box.linear_velocity = Vector3d(-0.1, 0, 0.2);
+  box.angular_velocity = Vector3d(0, 0, 1);  // about z: the box's principal axis z
+  s.bodies.push_back(box);
+  auto scene = MakeScene(s);
+  std::vector<sgal::BodyState> buffer(5);  // the wrong size, and reused below
+  for (int step = 0; step < 500; ++step) scene->Step();
+  for (int read = 0; read < 2; ++read) {
+    scene->ReadBodyStates(&buffer);
+    const std::vector<sgal::BodyState> fresh = scene->BodyStates();
+    ASSERT_EQ(buffer.size(), 2u);
+    for (size_t i = 0; i < fresh.size(); ++i) {
+      EXPECT_EQ(buffer[i].pose.position, fresh[i].pose.position) << i;
+      EXPECT_EQ(buffer[i].pose.orientation.coeffs(), fresh[i].pose.orientation.coeffs()) << i;
+      EXPECT_EQ(buffer[i].linear_velocity, fresh[i].linear_velocity) << i;
+      EXPECT_EQ(buffer[i].angular_velocity, fresh[i].angular_velocity) << i;
+    }
+  }
+  const double t = scene->time();
+  // the ball: its origin is its centre of mass, on a straight line, turned 2 t about z (to
+  // Bullet's single precision)
+  EXPECT_LT((buffer[0].pose.position - ball.linear_velocity * t).norm(), 1e-5);
+  EXPECT_LT((buffer[0].linear_velocity - ball.linear_velocity).norm(), 1e-6);
+  EXPECT_NEAR(buffer[0].pose.orientation.angularDistance(
+                  Eigen::Quaterniond(Eigen::AngleAxisd(2 * t, Vector3d::UnitZ()))),
+              0, 1e-5);
+  // the box: the centre of mass on its line, the origin turned t about it
+  const Vector3d com0 = box.pose.position + box.inertia.com;
+  const Vector3d com = com0 + box.linear_velocity * t;
+  const Vector3d origin = com - Eigen::AngleAxisd(t, Vector3d::UnitZ()) * box.inertia.com;
+  EXPECT_LT((buffer[1].pose.position - origin).norm(), 1e-5);
+  const Vector3d origin_velocity =
+      box.linear_velocity + Vector3d(0, 0, 1).cross(buffer[1].pose.position - com);
+  EXPECT_LT((buffer[1].linear_velocity - origin_velocity).norm(), 1e-5);
+}
+
 TEST(BulletScene, PendulumPeriodMatchesTheAnalyticValue) {
   const double l = 0.5, r = 0.02, m = 1.0, angle = 0.05;
   auto scene = MakeScene(Pendulum(l, angle));

@@ -57,6 +57,7 @@ class SceneSampler : public SourceBlock {
   bool fresh_ = false;
   uint64_t fetches_ = 0;
   std::vector<double> values_;  // body_count_ * kValuesPerBody, never resized
+  std::vector<sgal::BodyState> states_;  // what the scene gave, its memory reused
 };
 
 /// What RegisterScene did.

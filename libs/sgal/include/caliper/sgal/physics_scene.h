@@ -91,6 +91,9 @@ class PhysicsScene {
   virtual const Scene& description() const = 0;
 
   virtual std::vector<BodyState> BodyStates() const = 0;  // in description().bodies order
+  /// The same into `out` (resized to the bodies), whose memory is reused: for a reader at every
+  /// step (the DAQ's sampler), no allocation.
+  virtual void ReadBodyStates(std::vector<BodyState>* out) const { *out = BodyStates(); }
   virtual std::vector<TendonState> TendonStates() const = 0;
 
   /// Sets an actuator's input (voltage, duty, excitation). Throws std::out_of_range for an
