@@ -75,6 +75,18 @@ Interval BoxInterval(const Eigen::Vector3d& half, const Eigen::Vector3d& p,
   return std::make_pair(lo, hi);
 }
 
+/// The part of t in [0, t_max] where a signed distance start + t rate is below zero (inside a
+/// half-space): for a plane in its own frame and in the world's alike. t_max may be infinite.
+[[gnu::always_inline]] inline Interval HalfSpaceInterval(double start, double rate,
+                                                         double t_max) {
+  if (start < 0 && rate <= 0) return std::make_pair(0.0, t_max);  // inside, never leaves
+  if (start >= 0 && rate >= 0) return std::nullopt;               // outside, never enters
+  const double t = -start / rate;  // where it crosses
+  if (start < 0) return std::make_pair(0.0, std::min(t, t_max));
+  if (!(t < t_max)) return std::nullopt;
+  return std::make_pair(t, t_max);
+}
+
 [[gnu::always_inline]] inline Interval Union(Interval a, Interval b) {
   if (!a) return b;
   if (!b) return a;
@@ -114,7 +126,8 @@ void PrepareShape(WorldShape* shape) {
 
 namespace {
 
-/// SegmentInside in the shape's own frame: the points p + t d, t in [0, t_max].
+/// SegmentInside in the shape's own frame: the points p + t d, t in [0, t_max] (t_max may be
+/// infinite: a ray).
 Interval LocalInterval(const WorldShape& shape, const Eigen::Vector3d& p, const Eigen::Vector3d& d,
                        double margin, double t_max = 1) {
   return std::visit(
@@ -129,7 +142,7 @@ Interval LocalInterval(const WorldShape& shape, const Eigen::Vector3d& p, const 
           Interval i = CylinderInterval(r, h, p, d, t_max);
           // a cap's ball adds to the cylinder and the other ball only beyond its end plane: a
           // segment that stays short of that plane needs no test against it
-          const double z0 = p.z(), z1 = p.z() + t_max * d.z();
+          const double z0 = p.z(), z1 = d.z() == 0 ? z0 : p.z() + t_max * d.z();  // t_max may be inf
           if (std::max(z0, z1) > h)
             i = Union(i, SphereInterval(Eigen::Vector3d(0, 0, h), r, p, d, t_max));
           if (std::min(z0, z1) < -h)
@@ -138,12 +151,7 @@ Interval LocalInterval(const WorldShape& shape, const Eigen::Vector3d& p, const 
         } else if constexpr (std::is_same_v<T, sgal::Cylinder> || std::is_same_v<T, sgal::Cone>) {
           return CylinderInterval(g.radius + margin, g.length / 2 + margin, p, d, t_max);
         } else if constexpr (std::is_same_v<T, sgal::Plane>) {
-          const double da = g.normal.dot(p) - g.offset - margin;
-          const double db = g.normal.dot(p + t_max * d) - g.offset - margin;
-          if (da >= 0 && db >= 0) return std::nullopt;
-          if (da < 0 && db < 0) return std::make_pair(0.0, t_max);
-          const double t = t_max * da / (da - db);
-          return da < 0 ? std::make_pair(0.0, t) : std::make_pair(t, t_max);
+          return HalfSpaceInterval(g.normal.dot(p) - g.offset - margin, g.normal.dot(d), t_max);
         } else {
           Eigen::Vector3d center;
           const Eigen::Vector3d half =
@@ -357,23 +365,19 @@ namespace {
 // few 1e-16 m per metre of coordinates, so this holds for scenes up to kilometres across.
 constexpr double kClearanceSlack = 1e-9;
 
-/// Whether the segment a-b cuts the plane's half-space grown by `margin` over more than 1e-9 of
-/// its length, as SegmentInside would say, in the world's frame (no transform of the segment).
-bool PlaneCuts(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-               double margin) {
-  const auto* plane = std::get_if<sgal::Plane>(shape.geometry);
-  if (plane == nullptr) {
-    const auto i = SegmentInside(shape, a, b, margin);
-    return i && i->second - i->first > 1e-9;
+/// Whether the segment a-b cuts the shape grown by `margin` over more than 1e-9 of its length, as
+/// SegmentInside says; a plane in the world's frame (no transform of the segment).
+bool Cuts(const WorldShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+          double margin) {
+  Interval i;
+  if (const auto* plane = std::get_if<sgal::Plane>(shape.geometry)) {
+    const Eigen::Vector3d normal = shape.pose.linear() * plane->normal;
+    i = HalfSpaceInterval(normal.dot(a - shape.pose.translation()) - plane->offset - margin,
+                          normal.dot(b - a), 1.0);
+  } else {
+    i = SegmentInside(shape, a, b, margin);
   }
-  const Eigen::Vector3d normal = shape.pose.linear() * plane->normal;
-  const Eigen::Vector3d origin = shape.pose.translation();
-  const double da = normal.dot(a - origin) - plane->offset - margin;
-  const double db = normal.dot(b - origin) - plane->offset - margin;
-  if (da >= 0 && db >= 0) return false;
-  if (da < 0 && db < 0) return true;
-  const double t = da / (da - db);
-  return (da < 0 ? t : 1 - t) > 1e-9;
+  return i && i->second - i->first > 1e-9;
 }
 
 /// Whether `memory` proves that the routed segment a-b crosses no shape: every other shape was
@@ -400,7 +404,7 @@ bool ProvenClear(const ContactMemory& memory, size_t index, const Eigen::Vector3
       return false;
   }
   for (const WorldShape* plane : s.planes) {
-    if (PlaneCuts(*plane, a, b, margin)) return false;
+    if (Cuts(*plane, a, b, margin)) return false;
   }
   return true;
 }

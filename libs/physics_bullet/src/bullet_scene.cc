@@ -1352,7 +1352,9 @@ void BulletScene::ReadBodyStates(std::vector<sgal::BodyState>* out) const {
     const Eigen::Quaterniond com_rotation(q.w(), q.x(), q.y(), q.z());
     sgal::Pose& pose = states[i].pose;
     states[i].angular_velocity = spins_[i];
-    if (bodies_[i].com_is_body_frame) {  // what the general case gives, without its products
+    if (bodies_[i].com_is_body_frame) {
+      // the general case's values without its products (they multiply by the identity and add
+      // zeros: only the sign of a zero component can differ)
       pose.orientation = com_rotation.normalized();
       pose.position = coms_[i];
       states[i].linear_velocity = velocities_[i];

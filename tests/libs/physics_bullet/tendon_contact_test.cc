@@ -45,6 +45,30 @@ TEST(SegmentInside, FindsTheChordThroughEachPrimitive) {
   EXPECT_FALSE(SegmentInside(At(sphere, Vector3d(0, 0.6, 0)), a, b, 0));
 }
 
+// The half-space under a plane (z <= 0.2 here, grown by the margin), entered, left, inside all
+// along, outside all along, and run parallel to, in a frame that is not the world's.
+TEST(SegmentInside, FindsThePartUnderAPlane) {
+  const sgal::Geometry floor = sgal::Plane{};
+  const WorldShape plane = At(floor, Vector3d(0.3, -0.1, 0.2));
+  auto down = SegmentInside(plane, Vector3d(0, 0, 1.2), Vector3d(0, 0, -0.8), 0);
+  ASSERT_TRUE(down);
+  EXPECT_NEAR(down->first, 0.5, 1e-12);
+  EXPECT_EQ(down->second, 1.0);
+  auto up = SegmentInside(plane, Vector3d(1, 0, -0.8), Vector3d(0, 0, 1.2), 0.1);
+  ASSERT_TRUE(up);
+  EXPECT_EQ(up->first, 0.0);
+  EXPECT_NEAR(up->second, 0.55, 1e-12) << "the margin lifts the surface to z = 0.3";
+  auto under = SegmentInside(plane, Vector3d(0, 0, 0), Vector3d(5, 5, -1), 0);
+  ASSERT_TRUE(under);
+  EXPECT_EQ(under->first, 0.0);
+  EXPECT_EQ(under->second, 1.0);
+  EXPECT_FALSE(SegmentInside(plane, Vector3d(0, 0, 0.3), Vector3d(5, 5, 2), 0));
+  EXPECT_FALSE(SegmentInside(plane, Vector3d(0, 0, 0.25), Vector3d(9, 0, 0.25), 0)) << "above";
+  ASSERT_TRUE(SegmentInside(plane, Vector3d(0, 0, 0.15), Vector3d(9, 0, 0.15), 0)) << "below";
+  EXPECT_FALSE(SegmentInside(plane, Vector3d(0, 0, 0.5), Vector3d(0, 0, 0.2), 0))
+      << "ends on the surface";
+}
+
 TEST(SegmentInside, TakesAPreparedMeshByTheSameBox) {
   // an off-centre tetrahedron: its box is centred at (0.15, 0, 0.05), half extents (0.15, 0.1,
   // 0.05)
