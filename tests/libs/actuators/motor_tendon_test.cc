@@ -158,6 +158,38 @@ TEST(DcMotorTendon, PullsAFixedPathToTheStallTension) {
   EXPECT_NEAR(motor->Get("power"), kVoltage * motor->Get("current"), 1e-9);
 }
 
+// A stalled geared motor is a stiff damper: the back-EMF resists winding with b = rho N^2 k_t k_e /
+// (R r^2) at the line (1.2e5 N s/m for the shipped arm's motors), so a soft series spring K charges
+// toward the stall tension with tau = (b + c) / K, c the element's own damper. With the arm's
+// 3000 N/m that is 40.8 s: the demo's co-contracted elbow tensions creep up for minutes while the
+// elbow stands still. The motor's inertia (1173 kg at the line) adds a pole at b / m = 104 /s,
+// far from 1 / tau: the charge is one exponential to a few 1e-4.
+TEST(DcMotorTendon, ChargesASoftSeriesSpringWithTheBackEmfTimeConstant) {
+  constexpr double kVolts = 1, kStiffness = 3000, kDamper = 20, kPretension = 8;  // [V, N/m, N s/m, N]
+  sgal::Actuator a = Motor();
+  a.parameters["stiffness"] = kStiffness;
+  a.parameters["damping"] = kDamper;
+  a.parameters["pretension"] = kPretension;
+  a.parameters["rest_length"] = 0.04;
+  auto motor = Make(a);
+  motor->Reset(0.3);
+  motor->SetCommand(kVolts);
+  const double stall = StallTension(0.0045, kVolts);  // 374 N
+  const double rho = GearEfficiencyFactor(0.59, kVolts / 0.516, 0);
+  const double b = rho * 128 * 128 * 11.5e-3 * 11.5e-3 / (0.516 * 0.0045 * 0.0045);
+  const double tau = (b + kDamper) / kStiffness;
+  EXPECT_NEAR(tau, 40.8, 0.05);
+  double t = 0;
+  for (const double until : {0.25 * tau, 0.5 * tau, tau, 2 * tau}) {
+    RunFor(*motor, 0.3, until - t);
+    t = until;
+    const double expected = stall - (stall - kPretension) * std::exp(-t / tau);
+    EXPECT_NEAR(motor->tension(), expected, 2e-4 * stall) << "at t = " << t << " s";
+  }
+  // still 13.5 % short of the stall tension after two time constants
+  EXPECT_LT(motor->tension(), 0.9 * stall);
+}
+
 TEST(DcMotorTendon, WithAZenerElementStallsAtTheSameTension) {
   sgal::Actuator a = Motor();
   a.options["elastic"] = "zener";
