@@ -319,10 +319,12 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
     q.position = mid + away * ((exit ? exit->second : 0.0) * reach + 1e-9);
   } else {
     // perpendicular to the piece, away from the shape's centre (its frame's origin), in the
-    // shape's frame where the cut was found. The ray is followed along the unnormalised
-    // direction, so that the search need not wait for its length (a root and a division)
+    // shape's frame where the cut was found. Every point of the piece has the same part across
+    // it, so the direction is taken from the piece's start and need not wait for the cut (a root
+    // and a division). The ray is followed along the unnormalised direction, so that the search
+    // need not wait for its length either
     const Eigen::Vector3d mid_local = c.p + c.d * t_mid;
-    Eigen::Vector3d away = mid_local - c.d * (c.d.dot(mid_local) * inverse_l2);
+    Eigen::Vector3d away = c.p - c.d * (c.d.dot(c.p) * inverse_l2);
     double away2 = away.squaredNorm();
     if (away2 < 1e-18) {  // through the centre: any perpendicular
       away = c.d.unitOrthogonal().normalized();
