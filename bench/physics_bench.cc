@@ -22,15 +22,20 @@ namespace caliper::bench {
 namespace {
 
 int steps = 2000;
-int repeats = 5;
+int repeats = kStarts;
+bool verbose = false;  // each run's time
 
-/// Median time of one step [us] over `repeats` runs of `steps` steps, after a warm-up; with
-/// `fastest`, the fastest run's (what the work itself costs: interference only adds time).
-double Time(const std::function<void()>& make, const std::function<void()>& step,
+/// Time of one step [us] over `repeats` runs of `steps` steps, each after a warm-up. Each run
+/// starts the tree from the next start of the ensemble (TreeOptions::start), the same for every
+/// engine: the mean over the starts, since the tree tumbles and a run's cost depends on where it
+/// lands (a change in the last bits of a force moves a single start's time by several percent).
+/// With `fastest`, the fastest run's instead (a tree held still: what the work itself costs,
+/// interference only adds time).
+double Time(const std::function<void(int start)>& make, const std::function<void()>& step,
             bool fastest = false) {
   std::vector<double> runs;
   for (int r = 0; r < repeats; ++r) {
-    make();
+    make(r % kStarts);
     for (int i = 0; i < 100; ++i) step();
     const auto begin = std::chrono::steady_clock::now();
     for (int i = 0; i < steps; ++i) step();
@@ -38,17 +43,26 @@ double Time(const std::function<void()>& make, const std::function<void()>& step
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - begin).count();
     runs.push_back(us / steps);
   }
-  std::sort(runs.begin(), runs.end());
-  return fastest ? runs.front() : runs[runs.size() / 2];
+  if (verbose) {
+    std::printf("#   runs [us]:");
+    for (const double us : runs) std::printf(" %.1f", us);
+    std::printf("\n");
+  }
+  if (fastest) return *std::min_element(runs.begin(), runs.end());
+  double sum = 0;
+  for (const double us : runs) sum += us;
+  return sum / static_cast<double>(runs.size());
 }
 
 double TimeCaliper(const TreeOptions& tree, bool contact) {
   std::unique_ptr<sgal::PhysicsScene> scene;
   physics_bullet::Options options;
   options.tendon_body_contact = contact;
-  const sgal::Scene description = MakeTree(tree);
   return Time(
-      [&] {
+      [&](int start) {
+        TreeOptions o = tree;
+        o.start = start;
+        const sgal::Scene description = MakeTree(o);
         scene = physics_bullet::MakeScene(description, options);
         for (const auto& a : description.actuators) scene->SetCommand(a.name, 0.05);  // [V]
       },
@@ -57,12 +71,16 @@ double TimeCaliper(const TreeOptions& tree, bool contact) {
 
 double TimeRawBullet(const TreeOptions& tree) {
   std::unique_ptr<RawBulletWorld> world;
-  const sgal::Scene description = MakeTree(tree);
-  return Time([&] { world = std::make_unique<RawBulletWorld>(description); },
-              [&] { world->Step(1e-3); });
+  return Time(
+      [&](int start) {
+        TreeOptions o = tree;
+        o.start = start;
+        world = std::make_unique<RawBulletWorld>(MakeTree(o));
+      },
+      [&] { world->Step(1e-3); });
 }
 
-double TimeMuJoCo(const TreeOptions& tree) {
+mjModel* LoadMuJoCo(const TreeOptions& tree) {
   const std::string xml = MakeTreeMjcf(tree);
   const char* path = "/tmp/caliper-bench-tree40.xml";
   FILE* f = std::fopen(path, "w");
@@ -74,10 +92,19 @@ double TimeMuJoCo(const TreeOptions& tree) {
     std::fprintf(stderr, "MuJoCo rejected the generated model: %s\n", error);
     std::exit(1);
   }
+  return m;
+}
+
+double TimeMuJoCo(const TreeOptions& tree) {
+  mjModel* m = nullptr;
   mjData* d = nullptr;
   const double us = Time(
-      [&] {
+      [&](int start) {
         if (d) mj_deleteData(d);
+        if (m) mj_deleteModel(m);
+        TreeOptions o = tree;
+        o.start = start;
+        m = LoadMuJoCo(o);
         d = mj_makeData(m);
         for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 1.0;  // [N]
       },
@@ -94,19 +121,27 @@ double TimePassive(const TreeOptions& tree) {
   TreeOptions springs = tree;
   springs.actuator_kind = "ligament";
   std::unique_ptr<sgal::PhysicsScene> plain;
-  sgal::Scene description = MakeTree(springs);
-  for (auto& a : description.actuators) a.parameters["stiffness"] = 2000;
-  const auto start = physics_bullet::MakeScene(description)->TendonStates();
-  for (auto& a : description.actuators)
-    for (size_t t = 0; t < description.tendons.size(); ++t)
-      if (description.tendons[t].name == a.tendon) {
-        a.parameters["damping"] = 5;
-        a.parameters["rest_length"] = 0.98 * start[t].length;
-      }
+  // the ligaments' law, on a scene of any start (a turned tree has the same lengths)
+  auto describe = [&](int start, const std::vector<sgal::TendonState>* lengths) {
+    springs.start = start;
+    sgal::Scene description = MakeTree(springs);
+    for (auto& a : description.actuators) {
+      a.parameters["stiffness"] = 2000;
+      if (lengths == nullptr) continue;
+      for (size_t t = 0; t < description.tendons.size(); ++t)
+        if (description.tendons[t].name == a.tendon) {
+          a.parameters["damping"] = 5;
+          a.parameters["rest_length"] = 0.98 * (*lengths)[t].length;
+        }
+    }
+    return description;
+  };
+  const auto lengths = physics_bullet::MakeScene(describe(0, nullptr))->TendonStates();
   physics_bullet::Options no_contact;
   no_contact.tendon_body_contact = false;
-  return Time([&] { plain = physics_bullet::MakeScene(description, no_contact); },
-              [&] { plain->Step(); });
+  return Time(
+      [&](int start) { plain = physics_bullet::MakeScene(describe(start, &lengths), no_contact); },
+      [&] { plain->Step(); });
 }
 
 void Ratio(const char* name, double value, double target) {
@@ -152,12 +187,17 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--verbose")) verbose = true;
     else {
-      std::printf("Usage: physics_bench [--steps N] [--repeats R] [--only CASE]\n"
-                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms; medians of R runs of N steps.\n"
+      std::printf("Usage: physics_bench [--steps N] [--repeats R] [--only CASE] [--verbose]\n"
+                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms. A step time is the mean over\n"
+                  "R runs of N steps (default %d and %d), each run from the next of %d starting\n"
+                  "poses (upright and tilted by %.2f rad), the same for every engine.\n"
+                  "--verbose prints each run's time.\n"
                   "--only times one case (for profiling): tree_contact, tree_free,\n"
                   "spanning_on, spanning_off, tree_bare (no tendons), passive (ligaments, no tendon\n"
-                  "contact), raw_bullet.\n");
+                  "contact), raw_bullet.\n",
+                  steps, repeats, kStarts, kStartTilt);
       return std::strcmp(argv[i], "--help") ? 2 : 0;
     }
   }
@@ -226,7 +266,7 @@ int main(int argc, char** argv) {
     held.constraints.clear();
     std::unique_ptr<sgal::PhysicsScene> scene;
     return Time(
-        [&] {
+        [&](int) {
           scene = physics_bullet::MakeScene(held);
           for (const auto& a : held.actuators) scene->SetCommand(a.name, 0.05);  // [V]
         },

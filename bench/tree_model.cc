@@ -1,6 +1,7 @@
 #include "tree_model.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <sstream>
 
@@ -114,7 +115,16 @@ Eigen::Quaterniond ZTo(const Vector3d& v) {
   return Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), v);
 }
 
+const Vector3d kBase(0, 0, 0.5);  // where the spine starts: the tilts' pivot [m]
+
 }  // namespace
+
+Eigen::Quaterniond StartTilt(int start) {
+  if (start <= 0) return Eigen::Quaterniond::Identity();
+  const double azimuth = 2 * M_PI * (start - 1) / (kStarts - 1);
+  return Eigen::Quaterniond(
+      Eigen::AngleAxisd(kStartTilt, Vector3d(std::cos(azimuth), std::sin(azimuth), 0)));
+}
 
 sgal::Scene MakeTree(const TreeOptions& options) {
   sgal::Scene s;
@@ -124,7 +134,11 @@ sgal::Scene MakeTree(const TreeOptions& options) {
   for (const auto& l : links) {
     sgal::Body b;
     b.name = l.name;
-    b.pose.position = l.centre;
+    // the whole tree turned rigidly: the frames, tensors and attachments in the bodies' frames
+    // stay as they are
+    const Eigen::Quaterniond tilt = StartTilt(options.start);
+    b.pose.position = kBase + tilt * (l.centre - kBase);
+    b.pose.orientation = tilt;
     b.inertia.mass = 0.2;
     const double ia = 0.5 * 0.2 * kRadius * kRadius;
     const double ib = 0.2 * (3 * kRadius * kRadius + kSegment * kSegment) / 12;
@@ -187,9 +201,14 @@ std::string MakeTreeMjcf(const TreeOptions& options) {
   // nested bodies: write each link, children inside
   std::function<void(int)> write = [&](int i) {
     const Link& l = links[i];
-    const Vector3d rel = l.parent < 0 ? l.centre : Vector3d(l.centre - links[l.parent].centre);
+    const Eigen::Quaterniond tilt = StartTilt(options.start);
+    const Vector3d rel = l.parent < 0 ? Vector3d(kBase + tilt * (l.centre - kBase))
+                                      : Vector3d(l.centre - links[l.parent].centre);
     x << "<body name=\"" << l.name << "\" pos=\"" << rel.x() << " " << rel.y() << " " << rel.z()
-      << "\">\n";
+      << "\"";
+    if (l.parent < 0)  // the root's turn carries its children (their frames are relative)
+      x << " quat=\"" << tilt.w() << " " << tilt.x() << " " << tilt.y() << " " << tilt.z() << "\"";
+    x << ">\n";
     if (l.parent < 0) {
       x << "<freejoint/>\n";
     } else {
