@@ -2,6 +2,7 @@
 
 #include <btBulletDynamicsCommon.h>
 
+#include <cmath>
 #include <vector>
 
 namespace caliper::bench {
@@ -19,6 +20,7 @@ struct RawBulletWorld::Impl {
   btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<Eigen::Matrix3d> axes;  // each body's Bullet frame in its own frame
   std::vector<std::unique_ptr<btTypedConstraint>> constraints;
   struct Spring {
     btRigidBody* a;
@@ -33,10 +35,24 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
   Impl& w = *impl_;
   w.world.setGravity(Bt(s.gravity));
   for (const auto& b : s.bodies) {
-    // like Caliper's scene (like for like): one shape at the identity pose is given to Bullet
-    // directly, any other body gets a compound. Caliper also asks for the centre of mass at the
-    // shape and a diagonal tensor; the bench trees have both (com 0, tensors diagonal in the body
-    // frame, as the inertia below assumes), so the rule is the same here
+    // like Caliper's scene (like for like): a body with one shape at its centre of mass, whose
+    // tensor is diagonal in the shape's axes (to 1e-12 of its trace), has Bullet's frame in those
+    // axes and goes to Bullet as that shape alone; any other body gets a compound. The bench
+    // trees have the centre of mass at the body's origin, so the arm capsules (turned to x)
+    // qualify as well as the spine's
+    const bool dynamic = b.type == sgal::BodyType::kDynamic;
+    Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // Bullet's frame in the body's
+    bool alone = false;
+    if (b.shapes.size() == 1 && b.shapes[0].pose.position.isZero()) {
+      const Eigen::Matrix3d turn = b.shapes[0].pose.ToIsometry().linear();
+      const Eigen::Matrix3d in_shape = turn.transpose() * b.inertia.tensor * turn;
+      const double off =
+          std::abs(in_shape(0, 1)) + std::abs(in_shape(0, 2)) + std::abs(in_shape(1, 2));
+      if (!dynamic || off <= 1e-12 * in_shape.trace()) {
+        axes = turn;
+        alone = true;
+      }
+    }
     std::unique_ptr<btCompoundShape> compound;
     btCollisionShape* collision_shape = nullptr;
     for (const auto& shape : b.shapes) {
@@ -45,12 +61,11 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
         child = std::make_unique<btCapsuleShapeZ>(c->radius, c->length);
       else
         child = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
-      const btTransform pose(Bt(shape.pose.orientation), Bt(shape.pose.position));
-      if (b.shapes.size() == 1 && pose.getOrigin().isZero() &&
-          pose.getBasis() == btMatrix3x3::getIdentity()) {
+      if (alone) {
         collision_shape = child.get();
       } else {
         if (!compound) compound = std::make_unique<btCompoundShape>();
+        const btTransform pose(Bt(shape.pose.orientation), Bt(shape.pose.position));
         compound->addChildShape(pose, child.get());
         collision_shape = compound.get();
       }
@@ -60,13 +75,13 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
       compound = std::make_unique<btCompoundShape>();
       collision_shape = compound.get();
     }
-    const bool dynamic = b.type == sgal::BodyType::kDynamic;
     const double mass = dynamic ? b.inertia.mass : 0;
-    // the tree's tensors are diagonal in the body frame (capsules along x, y or z)
     const btVector3 inertia =
-        dynamic ? Bt(Eigen::Vector3d(b.inertia.tensor.diagonal())) : btVector3(0, 0, 0);
+        dynamic ? Bt(Eigen::Vector3d((axes.transpose() * b.inertia.tensor * axes).diagonal()))
+                : btVector3(0, 0, 0);
     btRigidBody::btRigidBodyConstructionInfo info(mass, nullptr, collision_shape, inertia);
-    info.m_startWorldTransform = btTransform(Bt(b.pose.orientation), Bt(b.pose.position));
+    const Eigen::Quaterniond frame = b.pose.orientation * Eigen::Quaterniond(axes);
+    info.m_startWorldTransform = btTransform(Bt(frame), Bt(b.pose.position));
     auto rb = std::make_unique<btRigidBody>(info);
     rb->setActivationState(DISABLE_DEACTIVATION);
     uint32_t group = 0, mask = 0;
@@ -78,19 +93,29 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
                          static_cast<int>(mask & 0x7fff));
     if (compound) w.shapes.push_back(std::move(compound));
     w.bodies.push_back(std::move(rb));
+    w.axes.push_back(axes);
   }
   auto body = [&](const std::string& name) { return w.bodies[s.BodyIndex(name)].get(); };
+  // a frame or point given in a body's frame, in Bullet's frame of that body
+  auto in_bullet = [&](const std::string& name, const sgal::Pose& p) {
+    const Eigen::Matrix3d axes = w.axes[s.BodyIndex(name)];
+    return btTransform(Bt(Eigen::Quaterniond(axes.transpose()) * p.orientation),
+                       Bt(Eigen::Vector3d(axes.transpose() * p.position)));
+  };
+  auto point_in_bullet = [&](const std::string& name, const Eigen::Vector3d& p) {
+    return Bt(Eigen::Vector3d(w.axes[s.BodyIndex(name)].transpose() * p));
+  };
   for (const auto& c : s.constraints) {
-    auto hinge = std::make_unique<btHingeConstraint>(
-        *body(c.body_a), *body(c.body_b),
-        btTransform(Bt(c.frame_a.orientation), Bt(c.frame_a.position)),
-        btTransform(Bt(c.frame_b.orientation), Bt(c.frame_b.position)));
+    auto hinge = std::make_unique<btHingeConstraint>(*body(c.body_a), *body(c.body_b),
+                                                     in_bullet(c.body_a, c.frame_a),
+                                                     in_bullet(c.body_b, c.frame_b));
     w.world.addConstraint(hinge.get(), true);
     w.constraints.push_back(std::move(hinge));
   }
   for (const auto& t : s.tendons) {
     Impl::Spring spring{body(t.path.front().body), body(t.path.back().body),
-                        Bt(t.path.front().position), Bt(t.path.back().position), 0};
+                        point_in_bullet(t.path.front().body, t.path.front().position),
+                        point_in_bullet(t.path.back().body, t.path.back().position), 0};
     const btVector3 a = spring.a->getWorldTransform() * spring.pa;
     const btVector3 b = spring.b->getWorldTransform() * spring.pb;
     spring.rest = (b - a).length() * 0.98;  // slightly stretched: every spring pulls

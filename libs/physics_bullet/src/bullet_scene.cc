@@ -403,6 +403,7 @@ void BulletScene::BuildBody(size_t index) {
 
   // Bullet wants the body frame at the centre of mass along the principal axes
   btVector3 principal(0, 0, 0);
+  bool shape_frame = false;  // Bullet's frame is the one shape's own: it goes to Bullet as itself
   if (dynamic) {
     const Eigen::Matrix3d& tensor = desc.inertia.tensor;
     // a body whose one shape sits at the centre of mass in the body's axes, with a tensor
@@ -411,11 +412,23 @@ void BulletScene::BuildBody(size_t index) {
     // poses only, so that every other body keeps the solver's frame (and its numbers)
     const bool diagonal = tensor(0, 1) == 0 && tensor(0, 2) == 0 && tensor(1, 2) == 0 &&
                           tensor(1, 0) == 0 && tensor(2, 0) == 0 && tensor(2, 1) == 0;
-    const bool shape_at_com =
-        desc.shapes.size() == 1 && desc.shapes[0].pose.position == desc.inertia.com &&
-        desc.shapes[0].pose.ToIsometry().linear() == Eigen::Matrix3d::Identity();
-    if (diagonal && shape_at_com) {
+    const bool shape_centred =
+        desc.shapes.size() == 1 && desc.shapes[0].pose.position == desc.inertia.com;
+    const Eigen::Matrix3d shape_axes = shape_centred
+                                           ? desc.shapes[0].pose.ToIsometry().linear()
+                                           : Eigen::Matrix3d(Eigen::Matrix3d::Identity());
+    // the tensor in the shape's axes: a turned capsule, cylinder or box whose tensor is its own
+    // (a link along x drawn as a capsule along z turned) has its principal axes there, to
+    // rounding; the off-diagonal terms, at most 1e-12 of the trace, are dropped
+    const Eigen::Matrix3d in_shape = shape_axes.transpose() * tensor * shape_axes;
+    const double off_diagonal =
+        std::abs(in_shape(0, 1)) + std::abs(in_shape(0, 2)) + std::abs(in_shape(1, 2));
+    if (diagonal && shape_centred && shape_axes == Eigen::Matrix3d::Identity()) {
       principal = ToBt(Vector3d(tensor.diagonal()), s * s);
+    } else if (shape_centred && off_diagonal <= 1e-12 * in_shape.trace()) {
+      data.com_in_body.linear() = shape_axes;
+      principal = ToBt(Vector3d(in_shape.diagonal()), s * s);
+      shape_frame = true;
     } else {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor);
       Eigen::Matrix3d axes = eig.eigenvectors();
@@ -432,7 +445,9 @@ void BulletScene::BuildBody(size_t index) {
   for (const auto& shape : desc.shapes) {
     data.children.push_back(MakeShape(shape.geometry, s, dynamic,
                                       "body '" + desc.name + "' shape '" + shape.name + "'"));
-    child_poses.push_back(ToBt(body_to_com * shape.pose.ToIsometry(), s));
+    // in the shape's own frame by construction: exactly the identity, not its rounded product
+    child_poses.push_back(shape_frame ? btTransform::getIdentity()
+                                      : ToBt(body_to_com * shape.pose.ToIsometry(), s));
   }
   // one shape at the identity in Bullet's own (float) numbers collides as itself: a compound
   // would only add its own collision algorithm and a manifold made and freed every step per pair

@@ -1,8 +1,11 @@
-// How the adapter hands a body's shapes and inertia to Bullet: one shape at the centre-of-mass
-// frame goes in directly (no compound), every other body in a compound, and both collide alike;
-// a tensor already diagonal in the body frame keeps the body's own axes and moves the body as
-// the eigen-solver's frame does.
+// How the adapter hands a body's shapes and inertia to Bullet: one shape at the centre of mass
+// whose axes hold the tensor's principal axes goes in directly (no compound), in the body's axes
+// or turned; every other body goes in a compound, and all collide alike; a tensor already
+// diagonal in the body frame keeps the body's own axes and moves the body as the eigen-solver's
+// frame does.
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "caliper/physics_bullet/bullet_scene.h"
 
@@ -16,10 +19,12 @@ using Eigen::Vector3d;
 const Vector3d kBoxSize(0.1, 0.2, 0.3);  // [m]
 constexpr double kBoxMass = 2.0;         // [kg]
 
-/// A 0.1 x 0.2 x 0.3 m box standing level above a floor plane, its edges along the world axes.
-/// With `body_turn` [rad] the body frame is turned about z and the shape turned back: the same
-/// box, but its tensor in the body frame is no longer diagonal, so Bullet gets a compound.
-sgal::Scene BoxOnFloor(double body_turn) {
+/// A 0.1 x 0.2 x 0.3 m box above a floor plane, its edges along the world axes turned by `tilt`
+/// [rad] about x. With `body_turn` [rad] the body frame is turned about z and the shape turned
+/// back: the same box, its tensor no longer diagonal in the body frame but still in the shape's
+/// axes, so the shape goes to Bullet alone in its own axes. `split` makes the box two stacked
+/// halves: the same box and tensor, in a compound.
+sgal::Scene BoxOnFloor(double body_turn, bool split, double tilt = 0) {
   sgal::Scene scene;
   sgal::Body floor;
   floor.name = "floor";
@@ -28,38 +33,66 @@ sgal::Scene BoxOnFloor(double body_turn) {
   scene.bodies.push_back(floor);
   sgal::Body box;
   box.name = "box";
-  const Quaterniond turn(Eigen::AngleAxisd(body_turn, Vector3d::UnitZ()));
-  box.pose.position = Vector3d(0, 0, 0.16);
+  const Quaterniond turn = Quaterniond(Eigen::AngleAxisd(tilt, Vector3d::UnitX())) *
+                           Quaterniond(Eigen::AngleAxisd(body_turn, Vector3d::UnitZ()));
+  const Quaterniond back(Eigen::AngleAxisd(-body_turn, Vector3d::UnitZ()));
+  box.pose.position = Vector3d(0, 0, 0.16 + 0.2 * std::sin(std::abs(tilt)));
   box.pose.orientation = turn;
   box.inertia.mass = kBoxMass;
   const Vector3d s2 = kBoxSize.cwiseProduct(kBoxSize);
   const Vector3d moments =
       kBoxMass / 12 * Vector3d(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y());
-  const Matrix3d back = turn.conjugate().toRotationMatrix();
-  box.inertia.tensor = back * moments.asDiagonal() * back.transpose();
-  sgal::Shape shape{"box", sgal::Box{kBoxSize}, {}};
-  shape.pose.orientation = turn.conjugate();
-  box.shapes.push_back(shape);
+  box.inertia.tensor = back.toRotationMatrix() * moments.asDiagonal() *
+                       back.toRotationMatrix().transpose();
+  if (split) {
+    const Vector3d half(kBoxSize.x(), kBoxSize.y(), kBoxSize.z() / 2);
+    for (const double z : {-0.25, 0.25}) {
+      sgal::Shape shape{z < 0 ? "lower" : "upper", sgal::Box{half}, {}};
+      shape.pose.orientation = back;
+      shape.pose.position = back * Vector3d(0, 0, z * kBoxSize.z());
+      box.shapes.push_back(shape);
+    }
+  } else {
+    sgal::Shape shape{"box", sgal::Box{kBoxSize}, {}};
+    shape.pose.orientation = back;
+    box.shapes.push_back(shape);
+  }
   scene.bodies.push_back(box);
   return scene;
 }
 
-double RestingHeight(double body_turn) {
-  const sgal::Scene scene = BoxOnFloor(body_turn);
-  if (body_turn != 0) {
-    const Matrix3d& t = scene.bodies[1].inertia.tensor;
-    EXPECT_NE(t(0, 1), 0) << "the turned body's tensor should not be diagonal";
-  }
+sgal::BodyState After(const sgal::Scene& scene, int steps) {
   auto physics = MakeScene(scene);
-  for (int i = 0; i < 1000; ++i) physics->Step();
-  return physics->BodyStates()[1].pose.position.z();
+  for (int i = 0; i < steps; ++i) physics->Step();
+  return physics->BodyStates()[1];
 }
 
 TEST(BodyShapes, ABoxAloneAndABoxInACompoundRestAtTheSameHeight) {
-  const double alone = RestingHeight(0);
-  const double in_compound = RestingHeight(0.5);
+  const double alone = After(BoxOnFloor(0, false), 1000).pose.position.z();
+  const double in_compound = After(BoxOnFloor(0, true), 1000).pose.position.z();
   EXPECT_NEAR(alone, kBoxSize.z() / 2, 1e-3);  // on its 0.1 x 0.2 m face, at half its height
   EXPECT_NEAR(in_compound, alone, 1e-5);
+}
+
+TEST(BodyShapes, ATurnedShapeHoldingThePrincipalAxesMovesAsTheSameShapeUnturned) {
+  const sgal::Scene turned = BoxOnFloor(0.5, false);
+  const Matrix3d& t = turned.bodies[1].inertia.tensor;
+  ASSERT_NE(t(0, 1), 0) << "the turned body's tensor should not be diagonal in its frame";
+  const double alone = After(turned, 1000).pose.position.z();
+  EXPECT_NEAR(alone, kBoxSize.z() / 2, 1e-3);
+  EXPECT_NEAR(After(BoxOnFloor(0.5, true), 1000).pose.position.z(), alone, 1e-5);
+  // dropped on an edge, it tips over onto a face exactly as the same box in the body's own axes
+  // does (alone too: a compound of two halves differs from both by about 1 mm, its contacts
+  // being its own)
+  const sgal::Scene dropped = BoxOnFloor(0.5, false, 0.4);
+  const sgal::BodyState own = After(dropped, 600);
+  const sgal::BodyState level = After(BoxOnFloor(0, false, 0.4), 600);
+  EXPECT_GT(own.pose.orientation.angularDistance(dropped.bodies[1].pose.orientation), 0.3)
+      << "it should have tipped";
+  EXPECT_LT((own.pose.position - level.pose.position).norm(), 1e-9);
+  const Quaterniond box_axes = own.pose.orientation * dropped.bodies[1].shapes[0].pose.orientation;
+  EXPECT_LT(box_axes.angularDistance(level.pose.orientation), 1e-6);
+  EXPECT_LT((own.angular_velocity - level.angular_velocity).norm(), 1e-6);
 }
 
 /// A free box spinning in space (no gravity), its moments not in ascending order, after 0.2 s.
