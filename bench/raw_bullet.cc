@@ -35,11 +35,12 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
   Impl& w = *impl_;
   w.world.setGravity(Bt(s.gravity));
   for (const auto& b : s.bodies) {
-    // like Caliper's scene (like for like): a body with one shape at its centre of mass, whose
-    // tensor is diagonal in the shape's axes (to 1e-12 of its trace), has Bullet's frame in those
-    // axes and goes to Bullet as that shape alone; any other body gets a compound. The bench
-    // trees have the centre of mass at the body's origin, so the arm capsules (turned to x)
-    // qualify as well as the spine's
+    // like Caliper's scene (like for like): a moving body with one shape at its centre of mass,
+    // whose tensor is diagonal in the shape's axes (to 1e-12 of its trace), has Bullet's frame in
+    // those axes and goes to Bullet as that shape alone; a fixed body only when its one shape
+    // sits at its origin in its axes; any other body gets a compound. The bench trees have the
+    // centre of mass at the body's origin, so the arm capsules (turned to x) qualify as well as
+    // the spine's
     const bool dynamic = b.type == sgal::BodyType::kDynamic;
     Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // Bullet's frame in the body's
     bool alone = false;
@@ -48,7 +49,7 @@ RawBulletWorld::RawBulletWorld(const sgal::Scene& s) : impl_(std::make_unique<Im
       const Eigen::Matrix3d in_shape = turn.transpose() * b.inertia.tensor * turn;
       const double off =
           std::abs(in_shape(0, 1)) + std::abs(in_shape(0, 2)) + std::abs(in_shape(1, 2));
-      if (!dynamic || off <= 1e-12 * in_shape.trace()) {
+      if (dynamic ? off <= 1e-12 * in_shape.trace() : turn == Eigen::Matrix3d::Identity()) {
         axes = turn;
         alone = true;
       }

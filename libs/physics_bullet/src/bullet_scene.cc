@@ -406,26 +406,21 @@ void BulletScene::BuildBody(size_t index) {
   bool shape_frame = false;  // Bullet's frame is the one shape's own: it goes to Bullet as itself
   if (dynamic) {
     const Eigen::Matrix3d& tensor = desc.inertia.tensor;
-    // a body whose one shape sits at the centre of mass in the body's axes, with a tensor
-    // diagonal in them, keeps those axes: Eigen's solver sorts the moments and would turn a
-    // capsule along z needlessly, and then its shape would need a compound. Exact zeros and
-    // poses only, so that every other body keeps the solver's frame (and its numbers)
-    const bool diagonal = tensor(0, 1) == 0 && tensor(0, 2) == 0 && tensor(1, 2) == 0 &&
-                          tensor(1, 0) == 0 && tensor(2, 0) == 0 && tensor(2, 1) == 0;
+    // a body whose one shape sits at the centre of mass with the tensor's principal axes (the
+    // tensor diagonal in the shape's axes, to 1e-12 of its trace: a capsule along the body's z,
+    // or a link along x drawn as a capsule along z turned) takes the shape's axes as Bullet's
+    // frame, and the shape goes to Bullet as itself. Eigen's solver sorts the moments and would
+    // turn such a frame needlessly, and the shape would then need a compound; every other body
+    // keeps the solver's frame (and its numbers)
     const bool shape_centred =
         desc.shapes.size() == 1 && desc.shapes[0].pose.position == desc.inertia.com;
     const Eigen::Matrix3d shape_axes = shape_centred
                                            ? desc.shapes[0].pose.ToIsometry().linear()
                                            : Eigen::Matrix3d(Eigen::Matrix3d::Identity());
-    // the tensor in the shape's axes: a turned capsule, cylinder or box whose tensor is its own
-    // (a link along x drawn as a capsule along z turned) has its principal axes there, to
-    // rounding; the off-diagonal terms, at most 1e-12 of the trace, are dropped
     const Eigen::Matrix3d in_shape = shape_axes.transpose() * tensor * shape_axes;
     const double off_diagonal =
         std::abs(in_shape(0, 1)) + std::abs(in_shape(0, 2)) + std::abs(in_shape(1, 2));
-    if (diagonal && shape_centred && shape_axes == Eigen::Matrix3d::Identity()) {
-      principal = ToBt(Vector3d(tensor.diagonal()), s * s);
-    } else if (shape_centred && off_diagonal <= 1e-12 * in_shape.trace()) {
+    if (shape_centred && off_diagonal <= 1e-12 * in_shape.trace()) {
       data.com_in_body.linear() = shape_axes;
       principal = ToBt(Vector3d(in_shape.diagonal()), s * s);
       shape_frame = true;

@@ -162,8 +162,8 @@ TEST(DcMotorTendon, PullsAFixedPathToTheStallTension) {
 // (R r^2) at the line (1.2e5 N s/m for the shipped arm's motors), so a soft series spring K charges
 // toward the stall tension with tau = (b + c) / K, c the element's own damper. With the arm's
 // 3000 N/m that is 40.8 s: the demo's co-contracted elbow tensions creep up for minutes while the
-// elbow stands still. The motor's inertia (1173 kg at the line) adds a pole at b / m = 104 /s,
-// far from 1 / tau: the charge is one exponential to a few 1e-4.
+// elbow stands still. The rotor and gear inertia (about 1,200 kg at the line) add a pole at
+// b / m, about 100 /s, far from 1 / tau: the charge is one exponential to a few 1e-4.
 TEST(DcMotorTendon, ChargesASoftSeriesSpringWithTheBackEmfTimeConstant) {
   constexpr double kVolts = 1, kStiffness = 3000, kDamper = 20, kPretension = 8;  // [V, N/m, N s/m, N]
   sgal::Actuator a = Motor();
