@@ -1,6 +1,7 @@
 #include "caliper/actuators/tendon_contact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -139,6 +140,15 @@ Interval LocalInterval(const WorldShape& shape, const Eigen::Vector3d& p, const 
           return SphereInterval(Eigen::Vector3d::Zero(), g.radius + margin, p, d, t_max);
         } else if constexpr (std::is_same_v<T, sgal::Capsule>) {
           const double r = g.radius + margin, h = g.length / 2;
+          // a piece wholly on one side of the capsule's box misses it (most pieces near a
+          // jointed neighbour do): no root nor division
+          if (std::isfinite(t_max)) {
+            const Eigen::Vector3d e = p + t_max * d;
+            const Eigen::Vector3d reach(r, r, h + r);
+            if ((p.array() > reach.array() && e.array() > reach.array()).any() ||
+                (p.array() < -reach.array() && e.array() < -reach.array()).any())
+              return std::nullopt;
+          }
           Interval i = CylinderInterval(r, h, p, d, t_max);
           // a cap's ball adds to the cylinder and the other ball only beyond its end plane: a
           // segment that stays short of that plane needs no test against it
@@ -216,11 +226,11 @@ double RayExit(const WorldShape& shape, const Eigen::Vector3d& m, const Eigen::V
 /// `l2` its squared length. No root nor division waits before the shapes are filtered.
 Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& ab, double l2,
                        const std::vector<Candidate>& candidates, int exclude_a, int exclude_b,
-                       double margin) {
+                       double margin, const WorldShape* skip = nullptr) {
   Crossing best;
   double best_len = 0;
   for (const Candidate& s : candidates) {
-    if (s.body == exclude_a || s.body == exclude_b) continue;
+    if (s.body == exclude_a || s.body == exclude_b || s.shape == skip) continue;
     // only shapes whose bounding ball (grown by the margin) comes near the segment are tested;
     // nothing here waits on the piece's length (a root and a division): its search starts at once
     const Eigen::Vector3d to_centre = s.centre - a;
@@ -271,6 +281,303 @@ double SurfaceReach(const WorldShape& shape, double margin) {
       *shape.geometry);
 }
 
+/// The half extents of a sphere's, capsule's or cylinder's box in its frame, grown by `margin`
+/// [m]; nothing for other shapes.
+std::optional<Eigen::Vector3d> LocalReach(const WorldShape& shape, double margin) {
+  if (const auto* sphere = std::get_if<sgal::Sphere>(shape.geometry))
+    return Eigen::Vector3d::Constant(sphere->radius + margin);
+  if (const auto* capsule = std::get_if<sgal::Capsule>(shape.geometry)) {
+    const double r = capsule->radius + margin;
+    return Eigen::Vector3d(r, r, capsule->length / 2 + r);
+  }
+  if (const auto* cylinder = std::get_if<sgal::Cylinder>(shape.geometry)) {
+    const double r = cylinder->radius + margin;
+    return Eigen::Vector3d(r, r, cylinder->length / 2 + margin);
+  }
+  return std::nullopt;
+}
+
+// Exact wraps (ContactOptions::exact_wraps). The shortest way of a string from a to b around a
+// convex shape is a tangent from a, a geodesic of the surface and a tangent to b. It is drawn as
+// a polygon circumscribing each curved part: its vertices stand out of the surface by
+// 1 / cos(half the turn between them), so that every edge touches the surface and none cuts it,
+// and the first and last edges continue the tangents. The length is the exact one.
+
+constexpr int kMaxWrapVertices = 32;
+constexpr double kMaxTurn = M_PI / 4;  // the largest turn of the string at one vertex [rad]
+/// cos(kMaxTurn / 2), and its inverse: how far out of the surface a vertex can stand, relative
+/// to its radius
+constexpr double kCosHalfMaxTurn = 0.92387953251128674;
+constexpr double kVertexReach = 1.0823922002923940;
+
+/// A wrap in the shape's frame: the vertices in order from a to b and the length from a to b.
+struct ExactWrap {
+  double length = 0;  // [m]
+  int count = 0;
+  std::array<Eigen::Vector3d, kMaxWrapVertices> vertices;
+  bool Add(const Eigen::Vector3d& v) {
+    if (count == kMaxWrapVertices) return false;
+    vertices[count++] = v;
+    return true;
+  }
+};
+
+/// Turns the unit vector (c, s) by the angle x; a small turn by its series, with no call.
+inline void Turn(double x, double* c, double* s) {
+  double cos_x, sin_x;
+  if (std::abs(x) < 0.02) {  // the first terms left out are below 1e-18
+    const double x2 = x * x;
+    cos_x = 1 - x2 / 2 * (1 - x2 / 12 * (1 - x2 / 30));
+    sin_x = x * (1 - x2 / 6 * (1 - x2 / 20 * (1 - x2 / 42)));
+  } else {
+    cos_x = std::cos(x);
+    sin_x = std::sin(x);
+  }
+  const double next = *c * cos_x - *s * sin_x;
+  *s = *s * cos_x + *c * sin_x;
+  *c = next;
+}
+
+/// Halves the angle whose cosine and sine are (*c, *s), for angles in (-pi, pi): two roots side
+/// by side (a small half angle's sine is off by about 1e-16 / itself, a vertex by far less than
+/// a nanometre).
+inline void Halve(double* c, double* s) {
+  const double half_sin = std::copysign(std::sqrt(std::max(0.0, (1 - *c) / 2)), *s);
+  *c = std::sqrt((1 + *c) / 2);
+  *s = half_sin;
+}
+
+/// Adds the vertices circumscribing the arc c + r (cos psi e1 + sin psi e2) from psi0 over the
+/// turn (either way, less than pi), both given by their cosines and sines, e1 and e2
+/// orthonormal: none when the turn is nil. The arc is cut in a power of two of equal turns of
+/// at most kMaxTurn, so that a half turn comes from the whole by halving, with no angle taken.
+bool AddArc(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2,
+            double cos0, double sin0, double cos_turn, double sin_turn, ExactWrap* wrap) {
+  if (!(std::abs(sin_turn) > 1e-12) && cos_turn > 0) return true;
+  int n = 1;
+  double cos_half = cos_turn, sin_half = sin_turn;
+  Halve(&cos_half, &sin_half);
+  while (cos_half < kCosHalfMaxTurn) {
+    n *= 2;
+    Halve(&cos_half, &sin_half);
+  }
+  const double out = r / cos_half;
+  // the vertices' directions by one rotation each
+  const double cos_step = cos_half * cos_half - sin_half * sin_half;
+  const double sin_step = 2 * sin_half * cos_half;
+  double cos_psi = cos0 * cos_half - sin0 * sin_half, sin_psi = sin0 * cos_half + cos0 * sin_half;
+  for (int k = 0; k < n; ++k) {
+    if (!wrap->Add(c + out * (cos_psi * e1 + sin_psi * e2))) return false;
+    const double next = cos_psi * cos_step - sin_psi * sin_step;
+    sin_psi = sin_psi * cos_step + cos_psi * sin_step;
+    cos_psi = next;
+  }
+  return true;
+}
+
+/// The string from a to b around the ball (c, r): a tangent, an arc of the great circle through
+/// a and b, a tangent. `hint` picks the plane when a, b and c are in line. The arc's ends (the
+/// tangent points) go to *t_a and *t_b. False when an end is inside or the ends see each other.
+bool WrapBall(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+              const Eigen::Vector3d& hint, ExactWrap* wrap, Eigen::Vector3d* t_a,
+              Eigen::Vector3d* t_b) {
+  const Eigen::Vector3d u = a - c, v = b - c;
+  const double r2 = r * r, du2 = u.squaredNorm(), dv2 = v.squaredNorm();
+  if (!(du2 > r2 && dv2 > r2)) return false;
+  const double du = std::sqrt(du2), dv = std::sqrt(dv2);
+  const Eigen::Vector3d e1 = u / du;
+  Eigen::Vector3d e2 = v - e1 * e1.dot(v);
+  const double across = e2.norm(), along = e1.dot(v);
+  if (across > 1e-12 * dv) {
+    e2 /= across;
+  } else {  // in line: the plane through the hint
+    e2 = hint - e1 * e1.dot(hint);
+    if (!(e2.squaredNorm() > 1e-24)) e2 = e1.unitOrthogonal();
+    e2.normalize();
+  }
+  // the angles at c, by their cosines and sines: gamma between a and b, alpha_a and alpha_b
+  // between each end and its tangent point (cos alpha = r / distance); the arc turns by
+  // gamma - alpha_a - alpha_b
+  const double tangent_a = std::sqrt(du2 - r2), tangent_b = std::sqrt(dv2 - r2);
+  const double cos_g = along / dv, sin_g = across / dv;
+  const double cos_a = r / du, sin_a = tangent_a / du, cos_b = r / dv, sin_b = tangent_b / dv;
+  const double cos_gb = cos_g * cos_b + sin_g * sin_b, sin_gb = sin_g * cos_b - cos_g * sin_b;
+  const double cos_turn = cos_gb * cos_a + sin_gb * sin_a;
+  const double sin_turn = sin_gb * cos_a - cos_gb * sin_a;
+  if (!(sin_turn > 0)) return false;  // the turn lies in (-pi, pi): the ends see each other
+  const double turn = std::atan2(sin_turn, cos_turn);
+  wrap->length = tangent_a + tangent_b + r * turn;
+  *t_a = c + r * (cos_a * e1 + sin_a * e2);
+  *t_b = c + r * (cos_gb * e1 + sin_gb * e2);
+  return AddArc(c, r, e1, e2, cos_a, sin_a, cos_turn, sin_turn, wrap);
+}
+
+/// One end of a capsule wrap over a cap: the end at u from the cap's centre (|u| > r), the string
+/// leaving the cap's ball for the side at p = r (cos theta, sin theta, 0) on its end circle. Its
+/// length from the end to p is the tangent plus r (phi - alpha), phi the angle between u and p,
+/// alpha = acos(r / |u|) the tangent's; the derivatives in theta are phi's.
+struct CapEnd {
+  Eigen::Vector3d u;
+  double du, inverse_du, tangent;
+  double k, k1, sin_phi, inverse_sin_phi;  // cos(phi), its derivative in theta, sin(phi)
+  double slope, curvature;  // d phi / d theta and d2 phi / d theta2 (k'' = -k)
+  void At(double cos_theta, double sin_theta) {
+    k = (u.x() * cos_theta + u.y() * sin_theta) * inverse_du;
+    k1 = (u.y() * cos_theta - u.x() * sin_theta) * inverse_du;
+    // the root and the reciprocal of its square side by side, not one after the other
+    const double sin2 = std::max(0.0, 1 - k * k);
+    sin_phi = std::sqrt(sin2);
+    inverse_sin_phi = sin_phi * (1 / sin2);
+    slope = -k1 * inverse_sin_phi;
+    curvature = k * inverse_sin_phi * (1 - slope * slope);
+  }
+  /// phi - alpha, the arc over the cap, by its cosine and sine; false when it is negative.
+  bool Arc(double r, double* cos_turn, double* sin_turn) const {
+    const double cos_alpha = r * inverse_du, sin_alpha = tangent * inverse_du;
+    *cos_turn = k * cos_alpha + sin_phi * sin_alpha;
+    *sin_turn = sin_phi * cos_alpha - k * sin_alpha;
+    return *sin_turn >= 0;
+  }
+};
+
+/// The string from a (beyond the end plane z = -h) to b (beyond z = h) over both caps of the
+/// capsule (radius r, caps' centres at z = -h and h) and along its side: where it crosses the end
+/// circles (theta_a, theta_b) minimises cap + helix + cap, by Newton's method from the ends'
+/// mean direction about the axis (or the hint's). The angles are carried as unit vectors, turned
+/// by each step, and their difference as a number. False when that is not the shortest way (a
+/// tangent would not meet its cap, or the search does not settle): the bisection takes it.
+bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& hint, ExactWrap* wrap) {
+  const Eigen::Vector3d ca(0, 0, -h), cb(0, 0, h);
+  CapEnd ea, eb;
+  ea.u = a - ca;
+  eb.u = b - cb;
+  ea.du = ea.u.norm();
+  eb.du = eb.u.norm();
+  if (!(ea.du > r && eb.du > r)) return false;
+  ea.inverse_du = 1 / ea.du;
+  eb.inverse_du = 1 / eb.du;
+  ea.tangent = std::sqrt(ea.du * ea.du - r * r);
+  eb.tangent = std::sqrt(eb.du * eb.du - r * r);
+  Eigen::Vector2d mean = ea.u.head<2>() / ea.du + eb.u.head<2>() / eb.du;
+  if (!(mean.squaredNorm() > 1e-16)) mean = hint.head<2>();
+  if (!(mean.squaredNorm() > 1e-24)) return false;
+  mean.normalize();
+  double cos_a = mean.x(), sin_a = mean.y(), cos_b = cos_a, sin_b = sin_a;
+  double turn = 0;  // theta_b - theta_a [rad]
+  const double rise2 = 4 * h * h, r2 = r * r;
+  bool settled = false;
+  for (int iteration = 0; iteration < 30 && !settled; ++iteration) {
+    ea.At(cos_a, sin_a);
+    eb.At(cos_b, sin_b);
+    if (!(ea.sin_phi > 1e-9 && eb.sin_phi > 1e-9)) return false;
+    const double helix2 = rise2 + r2 * turn * turn;
+    const double inverse_helix = std::sqrt(helix2) * (1 / helix2);
+    const double pull = r2 * turn * inverse_helix;
+    const double stiff = r2 * rise2 * inverse_helix * inverse_helix * inverse_helix;
+    const double g_a = r * ea.slope - pull, g_b = r * eb.slope + pull;
+    const double h_aa = r * ea.curvature + stiff, h_bb = r * eb.curvature + stiff;
+    const double h_ab = -stiff, det = h_aa * h_bb - h_ab * h_ab;
+    if (!(h_aa > 0 && det > 0)) return false;  // not near a minimum
+    const double inverse_det = 1 / det;
+    double step_a = -(h_bb * g_a - h_ab * g_b) * inverse_det;
+    double step_b = -(h_aa * g_b - h_ab * g_a) * inverse_det;
+    const double largest = std::max(std::abs(step_a), std::abs(step_b));
+    if (largest > 0.5) {  // no more than half a radian at once
+      step_a *= 0.5 / largest;
+      step_b *= 0.5 / largest;
+    }
+    Turn(step_a, &cos_a, &sin_a);
+    Turn(step_b, &cos_b, &sin_b);
+    turn += step_b - step_a;
+    // Newton's method doubles the digits a step: after a step under 1e-5 rad the angles are
+    // off by about 1e-10 rad (the vertices by 1e-10 of the radius), and the length, stationary
+    // in them, by about 1e-20 of the radius
+    settled = largest < 1e-5;
+  }
+  if (!settled) return false;
+  ea.At(cos_a, sin_a);
+  eb.At(cos_b, sin_b);
+  // each tangent must meet its cap before the end circle, and the helix turn the short way
+  double cos_arc_a, sin_arc_a, cos_arc_b, sin_arc_b;
+  if (!ea.Arc(r, &cos_arc_a, &sin_arc_a) || !eb.Arc(r, &cos_arc_b, &sin_arc_b) ||
+      !(std::abs(turn) < M_PI))
+    return false;
+  // both arcs' angles at once when neither passes a right angle (their sum is then below pi)
+  const double arcs =
+      cos_arc_a >= 0 && cos_arc_b >= 0
+          ? std::atan2(sin_arc_a * cos_arc_b + cos_arc_a * sin_arc_b,
+                       cos_arc_a * cos_arc_b - sin_arc_a * sin_arc_b)
+          : std::atan2(sin_arc_a, cos_arc_a) + std::atan2(sin_arc_b, cos_arc_b);
+  const double helix = std::sqrt(rise2 + r2 * turn * turn);
+  wrap->length = ea.tangent + eb.tangent + r * arcs + helix;
+  const Eigen::Vector3d p_a(r * cos_a, r * sin_a, 0), p_b(r * cos_b, r * sin_b, 0);
+  // over a's cap in the plane of u and p_a, from the tangent point to the end circle
+  Eigen::Vector3d e1 = ea.u * ea.inverse_du;
+  Eigen::Vector3d e2 = (p_a / r - ea.k * e1) * ea.inverse_sin_phi;
+  if (!AddArc(ca, r, e1, e2, r * ea.inverse_du, ea.tangent * ea.inverse_du, cos_arc_a, sin_arc_a,
+              wrap) ||
+      !wrap->Add(ca + p_a))
+    return false;
+  // along the side: a helix, straight when the side is unrolled; its vertices circumscribe
+  // the end circle's arc at heights in proportion
+  if (std::abs(turn) > 1e-12) {
+    int n = 1;
+    while (std::abs(turn) > n * kMaxTurn) n *= 2;  // as the arcs are cut
+    const double half = turn / (2 * n);
+    double cos_t = cos_a, sin_t = sin_a, cos_half = 1, sin_half = 0;
+    Turn(half, &cos_half, &sin_half);
+    Turn(half, &cos_t, &sin_t);
+    const double out = r / cos_half;
+    for (int k = 0; k < n; ++k) {
+      if (!wrap->Add(Eigen::Vector3d(out * cos_t, out * sin_t, -h + 2 * h * (k + 0.5) / n)))
+        return false;
+      Turn(2 * half, &cos_t, &sin_t);
+    }
+  }
+  if (!wrap->Add(cb + p_b)) return false;
+  // over b's cap, from the end circle back to the tangent point
+  e1 = eb.u * eb.inverse_du;
+  e2 = (p_b / r - eb.k * e1) * eb.inverse_sin_phi;
+  return AddArc(cb, r, e1, e2, eb.k, eb.sin_phi, cos_arc_b, -sin_arc_b, wrap);
+}
+
+/// The string from a to b around a sphere or capsule grown to radius r (in its frame), when one
+/// of the cases above is the shortest way; false otherwise.
+bool WrapExactly(const sgal::Geometry& geometry, double margin, const Eigen::Vector3d& a,
+                 const Eigen::Vector3d& b, const Eigen::Vector3d& hint, ExactWrap* wrap) {
+  wrap->count = 0;
+  Eigen::Vector3d t_a, t_b;
+  if (const auto* sphere = std::get_if<sgal::Sphere>(&geometry))
+    return WrapBall(Eigen::Vector3d::Zero(), sphere->radius + margin, a, b, hint, wrap, &t_a, &t_b);
+  const auto* capsule = std::get_if<sgal::Capsule>(&geometry);
+  if (capsule == nullptr) return false;
+  const double r = capsule->radius + margin, h = capsule->length / 2;
+  if (!(h > 1e-6 * r)) {  // no side to speak of: a ball
+    return WrapBall(Eigen::Vector3d::Zero(), r, a, b, hint, wrap, &t_a, &t_b);
+  }
+  // both ends beyond one end plane: over that cap's ball, if the arc stays beyond the plane too
+  // (the segments to the tangent points then do as well, and the capsule is the ball there)
+  for (const double side : {-1.0, 1.0}) {
+    if (side * a.z() > h && side * b.z() > h) {
+      const Eigen::Vector3d centre(0, 0, side * h);
+      return WrapBall(centre, r, a, b, hint, wrap, &t_a, &t_b) && side * t_a.z() >= h &&
+             side * t_b.z() >= h;
+    }
+  }
+  if (a.z() < -h && b.z() > h) return WrapCapsuleOverCaps(r, h, a, b, hint, wrap);
+  if (a.z() > h && b.z() < -h) {
+    // the same turned upside down (half a turn about x), and back
+    const Eigen::Vector3d flip(1, -1, -1);
+    if (!WrapCapsuleOverCaps(r, h, a.cwiseProduct(flip), b.cwiseProduct(flip),
+                             hint.cwiseProduct(flip), wrap))
+      return false;
+    for (int k = 0; k < wrap->count; ++k) wrap->vertices[k] = wrap->vertices[k].cwiseProduct(flip);
+    return true;
+  }
+  return false;  // the side first: the bisection
+}
+
 /// One routed segment being bent. Every detour point lies within `rho` of the routed segment, so
 /// a shape can come near a piece of the bent path only if it comes within its reach plus `rho`
 /// of the routed segment: `near` holds those, in the query's order, and grows with `rho`.
@@ -280,6 +587,10 @@ struct Bend {
   double rho = 0;  // [m]
   const ContactOptions* options;
   std::vector<PathPoint>* out;
+  /// What exact wraps add to the path's length over their polygons [m].
+  double extra_length = 0;
+  ExactWrap wrap;
+  std::array<Eigen::Vector3d, kMaxWrapVertices + 2> local;  // a wrap in another shape's frame
 
   void Select() {
     near->clear();
@@ -290,6 +601,82 @@ struct Bend {
     }
   }
 };
+
+/// Bends a-b exactly around the crossing's shape (ContactOptions::exact_wraps) when it is a
+/// sphere or capsule, the wrap is the shortest way, and no other shape cuts it.
+bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Bend* bend) {
+  const WorldShape& shape = *c.shape;
+  const ContactOptions& options = *bend->options;
+  // where the detour would go: across the piece, away from the shape's origin
+  const Eigen::Vector3d hint = c.p - c.d * (c.d.dot(c.p) / c.d.squaredNorm());
+  ExactWrap& wrap = bend->wrap;
+  if (!WrapExactly(*shape.geometry, options.margin, c.p, c.p + c.d, hint, &wrap)) return false;
+  // every vertex lies within the surface's reach, pushed out by at most kVertexReach: the
+  // shapes the pieces can come near must all be known
+  const double rho =
+      std::sqrt(c.distance2) + kVertexReach * SurfaceReach(shape, options.margin) + 1e-9;
+  if (!(rho <= options.margin + options.detour_reach)) return false;
+  if (rho > bend->rho) {
+    bend->rho = rho;
+    bend->Select();
+  }
+  // to the world, with the box around the whole wrap
+  const auto rotation = shape.pose.linear();
+  const Eigen::Vector3d origin = shape.pose.translation();
+  Eigen::Vector3d lo = a.position.cwiseMin(b.position), hi = a.position.cwiseMax(b.position);
+  for (int k = 0; k < wrap.count; ++k) {
+    Eigen::Vector3d& v = wrap.vertices[k];
+    v = origin + rotation * v;
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  // no other shape may cut a piece (the tendon's own ends' bodies excepted, as the bisection
+  // excepts them); only those whose bounding ball comes near the box can. Each is tested in its
+  // own frame, first by its box against all the pieces it may cut at once
+  const int count = wrap.count;
+  auto point = [&](int k) -> const Eigen::Vector3d& {
+    return k < 0 ? a.position : k < count ? wrap.vertices[k] : b.position;
+  };
+  for (const Candidate& n : *bend->near) {
+    if (n.shape == &shape) continue;
+    const Eigen::Vector3d nearest = n.centre.cwiseMax(lo).cwiseMin(hi);
+    if (!((n.centre - nearest).squaredNorm() <= n.reach2)) continue;  // planes: always tested
+    // pieces first..last (piece k runs from point k - 1 to point k)
+    const int first = n.body == a.body && !a.contact ? 1 : 0;
+    const int last = n.body == b.body && !b.contact ? count - 1 : count;
+    if (first > last) continue;
+    const auto turn = n.shape->pose.linear();
+    const Eigen::Vector3d at = n.shape->pose.translation();
+    std::array<Eigen::Vector3d, kMaxWrapVertices + 2>& local = bend->local;
+    Eigen::Vector3d local_lo = Eigen::Vector3d::Constant(kInf), local_hi = -local_lo;
+    for (int k = first - 1; k <= last; ++k) {
+      Eigen::Vector3d& q = local[k + 1];
+      q = turn.transpose() * (point(k) - at);
+      local_lo = local_lo.cwiseMin(q);
+      local_hi = local_hi.cwiseMax(q);
+    }
+    const std::optional<Eigen::Vector3d> reach = LocalReach(*n.shape, options.margin);
+    if (reach && ((local_lo.array() > reach->array()).any() ||
+                  (local_hi.array() < -reach->array()).any()))
+      continue;
+    for (int k = first; k <= last; ++k) {
+      const auto i = LocalInterval(*n.shape, local[k], local[k + 1] - local[k], options.margin);
+      if (i && i->second - i->first > 1e-9) return false;
+    }
+  }
+  double polygon = 0;
+  for (int k = 0; k <= count; ++k) polygon += (point(k) - point(k - 1)).norm();
+  std::vector<PathPoint>& out = *bend->out;
+  for (int k = 0; k < wrap.count; ++k) {
+    PathPoint q;
+    q.position = wrap.vertices[k];
+    q.body = shape.body;
+    q.contact = true;
+    out.push_back(q);
+  }
+  bend->extra_length += wrap.length - polygon;
+  return true;
+}
 
 void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (depth <= 0) return;
@@ -304,6 +691,7 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
   if (c.shape == nullptr) return;
   const WorldShape& shape = *c.shape;
   if (len < 1e-12) return;
+  if (options.exact_wraps && WrapCrossing(a, b, c, bend)) return;
   const double t_mid = (c.t_in + c.t_out) / 2;
   const Eigen::Vector3d mid = a.position + ab * t_mid;
   // the detour point: where the ray from the middle of the cut along `away` leaves the shape
@@ -444,16 +832,35 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
                                          travel, options.margin))
       continue;
     const size_t before = out.size();
-    shapes.clear();
     const double pad = options.margin + options.detour_reach;
-    query(a.position, b.position, pad, &shapes);
+    const std::vector<const WorldShape*>* given = &shapes;
+    if (memory != nullptr) {
+      // the engine is asked again only when the ends and shapes may have moved by the slack
+      ContactMemory::Segment& s = memory->segments[i];
+      // the box around the ends moved by at most this (each face by its axis' larger end move)
+      const double ends =
+          (a.position - s.query_a).cwiseAbs().cwiseMax((b.position - s.query_b).cwiseAbs()).norm();
+      if (!(s.query_travel >= 0 &&
+            ends + (travel - s.query_travel) + kClearanceSlack < ContactMemory::kQuerySlack)) {
+        s.shapes.clear();
+        query(a.position, b.position, pad + ContactMemory::kQuerySlack, &s.shapes);
+        s.query_a = a.position;
+        s.query_b = b.position;
+        s.query_travel = travel;
+      }
+      given = &s.shapes;
+    } else {
+      shapes.clear();
+      query(a.position, b.position, pad, &shapes);
+    }
     candidates.clear();
     const Eigen::Vector3d ab = b.position - a.position;
     const double l2 = ab.squaredNorm();
     // the distances only choose which shapes are tested (with slack): a product will do for the
     // division
     const double inverse_l2 = l2 > 0 ? 1 / l2 : 0.0;
-    for (const WorldShape* shape : shapes) {
+    bool inside_a_ball = false;  // of a shape the segment may not touch
+    for (const WorldShape* shape : *given) {
       const double radius = shape->bounding_radius >= 0 ? shape->bounding_radius
                                                         : sgal::BoundingRadius(*shape->geometry);
       const double reach = radius + options.margin;
@@ -461,6 +868,8 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       const double t = std::clamp((centre - a.position).dot(ab) * inverse_l2, 0.0, 1.0);
       const double distance2 = (a.position + t * ab - centre).squaredNorm();
       candidates.push_back({centre, reach * reach, reach, distance2, shape->body, shape});
+      inside_a_ball |= distance2 <= reach * reach && shape->body != exclude_a &&
+                       shape->body != exclude_b && std::isfinite(reach);
     }
     if (memory != nullptr) {
       // shapes the query left out lie farther than `pad` from the segment's box; those it gave
@@ -469,7 +878,10 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       ContactMemory::Segment& s = memory->segments[i];
       s.planes.clear();
       s.near.clear();
+      // a segment through a shape's bounding ball has no clearance: nothing to measure
+      if (inside_a_ball) clearance = -1;
       for (const Candidate& c : candidates) {
+        if (inside_a_ball) break;
         if (c.body == exclude_a || c.body == exclude_b) continue;
         if (std::isinf(c.reach)) {
           s.planes.push_back(c.shape);
@@ -506,7 +918,7 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
     straight += (path->points[i + 1].position - path->points[i].position).norm();
   for (size_t i = 0; i + 1 < out.size(); ++i)
     bent += (out[i + 1].position - out[i].position).norm();
-  path->length += bent - straight;
+  path->length += bent - straight + bend.extra_length;
   // the straight path's buffer becomes the next call's
   std::swap(path->points, out);
   return inserted;

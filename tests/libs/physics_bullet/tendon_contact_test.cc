@@ -98,7 +98,7 @@ TEST(SegmentInside, TakesAPreparedMeshByTheSameBox) {
   EXPECT_GT(crossings, 5) << "most of the segments should pass through the hull's box";
 }
 
-TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
+TEST(WrapAroundBodies, BisectsAStringAroundASphereToNearlyItsGeodesicLength) {
   const double r = 0.2, d = 1.0;
   const sgal::Geometry sphere = sgal::Sphere{r};
   const WorldShape shape = At(sphere, Vector3d(0, 0, -0.05));
@@ -110,6 +110,7 @@ TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
   ContactOptions options;
   options.margin = 0;
   options.max_depth = 5;
+  options.exact_wraps = false;
   const int inserted = WrapAroundBodies(&path, query, options);
   EXPECT_GT(inserted, 3);
   for (const auto& p : path.points) {
@@ -131,10 +132,11 @@ TEST(WrapAroundBodies, BendsAStringAroundASphereAtNearlyItsGeodesicLength) {
       << "straight " << 2 * d << " m, geodesic " << geodesic << " m";
 }
 
-// The default depth's accuracy (what every engine uses): a string whose ends lie 0.3 m either
-// side of a 0.2 m sphere, 0.05 m off its centre, wraps 63 degrees; its length is the geodesic's
-// to 0.1 % (0.063 % measured; a round fewer gives about four times the error).
-TEST(WrapAroundBodies, TheDefaultDepthWrapsADeepCrossingNearlyAtItsGeodesicLength) {
+// The bisection's default depth (what every engine uses for the shapes and crossings exact wraps
+// leave to it): a string whose ends lie 0.3 m either side of a 0.2 m sphere, 0.05 m off its
+// centre, wraps 63 degrees; its length is the geodesic's to 0.1 % (0.063 % measured; a round
+// fewer gives about four times the error).
+TEST(WrapAroundBodies, TheBisectionsDefaultDepthWrapsADeepCrossingNearlyAtItsGeodesicLength) {
   const double r = 0.2, d = 0.3;
   const sgal::Geometry sphere = sgal::Sphere{r};
   const WorldShape shape = At(sphere, Vector3d(0, 0, -0.05));
@@ -150,6 +152,7 @@ TEST(WrapAroundBodies, TheDefaultDepthWrapsADeepCrossingNearlyAtItsGeodesicLengt
     path.length = 2 * d;
     ContactOptions options;
     options.margin = 0;
+    options.exact_wraps = false;
     if (depth > 0) options.max_depth = depth;
     WrapAroundBodies(&path, query, options);
     return path.length;
@@ -160,6 +163,175 @@ TEST(WrapAroundBodies, TheDefaultDepthWrapsADeepCrossingNearlyAtItsGeodesicLengt
       std::abs(bent_length(ContactOptions().max_depth - 1) - geodesic) / geodesic;
   EXPECT_GT(coarser, 2.5 * error) << "one round fewer is about four times less accurate: "
                                    << coarser << " against " << error;
+}
+
+// Exact wraps: the length of the shortest way, and a polygon none of whose edges cuts the shape
+// (every edge touches it), turning by at most 45 degrees at a vertex.
+// Its length lies between the curve's and the polygon's: a polygon whose edges touch an arc of
+// radius r turning by 45 degrees at most is longer than the arc by under 0.0431 r a vertex.
+void ExpectATouchingPolygon(const WorldShape& shape, const PathGeometry& path, double r) {
+  double polygon = 0;
+  for (size_t i = 0; i + 1 < path.points.size(); ++i) {
+    EXPECT_FALSE(SegmentInside(shape, path.points[i].position, path.points[i + 1].position, -1e-9))
+        << "piece " << i << " cuts into the shape";
+    polygon += (path.points[i + 1].position - path.points[i].position).norm();
+  }
+  EXPECT_GE(polygon, path.length - 1e-12);
+  EXPECT_LE(polygon, path.length + 0.0431 * r * (path.points.size() - 2));
+  for (size_t i = 1; i + 1 < path.points.size(); ++i) {
+    const Vector3d in = path.points[i].position - path.points[i - 1].position;
+    const Vector3d out = path.points[i + 1].position - path.points[i].position;
+    const double turn = std::atan2(in.cross(out).norm(), in.dot(out));
+    EXPECT_LE(turn, M_PI / 4 + 1e-9) << "at point " << i;
+    EXPECT_TRUE(path.points[i].contact);
+    EXPECT_EQ(path.points[i].body, shape.body);
+  }
+}
+
+PathGeometry Wrapped(const WorldShape& shape, const Vector3d& a, const Vector3d& b, bool exact,
+                     int depth = 3) {
+  PathGeometry path;
+  path.points = {{a, -1}, {b, -1}};
+  path.length = (b - a).norm();
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) { out->push_back(&shape); };
+  ContactOptions options;
+  options.margin = 0;
+  options.max_depth = depth;
+  options.exact_wraps = exact;
+  options.detour_reach = 10;
+  WrapAroundBodies(&path, query, options);
+  return path;
+}
+
+TEST(WrapAroundBodies, WrapsABallExactlyAtItsGeodesicLength) {
+  // the deep crossing above, now to rounding
+  const double r = 0.2, d = 0.3;
+  const sgal::Geometry sphere = sgal::Sphere{r};
+  WorldShape shape = At(sphere, Vector3d(0, 0, -0.05));
+  const double D = std::hypot(d, 0.05);
+  const double geodesic =
+      2 * std::sqrt(D * D - r * r) + r * (2 * std::atan2(d, 0.05) - 2 * std::acos(r / D));
+  const PathGeometry path = Wrapped(shape, Vector3d(-d, 0, 0), Vector3d(d, 0, 0), true);
+  EXPECT_NEAR(path.length, geodesic, 1e-12);
+  EXPECT_EQ(path.points.size(), 4u) << "63 degrees in two equal turns (a power of two) of at most 45";
+  ExpectATouchingPolygon(shape, path, r);
+  // any plane through the centre: the same length, turned
+  shape.pose.linear() = Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Vector3d a = shape.pose * Vector3d(-d, 0, 0.05), b = shape.pose * Vector3d(d, 0, 0.05);
+  EXPECT_NEAR(Wrapped(shape, a, b, true).length, geodesic, 1e-12);
+}
+
+// A capsule crossed along its axis, as a tendon spans a bone from the bone above to the bone
+// below: over one cap, along the side, over the other. In the plane through the axis the way is
+// two tangents, two arcs of a quarter circle or less and the side's length.
+TEST(WrapAroundBodies, WrapsACapsuleCrossedAlongItsAxisAtItsGeodesicLength) {
+  const double r = 0.031, h = 0.02;
+  const sgal::Geometry capsule = sgal::Capsule{r, 2 * h};
+  const WorldShape shape = At(capsule, Vector3d(0.5, 0.2, 1.0), 3);
+  const Vector3d a(0.018, 0, -0.1), b(0.018, 0, 0.1);
+  const Vector3d u = a - Vector3d(0, 0, -h);
+  const double D = u.norm(), phi = std::acos(u.x() / D), alpha = std::acos(r / D);
+  const double geodesic = 2 * (std::sqrt(D * D - r * r) + r * (phi - alpha)) + 2 * h;
+  const Vector3d at = shape.pose.translation();
+  const PathGeometry path = Wrapped(shape, at + a, at + b, true);
+  EXPECT_NEAR(path.length, geodesic, 1e-12);
+  ExpectATouchingPolygon(shape, path, r);
+  // the bisection gets there from below, about four times closer a round
+  const double fine = Wrapped(shape, at + a, at + b, false, 10).length;
+  EXPECT_GT(fine, geodesic - 1e-6 * geodesic);
+  EXPECT_LT(fine, geodesic + 1e-12);
+}
+
+// Off the plane through the axis the string twists along the side (a helix) and meets each cap
+// in another plane: no closed form. For ends all around a turned capsule the exact wrap must be
+// a way round (no piece cuts in), no longer than the bisection refined until it no longer moves,
+// and the same in both directions. The bisection's way is not the shortest once the string
+// twists: its detours go straight out from the middle of each cut, and a twisted string is
+// pulled sideways too (0.21 % longer at a turn of 2.5 rad about the axis).
+TEST(WrapAroundBodies, WrapsATurnedCapsuleNoLongerThanAFineBisection) {
+  const double r = 0.03, h = 0.03;
+  const sgal::Geometry capsule = sgal::Capsule{r, 2 * h};
+  WorldShape shape = At(capsule, Vector3d(-0.2, 0.1, 0.4), 1);
+  shape.pose.linear() = Eigen::AngleAxisd(0.9, Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  int cases = 0;
+  for (double twist : {0.0, 0.6, 1.5, 2.5})
+    for (double offset : {0.0, 0.01}) {
+      // ends beyond both caps and within the side's radius of the axis (else the string may
+      // meet the side first: the bisection's), the far one turned about the axis by `twist`
+      const Vector3d a_local(0.015 + offset, -offset, -0.12);
+      const Vector3d b_local(0.02 * std::cos(twist), 0.02 * std::sin(twist), 0.09 + offset);
+      const Vector3d a = shape.pose * a_local, b = shape.pose * b_local;
+      const PathGeometry exact = Wrapped(shape, a, b, true);
+      const PathGeometry fine = Wrapped(shape, a, b, false, 11);
+      ASSERT_GT(exact.points.size(), 2u) << "twist " << twist << " offset " << offset;
+      // the fine bisection's pieces cut corners by up to 1e-8 m
+      EXPECT_LE(exact.length, fine.length * (1 + 1e-7)) << "twist " << twist << " offset " << offset;
+      EXPECT_GE(exact.length, fine.length * (1 - 3e-3)) << "twist " << twist << " offset " << offset;
+      if (twist == 0 && offset == 0) {  // in the plane through the axis: the same way
+        EXPECT_NEAR(exact.length, fine.length, 1e-7 * fine.length);
+      }
+      ExpectATouchingPolygon(shape, exact, r);
+      const PathGeometry back = Wrapped(shape, b, a, true);
+      EXPECT_NEAR(back.length, exact.length, 1e-12) << "twist " << twist << " offset " << offset;
+      ++cases;
+    }
+  EXPECT_EQ(cases, 8);
+}
+
+// Both ends beyond one end plane: over that cap alone, as over a ball.
+TEST(WrapAroundBodies, WrapsACapsuleOverOneCapAsOverItsBall) {
+  const double r = 0.05, h = 0.1;
+  const sgal::Geometry capsule = sgal::Capsule{r, 2 * h}, ball = sgal::Sphere{r};
+  const WorldShape shape = At(capsule, Vector3d::Zero());
+  const WorldShape cap = At(ball, Vector3d(0, 0, h));
+  const Vector3d a(-0.2, 0.01, 0.13), b(0.2, -0.02, 0.12);
+  const PathGeometry over_capsule = Wrapped(shape, a, b, true);
+  EXPECT_GT(over_capsule.points.size(), 2u);
+  EXPECT_NEAR(over_capsule.length, Wrapped(cap, a, b, true).length, 1e-12);
+  // the bisection goes out from the capsule's centre, not the cap's: off the great circle
+  const double fine = Wrapped(shape, a, b, false, 11).length;
+  EXPECT_LE(over_capsule.length, fine);
+  EXPECT_GE(over_capsule.length, fine * (1 - 3e-3));
+  ExpectATouchingPolygon(shape, over_capsule, r);
+}
+
+// What exact wraps do not cover goes to the bisection, unchanged: a capsule crossed across its
+// side, a box; and a wrap another shape cuts.
+TEST(WrapAroundBodies, LeavesToTheBisectionWhatItDoesNotWrapExactly) {
+  const sgal::Geometry capsule = sgal::Capsule{0.03, 0.1}, box = sgal::Box{Vector3d(0.1, 0.1, 0.1)};
+  for (const sgal::Geometry* g : {&capsule, &box}) {
+    const WorldShape shape = At(*g, Vector3d(0, 0.01, 0.02));
+    const Vector3d a(-0.2, 0, 0), b(0.2, 0, 0.01);
+    const PathGeometry exact = Wrapped(shape, a, b, true), bisected = Wrapped(shape, a, b, false);
+    ASSERT_GT(bisected.points.size(), 2u);
+    ASSERT_EQ(exact.points.size(), bisected.points.size());
+    for (size_t i = 0; i < exact.points.size(); ++i)
+      EXPECT_EQ(exact.points[i].position, bisected.points[i].position);
+    EXPECT_EQ(exact.length, bisected.length);
+  }
+  // a pebble on the big ball's wrap: the wrap is refused, the bisection goes round both
+  const sgal::Geometry big = sgal::Sphere{0.2}, small = sgal::Sphere{0.03};
+  const WorldShape ball = At(big, Vector3d(0, -0.05, 0), 1);
+  const WorldShape pebble = At(small, Vector3d(0.02, 0.17, 0), 2);
+  PathGeometry path;
+  path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
+  path.length = 2;
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    out->push_back(&ball);
+    out->push_back(&pebble);
+  };
+  ContactOptions options;
+  options.margin = 0;
+  options.max_depth = 5;
+  options.detour_reach = 1;
+  ASSERT_GT(WrapAroundBodies(&path, query, options), 0);
+  bool on_pebble = false;
+  for (const auto& p : path.points) on_pebble |= p.contact && p.body == 2;
+  EXPECT_TRUE(on_pebble) << "no detour point on the pebble";
+  const double ball_alone = Wrapped(ball, Vector3d(-1, 0, 0), Vector3d(1, 0, 0), true).length;
+  EXPECT_GT(path.length, ball_alone + 0.005) << "over the pebble, not under it";
 }
 
 TEST(WrapAroundBodies, LeavesSegmentsAloneThatMissOrEndOnTheBody) {

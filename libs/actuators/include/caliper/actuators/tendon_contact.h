@@ -49,8 +49,15 @@ using ShapeQuery = std::function<void(const Eigen::Vector3d& a, const Eigen::Vec
 struct ContactOptions {
   double margin = 0.001;  ///< tendon radius: how far the path stays from surfaces [m]
   int max_depth = 3;      ///< bisections per crossing: up to 2^depth - 1 points per body
-  /// Reach of the detour points beyond a segment: twice the largest shape's bounding radius [m].
-  /// One query per routed segment with this padding serves the whole refinement.
+  /// Spheres and capsules: the taut string's exact shortest way around the shape, with its exact
+  /// length (closed form for a sphere and for a capsule crossed over one cap; Newton's method on
+  /// where the string crosses the end circles for a capsule crossed over both caps), drawn as a
+  /// polygon whose edges touch the surface and turn by at most 45 degrees. Taken when no other
+  /// shape cuts it; otherwise, and for other shapes and crossings, the bisection.
+  bool exact_wraps = true;
+  /// Reach of the detour points beyond a segment: 2.1 times the largest shape's bounding radius,
+  /// grown by twice the margin [m]. One query per routed segment with this padding serves the
+  /// whole refinement; an exact wrap that would reach farther is left to the bisection.
   double detour_reach = 0.1;
 };
 
@@ -106,7 +113,15 @@ struct ContactMemory {
     std::vector<Near> near;
     /// The planes it may touch: no clearance bounds them, they are tested at every step.
     std::vector<const WorldShape*> planes;
+    /// The query's answer for the routed ends `query_a`, `query_b` with `kQuerySlack` more
+    /// padding, at `query_travel`: it holds every shape the query would give while the ends and
+    /// the shapes together have moved less than the slack (a segment that presses on a body
+    /// is searched at every step, but need not ask the engine every time).
+    std::vector<const WorldShape*> shapes;
+    Eigen::Vector3d query_a, query_b;
+    double query_travel = -1;  ///< negative: nothing asked yet
   };
+  static constexpr double kQuerySlack = 0.01;  ///< [m]
   std::vector<Segment> segments;
   double margin = -1;  ///< the margin the clearances hold for [m]
   /// Forgets everything (after the shapes were built again or replaced).
