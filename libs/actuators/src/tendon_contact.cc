@@ -327,8 +327,9 @@ inline void Turn(double x, double* c, double* s) {
   double cos_x, sin_x;
   if (std::abs(x) < 0.02) {  // the first terms left out are below 1e-18
     const double x2 = x * x;
-    cos_x = 1 - x2 / 2 * (1 - x2 / 12 * (1 - x2 / 30));
-    sin_x = x * (1 - x2 / 6 * (1 - x2 / 20 * (1 - x2 / 42)));
+    // by products with the coefficients: no division waits in the Newton steps
+    cos_x = 1 - x2 * (1.0 / 2 - x2 * (1.0 / 24 - x2 * (1.0 / 720)));
+    sin_x = x * (1 - x2 * (1.0 / 6 - x2 * (1.0 / 120 - x2 * (1.0 / 5040))));
   } else {
     cos_x = std::cos(x);
     sin_x = std::sin(x);
@@ -385,7 +386,8 @@ bool WrapBall(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, cons
   const double r2 = r * r, du2 = u.squaredNorm(), dv2 = v.squaredNorm();
   if (!(du2 > r2 && dv2 > r2)) return false;
   const double du = std::sqrt(du2), dv = std::sqrt(dv2);
-  const Eigen::Vector3d e1 = u / du;
+  const double inverse_du = 1 / du, inverse_dv = 1 / dv;
+  const Eigen::Vector3d e1 = u * inverse_du;
   Eigen::Vector3d e2 = v - e1 * e1.dot(v);
   const double across = e2.norm(), along = e1.dot(v);
   if (across > 1e-12 * dv) {
@@ -399,8 +401,9 @@ bool WrapBall(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, cons
   // between each end and its tangent point (cos alpha = r / distance); the arc turns by
   // gamma - alpha_a - alpha_b
   const double tangent_a = std::sqrt(du2 - r2), tangent_b = std::sqrt(dv2 - r2);
-  const double cos_g = along / dv, sin_g = across / dv;
-  const double cos_a = r / du, sin_a = tangent_a / du, cos_b = r / dv, sin_b = tangent_b / dv;
+  const double cos_g = along * inverse_dv, sin_g = across * inverse_dv;
+  const double cos_a = r * inverse_du, sin_a = tangent_a * inverse_du;
+  const double cos_b = r * inverse_dv, sin_b = tangent_b * inverse_dv;
   const double cos_gb = cos_g * cos_b + sin_g * sin_b, sin_gb = sin_g * cos_b - cos_g * sin_b;
   const double cos_turn = cos_gb * cos_a + sin_gb * sin_a;
   const double sin_turn = sin_gb * cos_a - cos_gb * sin_a;
@@ -459,10 +462,11 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
   eb.inverse_du = 1 / eb.du;
   ea.tangent = std::sqrt(ea.du * ea.du - r * r);
   eb.tangent = std::sqrt(eb.du * eb.du - r * r);
-  Eigen::Vector2d mean = ea.u.head<2>() / ea.du + eb.u.head<2>() / eb.du;
+  Eigen::Vector2d mean = ea.u.head<2>() * ea.inverse_du + eb.u.head<2>() * eb.inverse_du;
   if (!(mean.squaredNorm() > 1e-16)) mean = hint.head<2>();
-  if (!(mean.squaredNorm() > 1e-24)) return false;
-  mean.normalize();
+  const double mean2 = mean.squaredNorm();
+  if (!(mean2 > 1e-24)) return false;
+  mean *= 1 / std::sqrt(mean2);
   double cos_a = mean.x(), sin_a = mean.y(), cos_b = cos_a, sin_b = sin_a;
   double turn = 0;  // theta_b - theta_a [rad]
   const double rise2 = 4 * h * h, r2 = r * r;
@@ -514,7 +518,7 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
   const Eigen::Vector3d p_a(r * cos_a, r * sin_a, 0), p_b(r * cos_b, r * sin_b, 0);
   // over a's cap in the plane of u and p_a, from the tangent point to the end circle
   Eigen::Vector3d e1 = ea.u * ea.inverse_du;
-  Eigen::Vector3d e2 = (p_a / r - ea.k * e1) * ea.inverse_sin_phi;
+  Eigen::Vector3d e2 = (Eigen::Vector3d(cos_a, sin_a, 0) - ea.k * e1) * ea.inverse_sin_phi;
   if (!AddArc(ca, r, e1, e2, r * ea.inverse_du, ea.tangent * ea.inverse_du, cos_arc_a, sin_arc_a,
               wrap) ||
       !wrap->Add(ca + p_a))
@@ -528,9 +532,9 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
     double cos_t = cos_a, sin_t = sin_a, cos_half = 1, sin_half = 0;
     Turn(half, &cos_half, &sin_half);
     Turn(half, &cos_t, &sin_t);
-    const double out = r / cos_half;
+    const double out = r / cos_half, rise = 2 * h / n;
     for (int k = 0; k < n; ++k) {
-      if (!wrap->Add(Eigen::Vector3d(out * cos_t, out * sin_t, -h + 2 * h * (k + 0.5) / n)))
+      if (!wrap->Add(Eigen::Vector3d(out * cos_t, out * sin_t, -h + rise * (k + 0.5))))
         return false;
       Turn(2 * half, &cos_t, &sin_t);
     }
@@ -538,7 +542,7 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
   if (!wrap->Add(cb + p_b)) return false;
   // over b's cap, from the end circle back to the tangent point
   e1 = eb.u * eb.inverse_du;
-  e2 = (p_b / r - eb.k * e1) * eb.inverse_sin_phi;
+  e2 = (Eigen::Vector3d(cos_b, sin_b, 0) - eb.k * e1) * eb.inverse_sin_phi;
   return AddArc(cb, r, e1, e2, eb.k, eb.sin_phi, cos_arc_b, -sin_arc_b, wrap);
 }
 
@@ -587,8 +591,9 @@ struct Bend {
   double rho = 0;  // [m]
   const ContactOptions* options;
   std::vector<PathPoint>* out;
-  /// What exact wraps add to the path's length over their polygons [m].
-  double extra_length = 0;
+  /// The exact wraps: where their pieces run in `out` (from the point before the first vertex
+  /// to the point after the last) and their lengths [m], in order.
+  std::vector<ContactScratch::Wrapped>* wrapped;
   ExactWrap wrap;
   std::array<Eigen::Vector3d, kMaxWrapVertices + 2> local;  // a wrap in another shape's frame
 
@@ -647,6 +652,20 @@ bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Ben
     if (first > last) continue;
     const auto turn = n.shape->pose.linear();
     const Eigen::Vector3d at = n.shape->pose.translation();
+    const std::optional<Eigen::Vector3d> reach = LocalReach(*n.shape, options.margin);
+    if (reach) {
+      // along its axis alone first (a third of the products): a jointed neighbour's box ends
+      // where the wrap begins
+      const Eigen::Vector3d axis = turn.col(2);
+      const double offset = axis.dot(at);
+      double z_lo = kInf, z_hi = -kInf;
+      for (int k = first - 1; k <= last; ++k) {
+        const double z = axis.dot(point(k)) - offset;
+        z_lo = std::min(z_lo, z);
+        z_hi = std::max(z_hi, z);
+      }
+      if (z_lo > reach->z() || z_hi < -reach->z()) continue;
+    }
     std::array<Eigen::Vector3d, kMaxWrapVertices + 2>& local = bend->local;
     Eigen::Vector3d local_lo = Eigen::Vector3d::Constant(kInf), local_hi = -local_lo;
     for (int k = first - 1; k <= last; ++k) {
@@ -655,7 +674,6 @@ bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Ben
       local_lo = local_lo.cwiseMin(q);
       local_hi = local_hi.cwiseMax(q);
     }
-    const std::optional<Eigen::Vector3d> reach = LocalReach(*n.shape, options.margin);
     if (reach && ((local_lo.array() > reach->array()).any() ||
                   (local_hi.array() < -reach->array()).any()))
       continue;
@@ -664,9 +682,9 @@ bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Ben
       if (i && i->second - i->first > 1e-9) return false;
     }
   }
-  double polygon = 0;
-  for (int k = 0; k <= count; ++k) polygon += (point(k) - point(k - 1)).norm();
+  // a is the last point out (Refine's order); b follows the vertices
   std::vector<PathPoint>& out = *bend->out;
+  bend->wrapped->push_back({out.size() - 1, out.size() + count, wrap.length});
   for (int k = 0; k < wrap.count; ++k) {
     PathPoint q;
     q.position = wrap.vertices[k];
@@ -674,7 +692,6 @@ bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Ben
     q.contact = true;
     out.push_back(q);
   }
-  bend->extra_length += wrap.length - polygon;
   return true;
 }
 
@@ -819,6 +836,8 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
   Bend bend;
   bend.candidates = &candidates;
   bend.near = &scratch->near;
+  bend.wrapped = &scratch->wrapped;
+  scratch->wrapped.clear();
   bend.options = &options;
   bend.out = &out;
   int inserted = 0;
@@ -833,26 +852,8 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
       continue;
     const size_t before = out.size();
     const double pad = options.margin + options.detour_reach;
-    const std::vector<const WorldShape*>* given = &shapes;
-    if (memory != nullptr) {
-      // the engine is asked again only when the ends and shapes may have moved by the slack
-      ContactMemory::Segment& s = memory->segments[i];
-      // the box around the ends moved by at most this (each face by its axis' larger end move)
-      const double ends =
-          (a.position - s.query_a).cwiseAbs().cwiseMax((b.position - s.query_b).cwiseAbs()).norm();
-      if (!(s.query_travel >= 0 &&
-            ends + (travel - s.query_travel) + kClearanceSlack < ContactMemory::kQuerySlack)) {
-        s.shapes.clear();
-        query(a.position, b.position, pad + ContactMemory::kQuerySlack, &s.shapes);
-        s.query_a = a.position;
-        s.query_b = b.position;
-        s.query_travel = travel;
-      }
-      given = &s.shapes;
-    } else {
-      shapes.clear();
-      query(a.position, b.position, pad, &shapes);
-    }
+    shapes.clear();
+    query(a.position, b.position, pad, &shapes);
     candidates.clear();
     const Eigen::Vector3d ab = b.position - a.position;
     const double l2 = ab.squaredNorm();
@@ -860,7 +861,7 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
     // division
     const double inverse_l2 = l2 > 0 ? 1 / l2 : 0.0;
     bool inside_a_ball = false;  // of a shape the segment may not touch
-    for (const WorldShape* shape : *given) {
+    for (const WorldShape* shape : shapes) {
       const double radius = shape->bounding_radius >= 0 ? shape->bounding_radius
                                                         : sgal::BoundingRadius(*shape->geometry);
       const double reach = radius + options.margin;
@@ -916,9 +917,18 @@ int WrapAroundBodies(PathGeometry* path, const ShapeQuery& query, const ContactO
   double straight = 0, bent = 0;
   for (size_t i = 0; i + 1 < path->points.size(); ++i)
     straight += (path->points[i + 1].position - path->points[i].position).norm();
-  for (size_t i = 0; i + 1 < out.size(); ++i)
-    bent += (out[i + 1].position - out[i].position).norm();
-  path->length += bent - straight + bend.extra_length;
+  // the pieces of exact wraps by their exact lengths
+  auto wrap = scratch->wrapped.begin();
+  for (size_t i = 0; i + 1 < out.size(); ++i) {
+    if (wrap != scratch->wrapped.end() && wrap->first == i) {
+      bent += wrap->length;
+      i = wrap->last - 1;
+      ++wrap;
+    } else {
+      bent += (out[i + 1].position - out[i].position).norm();
+    }
+  }
+  path->length += bent - straight;
   // the straight path's buffer becomes the next call's
   std::swap(path->points, out);
   return inserted;

@@ -350,7 +350,7 @@ void PathForces(const PathGeometry& path, double tension, std::vector<PointForce
     const Vector3d d = path.points[k + 1].position - path.points[k].position;
     // one root: d / |d| is what normalized() computes
     const double length = d.norm();
-    const Vector3d unit = length > kTiny ? Vector3d(d / length) : Vector3d::Zero();
+    const Vector3d unit = length > kTiny ? Vector3d(d * (1 / length)) : Vector3d::Zero();
     const double mu = path.points[k].friction;
     if (k > 0 && mu > 0 && !before.isZero() && !unit.isZero()) {
       const double straight = std::acos(std::clamp(-before.dot(unit), -1.0, 1.0));

@@ -83,6 +83,12 @@ struct ContactScratch {
   std::vector<const WorldShape*> shapes;  // the query's answer for one segment
   std::vector<Candidate> candidates;      // the same, packed
   std::vector<Candidate> near;            // those the detours built so far can come near
+  /// An exact wrap in `points`: its pieces run from point `first` to point `last` [m].
+  struct Wrapped {
+    size_t first, last;
+    double length;
+  };
+  std::vector<Wrapped> wrapped;  // in order
 };
 
 /// The same, with the caller's buffers. `path->points` and `scratch->points` may be swapped.
@@ -113,15 +119,7 @@ struct ContactMemory {
     std::vector<Near> near;
     /// The planes it may touch: no clearance bounds them, they are tested at every step.
     std::vector<const WorldShape*> planes;
-    /// The query's answer for the routed ends `query_a`, `query_b` with `kQuerySlack` more
-    /// padding, at `query_travel`: it holds every shape the query would give while the ends and
-    /// the shapes together have moved less than the slack (a segment that presses on a body
-    /// is searched at every step, but need not ask the engine every time).
-    std::vector<const WorldShape*> shapes;
-    Eigen::Vector3d query_a, query_b;
-    double query_travel = -1;  ///< negative: nothing asked yet
   };
-  static constexpr double kQuerySlack = 0.01;  ///< [m]
   std::vector<Segment> segments;
   double margin = -1;  ///< the margin the clearances hold for [m]
   /// Forgets everything (after the shapes were built again or replaced).
