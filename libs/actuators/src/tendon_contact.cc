@@ -515,16 +515,17 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
           : std::atan2(sin_arc_a, cos_arc_a) + std::atan2(sin_arc_b, cos_arc_b);
   const double helix = std::sqrt(rise2 + r2 * turn * turn);
   wrap->length = ea.tangent + eb.tangent + r * arcs + helix;
-  const Eigen::Vector3d p_a(r * cos_a, r * sin_a, 0), p_b(r * cos_b, r * sin_b, 0);
   // over a's cap in the plane of u and p_a, from the tangent point to the end circle
   Eigen::Vector3d e1 = ea.u * ea.inverse_du;
   Eigen::Vector3d e2 = (Eigen::Vector3d(cos_a, sin_a, 0) - ea.k * e1) * ea.inverse_sin_phi;
   if (!AddArc(ca, r, e1, e2, r * ea.inverse_du, ea.tangent * ea.inverse_du, cos_arc_a, sin_arc_a,
-              wrap) ||
-      !wrap->Add(ca + p_a))
+              wrap))
     return false;
   // along the side: a helix, straight when the side is unrolled; its vertices circumscribe
-  // the end circle's arc at heights in proportion
+  // the end circle's arc at heights in proportion. Where the string passes from cap to side
+  // (p_a, p_b) it needs no vertex: the last vertex over the cap and the first along the side
+  // both lie in the plane touching the capsule there, so the edge between them does too, and
+  // no edge cuts in
   if (std::abs(turn) > 1e-12) {
     int n = 1;
     while (std::abs(turn) > n * kMaxTurn) n *= 2;  // as the arcs are cut
@@ -539,7 +540,6 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
       Turn(2 * half, &cos_t, &sin_t);
     }
   }
-  if (!wrap->Add(cb + p_b)) return false;
   // over b's cap, from the end circle back to the tangent point
   e1 = eb.u * eb.inverse_du;
   e2 = (Eigen::Vector3d(cos_b, sin_b, 0) - eb.k * e1) * eb.inverse_sin_phi;
