@@ -639,8 +639,44 @@ TEST(TendonContact, StringPressesOnABallItWouldCutThrough) {
   const double expected_force = 2 * 10.0 * std::sin(elevation);
   const double dt = scene->description().settings.time_step;
   const Vector3d v = scene->BodyStates()[0].linear_velocity;
-  EXPECT_NEAR(-v.z() / dt, expected_force / 1.0, 0.03 * expected_force);
+  EXPECT_NEAR(-v.z() / dt, expected_force / 1.0, 1e-4 * expected_force)
+      << "the exact wrap's first and last pieces are the tangents";
   EXPECT_NEAR(v.x(), 0, 1e-9);
+}
+
+// A tendon spanning a bone from the bone above to the bone below, in the engine: its length is
+// the geodesic over both caps and along the side, and the bone is pushed aside by the tension
+// turned at the two tangents, T (u_out - u_in).
+TEST(TendonContact, SpansACapsuleBoneAtItsGeodesicLengthAndPushesItAside) {
+  testing::RegisterTestKinds();
+  const double r = 0.03, h = 0.02, x0 = 0.018, z0 = 0.1, tension = 10.0;
+  sgal::Scene s = StringOverBall(true);
+  s.bodies[0].name = "bone";
+  s.bodies[0].pose.position = Vector3d::Zero();
+  s.bodies[0].shapes = {{"s", sgal::Capsule{r, 2 * h}, {}}};
+  s.tendons[0].path[0].position = Vector3d(x0, 0, -z0);
+  s.tendons[0].path[1].position = Vector3d(x0, 0, z0);
+  auto scene = physics_bullet::MakeScene(s);
+  // in the plane y = 0: from a, the tangent to the lower cap's circle on the +x side
+  const Vector3d a(x0, 0, -z0), centre(0, 0, -h);
+  const Vector3d w = a - centre;
+  const double D = w.norm(), alpha = std::acos(r / D), psi = std::atan2(w.z(), w.x()) + alpha;
+  const Vector3d touch = centre + r * Vector3d(std::cos(psi), 0, std::sin(psi));
+  const double arc = -psi;  // from the tangent point up to the side at angle 0
+  ASSERT_GT(arc, 0);
+  const double geodesic = 2 * (std::sqrt(D * D - r * r) + r * arc) + 2 * h;
+  const auto before = scene->TendonStates()[0];
+  EXPECT_GT(before.contacts, 0);
+  EXPECT_NEAR(before.length, geodesic, 1e-12);
+  // one step: the push, from the bone's speed (mass 1 kg)
+  const Vector3d in = (touch - a).normalized();
+  const double push = -2 * tension * in.x();
+  scene->Step();
+  const double dt = scene->description().settings.time_step;
+  const Vector3d v = scene->BodyStates()[0].linear_velocity;
+  EXPECT_NEAR(v.x() / dt, push, 1e-4 * std::abs(push)) << "push " << push << " N";
+  EXPECT_NEAR(v.z() / dt, 0, 1e-4 * std::abs(push));
+  EXPECT_NEAR(v.y(), 0, 1e-12);
 }
 
 TEST(TendonContact, FindsABodyARestoreMovedOntoTheString) {
