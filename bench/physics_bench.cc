@@ -25,59 +25,75 @@ int steps = 2000;
 int repeats = kStarts;
 bool verbose = false;  // each run's time
 
-/// Time of one step [us] over `repeats` runs of `steps` steps, each after a warm-up. Each run
-/// starts the tree from the next start of the ensemble (TreeOptions::start), the same for every
-/// engine: the mean over the starts, since the tree tumbles and a run's cost depends on where it
-/// lands (a change in the last bits of a force moves a single start's time by several percent).
-/// With `fastest`, the fastest run's instead (a tree held still: what the work itself costs,
-/// interference only adds time).
-double Time(const std::function<void(int start)>& make, const std::function<void()>& step,
-            bool fastest = false) {
-  std::vector<double> runs;
-  for (int r = 0; r < repeats; ++r) {
-    make(r % kStarts);
-    for (int i = 0; i < 100; ++i) step();
-    const auto begin = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) step();
-    const double us =
-        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - begin).count();
-    runs.push_back(us / steps);
+/// One engine on one tree: how to build it from a start of the ensemble, and one step.
+struct Case {
+  std::function<void(int start)> make;
+  std::function<void()> step;
+};
+
+/// Each case's time of one step [us] over `repeats` runs of `steps` steps, each after a warm-up.
+/// Each run starts the tree from the next start of the ensemble (TreeOptions::start), the same
+/// for every engine: the mean over the starts, since the tree tumbles and a run's cost depends on
+/// where it lands (a change in the last bits of a force moves a single start's time by several
+/// percent). The cases' runs take turns start by start, so that a change in the machine's speed
+/// while they run (this shared machine's drifts by several percent over seconds) falls on all of
+/// them alike and leaves their ratios alone. With `fastest`, the fastest run's instead (a tree
+/// held still: what the work itself costs, interference only adds time).
+std::vector<double> Time(const std::vector<const Case*>& cases, bool fastest = false) {
+  std::vector<std::vector<double>> runs(cases.size());
+  for (int r = 0; r < repeats; ++r)
+    for (size_t c = 0; c < cases.size(); ++c) {
+      cases[c]->make(r % kStarts);
+      for (int i = 0; i < 100; ++i) cases[c]->step();
+      const auto begin = std::chrono::steady_clock::now();
+      for (int i = 0; i < steps; ++i) cases[c]->step();
+      const double us = std::chrono::duration<double, std::micro>(
+                            std::chrono::steady_clock::now() - begin)
+                            .count();
+      runs[c].push_back(us / steps);
+    }
+  std::vector<double> times;
+  for (const std::vector<double>& case_runs : runs) {
+    if (verbose) {
+      std::printf("#   runs [us]:");
+      for (const double us : case_runs) std::printf(" %.1f", us);
+      std::printf("\n");
+    }
+    if (fastest) {
+      times.push_back(*std::min_element(case_runs.begin(), case_runs.end()));
+    } else {
+      double sum = 0;
+      for (const double us : case_runs) sum += us;
+      times.push_back(sum / static_cast<double>(case_runs.size()));
+    }
   }
-  if (verbose) {
-    std::printf("#   runs [us]:");
-    for (const double us : runs) std::printf(" %.1f", us);
-    std::printf("\n");
-  }
-  if (fastest) return *std::min_element(runs.begin(), runs.end());
-  double sum = 0;
-  for (const double us : runs) sum += us;
-  return sum / static_cast<double>(runs.size());
+  return times;
 }
 
-double TimeCaliper(const TreeOptions& tree, bool contact) {
-  std::unique_ptr<sgal::PhysicsScene> scene;
+double Time(const Case& one, bool fastest = false) { return Time({&one}, fastest)[0]; }
+
+Case CaliperCase(const TreeOptions& tree, bool contact) {
+  auto scene = std::make_shared<std::unique_ptr<sgal::PhysicsScene>>();
   physics_bullet::Options options;
   options.tendon_body_contact = contact;
-  return Time(
-      [&](int start) {
-        TreeOptions o = tree;
-        o.start = start;
-        const sgal::Scene description = MakeTree(o);
-        scene = physics_bullet::MakeScene(description, options);
-        for (const auto& a : description.actuators) scene->SetCommand(a.name, 0.05);  // [V]
-      },
-      [&] { scene->Step(); });
+  return {[=](int start) {
+            TreeOptions o = tree;
+            o.start = start;
+            const sgal::Scene description = MakeTree(o);
+            *scene = physics_bullet::MakeScene(description, options);
+            for (const auto& a : description.actuators) (*scene)->SetCommand(a.name, 0.05);  // [V]
+          },
+          [=] { (*scene)->Step(); }};
 }
 
-double TimeRawBullet(const TreeOptions& tree) {
-  std::unique_ptr<RawBulletWorld> world;
-  return Time(
-      [&](int start) {
-        TreeOptions o = tree;
-        o.start = start;
-        world = std::make_unique<RawBulletWorld>(MakeTree(o));
-      },
-      [&] { world->Step(1e-3); });
+Case RawBulletCase(const TreeOptions& tree) {
+  auto world = std::make_shared<std::unique_ptr<RawBulletWorld>>();
+  return {[=](int start) {
+            TreeOptions o = tree;
+            o.start = start;
+            *world = std::make_unique<RawBulletWorld>(MakeTree(o));
+          },
+          [=] { (*world)->Step(1e-3); }};
 }
 
 mjModel* LoadMuJoCo(const TreeOptions& tree) {
@@ -95,34 +111,38 @@ mjModel* LoadMuJoCo(const TreeOptions& tree) {
   return m;
 }
 
-double TimeMuJoCo(const TreeOptions& tree) {
+/// A MuJoCo model and its data, freed with the case.
+struct MuJoCoWorld {
   mjModel* m = nullptr;
   mjData* d = nullptr;
-  const double us = Time(
-      [&](int start) {
-        if (d) mj_deleteData(d);
-        if (m) mj_deleteModel(m);
-        TreeOptions o = tree;
-        o.start = start;
-        m = LoadMuJoCo(o);
-        d = mj_makeData(m);
-        for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 1.0;  // [N]
-      },
-      [&] { mj_step(m, d); });
-  mj_deleteData(d);
-  mj_deleteModel(m);
-  return us;
+  ~MuJoCoWorld() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+};
+
+Case MuJoCoCase(const TreeOptions& tree) {
+  auto world = std::make_shared<MuJoCoWorld>();
+  return {[=](int start) {
+            if (world->d) mj_deleteData(world->d);
+            if (world->m) mj_deleteModel(world->m);
+            TreeOptions o = tree;
+            o.start = start;
+            world->m = LoadMuJoCo(o);
+            world->d = mj_makeData(world->m);
+            for (int i = 0; i < world->m->nu; ++i) world->d->ctrl[i] = 1.0;  // [N]
+          },
+          [=] { mj_step(world->m, world->d); }};
 }
 
 /// The like-for-like case of the raw baseline: ligaments with its springs' law (2000 N/m, 5 N s/m,
 /// slack at 98 % of the starting length, so that every one pulls), no tendon-body contact; the
 /// same forces give the same motion and the same contacts.
-double TimePassive(const TreeOptions& tree) {
+Case PassiveCase(const TreeOptions& tree) {
   TreeOptions springs = tree;
   springs.actuator_kind = "ligament";
-  std::unique_ptr<sgal::PhysicsScene> plain;
   // the ligaments' law, on a scene of any start (a turned tree has the same lengths)
-  auto describe = [&](int start, const std::vector<sgal::TendonState>* lengths) {
+  auto describe = [springs](int start, const std::vector<sgal::TendonState>* lengths) mutable {
     springs.start = start;
     sgal::Scene description = MakeTree(springs);
     for (auto& a : description.actuators) {
@@ -137,11 +157,17 @@ double TimePassive(const TreeOptions& tree) {
     return description;
   };
   const auto lengths = physics_bullet::MakeScene(describe(0, nullptr))->TendonStates();
+  auto plain = std::make_shared<std::unique_ptr<sgal::PhysicsScene>>();
   physics_bullet::Options no_contact;
   no_contact.tendon_body_contact = false;
-  return Time(
-      [&](int start) { plain = physics_bullet::MakeScene(describe(start, &lengths), no_contact); },
-      [&] { plain->Step(); });
+  return {[=](int start) mutable {
+            *plain = physics_bullet::MakeScene(describe(start, &lengths), no_contact);
+          },
+          [=] { (*plain)->Step(); }};
+}
+
+double TimeCaliper(const TreeOptions& tree, bool contact) {
+  return Time(CaliperCase(tree, contact));
 }
 
 void Ratio(const char* name, double value, double target) {
@@ -162,11 +188,11 @@ bool TimeOnly(const std::string& name) {
   if (name == "spanning_off") contact = false;
   if (name == "tree_bare") o.tendons = 0;
   if (name == "passive") {
-    std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimePassive(o));
+    std::printf("# step time [us]: %s %.1f\n", name.c_str(), Time(PassiveCase(o)));
     return true;
   }
   if (name == "raw_bullet") {
-    std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimeRawBullet(o));
+    std::printf("# step time [us]: %s %.1f\n", name.c_str(), Time(RawBulletCase(o)));
     return true;
   }
   if (name != "tree_contact" && name != "tree_free" && name != "spanning_on" &&
@@ -211,33 +237,40 @@ int main(int argc, char** argv) {
   free.floor = false;
   free.self_contact = false;
 
-  const double caliper_contact = TimeCaliper(contact, true);
-  const double raw_contact = TimeRawBullet(contact);
+  // the cases a ratio compares run by turns (Time)
+  const Case caliper_contact_case = CaliperCase(contact, true);
+  const Case raw_contact_case = RawBulletCase(contact), passive_case = PassiveCase(contact);
+  const Case mujoco_contact_case = MuJoCoCase(contact);
+  const std::vector<double> contact_times =
+      Time({&caliper_contact_case, &raw_contact_case, &passive_case, &mujoco_contact_case});
+  const double caliper_contact = contact_times[0], raw_contact = contact_times[1];
   std::printf("# step time [us]: Caliper %.1f, raw Bullet with 80 springs %.1f (floor + self contact)\n",
               caliper_contact, raw_contact);
   Ratio("caliper_vs_raw_bullet", caliper_contact / raw_contact, 1.5);
 
   // like for like with the baseline's plain springs: passive tendons, no tendon-body contact
-  const double caliper_springs = TimePassive(contact);
+  const double caliper_springs = contact_times[2];
   std::printf("# step time [us]: Caliper with 80 passive tendons and no tendon contact %.1f "
               "(information: the cost of the DC motors and of tendon contact is the rest)\n",
               caliper_springs);
   Ratio("caliper_passive_tendons_vs_raw_bullet", caliper_springs / raw_contact, 1.15);
 
-  const double mujoco_contact = TimeMuJoCo(contact);
+  const double mujoco_contact = contact_times[3];
   std::printf("# step time [us]: MuJoCo 2.2.2 %.1f (floor + self contact)\n", mujoco_contact);
   Ratio("caliper_vs_mujoco_contact", caliper_contact / mujoco_contact, 1.0);
 
-  const double caliper_free = TimeCaliper(free, true);
-  const double mujoco_free = TimeMuJoCo(free);
+  const Case caliper_free_case = CaliperCase(free, true), mujoco_free_case = MuJoCoCase(free);
+  const std::vector<double> free_times = Time({&caliper_free_case, &mujoco_free_case});
+  const double caliper_free = free_times[0], mujoco_free = free_times[1];
   std::printf("# step time [us]: Caliper %.1f, MuJoCo 2.2.2 %.1f (no contact)\n", caliper_free,
               mujoco_free);
   Ratio("caliper_vs_mujoco_no_contact", caliper_free / mujoco_free, 1.5);
 
   TreeOptions spanning = free;
   spanning.spanning_tendons = true;
-  const double on = TimeCaliper(spanning, true);
-  const double off = TimeCaliper(spanning, false);
+  const Case on_case = CaliperCase(spanning, true), off_case = CaliperCase(spanning, false);
+  const std::vector<double> spanning_times = Time({&on_case, &off_case});
+  const double on = spanning_times[0], off = spanning_times[1];
   std::printf("# step time [us]: tendons pressing on bodies, contact on %.1f, off %.1f\n", on, off);
   Ratio("tendon_contact_on_vs_off", on / off, 1.5);  // issue #16's target
 
@@ -264,13 +297,14 @@ int main(int argc, char** argv) {
     for (auto& body : held.bodies)
       if (body.type == sgal::BodyType::kDynamic) body.type = sgal::BodyType::kKinematic;
     held.constraints.clear();
-    std::unique_ptr<sgal::PhysicsScene> scene;
-    return Time(
-        [&](int) {
-          scene = physics_bullet::MakeScene(held);
-          for (const auto& a : held.actuators) scene->SetCommand(a.name, 0.05);  // [V]
-        },
-        [&] { scene->Step(); }, true);
+    auto scene = std::make_shared<std::unique_ptr<sgal::PhysicsScene>>();
+    const Case still{[=](int) {
+                       *scene = physics_bullet::MakeScene(held);
+                       for (const auto& a : held.actuators)
+                         (*scene)->SetCommand(a.name, 0.05);  // [V]
+                     },
+                     [=] { (*scene)->Step(); }};
+    return Time(still, true);
   };
   // the fastest runs: the tendons' share is a difference, and at 10 tendons (under 2 us) a
   // disturbed median of either time would make it nothing; the tree without tendons is timed
