@@ -487,6 +487,12 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
     double step_a = -(h_bb * g_a - h_ab * g_b) * inverse_det;
     double step_b = -(h_aa * g_b - h_ab * g_a) * inverse_det;
     const double largest = std::max(std::abs(step_a), std::abs(step_b));
+    // Newton's method doubles the digits a step: a step under 1e-6 rad says these angles are off
+    // by about that, so the wrap is taken here (its vertices off the geodesic's by 1e-6 of the
+    // radius, their edges still touching; the length, stationary in the angles, by 1e-12 of it)
+    // without evaluating the point again
+    settled = largest < 1e-6;
+    if (settled) break;
     if (largest > 0.5) {  // no more than half a radian at once
       step_a *= 0.5 / largest;
       step_b *= 0.5 / largest;
@@ -494,14 +500,8 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
     Turn(step_a, &cos_a, &sin_a);
     Turn(step_b, &cos_b, &sin_b);
     turn += step_b - step_a;
-    // Newton's method doubles the digits a step: after a step under 1e-5 rad the angles are
-    // off by about 1e-10 rad (the vertices by 1e-10 of the radius), and the length, stationary
-    // in them, by about 1e-20 of the radius
-    settled = largest < 1e-5;
   }
   if (!settled) return false;
-  ea.At(cos_a, sin_a);
-  eb.At(cos_b, sin_b);
   // each tangent must meet its cap before the end circle, and the helix turn the short way
   double cos_arc_a, sin_arc_a, cos_arc_b, sin_arc_b;
   if (!ea.Arc(r, &cos_arc_a, &sin_arc_a) || !eb.Arc(r, &cos_arc_b, &sin_arc_b) ||
