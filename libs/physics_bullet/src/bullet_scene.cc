@@ -632,7 +632,7 @@ void BulletScene::BuildTendons() {
       largest = std::max(largest, r + shape.pose.position.norm());
     }
   // a detour point lies within its shape's reach of the shape's origin, which lies within that
-  // reach of the segment; an exact wrap's vertices stand out of the surface by up to 3.6 %
+  // reach of the segment; an exact wrap's vertices stand out of the surface by up to 8.3 %
   detour_reach_ = 2.1 * largest;
   CacheBodyPoses();
   RefreshWorldShapes();

@@ -83,7 +83,8 @@ struct ContactScratch {
   std::vector<const WorldShape*> shapes;  // the query's answer for one segment
   std::vector<Candidate> candidates;      // the same, packed
   std::vector<Candidate> near;            // those the detours built so far can come near
-  /// An exact wrap in `points`: its pieces run from point `first` to point `last` [m].
+  /// An exact wrap in `points`: its pieces run from point `first` to point `last`; its exact
+  /// length [m].
   struct Wrapped {
     size_t first, last;
     double length;
