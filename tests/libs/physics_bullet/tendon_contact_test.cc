@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "test_kinds.h"
@@ -277,6 +278,71 @@ TEST(WrapAroundBodies, WrapsATurnedCapsuleNoLongerThanAFineBisection) {
       ++cases;
     }
   EXPECT_EQ(cases, 8);
+}
+
+// Random crossings of balls and of capsules spanned from beyond one end to beyond the other:
+// every exact wrap touches and never cuts in (by 1e-9 m), is no shorter than the straight
+// segment and no longer than its own polygon, nor than a depth-9 bisection beyond that
+// bisection's own corner cutting (2e-6). With one round of bisection allowed, a refused wrap
+// leaves a single bisection point and its polygon's length: what was taken shows.
+TEST(WrapAroundBodies, ExactWrapsOfRandomCrossingsNeverCutIn) {
+  std::mt19937 random(2026);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double margin = 0.001;
+  int taken[2] = {0, 0}, crossings[2] = {0, 0};
+  for (int k = 0; k < 1200; ++k) {
+    const bool is_capsule = k % 2 == 1;
+    const double r = 0.02 + 0.015 * (u(random) + 1), h = 0.01 + 0.02 * (u(random) + 1);
+    const sgal::Geometry geometry =
+        is_capsule ? sgal::Geometry(sgal::Capsule{r, 2 * h}) : sgal::Geometry(sgal::Sphere{r});
+    WorldShape shape = At(geometry, Vector3d(u(random), u(random), u(random)) * 0.1);
+    shape.pose.linear() = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+    const double reach = r + margin;
+    Vector3d a, b;
+    if (is_capsule) {  // beyond opposite ends, within the side's radius of the axis
+      a = Vector3d(u(random) * 0.7 * reach, u(random) * 0.7 * reach, -h - reach - 0.1 * (u(random) + 1.2));
+      b = Vector3d(u(random) * 0.7 * reach, u(random) * 0.7 * reach, h + reach + 0.1 * (u(random) + 1.2));
+    } else {  // ends around the ball, often nearly opposite
+      a = Vector3d(u(random), u(random), u(random)).normalized() * (reach + 0.2 * (u(random) + 1.1));
+      b = k % 4 == 0 ? Vector3d(-a + Vector3d(u(random), u(random), u(random)) * 0.02)
+                     : Vector3d(Vector3d(u(random), u(random), u(random)).normalized() *
+                                (reach + 0.2 * (u(random) + 1.1)));
+    }
+    a = shape.pose * a;
+    b = shape.pose * b;
+    if (!SegmentInside(shape, a, b, margin)) continue;
+    ++crossings[is_capsule];
+    const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                                 std::vector<const WorldShape*>* out) { out->push_back(&shape); };
+    auto wrap = [&](bool exact, int depth) {
+      PathGeometry path;
+      path.points = {{a, -1}, {b, -1}};
+      path.length = (b - a).norm();
+      ContactOptions options;
+      options.margin = margin;
+      options.exact_wraps = exact;
+      options.max_depth = depth;
+      options.detour_reach = 10;
+      WrapAroundBodies(&path, query, options);
+      return path;
+    };
+    const PathGeometry path = wrap(true, 1);
+    double polygon = 0;
+    for (size_t i = 0; i + 1 < path.points.size(); ++i)
+      polygon += (path.points[i + 1].position - path.points[i].position).norm();
+    if (!(path.length < polygon - 1e-13)) continue;  // refused: a bisection point
+    ++taken[is_capsule];
+    for (size_t i = 0; i + 1 < path.points.size(); ++i)
+      ASSERT_FALSE(SegmentInside(shape, path.points[i].position, path.points[i + 1].position,
+                                 margin - 1e-9))
+          << "case " << k << ", piece " << i << " cuts in";
+    ASSERT_GE(path.length, (b - a).norm()) << "case " << k;
+    ASSERT_LE(path.length, wrap(false, 9).length * (1 + 2e-6)) << "case " << k;
+  }
+  EXPECT_GT(crossings[0], 250);
+  EXPECT_EQ(taken[0], crossings[0]) << "a ball is always wrapped exactly";
+  EXPECT_GT(crossings[1], 500);
+  EXPECT_GT(taken[1], 0.95 * crossings[1]) << taken[1] << " of " << crossings[1];
 }
 
 // Both ends beyond one end plane: over that cap alone, as over a ball.
