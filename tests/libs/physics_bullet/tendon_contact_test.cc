@@ -296,7 +296,9 @@ TEST(WrapAroundBodies, ExactWrapsOfRandomCrossingsNeverCutIn) {
     const sgal::Geometry geometry =
         is_capsule ? sgal::Geometry(sgal::Capsule{r, 2 * h}) : sgal::Geometry(sgal::Sphere{r});
     WorldShape shape = At(geometry, Vector3d(u(random), u(random), u(random)) * 0.1);
-    shape.pose.linear() = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+    shape.pose.linear() =
+        Eigen::AngleAxisd(M_PI * u(random), Vector3d(u(random), u(random), u(random)).normalized())
+            .toRotationMatrix();
     const double reach = r + margin;
     Vector3d a, b;
     if (is_capsule) {  // beyond opposite ends, within the side's radius of the axis
