@@ -226,11 +226,11 @@ double RayExit(const WorldShape& shape, const Eigen::Vector3d& m, const Eigen::V
 /// `l2` its squared length. No root nor division waits before the shapes are filtered.
 Crossing FirstCrossing(const Eigen::Vector3d& a, const Eigen::Vector3d& ab, double l2,
                        const std::vector<Candidate>& candidates, int exclude_a, int exclude_b,
-                       double margin, const WorldShape* skip = nullptr) {
+                       double margin) {
   Crossing best;
   double best_len = 0;
   for (const Candidate& s : candidates) {
-    if (s.body == exclude_a || s.body == exclude_b || s.shape == skip) continue;
+    if (s.body == exclude_a || s.body == exclude_b) continue;
     // only shapes whose bounding ball (grown by the margin) comes near the segment are tested;
     // nothing here waits on the piece's length (a root and a division): its search starts at once
     const Eigen::Vector3d to_centre = s.centre - a;
@@ -376,12 +376,23 @@ bool AddArc(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& e1, const
   return true;
 }
 
+/// From the frame's origin (the shape's) across the line p + t d, 1 / |d|^2 given: where the
+/// bisection's detour goes out, and what picks an exact wrap's way round when the ends and the
+/// centre are in line.
+Eigen::Vector3d Across(const Eigen::Vector3d& p, const Eigen::Vector3d& d, double inverse_d2) {
+  return p - d * (d.dot(p) * inverse_d2);
+}
+
+Eigen::Vector3d Across(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return Across(a, b - a, 1 / (b - a).squaredNorm());
+}
+
 /// The string from a to b around the ball (c, r): a tangent, an arc of the great circle through
-/// a and b, a tangent. `hint` picks the plane when a, b and c are in line. The arc's ends (the
-/// tangent points) go to *t_a and *t_b. False when an end is inside or the ends see each other.
+/// a and b, a tangent (when a, b and c are in line, in the plane through Across(a, b)). The arc's
+/// ends (the tangent points) go to *t_a and *t_b. False when an end is inside or the ends see
+/// each other.
 bool WrapBall(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-              const Eigen::Vector3d& hint, ExactWrap* wrap, Eigen::Vector3d* t_a,
-              Eigen::Vector3d* t_b) {
+              ExactWrap* wrap, Eigen::Vector3d* t_a, Eigen::Vector3d* t_b) {
   const Eigen::Vector3d u = a - c, v = b - c;
   const double r2 = r * r, du2 = u.squaredNorm(), dv2 = v.squaredNorm();
   if (!(du2 > r2 && dv2 > r2)) return false;
@@ -392,8 +403,9 @@ bool WrapBall(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, cons
   const double across = e2.norm(), along = e1.dot(v);
   if (across > 1e-12 * dv) {
     e2 /= across;
-  } else {  // in line: the plane through the hint
-    e2 = hint - e1 * e1.dot(hint);
+  } else {  // in line (rarely): the plane through the line's perpendicular
+    const Eigen::Vector3d across_line = Across(a, b);
+    e2 = across_line - e1 * e1.dot(across_line);
     if (!(e2.squaredNorm() > 1e-24)) e2 = e1.unitOrthogonal();
     e2.normalize();
   }
@@ -446,11 +458,11 @@ struct CapEnd {
 /// The string from a (beyond the end plane z = -h) to b (beyond z = h) over both caps of the
 /// capsule (radius r, caps' centres at z = -h and h) and along its side: where it crosses the end
 /// circles (theta_a, theta_b) minimises cap + helix + cap, by Newton's method from the ends'
-/// mean direction about the axis (or the hint's). The angles are carried as unit vectors, turned
+/// mean direction about the axis (or Across(a, b)'s). The angles are carried as unit vectors, turned
 /// by each step, and their difference as a number. False when that is not the shortest way (a
 /// tangent would not meet its cap, or the search does not settle): the bisection takes it.
 bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& hint, ExactWrap* wrap) {
+                         ExactWrap* wrap) {
   const Eigen::Vector3d ca(0, 0, -h), cb(0, 0, h);
   CapEnd ea, eb;
   ea.u = a - ca;
@@ -463,7 +475,7 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
   ea.tangent = std::sqrt(ea.du * ea.du - r * r);
   eb.tangent = std::sqrt(eb.du * eb.du - r * r);
   Eigen::Vector2d mean = ea.u.head<2>() * ea.inverse_du + eb.u.head<2>() * eb.inverse_du;
-  if (!(mean.squaredNorm() > 1e-16)) mean = hint.head<2>();
+  if (!(mean.squaredNorm() > 1e-16)) mean = Across(a, b).head<2>();
   const double mean2 = mean.squaredNorm();
   if (!(mean2 > 1e-24)) return false;
   mean *= 1 / std::sqrt(mean2);
@@ -549,32 +561,31 @@ bool WrapCapsuleOverCaps(double r, double h, const Eigen::Vector3d& a, const Eig
 /// The string from a to b around a sphere or capsule grown to radius r (in its frame), when one
 /// of the cases above is the shortest way; false otherwise.
 bool WrapExactly(const sgal::Geometry& geometry, double margin, const Eigen::Vector3d& a,
-                 const Eigen::Vector3d& b, const Eigen::Vector3d& hint, ExactWrap* wrap) {
+                 const Eigen::Vector3d& b, ExactWrap* wrap) {
   wrap->count = 0;
   Eigen::Vector3d t_a, t_b;
   if (const auto* sphere = std::get_if<sgal::Sphere>(&geometry))
-    return WrapBall(Eigen::Vector3d::Zero(), sphere->radius + margin, a, b, hint, wrap, &t_a, &t_b);
+    return WrapBall(Eigen::Vector3d::Zero(), sphere->radius + margin, a, b, wrap, &t_a, &t_b);
   const auto* capsule = std::get_if<sgal::Capsule>(&geometry);
   if (capsule == nullptr) return false;
   const double r = capsule->radius + margin, h = capsule->length / 2;
   if (!(h > 1e-6 * r)) {  // no side to speak of: a ball
-    return WrapBall(Eigen::Vector3d::Zero(), r, a, b, hint, wrap, &t_a, &t_b);
+    return WrapBall(Eigen::Vector3d::Zero(), r, a, b, wrap, &t_a, &t_b);
   }
   // both ends beyond one end plane: over that cap's ball, if the arc stays beyond the plane too
   // (the segments to the tangent points then do as well, and the capsule is the ball there)
   for (const double side : {-1.0, 1.0}) {
     if (side * a.z() > h && side * b.z() > h) {
       const Eigen::Vector3d centre(0, 0, side * h);
-      return WrapBall(centre, r, a, b, hint, wrap, &t_a, &t_b) && side * t_a.z() >= h &&
+      return WrapBall(centre, r, a, b, wrap, &t_a, &t_b) && side * t_a.z() >= h &&
              side * t_b.z() >= h;
     }
   }
-  if (a.z() < -h && b.z() > h) return WrapCapsuleOverCaps(r, h, a, b, hint, wrap);
+  if (a.z() < -h && b.z() > h) return WrapCapsuleOverCaps(r, h, a, b, wrap);
   if (a.z() > h && b.z() < -h) {
     // the same turned upside down (half a turn about x), and back
     const Eigen::Vector3d flip(1, -1, -1);
-    if (!WrapCapsuleOverCaps(r, h, a.cwiseProduct(flip), b.cwiseProduct(flip),
-                             hint.cwiseProduct(flip), wrap))
+    if (!WrapCapsuleOverCaps(r, h, a.cwiseProduct(flip), b.cwiseProduct(flip), wrap))
       return false;
     for (int k = 0; k < wrap->count; ++k) wrap->vertices[k] = wrap->vertices[k].cwiseProduct(flip);
     return true;
@@ -612,10 +623,8 @@ struct Bend {
 bool WrapCrossing(const PathPoint& a, const PathPoint& b, const Crossing& c, Bend* bend) {
   const WorldShape& shape = *c.shape;
   const ContactOptions& options = *bend->options;
-  // where the detour would go: across the piece, away from the shape's origin
-  const Eigen::Vector3d hint = c.p - c.d * (c.d.dot(c.p) / c.d.squaredNorm());
   ExactWrap& wrap = bend->wrap;
-  if (!WrapExactly(*shape.geometry, options.margin, c.p, c.p + c.d, hint, &wrap)) return false;
+  if (!WrapExactly(*shape.geometry, options.margin, c.p, c.p + c.d, &wrap)) return false;
   // every vertex lies within the surface's reach, pushed out by at most kVertexReach: the
   // shapes the pieces can come near must all be known
   const double rho =
@@ -729,7 +738,7 @@ void Refine(const PathPoint& a, const PathPoint& b, Bend* bend, int depth) {
     // and a division). The ray is followed along the unnormalised direction, so that the search
     // need not wait for its length either
     const Eigen::Vector3d mid_local = c.p + c.d * t_mid;
-    Eigen::Vector3d away = c.p - c.d * (c.d.dot(c.p) * inverse_l2);
+    Eigen::Vector3d away = Across(c.p, c.d, inverse_l2);
     double away2 = away.squaredNorm();
     if (away2 < 1e-18) {  // through the centre: any perpendicular
       away = c.d.unitOrthogonal().normalized();

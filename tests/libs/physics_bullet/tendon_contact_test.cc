@@ -166,6 +166,27 @@ TEST(WrapAroundBodies, TheBisectionsDefaultDepthWrapsADeepCrossingNearlyAtItsGeo
                                    << coarser << " against " << error;
 }
 
+// A string from (-1, 0, 0) to (1, 0, 0) past a ball and a pebble, bent.
+PathGeometry OverBallAndPebble(const WorldShape& ball, const WorldShape& pebble,
+                               const ContactOptions& options) {
+  PathGeometry path;
+  path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
+  path.length = 2;
+  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
+                               std::vector<const WorldShape*>* out) {
+    out->push_back(&ball);
+    out->push_back(&pebble);
+  };
+  EXPECT_GT(WrapAroundBodies(&path, query, options), 0) << "the string cuts the ball";
+  return path;
+}
+
+bool PressesOn(const PathGeometry& path, int body) {
+  for (const auto& p : path.points)
+    if (p.contact && p.body == body) return true;
+  return false;
+}
+
 // Exact wraps: the length of the shortest way, and a polygon none of whose edges cuts the shape
 // (every edge touches it), turning by at most 45 degrees at a vertex.
 // Its length lies between the curve's and the polygon's: a polygon whose edges touch an arc of
@@ -382,22 +403,12 @@ TEST(WrapAroundBodies, LeavesToTheBisectionWhatItDoesNotWrapExactly) {
   const sgal::Geometry big = sgal::Sphere{0.2}, small = sgal::Sphere{0.03};
   const WorldShape ball = At(big, Vector3d(0, -0.05, 0), 1);
   const WorldShape pebble = At(small, Vector3d(0.02, 0.17, 0), 2);
-  PathGeometry path;
-  path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
-  path.length = 2;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
-                               std::vector<const WorldShape*>* out) {
-    out->push_back(&ball);
-    out->push_back(&pebble);
-  };
   ContactOptions options;
   options.margin = 0;
   options.max_depth = 5;
   options.detour_reach = 1;
-  ASSERT_GT(WrapAroundBodies(&path, query, options), 0);
-  bool on_pebble = false;
-  for (const auto& p : path.points) on_pebble |= p.contact && p.body == 2;
-  EXPECT_TRUE(on_pebble) << "no detour point on the pebble";
+  const PathGeometry path = OverBallAndPebble(ball, pebble, options);
+  EXPECT_TRUE(PressesOn(path, 2)) << "no detour point on the pebble";
   const double ball_alone = Wrapped(ball, Vector3d(-1, 0, 0), Vector3d(1, 0, 0), true).length;
   EXPECT_GT(path.length, ball_alone + 0.005) << "over the pebble, not under it";
 }
@@ -445,21 +456,11 @@ TEST(WrapAroundBodies, BendsAroundAShapeOnlyItsDetourComesNear) {
   const WorldShape pebble = At(small, Vector3d(-0.5, 0.075, 0), 2);
   ASSERT_FALSE(SegmentInside(pebble, Vector3d(-1, 0, 0), Vector3d(1, 0, 0), 0.01))
       << "the straight string must miss the pebble for this test to mean anything";
-  PathGeometry path;
-  path.points = {{Vector3d(-1, 0, 0), -1}, {Vector3d(1, 0, 0), -1}};
-  path.length = 2;
-  const ShapeQuery query = [&](const Vector3d&, const Vector3d&, double,
-                               std::vector<const WorldShape*>* out) {
-    out->push_back(&ball);
-    out->push_back(&pebble);
-  };
   ContactOptions options;
   options.margin = 0.001;
   options.max_depth = 5;
-  EXPECT_GT(WrapAroundBodies(&path, query, options), 0);
-  bool on_pebble = false;
-  for (const auto& p : path.points) on_pebble |= p.contact && p.body == 2;
-  EXPECT_TRUE(on_pebble) << "no detour point on the pebble";
+  const PathGeometry path = OverBallAndPebble(ball, pebble, options);
+  EXPECT_TRUE(PressesOn(path, 2)) << "no detour point on the pebble";
   for (size_t i = 0; i + 1 < path.points.size(); ++i)
     EXPECT_FALSE(SegmentInside(pebble, path.points[i].position, path.points[i + 1].position, -1e-3))
         << "segment " << i << " cuts through the pebble";
