@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "caliper/collada/importer.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 namespace caliper::bench {
 namespace {

@@ -25,11 +25,11 @@
 #include <filesystem>
 
 #include "caliper/core/scratch_directory.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
 namespace {
 
-using namespace caliper::model;
+using namespace caliper::simulation;
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 

@@ -21,7 +21,7 @@
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
 #include "caliper/sgal/scene.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 #include "fuzz_input.h"
 
 namespace {

@@ -14,7 +14,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 #include "caliper/core/arguments.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "caliper/actuators/actuator.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 namespace caliper::ctl {
 

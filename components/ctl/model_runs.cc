@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "caliper/rtc/client_orb.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 namespace caliper::ctl {
 

@@ -23,7 +23,7 @@
 #include "caliper/core/confined_path.h"
 #include "caliper/core/system.h"
 #include "caliper/rtc/idl_names.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 #include "csv_recording.h"
 #include "model_client.h"
 #include "model_runs.h"

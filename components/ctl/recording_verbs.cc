@@ -11,7 +11,7 @@
 #include "caliper/model.hh"
 #include "caliper/recording/recording.h"
 #include "model_client.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
 namespace caliper::ctl {
 namespace {
@@ -250,7 +250,7 @@ int Verify(const std::string& path) {
     printed = true;
     std::cerr << "\rverifying: step " << step << " of " << last << std::flush;
   };
-  model::Verification v = model::VerifyRecording(path, progress);
+  simulation::Verification v = simulation::VerifyRecording(path, progress);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (printed) std::cerr << "\n";
   std::cerr << "re-simulated " << v.steps << " steps in " << Num(s, 3) << " s ("

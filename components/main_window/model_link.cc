@@ -16,7 +16,7 @@
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 namespace caliper::main_window {
 

@@ -5,10 +5,12 @@
 #include "caliper/logging.hh"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/naming.h"
-#include "fault_injection.h"
-#include "model_files.h"
+#include "caliper/simulation/fault_injection.h"
+#include "caliper/simulation/model_files.h"
 
 namespace caliper::model {
+
+using namespace simulation;
 
 namespace {
 

@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "caliper/rtc/runtime.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
 namespace caliper::model {
 
@@ -33,7 +33,7 @@ class ModelComponent : public rtc::Component {
   rtc::ReturnCode OnFinalize() override;
   rtc::ReturnCode OnExecute() override;
 
-  ModelCore& core() { return *core_; }
+  simulation::ModelCore& core() { return *core_; }
   static std::vector<core::ConfigKey> ConfigKeys();
 
  private:
@@ -44,7 +44,7 @@ class ModelComponent : public rtc::Component {
   void StopLogWatch();
 
   rtc::Runtime& runtime_;
-  std::unique_ptr<ModelCore> core_;
+  std::unique_ptr<simulation::ModelCore> core_;
   bool autostart_;
   // looks for the Logging component every 2 s until found, on a thread of its own (naming
   // lookups never run on the stepping thread)

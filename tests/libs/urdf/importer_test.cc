@@ -18,7 +18,7 @@
 #include "../collada/scene_compare.h"
 #include "caliper/collada/exporter.h"
 #include "caliper/urdf/importer.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 namespace caliper::urdf {
 namespace {

@@ -10,9 +10,9 @@
 #include <thread>
 
 #include "corpus.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 std::string ReadFile(const std::string& path) {
@@ -220,4 +220,4 @@ TEST(ExperimentRun, ZaeArchiveLoadsByContent) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -2,8 +2,8 @@
 // that leave the Model answering (and stop or pause ending them), every kind of exception in a
 // step ending as a fault at the start of the failing step, and the bounds of what one call or
 // one queue may take.
-#include "model_core.h"
-#include "fault_injection.h"
+#include "caliper/simulation/model_core.h"
+#include "caliper/simulation/fault_injection.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include <vector>
 
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 using namespace std::chrono_literals;
@@ -357,4 +357,4 @@ TEST(ModelCore, AParameterCannotMakeOneStepRunForHours) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -16,9 +16,9 @@
 #include "caliper/core/scratch_directory.h"
 #include "caliper/recording/recording.h"
 #include "caliper/sgal/edits.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 std::string Model(const std::string& file) {
@@ -385,4 +385,4 @@ TEST_F(ModelRecording, AFullDiskEndsTheRecordingAndTheSimulationGoesOn) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation

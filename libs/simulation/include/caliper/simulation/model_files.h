@@ -20,7 +20,7 @@
 #include "caliper/core/config.h"
 #include "caliper/core/confined_path.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 struct ModelFiles {
   core::ConfinedPaths read;   ///< model.read_dirs, then the write directory
@@ -37,4 +37,4 @@ struct ModelFiles {
   static ModelFiles FromConfig(const core::Config& config);
 };
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -14,9 +14,9 @@
 #include <thread>
 #include <vector>
 
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 using namespace std::chrono_literals;
@@ -250,4 +250,4 @@ TEST(LosslessFeed, AStopOrPauseEndsAWaitAtOnce) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation

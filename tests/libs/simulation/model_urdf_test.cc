@@ -14,11 +14,11 @@
 #include <vector>
 
 #include "caliper/collada/importer.h"
-#include "caliper/urdf/model_file.h"
-#include "model_core.h"
-#include "model_files.h"
+#include "caliper/model_file/model_file.h"
+#include "caliper/simulation/model_core.h"
+#include "caliper/simulation/model_files.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 namespace fs = std::filesystem;
@@ -240,4 +240,4 @@ TEST_F(ConfinedUrdfTest, AUrdfWithAMeshOutsideIsRefusedNamingTheMesh) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation

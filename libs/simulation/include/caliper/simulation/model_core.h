@@ -25,7 +25,7 @@
 #include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/sgal/physics_scene.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 enum class RunState { kEmpty, kStopped, kRunning, kPaused, kFaulted };
 const char* ToString(RunState state);
@@ -528,4 +528,4 @@ Verification VerifyRecording(const std::string& path,
 /// `arm.v2` from `Arm V2!`: lower case, letters, digits, underscores.
 std::string IdSafe(const std::string& name);
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -1,10 +1,10 @@
-#include "model_files.h"
+#include "caliper/simulation/model_files.h"
 
 #include <cstdlib>
 
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 std::vector<core::ConfigKey> ModelFiles::ConfigKeys() {
   using Type = core::ConfigKey::Type;
@@ -50,4 +50,4 @@ ModelFiles ModelFiles::FromConfig(const core::Config& config) {
                                         "model.write_dir", "the Model writes scenes", true)};
 }
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "caliper/sgal/physics_scene.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 struct InjectedFault {
   enum class Kind { kNone, kFault, kBadAlloc, kOutOfRange, kRuntime, kUnknownType };
@@ -32,4 +32,4 @@ std::unique_ptr<sgal::PhysicsScene> WithInjectedFault(std::unique_ptr<sgal::Phys
 /// a reload) do not, so that the Model can be seen to come back.
 PhysicsFactory FailFirstScene(InjectedFault fault, physics_bullet::Options options = {});
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -1,4 +1,4 @@
-#include "fault_injection.h"
+#include "caliper/simulation/fault_injection.h"
 
 #include <atomic>
 #include <new>
@@ -7,7 +7,7 @@
 #include "caliper/core/numbers.h"
 #include "caliper/physics_bullet/bullet_scene.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 class FailingScene : public sgal::PhysicsScene {
@@ -97,4 +97,4 @@ PhysicsFactory FailFirstScene(InjectedFault fault, physics_bullet::Options optio
   };
 }
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

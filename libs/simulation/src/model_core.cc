@@ -1,4 +1,4 @@
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
 #include <algorithm>
 #include <cctype>
@@ -17,9 +17,9 @@
 #include "caliper/collada/importer.h"
 #include "caliper/core/scratch_directory.h"
 #include "caliper/logging/log.h"
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 using Clock = std::chrono::steady_clock;
 
@@ -1028,9 +1028,9 @@ std::string ModelCore::model_name() const {
   return loaded_ ? loaded_->name : "";
 }
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 ModelCore::EditStatus ModelCore::ApplyEdit(const Rebuild& rebuild) {
   // Built outside the lock (a scene of meshes takes a while; steps and other clients go on),
@@ -1345,4 +1345,4 @@ ModelCore::Selection ModelCore::selection() const {
   return selection_;
 }
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

@@ -1,4 +1,4 @@
-#include "caliper/urdf/model_file.h"
+#include "caliper/model_file/model_file.h"
 
 #include <libxml/parser.h>
 #include <libxml/tree.h>

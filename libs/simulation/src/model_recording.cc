@@ -19,9 +19,9 @@
 #include "caliper/collada/exporter.h"
 #include "caliper/core/scratch_directory.h"
 #include "caliper/logging/log.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 
 namespace {
 
@@ -660,4 +660,4 @@ Verification VerifyRecording(const std::string& path,
   return v;
 }
 
-}  // namespace caliper::model
+}  // namespace caliper::simulation

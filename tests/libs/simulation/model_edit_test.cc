@@ -14,9 +14,9 @@
 #include "caliper/collada/importer.h"
 #include "caliper/core/scratch_directory.h"
 #include "caliper/sgal/edits.h"
-#include "model_core.h"
+#include "caliper/simulation/model_core.h"
 
-namespace caliper::model {
+namespace caliper::simulation {
 namespace {
 
 std::string Model(const std::string& file) {
@@ -433,4 +433,4 @@ TEST_F(ModelEdit, SelectionIsCheckedAndCounted) {
 }
 
 }  // namespace
-}  // namespace caliper::model
+}  // namespace caliper::simulation
