@@ -1,6 +1,6 @@
 // Fuzz target: calibration files (caliper-calibrate's spec, JSON through Boost.PropertyTree)
-// read by calibrate::LoadSpec with the files they name: the experiment file and the measured
-// CSVs (calibrate::LoadMeasured).
+// read by calibration::LoadSpec with the files they name: the experiment file and the measured
+// CSVs (calibration::LoadMeasured).
 // Input: the calibration file, then optionally a line `@@` and the experiment file, then a line
 // `@@` and a measured CSV. The calibration file names them "FUZZ-runs.json" and
 // "FUZZ-measured.csv" (`FUZZ-` is replaced by this process's file prefix, as in every file).
@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "calibration.h"
+#include "caliper/calibration/calibration.h"
 #include "fuzz_input.h"
 
 namespace {
 
 using caliper::fuzz::Check;
-namespace cal = caliper::calibrate;
+namespace cal = caliper::calibration;
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))

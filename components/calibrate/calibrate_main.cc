@@ -11,20 +11,22 @@
 #include <iostream>
 #include <sstream>
 
-#include "arguments.h"
-#include "calibration.h"
+#include "caliper/calibration/calibration.h"
+#include "caliper/client/experiments.h"
+#include "caliper/client/model_pool.h"
+#include "caliper/client/scene_transfer.h"
+#include "caliper/core/arguments.h"
 #include "caliper/core/system.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
-#include "evaluator.h"
-#include "model_runs.h"
+#include "caliper/calibration/evaluator.h"
 #include "optimiser.h"
 #include "report.h"
 
 namespace fs = std::filesystem;
 using namespace caliper;
-using namespace caliper::calibrate;
+using namespace caliper::calibration;
 namespace M = ::Caliper::Simulation;
 
 namespace {
@@ -69,45 +71,45 @@ unsigned Whole(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   const long v = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || *end != '\0' || v < 1 || v > 1000000)
-    throw ctl::UsageError(flag + " takes a whole number from 1 to 1000000");
+    throw core::UsageError(flag + " takes a whole number from 1 to 1000000");
   return static_cast<unsigned>(v);
 }
 
 Options Parse(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (ctl::TakeFlag(args, "-h") || ctl::TakeFlag(args, "--help")) {
+  if (core::TakeFlag(args, "-h") || core::TakeFlag(args, "--help")) {
     std::cout << kUsage;
     std::exit(0);
   }
   Options o;
   std::string value;
-  ctl::TakeOption(args, "--out", &o.out);
-  ctl::TakeOption(args, "--models", &o.models);
-  ctl::TakeOption(args, "--nameservice", &o.nameservice);
-  o.dry_run = ctl::TakeFlag(args, "--dry-run");
-  o.resume = ctl::TakeFlag(args, "--resume");
-  if (ctl::TakeOption(args, "--generations", &value)) o.generations = Whole("--generations", value);
-  if (ctl::TakeOption(args, "--islands", &value)) o.islands = Whole("--islands", value);
-  if (ctl::TakeOption(args, "--run-timeout", &value))
+  core::TakeOption(args, "--out", &o.out);
+  core::TakeOption(args, "--models", &o.models);
+  core::TakeOption(args, "--nameservice", &o.nameservice);
+  o.dry_run = core::TakeFlag(args, "--dry-run");
+  o.resume = core::TakeFlag(args, "--resume");
+  if (core::TakeOption(args, "--generations", &value)) o.generations = Whole("--generations", value);
+  if (core::TakeOption(args, "--islands", &value)) o.islands = Whole("--islands", value);
+  if (core::TakeOption(args, "--run-timeout", &value))
     o.run_timeout_s = Whole("--run-timeout", value);
-  ctl::RejectOptions(args);
-  if (args.size() != 1) throw ctl::UsageError("expected one calibration FILE");
+  core::RejectOptions(args);
+  if (args.size() != 1) throw core::UsageError("expected one calibration FILE");
   o.file = args[0];
   if (o.out.empty()) o.out = fs::path(o.file).stem().string() + "-calibration";
   return o;
 }
 
 // The parameters' values in the scene as it is (asked of a Model).
-std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
+std::vector<double> SceneValues(const Spec& spec, client::ModelPool& pool) {
   // a URDF is imported here and sent converted: its import warnings are said here, once
   std::vector<std::string> warnings;
-  const std::string bytes = ctl::ReadScene(spec.experiments.front().scene, &warnings);
+  const std::string bytes = client::ReadScene(spec.experiments.front().scene, &warnings);
   for (const auto& w : warnings) std::cerr << "caliper-calibrate: warning: " << w << "\n";
   std::vector<double> values;
   pool.WithModel([&](M::Model_ptr model) {
     try {
-      model->load_scene_data(ctl::SceneFileName(spec.experiments.front().scene).c_str(),
-                             ctl::ToOctets(bytes));
+      model->load_scene_data(client::SceneFileName(spec.experiments.front().scene).c_str(),
+                             client::ToOctets(bytes));
       ::Caliper::Scene::StringSeq ids;
       ids.length(static_cast<CORBA::ULong>(spec.parameters.size()));
       for (CORBA::ULong i = 0; i < ids.length(); ++i) ids[i] = spec.parameters[i].id.c_str();
@@ -115,17 +117,17 @@ std::vector<double> SceneValues(const Spec& spec, ModelPool& pool) {
       values.clear();
       for (CORBA::ULong i = 0; i < got->length(); ++i) {
         if (got[i].data.length() != 1)
-          throw SetupError(spec.parameters[i].id + " is not a scalar parameter");
+          throw client::SetupError(spec.parameters[i].id + " is not a scalar parameter");
         values.push_back(got[i].data[0]);
       }
     } catch (const M::LoadFailed& e) {
-      throw SetupError(e.reason.in());
+      throw client::SetupError(e.reason.in());
     } catch (const M::NotAvailable& e) {
-      throw Busy(e.reason.in());  // another Model, or this one once it is idle
+      throw client::NotAvailableError(e.reason.in());  // another Model, or this one once it is idle
     } catch (const ::Caliper::Daq::UnknownId& e) {
-      throw SetupError(std::string(e.reason.in()) + " (a parameter to fit)");
+      throw client::SetupError(std::string(e.reason.in()) + " (a parameter to fit)");
     } catch (const ::Caliper::Daq::NotAvailable& e) {
-      throw SetupError(e.reason.in());
+      throw client::SetupError(e.reason.in());
     }
   });
   return values;
@@ -198,17 +200,17 @@ int Run(const Options& o) {
   if (o.resume && !fs::exists(checkpoint))
     throw std::runtime_error("--resume: no checkpoint at " + checkpoint);
 
-  ctl::OmniThread omni;
+  rtc::OmniThread omni;
   const std::string address = rtc::NamingAddress(o.nameservice);
   CORBA::ORB_var orb = rtc::ClientOrb("caliper-calibrate", 10, address);  // TLS when on a network
-  ModelPool pool(
+  client::ModelPool::Options pool_options;
+  pool_options.run_timeout_s = o.run_timeout_s;
+  client::ModelPool pool(
       [&] {
         CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, address);
-        std::vector<std::tuple<std::string, std::string, CORBA::Object_var>> out;
-        for (auto& e : ctl::FindModels(root, o.models)) out.emplace_back(e.name, e.path, e.object);
-        return out;
+        return client::FindModels(root, o.models);
       },
-      o.run_timeout_s);
+      pool_options);
   pool.on_lost = [](const std::string& what) {
     std::cerr << "\nModel lost: " << what << "; its run goes to another Model\n";
   };
@@ -267,7 +269,7 @@ int Run(const Options& o) {
   const unsigned first_generation = search->progress().generation;
   bool interrupted = false;
   while (search->progress().generation < spec.optimiser.generations) {
-    interrupted = !search->Generation(ctl::InterruptPending);
+    interrupted = !search->Generation(core::InterruptPending);
     search->Save(checkpoint);
     pool.Refresh();  // Models that appeared or came back join the next generation
     const Progress& p = search->progress();
@@ -322,7 +324,7 @@ int Run(const Options& o) {
     pool.WithModel([&](M::Model_ptr model) {
       const auto e = WithParameters(spec.experiments.front(), spec.parameters, fitted);
       M::Recording_var ignored = model->run_experiment(
-          ctl::ToIdl(e, ctl::ReadScene(e.scene)));  // leaves the tuned scene loaded
+          client::ToIdl(e, client::ReadScene(e.scene)));  // leaves the tuned scene loaded
       M::Octets_var data = model->export_scene();
       core::WriteFileReplacing(tuned, [&](std::ostream& out) {
         out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
@@ -356,7 +358,7 @@ int main(int argc, char** argv) {
   Options options;
   try {
     options = Parse(argc, argv);
-  } catch (const ctl::UsageError& e) {
+  } catch (const core::UsageError& e) {
     std::cerr << "caliper-calibrate: " << e.what() << "\n" << kUsage;
     return 2;
   }

@@ -21,9 +21,9 @@
 #include <thread>
 
 #include "caliper/core/system.h"
-#include "evaluator.h"
+#include "caliper/calibration/evaluator.h"
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 namespace {
 
@@ -179,4 +179,4 @@ bool Search::Generation(const std::function<bool()>& interrupted) {
   return !stop;
 }
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

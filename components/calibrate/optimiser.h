@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "calibration.h"
+#include "caliper/calibration/calibration.h"
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 class Evaluator;
 
@@ -51,4 +51,4 @@ class Search {
   void Measure();
 };
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

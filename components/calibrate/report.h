@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 struct Curve {
   std::string name;
@@ -25,4 +25,4 @@ struct Plot {
 std::string WritePng(const std::string& path, const std::vector<Plot>& plots, int width = 900,
                      int height_per_plot = 260);
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

@@ -18,7 +18,7 @@
 
 #include "report.h"
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 namespace {
 
@@ -87,4 +87,4 @@ std::string WritePng(const std::string& path, const std::vector<Plot>& plots, in
   return "";
 }
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

@@ -18,6 +18,9 @@
 
 #include "batch_plan.h"
 #include "cluster_verbs.h"
+#include "caliper/client/experiments.h"
+#include "caliper/client/model_pool.h"
+#include "caliper/client/scene_transfer.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/experiment/experiment.h"
@@ -25,7 +28,6 @@
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
 #include "csv_recording.h"
-#include "model_runs.h"
 
 namespace caliper::ctl {
 
@@ -49,17 +51,15 @@ struct BatchOptions {
   unsigned long spawn = 0;        // Models to ask the managers for (0: use those bound)
 };
 
-// One Model the batch uses, and its worker thread.
+// One Model of the pool the batch uses, and its worker thread.
 struct Slot {
   std::string name;  // model1@hostb
-  std::string path;
-  std::mutex mutex;  // guards model, ticket, since, last_answer, sim_time
-  M::Model_var model;
+  size_t index = 0;  // in the pool
+  std::mutex mutex;  // guards ticket, since, last_answer, sim_time, in_call
   std::optional<BatchPlan::Ticket> ticket;
   Clock::time_point since, last_answer;
   double sim_time = 0;  // of the run in flight, from the last status poll [s]
-  std::atomic<bool> down{false};
-  bool in_call = false;  // guarded by mutex
+  bool in_call = false;
   std::thread thread;
 };
 
@@ -80,14 +80,21 @@ class BatchRun {
  public:
   BatchRun(Client& client, BatchOptions options, std::vector<experiment::Experiment> runs)
       : client_(client), options_(std::move(options)), runs_(std::move(runs)),
-        plan_(runs_.size(), options_.max_attempts), written_(runs_.size(), false) {}
+        plan_(runs_.size(), options_.max_attempts), written_(runs_.size(), false),
+        pool_([this] { return FindModels(); }, PoolOptions()) {
+    pool_.on_joined = [this](size_t index) { Join(index); };
+  }
 
   // Dispatch, then Finish also when Dispatch throws (its message printed); the exit code.
   int Run();
 
  private:
   void LoadScenes();
-  void Discover();
+  // the Models matching --models (only those asked of the managers with --spawn)
+  std::vector<client::ModelEntry> FindModels();
+  client::ModelPool::Options PoolOptions() const;
+  // a Model found: its slot and worker
+  void Join(size_t index);
   void Work(Slot* slot);
   void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
   void Watch();
@@ -112,6 +119,7 @@ class BatchRun {
   std::vector<std::string> write_errors_;
   std::atomic<bool> stop_{false};
   std::vector<SpawnedModel> spawned_;  // asked of the managers; only these are used
+  client::ModelPool pool_;             // last: its finder uses the members above
   Clock::time_point begin_ = Clock::now();
   Clock::time_point last_progress_;
   double total_sim_s_ = 0;
@@ -121,70 +129,51 @@ void BatchRun::LoadScenes() {
   for (const auto& e : runs_) {
     if (scenes_.count(e.scene)) continue;
     try {
-      scenes_[e.scene] = ReadScene(e.scene);
+      scenes_[e.scene] = client::ReadScene(e.scene);
     } catch (const std::runtime_error& error) {
       throw Failure(options_.file + ": experiment '" + e.name + "': " + error.what());
     }
   }
 }
 
-void BatchRun::Discover() {
-  std::vector<ModelEntry> entries;
-  try {
-    CosNaming::NamingContext_var root = client_.Root();
-    entries = FindModels(root, options_.models);
-  } catch (const std::exception&) {
-    return;  // the naming service is unreachable for now: the Models we have go on
-  } catch (const CORBA::Exception&) {
-    return;
-  }
+std::vector<client::ModelEntry> BatchRun::FindModels() {
+  CosNaming::NamingContext_var root = client_.Root();
+  std::vector<client::ModelEntry> entries = client::FindModels(root, options_.models);
+  if (spawned_.empty()) return entries;
+  std::vector<client::ModelEntry> ours;
+  for (auto& e : entries)
+    if (std::any_of(spawned_.begin(), spawned_.end(),
+                    [&](const auto& m) { return m.path == e.path; }))
+      ours.push_back(std::move(e));
+  return ours;
+}
+
+client::ModelPool::Options BatchRun::PoolOptions() const {
+  client::ModelPool::Options o;
+  o.run_timeout_s = options_.run_timeout_s;
+  o.attempts = options_.max_attempts;
+  o.probe_timeout_s = 2;
+  return o;
+}
+
+void BatchRun::Join(size_t index) {
+  auto slot = std::make_unique<Slot>();
+  slot->name = pool_.name(index);
+  slot->index = index;
+  Slot* raw = slot.get();
   std::lock_guard<std::mutex> lock(slots_mutex_);
-  for (auto& e : entries) {
-    if (!spawned_.empty() && std::none_of(spawned_.begin(), spawned_.end(), [&](const auto& m) {
-          return m.path == e.path;
-        }))
-      continue;
-    Slot* known = nullptr;
-    for (auto& s : slots_)
-      if (s->path == e.path) known = s.get();
-    if (known != nullptr) {
-      // a new process under a name whose Model died: use it
-      std::lock_guard<std::mutex> slot_lock(known->mutex);
-      if (known->down && !known->in_call && !e.object->_is_equivalent(known->model)) {
-        M::Model_var fresh = M::Model::_unchecked_narrow(e.object);
-        known->model = fresh;
-      }
-      continue;
-    }
-    auto slot = std::make_unique<Slot>();
-    slot->name = e.name;
-    slot->path = e.path;
-    slot->model = M::Model::_unchecked_narrow(e.object);
-    Slot* raw = slot.get();
-    slots_.push_back(std::move(slot));
-    raw->thread = std::thread([this, raw] { Work(raw); });
-  }
+  slots_.push_back(std::move(slot));
+  raw->thread = std::thread([this, raw] { Work(raw); });
 }
 
 void BatchRun::Work(Slot* slot) {
-  OmniThread omni;
+  rtc::OmniThread omni;
   // the run call may take long; a dead peer is found by the watcher's status polls
   omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
   while (!stop_ && !plan_.finished()) {
-    if (slot->down) {
-      M::Model_var model;
-      {
-        std::lock_guard<std::mutex> lock(slot->mutex);
-        model = M::Model::_duplicate(slot->model);
-      }
-      try {
-        omniORB::setClientThreadCallTimeout(2000);
-        M::SimulationStatus_var s = model->status();
-        // back when it answers and no longer runs what it was given up on
-        if (s->state != M::RUNNING) slot->down = false;
-      } catch (const CORBA::Exception&) {
-      }
-      if (slot->down) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    if (pool_.down(slot->index)) {
+      // back when it answers and no longer runs what it was given up on
+      if (!pool_.Probe(slot->index)) std::this_thread::sleep_for(std::chrono::milliseconds(500));
       omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
       continue;
     }
@@ -205,9 +194,9 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
     slot->ticket = ticket;
     slot->since = slot->last_answer = Clock::now();
     slot->sim_time = 0;
-    model = M::Model::_duplicate(slot->model);
   }
-  const M::Experiment idl = ToIdl(runs_[ticket.run], scenes_.at(runs_[ticket.run].scene));
+  model = pool_.model(slot->index);
+  const M::Experiment idl = client::ToIdl(runs_[ticket.run], scenes_.at(runs_[ticket.run].scene));
   const auto begin = Clock::now();
   try {
     M::Recording_var r = model->run_experiment(idl);
@@ -230,10 +219,10 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   } catch (const M::NotAvailable& e) {
     // busy with a run given up on earlier, or shutting down: set aside until it is idle
     plan_.Retry(ticket, slot->name + ": " + e.reason.in());
-    slot->down = true;
+    pool_.SetDown(slot->index, e.reason.in());
   } catch (const CORBA::SystemException& e) {
     plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
-    slot->down = true;
+    pool_.SetDown(slot->index, rtc::Describe(e));
   } catch (const CORBA::Exception& e) {
     plan_.Fail(ticket, slot->name + ": " + rtc::Describe(e));
   }
@@ -280,9 +269,9 @@ void BatchRun::Watch() {
     {
       std::lock_guard<std::mutex> lock(slot->mutex);
       ticket = slot->ticket;
-      model = M::Model::_duplicate(slot->model);
       last = slot->last_answer;
     }
+    model = pool_.model(slot->index);
     if (!ticket) continue;
     std::string failure;
     try {
@@ -298,7 +287,7 @@ void BatchRun::Watch() {
     if (silent >= options_.stall_s) {
       plan_.Retry(*ticket, slot->name + ": no answer for " + Fixed(silent, 1) + " s (" + failure +
                                ")");
-      slot->down = true;
+      pool_.SetDown(slot->index, failure);
     }
   }
 }
@@ -320,7 +309,7 @@ void BatchRun::Progress(bool last) {
     std::lock_guard<std::mutex> lock(slots_mutex_);
     for (auto& s : slots_) {
       std::lock_guard<std::mutex> slot_lock(s->mutex);
-      models += s->down ? 0 : 1;
+      models += pool_.down(s->index) ? 0 : 1;
       if (s->ticket) {
         ++busy;
         sim_done += s->sim_time;
@@ -384,7 +373,7 @@ void BatchRun::WriteSummary(double wall_s) {
 }
 
 int BatchRun::Run() {
-  OmniThread omni;
+  rtc::OmniThread omni;
   int rc = 1;
   try {
     rc = Dispatch();
@@ -438,7 +427,7 @@ int BatchRun::Dispatch() {
   }
   const auto waited = Clock::now();
   while (true) {
-    Discover();
+    pool_.Refresh(false);
     {
       std::lock_guard<std::mutex> lock(slots_mutex_);
       if (!slots_.empty()) break;
@@ -460,7 +449,7 @@ int BatchRun::Dispatch() {
   bool interrupted = false;
   while (!plan_.finished()) {
     plan_.WaitForChange(std::chrono::milliseconds(100));
-    if (InterruptPending()) {
+    if (core::InterruptPending()) {
       interrupted = true;
       break;
     }
@@ -468,7 +457,7 @@ int BatchRun::Dispatch() {
     last_watch = Clock::now();
     Watch();
     if (Since(last_discovery) > 2) {
-      Discover();
+      pool_.Refresh(false);
       last_discovery = Clock::now();
     }
     Progress(false);
@@ -557,7 +546,8 @@ void AddBatchVerb(std::map<std::string, Verb>* verbs) {
       "  --max-attempts   tries per run before it is reported failed (5)\n"
       "  --run-timeout    the longest one run may take [s] (3600)\n"
       "  --wait-models    how long to wait for a first Model [s] (10)\n"
-      "  --out DIR        DIR/runs/NAME.csv (time [s] and the ids with units, 17 digits) and\n"
+      "  --out DIR        DIR/runs/NAME.csv (time [s] and the ids with units, in the shortest\n"
+      "                   text that reads back exactly) and\n"
       "                   DIR/summary.csv (status, Model, attempts, times, every retry with its\n"
       "                   reason); default FILE-DATE-TIME. Progress goes to stderr.\n"
       "  A physics fault fails its run with the Model's report (not retried). Exit 0 when every\n"

@@ -333,7 +333,8 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
 
 int Main(int argc, char** argv) {
   const auto verbs = Verbs();
-  Options options;
+  client::SessionOptions options;
+  options.program = "caliper-ctl";
   // the global options, up to the verb; the verb's own follow it
   core::ArgumentSpec spec;
   spec.valued = {"--nameservice", "--timeout"};

@@ -21,25 +21,6 @@ std::string TakeModel(std::vector<std::string>& args) {
   return name;
 }
 
-ModelRef Connect(Client& client, const std::string& name) {
-  rtc::ComponentEntry e = client.Find(name);
-  ModelRef ref;
-  ref.name = name;
-  ref.path = e.path;
-  ref.local = e.host == core::HostName();
-  try {
-    ref.model = ::Caliper::Simulation::Model::_narrow(e.object);
-  } catch (const CORBA::Exception& ex) {
-    throw Failure(Client::Unreachable(e.path, ex));
-  }
-  if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
-  return ref;
-}
-
-::Caliper::Simulation::SimulationStatus* StatusOf(const ModelRef& m) {
-  return Call(m, [&] { return m.model->status(); });
-}
-
 std::string Num(double v, int precision) {
   std::ostringstream s;
   s << std::setprecision(precision) << v;

@@ -1,61 +1,28 @@
 #pragma once
-// What caliper-ctl's verbs on a Model (model_verbs, recording_verbs) share: finding the Model by
-// instance name, turning what its calls raise into messages, label/value lines and numbers from
-// the command line.
+// What caliper-ctl's verbs on a Model (model_verbs, recording_verbs) share beside the client
+// library's Model (libs/client: finding it, calls and their errors): label/value lines and
+// numbers from the command line.
 
 #include <string>
 #include <vector>
 
-#include "caliper/model.hh"
+#include "caliper/client/model.h"
 #include "caliper/rtc/idl_names.h"
 #include "client.h"
 
 namespace caliper::ctl {
 
-/// The Model a verb works on.
-struct ModelRef {
-  std::string name;
-  std::string path;
-  bool local = true;  // on this host: it shares our files
-  ::Caliper::Simulation::Model_var model;
-};
+using client::Call;
+using client::ModelRef;
+using client::StatusOf;
 
 /// Takes `--model NAME` out of args: the Model's instance name, model0 without it.
 std::string TakeModel(std::vector<std::string>& args);
 
-/// The Model bound as `name`; Failure when it is not bound, not reachable or not a Model.
-ModelRef Connect(Client& client, const std::string& name);
-
-/// Runs calls on the Model and turns what they raise into messages: a user exception's reason
-/// (exit 1), or that the Model cannot be reached.
-template <class F>
-auto Call(const ModelRef& m, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const ::Caliper::Daq::UnknownId& e) {
-    const std::string reason = e.reason.in(), id = e.id.in();
-    throw Failure(reason.find("'" + id + "'") != std::string::npos
-                      ? reason
-                      : "unknown id '" + id + "': " + reason);
-  } catch (const ::Caliper::Daq::InvalidParameter& e) {
-    throw Failure(e.reason.in());
-  } catch (const ::Caliper::Simulation::NotAvailable& e) {
-    throw Failure(m.name + ": " + e.reason.in());
-  } catch (const ::Caliper::Daq::NotAvailable& e) {
-    throw Failure(m.name + ": " + e.reason.in());
-  } catch (const ::Caliper::Simulation::LoadFailed& e) {
-    throw Failure(e.reason.in());
-  } catch (const ::Caliper::Simulation::EditRefused& e) {
-    throw Failure(m.name + ": edit refused: " + e.reason.in());
-  } catch (const CORBA::UserException& e) {
-    throw Failure(m.path + ": " + rtc::Describe(e));
-  } catch (const CORBA::SystemException& e) {
-    throw Failure(Client::Unreachable(m.path, e));
-  }
+/// The Model bound as `name` (client::ConnectModel).
+inline ModelRef Connect(Client& client, const std::string& name) {
+  return client::ConnectModel(client, name);
 }
-
-/// The Model's status (through Call); the caller owns it.
-::Caliper::Simulation::SimulationStatus* StatusOf(const ModelRef& m);
 
 /// A value with `precision` significant digits: 7 for values (Bullet computes in single
 /// precision), more for times.

@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 
+#include "caliper/client/scene_transfer.h"
 #include "caliper/model.hh"
 #include "caliper/core/confined_path.h"
 #include "caliper/core/system.h"
@@ -26,7 +27,6 @@
 #include "caliper/model_file/model_file.h"
 #include "csv_recording.h"
 #include "model_client.h"
-#include "model_runs.h"
 
 namespace caliper::ctl {
 namespace {
@@ -45,36 +45,6 @@ S::StringSeq ToSeq(const std::vector<std::string>& ids) {
   return out;
 }
 
-// Files go by content to a Model on another host (or with --send): it shares no disk with us.
-bool ByContent(const ModelRef& m, bool send_flag) { return send_flag || !m.local; }
-
-// Whether a Model on this host takes `path` itself: it reads only below its search path and
-// writes only below its write directory (file_access); other files go by content.
-bool ModelTakesPath(const ModelRef& m, const std::string& path,
-                    core::ConfinedPaths::Access access) {
-  M::FileAccess_var files = Call(m, [&] { return m.model->file_access(); });
-  std::vector<std::string> dirs;
-  if (access == core::ConfinedPaths::Access::kRead) {
-    for (CORBA::ULong i = 0; i < files->read_dirs.length(); ++i)
-      dirs.push_back(files->read_dirs[i].in());
-  } else if (*files->write_dir.in() != '\0') {
-    dirs.push_back(files->write_dir.in());
-  }
-  // the Model's COLLADA library reads names as URIs: it refuses '#', '?' and '%'
-  const core::ConfinedPaths confined(dirs, "", "", true);
-  if (!confined.Allows(path, access)) return false;
-  if (access == core::ConfinedPaths::Access::kWrite) return true;
-  // a URDF whose meshes lie elsewhere the Model refuses as a whole: convert and send it here
-  std::vector<std::string> others;
-  try {
-    others = model_file::FilesRead(path);
-  } catch (const collada::ImportError&) {
-    return true;  // not XML: the Model reports it, naming the file
-  }
-  for (const auto& file : others)
-    if (!confined.Allows(file, access)) return false;
-  return true;
-}
 
 // Channel metadata by id (one list call).
 std::map<std::string, D::ChannelInfo> Channels(const ModelRef& m, const std::string& pattern) {
@@ -123,32 +93,26 @@ int Load(Client& client, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
   ModelRef m = Connect(client, name);
-  const bool send =
-      ByContent(m, send_flag) || !ModelTakesPath(m, path, core::ConfinedPaths::Access::kRead);
+  const bool send = Call(m, [&] {
+    return client::SendsByContent(m.model, path, m.local, send_flag,
+                                  core::ConfinedPaths::Access::kRead);
+  });
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
+  client::SentScene sent;
   Call(m, [&] {
     try {
-      if (send) {
-        std::string bytes;
-        std::vector<std::string> warnings;
-        try {
-          bytes = ReadScene(path, &warnings);  // a URDF converted to COLLADA here
-        } catch (const std::runtime_error& e) {
-          throw Failure(e.what());
-        }
-        for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
-        m.model->load_scene_data(SceneFileName(path).c_str(), ToOctets(bytes));
-      } else {
-        m.model->load_scene(path.c_str());
-      }
+      sent = client::LoadScene(m.model, path, send);  // a URDF converted to COLLADA here
     } catch (const M::LoadFailed& e) {
       std::string message = (send ? path + " (sent by content): " : std::string()) + e.reason.in();
       M::SimulationStatus_var s = StatusOf(m);
       if (s->state != M::EMPTY)
         message += "\n  (" + name + " keeps " + s->scene.in() + ", " + rtc::Name(s->state) + ")";
       throw Failure(message);
+    } catch (const std::runtime_error& e) {
+      throw Failure(e.what());
     }
   });
+  for (const auto& w : sent.warnings) std::cerr << "warning: " << w << "\n";
   M::SimulationStatus_var s = StatusOf(m);
   std::cout << name << ": loaded " << path << (send ? " (sent by content)" : "") << " ("
             << rtc::Name(s->state) << ", time step "
@@ -229,8 +193,10 @@ int Save(Client& client, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected one FILE");
   const std::string path = Absolute(args[0]);
   ModelRef m = Connect(client, name);
-  const bool fetch =
-      ByContent(m, send_flag) || !ModelTakesPath(m, path, core::ConfinedPaths::Access::kWrite);
+  const bool fetch = Call(m, [&] {
+    return client::SendsByContent(m.model, path, m.local, send_flag,
+                                  core::ConfinedPaths::Access::kWrite);
+  });
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   if (fetch) {
     M::Octets_var data = Call(m, [&] { return m.model->export_scene(); });

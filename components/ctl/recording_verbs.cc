@@ -1,5 +1,10 @@
 #include "recording_verbs.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -8,10 +13,10 @@
 
 #include "caliper/collada/importer.h"
 #include "caliper/core/numbers.h"
+#include "caliper/core/system.h"
 #include "caliper/model.hh"
 #include "caliper/recording/recording.h"
 #include "model_client.h"
-#include "caliper/simulation/model_core.h"
 
 namespace caliper::ctl {
 namespace {
@@ -239,31 +244,27 @@ int Info(const std::string& path) {
   return 0;
 }
 
+// Re-simulates in a Model process started for it (caliper-model --verify, beside this program
+// or in $CALIPER_BIN_DIR), so that caliper-ctl links no physics.
 int Verify(const std::string& path) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto last_print = t0;
-  bool printed = false;
-  const auto progress = [&](uint64_t step, uint64_t last) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_print < std::chrono::milliseconds(250)) return;
-    last_print = now;
-    printed = true;
-    std::cerr << "\rverifying: step " << step << " of " << last << std::flush;
-  };
-  simulation::Verification v = simulation::VerifyRecording(path, progress);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (printed) std::cerr << "\n";
-  std::cerr << "re-simulated " << v.steps << " steps in " << Num(s, 3) << " s ("
-            << Num(s > 0 ? v.steps / s : 0, 4) << " steps/s)\n";
-  if (v.identical) {
-    std::cout << "identical: " << v.steps << " steps, " << v.keyframes << " keyframes, "
-              << v.samples << " samples compared bit for bit\n";
-    return 0;
+  const char* dir = std::getenv("CALIPER_BIN_DIR");
+  const std::string model =
+      (dir != nullptr && *dir != '\0' ? std::string(dir) : core::ProgramDirectory()) +
+      "/caliper-model";
+  std::cout.flush();
+  const pid_t pid = fork();
+  if (pid < 0) throw Failure(std::string("cannot start ") + model + ": " + std::strerror(errno));
+  if (pid == 0) {
+    execl(model.c_str(), model.c_str(), "--verify", path.c_str(), static_cast<char*>(nullptr));
+    std::cerr << "caliper-ctl replay: cannot run " << model << ": " << std::strerror(errno)
+              << "\n";
+    _exit(127);
   }
-  std::cout << "diverges at step " << v.divergent_step << " (after " << v.steps << " steps, "
-            << v.keyframes << " keyframes and " << v.samples << " samples identical): " << v.detail
-            << "\n";
-  return 1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status) == 0 ? 0 : 1;
+  throw Failure(model + " --verify ended by signal " + std::to_string(WTERMSIG(status)));
 }
 
 int Replay(Client& client, std::vector<std::string>& args) {

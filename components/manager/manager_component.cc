@@ -22,15 +22,6 @@ namespace RTC = ::Caliper::RTC;
 const char* const kStartable = "model";  // the types create() starts
 constexpr auto kPollPeriod = std::chrono::milliseconds(50);
 
-// The directory of this program (for its sibling programs).
-std::string OwnDirectory() {
-  char path[PATH_MAX];
-  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
-  if (n <= 0) return ".";
-  const std::string exe(path, static_cast<size_t>(n));
-  return exe.substr(0, exe.rfind('/'));
-}
-
 // `giop:tcp:ADDR:` for `giop:tcp:ADDR:PORT`: children cannot share the manager's fixed port.
 std::string WithoutPort(const std::string& endpoint) {
   const size_t colon = endpoint.rfind(':');
@@ -66,7 +57,7 @@ ManagerComponent::ManagerComponent(rtc::Runtime& runtime)
     : runtime_(runtime),
       bin_dir_(runtime.config().GetString("manager.bin_dir")),
       start_timeout_(runtime.config().GetDouble("manager.start_timeout")) {
-  if (bin_dir_.empty()) bin_dir_ = OwnDirectory();
+  if (bin_dir_.empty()) bin_dir_ = core::ProgramDirectory();
   SupervisorOptions options;
   const long long max = runtime.config().GetInt("manager.max_models");
   options.max_running =

@@ -84,6 +84,7 @@ S::TendonStateSeq ToIdl(const std::vector<sgal::TendonState>& tendons) {
       for (int c = 0; c < 3; ++c) out[i].points[3 * k + c] = t.points[k][c];
   }
   return out;
+}
 
 D::Value ToIdl(const daq::Reading& v) {
   D::Value out;

@@ -2,9 +2,14 @@
 #include "caliper/rtc/runtime.h"
 #include "model_component.h"
 #include "model_servant.h"
+#include "model_verify.h"
+
+#include <cstring>
 
 int main(int argc, char** argv) {
   using namespace caliper;
+  // re-simulating a recording for caliper-ctl replay --verify: no session, no CORBA
+  if (argc == 3 && std::strcmp(argv[1], "--verify") == 0) return model::VerifyMain(argv[2]);
   rtc::ComponentType type;
   type.name = "model";
   type.description = "Model: the physics of one tendon-driven robot scene, served over CORBA.";

@@ -4,6 +4,7 @@
 
 #include "caliper/logging/log.h"
 #include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/naming.h"
 #include "caliper/rtc/peers.h"
 #include "model_convert.h"
 

@@ -115,4 +115,21 @@ void WriteFileReplacing(const std::string& path,
   if (std::rename(temporary.c_str(), target.c_str()) != 0) fail("cannot replace it", errno);
 }
 
+bool InterruptPending() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  const timespec none = {0, 0};
+  return sigtimedwait(&set, nullptr, &none) > 0;
+}
+
+std::string ProgramDirectory() {
+  char path[4096];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return ".";
+  const std::string exe(path, static_cast<size_t>(n));
+  return exe.substr(0, exe.rfind('/'));
+}
+
 }  // namespace caliper::core

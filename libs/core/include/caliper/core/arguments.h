@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <functional>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -53,5 +54,22 @@ struct Arguments {
 /// (`-1.5` is positional) looks like an option. Stops at the first unknown option or missing
 /// value.
 Arguments ParseArguments(const std::vector<std::string>& words, const ArgumentSpec& spec);
+
+/// A usage error of a command-line tool: the message, then the tool's help; exit code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Options taken out of a word list one at a time, wherever they stand among the positional
+// words and some more than once (caliper-ctl's verbs, caliper-calibrate), before RejectOptions
+// refuses what is left that looks like an option.
+
+/// Takes `--flag VALUE` out of args; returns true when it was there. UsageError without a value.
+bool TakeOption(std::vector<std::string>& args, const std::string& flag, std::string* value);
+/// Takes `--flag` out of args; returns true when it was there.
+bool TakeFlag(std::vector<std::string>& args, const std::string& flag);
+/// UsageError for the first remaining argument that looks like an option (`--x`), so that a
+/// misspelt option is not taken for a positional argument. Negative numbers pass.
+void RejectOptions(const std::vector<std::string>& args);
 
 }  // namespace caliper::core

@@ -33,4 +33,12 @@ bool ProcessAlive(long pid);
 /// device"); exceptions from `write` leave `path` untouched and propagate.
 void WriteFileReplacing(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// True when SIGINT or SIGTERM is pending (for programs that block both in every thread and
+/// look between steps of their work); takes the signal.
+bool InterruptPending();
+
+/// The directory of this process's program (/proc/self/exe), "." when it cannot be read: where
+/// its sibling programs are.
+std::string ProgramDirectory();
+
 }  // namespace caliper::core

@@ -25,7 +25,7 @@
 
 #include "caliper/experiment/experiment.h"
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 /// A file or value that cannot be used: the message names the file and what is wrong.
 class SpecError : public std::runtime_error {
@@ -109,4 +109,4 @@ experiment::Experiment WithParameters(const experiment::Experiment& e,
                                       const std::vector<Parameter>& parameters,
                                       const std::vector<double>& values);
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

@@ -1,6 +1,6 @@
 // Calibration files, measured CSVs, the search space's scaling and the cost: exact values on
 // small hand-made data, and errors that name the file and what is wrong.
-#include "calibration.h"
+#include "caliper/calibration/calibration.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 namespace {
 
 namespace fs = std::filesystem;
@@ -187,4 +187,4 @@ TEST(ColumnNames, FollowRecordingCsvs) {
 }
 
 }  // namespace
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

@@ -1,4 +1,4 @@
-#include "calibration.h"
+#include "caliper/calibration/calibration.h"
 
 #include <algorithm>
 #include <boost/property_tree/json_parser.hpp>
@@ -12,7 +12,7 @@
 
 #include "caliper/core/numbers.h"
 
-namespace caliper::calibrate {
+namespace caliper::calibration {
 
 namespace fs = std::filesystem;
 using boost::property_tree::ptree;
@@ -274,4 +274,4 @@ experiment::Experiment WithParameters(const experiment::Experiment& e,
   return out;
 }
 
-}  // namespace caliper::calibrate
+}  // namespace caliper::calibration

@@ -1,0 +1,61 @@
+#include "caliper/client/model.h"
+
+#include <fnmatch.h>
+
+#include <cstring>
+
+#include "caliper/core/system.h"
+
+namespace caliper::client {
+
+namespace M = ::Caliper::Simulation;
+
+ModelRef ConnectModel(Session& session, const std::string& name) {
+  rtc::ComponentEntry e = session.Find(name);
+  ModelRef ref;
+  ref.name = name;
+  ref.path = e.path;
+  ref.local = e.host == core::HostName();
+  try {
+    ref.model = M::Model::_narrow(e.object);
+  } catch (const CORBA::Exception& ex) {
+    throw ConnectionError(Session::Unreachable(e.path, ex), e.path);
+  }
+  if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
+  return ref;
+}
+
+M::SimulationStatus* StatusOf(const ModelRef& m) {
+  return Call(m, [&] { return m.model->status(); });
+}
+
+namespace {
+
+// Whether a bound object is a Model: its reference names the type (no call), or else it is
+// asked; one that does not answer counts as a Model, for the caller to probe.
+bool IsModel(CORBA::Object_ptr object) {
+  const char* type = object->_PR_getobj()->_mostDerivedRepoId();
+  if (type != nullptr && std::strcmp(type, M::Model::_PD_repoId) == 0) return true;
+  try {
+    return object->_is_a(M::Model::_PD_repoId);
+  } catch (const CORBA::SystemException&) {
+    return true;
+  }
+}
+
+}  // namespace
+
+std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std::string& glob) {
+  std::vector<ModelEntry> out;
+  for (auto& e : rtc::ListComponents(root)) {
+    const std::string name = e.instance + "@" + e.host;
+    if (fnmatch(glob.c_str(), e.instance.c_str(), 0) != 0 &&
+        fnmatch(glob.c_str(), name.c_str(), 0) != 0)
+      continue;
+    if (!IsModel(e.object)) continue;
+    out.push_back({name, e.path, e.object});
+  }
+  return out;
+}
+
+}  // namespace caliper::client

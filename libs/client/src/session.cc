@@ -1,0 +1,88 @@
+#include "caliper/client/session.h"
+
+#include "caliper/rtc/client_orb.h"
+
+namespace caliper::client {
+
+Session::~Session() {
+  if (CORBA::is_nil(orb_)) return;
+  try {
+    orb_->destroy();
+  } catch (...) {
+  }
+}
+
+CosNaming::NamingContext_ptr Session::Root() {
+  Connect();
+  try {
+    return rtc::ResolveRoot(orb_, address_);
+  } catch (const rtc::Unreachable& e) {
+    throw ConnectionError(std::string(e.what()) +
+                              "\n  (is a session running? start one with `launch/caliper demo`, "
+                              "or pass --nameservice corbaname::HOST:PORT)",
+                          address_);
+  }
+}
+
+rtc::ComponentEntry Session::Find(const std::string& name) {
+  CosNaming::NamingContext_var root = Root();
+  try {
+    return rtc::FindComponent(root, name);
+  } catch (const rtc::NotFound& e) {
+    throw Failure(e.what());
+  }
+}
+
+std::vector<rtc::ComponentEntry> Session::List() {
+  CosNaming::NamingContext_var root = Root();
+  try {
+    return rtc::ListComponents(root);
+  } catch (const CORBA::SystemException& e) {
+    throw ConnectionError(Unreachable(address_, e), address_);
+  }
+}
+
+::Caliper::RTC::LightweightRTObject_ptr Session::Component(const std::string& name,
+                                                           std::string* path) {
+  rtc::ComponentEntry e = Find(name);
+  if (path) *path = e.path;
+  try {
+    ::Caliper::RTC::LightweightRTObject_var obj =
+        ::Caliper::RTC::LightweightRTObject::_narrow(e.object);
+    if (CORBA::is_nil(obj)) throw Failure(e.path + " is not a Caliper component");
+    return obj._retn();
+  } catch (const CORBA::Exception& ex) {
+    throw ConnectionError(Unreachable(e.path, ex), e.path);
+  }
+}
+
+std::string Session::Unreachable(const std::string& path, const CORBA::Exception& e) {
+  return "cannot reach " + path + ": " + rtc::Describe(e) +
+         " (the process may have died; its name is stale)";
+}
+
+CORBA::ORB_ptr Session::orb() {
+  Connect();
+  return orb_.in();
+}
+
+PortableServer::POA_ptr Session::RootPoa() {
+  CORBA::Object_var obj = orb()->resolve_initial_references("RootPOA");
+  PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
+  poa->the_POAManager()->activate();
+  return poa._retn();
+}
+
+const std::string& Session::address() {
+  Connect();
+  return address_;
+}
+
+void Session::Connect() {
+  if (!CORBA::is_nil(orb_)) return;
+  address_ = rtc::NamingAddress(options_.nameservice);
+  // TLS when on a network
+  orb_ = rtc::ClientOrb(options_.program.c_str(), options_.timeout_s, address_);
+}
+
+}  // namespace caliper::client
