@@ -326,6 +326,7 @@ run_sanitized() {  # SANITIZERS SCOPE [CTEST ARGS]
   [ "$scope" = unit ] && select=(-LE 'gui|integration')
   if [ ! -f "$dir/build.ninja" ]; then
     say "configuring $dir (sanitizers $sanitize)"
+    mkdir -p "$dir/.cmake/api/v1/query" && : >"$dir/.cmake/api/v1/query/codemodel-v2"
     cmake -S "$ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCALIPER_SANITIZE="$sanitize" -DCALIPER_WERROR=OFF -DCALIPER_BENCH=OFF >/dev/null || return 1
   fi

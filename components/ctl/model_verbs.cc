@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 
+#include "caliper/client/data_feed.h"
 #include "caliper/client/scene_transfer.h"
 #include "caliper/model.hh"
 #include "caliper/core/confined_path.h"
@@ -337,38 +338,6 @@ int Motor(Client& client, std::vector<std::string>& args) {
 
 // ------------------------------------------------------------------------ record
 
-// Receives the subscription's batches (on ORB threads) and hands them to the recording.
-class CsvConsumer : public virtual POA_Caliper::Daq::DataConsumer {
- public:
-  explicit CsvConsumer(CsvRecording* recording) : recording_(recording) {}
-
-  void on_samples(const D::SampleBatch& batch) override {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (closed_) return;
-    ++batches;
-    for (CORBA::ULong i = 0; i < batch.stale_ids.length(); ++i)
-      stale.insert(batch.stale_ids[i].in());
-    const size_t width = batch.values_per_sample;
-    size_t count = batch.times.length();
-    if (width > 0 && batch.data.length() < count * width) count = batch.data.length() / width;
-    recording_->Add(batch.batch, batch.times.get_buffer(), count, batch.data.get_buffer(), width);
-  }
-
-  // No batch reaches the recording after this.
-  void Close() {
-    std::lock_guard<std::mutex> lock(mutex);
-    closed_ = true;
-  }
-
-  std::mutex mutex;  // guards the recording and the fields below
-  uint64_t batches = 0;
-  std::set<std::string> stale;
-
- private:
-  CsvRecording* recording_;
-  bool closed_ = false;
-};
-
 // `recording:  45% (t = 0.450 of 1 s), 45 samples`; a complete recording shows 100 %.
 std::string Progress(const CsvRecording& r, double start, double duration) {
   const double t = std::isnan(r.last_time()) ? start : r.last_time();
@@ -417,17 +386,11 @@ int Record(Client& client, std::vector<std::string>& args) {
   if (!file) throw Failure("cannot write " + csv_path + ": " + std::strerror(errno));
   CsvRecording recording(file, columns, start + duration);
 
-  // the consumer lives in this process's RootPOA; the Model calls it from its sender thread
-  PortableServer::POA_var poa = client.RootPoa();
-  auto* consumer = new CsvConsumer(&recording);
-  PortableServer::ServantBase_var owner = consumer;
-  PortableServer::ObjectId_var oid = poa->activate_object(consumer);
-  CORBA::Object_var ref = poa->id_to_reference(oid);
-  D::DataConsumer_var consumer_ref = D::DataConsumer::_narrow(ref);
-  // lossless: stepping in lock-step or as fast as possible, the Model waits for this recorder
-  const CORBA::ULongLong subscription =
-      Call(m, [&] { return m.model->subscribe_lossless(ids, every, consumer_ref); });
-
+  // lossless: stepping in lock-step or as fast as possible, the Model waits for this recorder;
+  // the batches come on ORB threads
+  client::DataFeed feed(client, m, args, every, true, [&](const client::Batch& b) {
+    recording.Add(b.number, b.times, b.count, b.data, b.values_per_sample);
+  });
   std::cerr << "recording " << args.size() << " id" << (args.size() == 1 ? "" : "s") << " ("
             << recording.values_per_sample() << " columns) every " << every << " step"
             << (every == 1 ? "" : "s") << " (" << Num(every * status->time_step) << " s) "
@@ -457,14 +420,14 @@ int Record(Client& client, std::vector<std::string>& args) {
   D::SubscriptionStatus counts{};  // the Model's, as last read
   auto read_counts = [&] {
     try {
-      counts = m.model->subscription_status(subscription);
-    } catch (const D::UnknownId& e) {
-      ended = e.reason.in();  // the Model ended it (a consumer that missed a push deadline)
+      counts = feed.Status();
+    } catch (const client::UnknownIdError& e) {
+      ended = e.what();  // the Model ended it (a consumer that missed a push deadline)
     }
   };
   while (true) {
     {
-      std::lock_guard<std::mutex> lock(consumer->mutex);
+      std::lock_guard<std::mutex> lock(feed.mutex());
       if (recording.done()) break;
     }
     const timespec wait = {0, 100 * 1000 * 1000};
@@ -475,7 +438,7 @@ int Record(Client& client, std::vector<std::string>& args) {
     }
     const auto t = Clock::now();
     if (t - last_progress >= std::chrono::milliseconds(250)) {
-      std::lock_guard<std::mutex> lock(consumer->mutex);
+      std::lock_guard<std::mutex> lock(feed.mutex());
       const std::string text = Progress(recording, start, duration) + idle_note;
       if (text != shown) std::cerr << "\r" << text << std::flush;
       shown = text;
@@ -486,14 +449,14 @@ int Record(Client& client, std::vector<std::string>& args) {
       // of waiting forever
       try {
         read_counts();
-      } catch (const CORBA::SystemException& e) {
-        lost = Client::Unreachable(m.path, e);
+      } catch (const client::ConnectionError& e) {
+        lost = e.what();
         break;
       }
       if (!ended.empty()) break;
       uint64_t samples = 0;
       {
-        std::lock_guard<std::mutex> lock(consumer->mutex);
+        std::lock_guard<std::mutex> lock(feed.mutex());
         samples = recording.samples();
       }
       // a step request samples while the state is not RUNNING: only a Model that sent nothing
@@ -517,22 +480,16 @@ int Record(Client& client, std::vector<std::string>& args) {
   if (lost.empty() && ended.empty()) {
     try {
       read_counts();  // what the Model dropped, if anything, for the report
-    } catch (const CORBA::SystemException& e) {
-      lost = Client::Unreachable(m.path, e);
+    } catch (const client::ConnectionError& e) {
+      lost = e.what();
     }
   }
-  consumer->Close();
-  try {
-    m.model->unsubscribe(subscription);
-  } catch (const CORBA::Exception&) {
-    // gone already: it sends nothing more either way
-  }
-  poa->deactivate_object(oid);
+  feed.Close();
   file.flush();
   const bool written = static_cast<bool>(file);
   file.close();
 
-  std::lock_guard<std::mutex> lock(consumer->mutex);
+  std::lock_guard<std::mutex> lock(feed.mutex());
   const std::string last = Progress(recording, start, duration);
   // blanks over the rest of a longer line shown before (one with the idle note)
   std::cerr << "\r" << last
@@ -545,8 +502,8 @@ int Record(Client& client, std::vector<std::string>& args) {
               << Num(recording.last_time(), 10) << " s)";
   std::cout << " to " << csv_path << "\n";
   if (recording.missing_batches() == 0)
-    std::cout << "no gaps: " << consumer->batches << " batch"
-              << (consumer->batches == 1 ? "" : "es") << ", numbered without a break\n";
+    std::cout << "no gaps: " << feed.batches() << " batch"
+              << (feed.batches() == 1 ? "" : "es") << ", numbered without a break\n";
   else
     std::cout << "gaps: " << recording.missing_batches() << " batches never arrived (numbers "
               << recording.gaps() << "); the samples they held are missing from the file\n";
@@ -561,9 +518,9 @@ int Record(Client& client, std::vector<std::string>& args) {
       std::cout << "; it waited " << Num(counts.waited, 3) << " s for this recorder";
     std::cout << ")\n";
   }
-  if (!consumer->stale.empty()) {
+  if (!feed.stale().empty()) {
     std::cerr << "warning: ids no longer in the Model (a scene was loaded; their values are nan):";
-    for (const auto& id : consumer->stale) std::cerr << " " << id;
+    for (const auto& id : feed.stale()) std::cerr << " " << id;
     std::cerr << "\n";
   }
   if (!written) throw Failure("write error on " + csv_path);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -20,7 +19,7 @@ using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
 // The worker's state. The CORBA part is set up by the constructor and then touched by the
-// worker thread only; the rest is guarded by `mutex`.
+// worker thread only (its hooks and jobs); `status` is guarded by `mutex`.
 struct LogLink::Impl {
   explicit Impl(LogLink::Options o)
       : options(std::move(o)),
@@ -28,7 +27,8 @@ struct LogLink::Impl {
         short_ms(static_cast<CORBA::ULong>(options.call_timeout_ms)),
         query_ms(static_cast<CORBA::ULong>(options.query_timeout_ms)) {}
 
-  void Run();
+  void Tick();
+  void FillGaps();
   bool FetchAfter(uint64_t after_serial, std::vector<LiveRecord>* out);
   void Connect();
   bool Check();
@@ -40,20 +40,16 @@ struct LogLink::Impl {
     omniORB::setClientThreadCallTimeout(ms);
     if (!CORBA::is_nil(target)) omniORB::setClientCallTimeout(target, ms);
   }
-  bool Stopping() {
-    std::lock_guard<std::mutex> lock(mutex);
-    return stop;
-  }
+  bool Stopping() const { return worker.stopping(); }
 
   const LogLink::Options options;
   const std::shared_ptr<LiveInbox> inbox;
   const CORBA::ULong short_ms;
   const CORBA::ULong query_ms;
 
+  client::WorkerHandle worker;  // the thread that runs Tick and FillGaps
+
   std::mutex mutex;
-  std::condition_variable wake;  // the worker: stop or a gap; the destructor: finished
-  bool stop = false;
-  bool finished = false;  // the worker has unregistered and ends
   LinkStatus status;
 
   CORBA::ORB_var orb;
@@ -122,13 +118,21 @@ LogLink::LogLink(Options options)
     : options_(std::move(options)), impl_(std::make_shared<Impl>(options_)) {
   Impl& i = *impl_;
   i.status.message = "looking for " + options_.instance + " ...";
-  // a gap in the pushed serials wakes the worker to query it
-  std::weak_ptr<Impl> weak = impl_;
-  i.inbox->set_on_gap([weak] {
-    if (auto impl = weak.lock()) {
-      { std::lock_guard<std::mutex> lock(impl->mutex); }
-      impl->wake.notify_all();
-    }
+  // the worker's hooks share its state: a worker left inside a call outlives the LogLink
+  client::Worker::Hooks hooks;
+  hooks.start = [impl = impl_] { impl->Limit(impl->short_ms); };
+  hooks.tick = [impl = impl_] { impl->Tick(); };
+  hooks.finish = [impl = impl_] { impl->Drop("stopped"); };
+  worker_ = std::make_unique<client::Worker>(
+      client::Worker::Options{milliseconds(options_.retry_period_ms),
+                              milliseconds(options_.stop_timeout_ms)},
+      std::move(hooks));
+  i.worker = worker_->handle();
+  // a gap in the pushed serials: the worker queries it
+  i.inbox->set_on_gap([worker = i.worker, weak = std::weak_ptr<Impl>(impl_)] {
+    worker.Post([weak] {
+      if (auto impl = weak.lock()) impl->FillGaps();
+    });
   });
   i.orb = rtc::ClientOrb();
   CORBA::Object_var obj = i.orb->resolve_initial_references("RootPOA");
@@ -141,26 +145,15 @@ LogLink::LogLink(Options options)
   i.servant_id = i.poa->activate_object(i.listener_servant);
   CORBA::Object_var ref = i.poa->id_to_reference(i.servant_id);
   i.listener = L::LogListener::_narrow(ref);
-  worker_ = std::thread([impl = impl_] { impl->Run(); });
+  worker_->Start();
 }
 
 LogLink::~LogLink() {
   Impl& i = *impl_;
-  bool finished = false;
-  {
-    std::unique_lock<std::mutex> lock(i.mutex);
-    i.stop = true;
-    i.wake.notify_all();
-    finished =
-        i.wake.wait_for(lock, milliseconds(options_.stop_timeout_ms), [&] { return i.finished; });
-  }
-  if (finished) {
-    worker_.join();
-  } else {
-    // inside a call to a logger that stopped answering: it ends when the call times out (the
-    // state it needs is shared with it); nothing it takes in reaches anyone now
-    worker_.detach();
-  }
+  // the worker unregisters (Drop) and ends; one inside a call to a logger that stopped answering
+  // is left to end when the call times out (the state it needs is shared with it); nothing it
+  // takes in reaches anyone now
+  worker_->Stop(milliseconds(options_.stop_timeout_ms));
   i.inbox->Stop();
   try {
     i.poa->deactivate_object(i.servant_id);
@@ -270,9 +263,9 @@ void LogLink::Impl::Connect() {
     session_file = file.in();
     path = entry.path;
     waiting_since = kNone;
+    if (Stopping()) return;  // the worker ends and unregisters
     {
       std::lock_guard<std::mutex> lock(mutex);
-      if (stop) return;  // the loop ends and unregisters
       status.message = "reading the records " + name + " holds ...";
       status.session_file = session_file;
     }
@@ -360,35 +353,20 @@ void LogLink::Impl::FillGap() {
   }
 }
 
-void LogLink::Impl::Run() {
-  const rtc::OmniThread omni;  // per-thread call timeouts need an omni_thread
-  Limit(short_ms);
-  auto next = Clock::now();
-  for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex);
-      const bool registered = !CORBA::is_nil(logger);
-      wake.wait_until(lock, next, [&] { return stop || (registered && inbox->gap_pending()); });
-      if (stop) break;
-    }
-    if (!CORBA::is_nil(logger) && inbox->gap_pending()) {
-      FillGap();
-      continue;
-    }
-    if (Clock::now() < next) continue;
-    if (CORBA::is_nil(logger) || !Check()) {
-      if (Stopping()) break;
-      Connect();
-    }
-    next = Clock::now() +
-           milliseconds(CORBA::is_nil(logger) ? options.retry_period_ms : options.check_period_ms);
+void LogLink::Impl::FillGaps() {
+  // records wait behind a gap: it comes before anything else
+  while (!Stopping() && !CORBA::is_nil(logger) && inbox->gap_pending()) FillGap();
+}
+
+void LogLink::Impl::Tick() {
+  FillGaps();
+  if (Stopping()) return;
+  if (CORBA::is_nil(logger) || !Check()) {
+    if (Stopping()) return;
+    Connect();
   }
-  Drop("stopped");
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    finished = true;
-  }
-  wake.notify_all();
+  worker.TickIn(
+      milliseconds(CORBA::is_nil(logger) ? options.retry_period_ms : options.check_period_ms));
 }
 
 }  // namespace caliper::log_viewer

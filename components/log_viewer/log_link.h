@@ -11,9 +11,9 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "caliper/client/worker.h"
 #include "caliper/logging/record.h"
 #include "live_inbox.h"
 
@@ -70,7 +70,7 @@ class LogLink {
  private:
   Options options_;
   std::shared_ptr<Impl> impl_;
-  std::thread worker_;
+  std::unique_ptr<client::Worker> worker_;  // its hooks share impl_
 };
 
 }  // namespace caliper::log_viewer

@@ -10,13 +10,13 @@
 #include <utility>
 #include <vector>
 
+#include "caliper/client/scene_transfer.h"
 #include "caliper/core/confined_path.h"
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
 #include "caliper/rtc/naming.h"
-#include "caliper/model_file/model_file.h"
 
 namespace caliper::main_window {
 
@@ -38,7 +38,8 @@ struct ModelLink::Impl {
   bool scene_read = false;            // SceneInfo read for `edit_scene` at `edit_revision`
   std::string edit_scene;
   std::uint64_t edit_revision = 0;
-  bool files_read = false;  // write_dir read from this Model
+  bool files_read = false;         // write_dir read from this Model
+  bool relist_components = false;  // a component action ran since the last listing
 
   CosNaming::NamingContext_ptr Root(const std::string& nameservice) {
     if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
@@ -50,17 +51,27 @@ ModelLink::ModelLink(Options options)
     : impl_(std::make_unique<Impl>()), options_(std::move(options)) {
   impl_->orb = rtc::ClientOrb();
   snapshot_.connection_message = "no Model: looking for " + options_.instance + " ...";
-  worker_ = std::thread([this] { Run(); });
+  // the hooks use `this`: the destructor waits for the worker, however long its call takes
+  const auto short_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
+  client::Worker::Hooks hooks;
+  hooks.start = [short_ms] { omniORB::setClientConnectTimeout(short_ms); };
+  hooks.after_jobs = [this] { ListComponentsIfDue(); };
+  hooks.tick = [this] {
+    ListComponentsIfDue();
+    Poll();
+  };
+  hooks.finish = [this] {
+    impl_->model = M::Model::_nil();
+    impl_->root = CosNaming::NamingContext::_nil();
+  };
+  worker_ = std::make_unique<client::Worker>(
+      client::Worker::Options{std::chrono::milliseconds(options_.poll_period_ms),
+                              client::Worker::kForever},
+      std::move(hooks));
+  worker_->Start();
 }
 
-ModelLink::~ModelLink() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  worker_.join();
-}
+ModelLink::~ModelLink() { worker_->Stop(client::Worker::kForever); }
 
 Snapshot ModelLink::snapshot() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -70,58 +81,34 @@ Snapshot ModelLink::snapshot() const {
 void ModelLink::Queue(std::string what, std::function<void(Impl&)> call, bool needs_model) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    queue_.push_back(Command{std::move(what), std::move(call), needs_model});
     ++snapshot_.commands_queued;
   }
-  wake_.notify_all();
+  worker_->Post([this, command = Command{std::move(what), std::move(call), needs_model}] {
+    RunCommand(command);
+  });
 }
 
 void ModelLink::LoadScene(const std::string& path) {
   const int long_ms = options_.long_call_timeout_ms;
   Queue("load " + path, [this, path, long_ms](Impl& i) {
     omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(long_ms));
-    // the Model reads only below its search path: other files go by content
-    M::FileAccess_var files = i.model->file_access();
-    std::vector<std::string> dirs;
-    for (CORBA::ULong k = 0; k < files->read_dirs.length(); ++k)
-      dirs.push_back(files->read_dirs[k].in());
-    const core::ConfinedPaths confined(dirs, "", "", true);
-    const auto kRead = core::ConfinedPaths::Access::kRead;
-    // a URDF goes by path only when its meshes lie there too (the Model refuses it otherwise)
-    bool by_path = confined.Allows(path, kRead);
-    if (by_path) {
-      try {
-        for (const auto& file : model_file::FilesRead(path))
-          by_path &= confined.Allows(file, kRead);
-      } catch (const collada::ImportError&) {
-        // not XML: the Model says so, naming the file
-      }
-    }
-    if (by_path) {
-      i.model->load_scene(path.c_str());
-    } else {
-      // by content a Model takes COLLADA: a URDF is imported here and sent converted (NAME.dae)
-      std::vector<std::string> warnings;
-      const model_file::Content content = model_file::ContentToSend(path, &warnings);
-      if (!warnings.empty()) {
-        // the Model imports the converted COLLADA without a word: the URDF's warnings are said
-        // here, in the status bar and on the terminal
-        std::string notice = content.file_name + " (converted from " + path +
-                             "): " + std::to_string(warnings.size()) + " import warning" +
-                             (warnings.size() == 1 ? "" : "s") + ": " + warnings.front();
-        for (const auto& w : warnings)
-          std::fprintf(stderr, "caliper-main: warning: %s\n", w.c_str());
-        std::lock_guard<std::mutex> lock(mutex_);
-        snapshot_.last_notice = std::move(notice);
-        ++snapshot_.notice_serial;
-      }
-      const std::string& bytes = content.bytes;
-      if (bytes.size() > static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20))
-        throw std::runtime_error(path + " is larger than one CORBA message carries");
-      M::Octets data(static_cast<CORBA::ULong>(bytes.size()));
-      data.length(static_cast<CORBA::ULong>(bytes.size()));
-      std::copy(bytes.begin(), bytes.end(), reinterpret_cast<char*>(data.get_buffer()));
-      i.model->load_scene_data(content.file_name.c_str(), data);
+    // the rule of client::SendsByContent: by path when the Model reads it there (a URDF with
+    // its meshes), else by content, a URDF converted to COLLADA here
+    const bool by_content = client::SendsByContent(i.model, path, true, false,
+                                                   core::ConfinedPaths::Access::kRead);
+    const client::SentScene sent = client::LoadScene(i.model, path, by_content);
+    const auto& warnings = sent.warnings;
+    if (!warnings.empty()) {
+      // the Model imports the converted COLLADA without a word: the URDF's warnings are said
+      // here, in the status bar and on the terminal
+      std::string notice = sent.file_name + " (converted from " + path +
+                           "): " + std::to_string(warnings.size()) + " import warning" +
+                           (warnings.size() == 1 ? "" : "s") + ": " + warnings.front();
+      for (const auto& w : warnings)
+        std::fprintf(stderr, "caliper-main: warning: %s\n", w.c_str());
+      std::lock_guard<std::mutex> lock(mutex_);
+      snapshot_.last_notice = std::move(notice);
+      ++snapshot_.notice_serial;
     }
     i.channels_listed = false;
   });
@@ -505,231 +492,252 @@ void ModelLink::Watch(std::vector<std::string> ids) {
   watched_ = std::move(ids);
 }
 
-void ModelLink::Run() {
-  const rtc::OmniThread omni;  // per-thread call timeouts need an omni_thread
+namespace {
+
+ModelStatus FromIdl(const M::SimulationStatus& s) {
+  ModelStatus status;
+  status.state = rtc::Name(s.state);
+  status.scene = s.scene.in();
+  status.sim_time = s.sim_time;
+  status.steps = s.steps;
+  status.time_step = s.time_step;
+  status.real_time_factor = s.real_time_factor;
+  status.achieved_real_time_factor = s.achieved_real_time_factor;
+  status.last_error = s.last_error.in();
+  return status;
+}
+
+}  // namespace
+
+void ModelLink::RunCommand(const Command& command) {
   Impl& i = *impl_;
   const auto short_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
-  omniORB::setClientConnectTimeout(short_ms);
-  const auto period = std::chrono::milliseconds(options_.poll_period_ms);
-  auto next_poll = Clock::now();
-
-  // drops the Model after a system exception: it is looked up again
-  auto lost = [&](const std::string& why) {
-    i.model = M::Model::_nil();
-    i.channels_listed = false;
-    i.scene_read = false;
-    i.files_read = false;
-    std::lock_guard<std::mutex> lock(mutex_);
-    snapshot_.connected = false;
-    snapshot_.connection_message = "no Model reachable: " + why;
-  };
-
-  for (;;) {
-    std::deque<Command> commands;
-    std::vector<std::string> watched;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait_until(lock, next_poll, [&] { return stopping_ || !queue_.empty(); });
-      if (stopping_) break;
-      commands.swap(queue_);
-      watched = watched_;
-    }
-
-    bool relist_components = false;
-    for (auto& [what, call, needs_model] : commands) {
-      std::string error;
-      if (!needs_model) {
-        relist_components = true;
-        try {
-          omniORB::setClientThreadCallTimeout(short_ms);
-          call(i);
-        } catch (const CORBA::Exception& e) {
-          error = what + ": " + rtc::Describe(e);
-        } catch (const std::exception& e) {
-          error = what + ": " + e.what();
-        }
-      } else if (CORBA::is_nil(i.model)) {
-        error = what + ": no Model reachable";
-      } else {
-        try {
-          omniORB::setClientThreadCallTimeout(short_ms);
-          call(i);
-        } catch (const D::UnknownId& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const D::InvalidParameter& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const M::NotAvailable& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const D::NotAvailable& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const M::LoadFailed& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const M::EditRefused& e) {
-          error = what + ": " + e.reason.in();
-        } catch (const CORBA::SystemException& e) {
-          error = what + ": " + rtc::Describe(e);
-          lost(rtc::Describe(e));
-        } catch (const CORBA::Exception& e) {
-          error = what + ": " + rtc::Describe(e);
-        }
-      }
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++snapshot_.commands_done;
-      if (!error.empty()) {
-        snapshot_.last_error = error;
-        ++snapshot_.error_serial;
-      }
-    }
-
-    omniORB::setClientThreadCallTimeout(short_ms);
-    if (relist_components ||
-        Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.components_period_ms)) {
-      i.last_listing = Clock::now();
-      ListComponents();
-    }
-
-    if (Clock::now() < next_poll) continue;
-    next_poll = Clock::now() + period;
-
-    // look the Model up (not more often than the reconnect period)
-    if (CORBA::is_nil(i.model)) {
-      if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
-        continue;
-      i.last_lookup = Clock::now();
-      try {
-        CosNaming::NamingContext_var root =
-            rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-        M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
-        if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
-        i.model = model;
-      } catch (const CORBA::Exception& e) {
-        lost(rtc::Describe(e));
-        continue;
-      } catch (const std::exception& e) {
-        lost(e.what());
-        continue;
-      }
-    }
-
+  const std::string& what = command.what;
+  std::string error;
+  if (!command.needs_model) {
+    i.relist_components = true;
     try {
-      M::SimulationStatus_var s = i.model->status();
-      ModelStatus status;
-      status.state = rtc::Name(s->state);
-      status.scene = s->scene.in();
-      status.sim_time = s->sim_time;
-      status.steps = s->steps;
-      status.time_step = s->time_step;
-      status.real_time_factor = s->real_time_factor;
-      status.achieved_real_time_factor = s->achieved_real_time_factor;
-      status.last_error = s->last_error.in();
-
-      std::vector<Channel> channels;
-      const bool relist = !i.channels_listed || status.scene != i.scene;
-      if (relist) {
-        D::ChannelInfoSeq_var infos = i.model->list("*");
-        for (CORBA::ULong k = 0; k < infos->length(); ++k) {
-          const D::ChannelInfo& c = infos[k];
-          channels.push_back(Channel{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.writable),
-                                     bool(c.is_static), c.description.in()});
-        }
-        i.channels_listed = true;
-        i.scene = status.scene;
-      }
-
-      std::map<std::string, double> values;
-      if (!watched.empty() && !relist) {
-        S::StringSeq ids;
-        ids.length(static_cast<CORBA::ULong>(watched.size()));
-        for (CORBA::ULong k = 0; k < ids.length(); ++k) ids[k] = watched[k].c_str();
-        try {
-          D::ValueSeq_var got = i.model->get(ids);
-          for (CORBA::ULong k = 0; k < got->length() && k < ids.length(); ++k)
-            if (got[k].data.length() == 1) values[watched[k]] = got[k].data[0];
-        } catch (const D::UnknownId&) {
-          i.channels_listed = false;  // the scene changed under us: list again
-        }
-      }
-
-      // the edit history and the selection, shared with the renderer and other clients; the
-      // scene is read again after each edit (from any client) and with each new scene
-      M::EditStatus_var edit;
-      M::Selection_var selection;
-      bool editing = false;
-      try {
-        edit = i.model->edit_status();
-        selection = i.model->current_selection();
-        editing = true;
-      } catch (const CORBA::BAD_OPERATION&) {
-        // a Model built before scene editing: everything else still works
-      }
-      if (!editing || status.state == "EMPTY") {
-        i.scene_read = false;
-      } else if (!i.scene_read || edit->revision != i.edit_revision ||
-                 status.scene != i.edit_scene) {
-        // an edit may add or remove parameters (a tendon's actuator): list them again
-        if (i.scene_read && edit->revision != i.edit_revision) i.channels_listed = false;
-        try {
-          // a scene with large meshes takes longer than a short call to describe
-          omniORB::setClientThreadCallTimeout(
-              static_cast<CORBA::ULong>(options_.long_call_timeout_ms));
-          ReadScene();
-          i.scene_read = true;
-          i.edit_scene = status.scene;
-          i.edit_revision = edit->revision;
-        } catch (const M::NotAvailable&) {
-          // no scene (a load in progress): read it at the next poll
-        } catch (const M::EditRefused&) {
-          // a body went away between the description and its shapes: read it again
-        }
-        omniORB::setClientThreadCallTimeout(short_ms);
-      }
-
-      // the recording and the replay (a Model built before recordings has neither)
-      bool recordings = false;
-      RecordInfo record;
-      ReplayInfo replay;
-      try {
-        record = FromIdl(M::RecordStatus_var(i.model->recording_status()).in());
-        replay = FromIdl(M::ReplayStatus_var(i.model->replay_status()).in());
-        recordings = true;
-      } catch (const CORBA::BAD_OPERATION&) {
-      }
-      std::string write_dir;
-      if (!i.files_read) {
-        write_dir = M::FileAccess_var(i.model->file_access())->write_dir.in();
-      }
-
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!i.files_read) {
-        snapshot_.write_dir = write_dir;
-        i.files_read = true;
-      }
-      snapshot_.recordings = recordings;
-      snapshot_.record = record;
-      snapshot_.replay = replay;
-      snapshot_.editing = editing;
-      if (editing) {
-        snapshot_.edit = FromIdl(edit.in());
-        snapshot_.selection = SelectionInfo{selection->kind.in(), selection->name.in(),
-                                            selection->index, selection->revision};
-      }
-      snapshot_.connected = true;
-      snapshot_.connection_message.clear();
-      snapshot_.status = status;
-      if (relist) {
-        snapshot_.channels = std::move(channels);
-        ++snapshot_.channels_version;
-        snapshot_.values.clear();
-      }
-      for (auto& [id, v] : values) snapshot_.values[id] = v;
-    } catch (const CORBA::SystemException& e) {
-      lost(rtc::Describe(e));
+      omniORB::setClientThreadCallTimeout(short_ms);
+      command.call(i);
     } catch (const CORBA::Exception& e) {
-      lost(rtc::Describe(e));
+      error = what + ": " + rtc::Describe(e);
+    } catch (const std::exception& e) {
+      error = what + ": " + e.what();
+    }
+  } else if (CORBA::is_nil(i.model)) {
+    error = what + ": no Model reachable";
+  } else {
+    try {
+      omniORB::setClientThreadCallTimeout(short_ms);
+      command.call(i);
+    } catch (const D::UnknownId& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const D::InvalidParameter& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const M::NotAvailable& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const D::NotAvailable& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const M::LoadFailed& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const M::EditRefused& e) {
+      error = what + ": " + e.reason.in();
+    } catch (const CORBA::SystemException& e) {
+      error = what + ": " + rtc::Describe(e);
+      Lost(rtc::Describe(e));
+    } catch (const CORBA::Exception& e) {
+      error = what + ": " + rtc::Describe(e);
+    } catch (const std::exception& e) {
+      // a file that cannot be read or converted here (client::LoadScene)
+      error = what + ": " + e.what();
     }
   }
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++snapshot_.commands_done;
+  if (!error.empty()) {
+    snapshot_.last_error = error;
+    ++snapshot_.error_serial;
+  }
+}
+
+void ModelLink::ListComponentsIfDue() {
+  Impl& i = *impl_;
+  omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.call_timeout_ms));
+  if (i.relist_components ||
+      Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.components_period_ms)) {
+    i.relist_components = false;
+    i.last_listing = Clock::now();
+    ListComponents();
+  }
+}
+
+void ModelLink::Lost(const std::string& why) {
+  Impl& i = *impl_;
   i.model = M::Model::_nil();
-  i.root = CosNaming::NamingContext::_nil();
+  i.channels_listed = false;
+  i.scene_read = false;
+  i.files_read = false;
+  std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_.connected = false;
+  snapshot_.connection_message = "no Model reachable: " + why;
+}
+
+bool ModelLink::LookUp() {
+  // not more often than the reconnect period
+  Impl& i = *impl_;
+  if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
+    return false;
+  i.last_lookup = Clock::now();
+  try {
+    CosNaming::NamingContext_var root =
+        rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
+    M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+    if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
+    i.model = model;
+    return true;
+  } catch (const CORBA::Exception& e) {
+    Lost(rtc::Describe(e));
+  } catch (const std::exception& e) {
+    Lost(e.what());
+  }
+  return false;
+}
+
+void ModelLink::Poll() {
+  if (CORBA::is_nil(impl_->model) && !LookUp()) return;
+  std::vector<std::string> watched;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    watched = watched_;
+  }
+  try {
+    PollModel(watched);
+  } catch (const CORBA::SystemException& e) {
+    Lost(rtc::Describe(e));
+  } catch (const CORBA::Exception& e) {
+    Lost(rtc::Describe(e));
+  }
+}
+
+bool ModelLink::ListChannels(const std::string& scene, std::vector<Channel>* channels) {
+  Impl& i = *impl_;
+  if (i.channels_listed && scene == i.scene) return false;
+  D::ChannelInfoSeq_var infos = i.model->list("*");
+  for (CORBA::ULong k = 0; k < infos->length(); ++k) {
+    const D::ChannelInfo& c = infos[k];
+    channels->push_back(Channel{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.writable),
+                                bool(c.is_static), c.description.in()});
+  }
+  i.channels_listed = true;
+  i.scene = scene;
+  return true;
+}
+
+std::map<std::string, double> ModelLink::ReadValues(const std::vector<std::string>& watched) {
+  Impl& i = *impl_;
+  std::map<std::string, double> values;
+  S::StringSeq ids;
+  ids.length(static_cast<CORBA::ULong>(watched.size()));
+  for (CORBA::ULong k = 0; k < ids.length(); ++k) ids[k] = watched[k].c_str();
+  try {
+    D::ValueSeq_var got = i.model->get(ids);
+    for (CORBA::ULong k = 0; k < got->length() && k < ids.length(); ++k)
+      if (got[k].data.length() == 1) values[watched[k]] = got[k].data[0];
+  } catch (const D::UnknownId&) {
+    i.channels_listed = false;  // the scene changed under us: list again
+  }
+  return values;
+}
+
+bool ModelLink::ReadEditing(const ModelStatus& status, EditInfo* edit_info,
+                            SelectionInfo* selection_info) {
+  // the edit history and the selection, shared with the renderer and other clients; the
+  // scene is read again after each edit (from any client) and with each new scene
+  Impl& i = *impl_;
+  M::EditStatus_var edit;
+  M::Selection_var selection;
+  try {
+    edit = i.model->edit_status();
+    selection = i.model->current_selection();
+  } catch (const CORBA::BAD_OPERATION&) {
+    // a Model built before scene editing: everything else still works
+    i.scene_read = false;
+    return false;
+  }
+  if (status.state == "EMPTY") {
+    i.scene_read = false;
+  } else if (!i.scene_read || edit->revision != i.edit_revision || status.scene != i.edit_scene) {
+    // an edit may add or remove parameters (a tendon's actuator): list them again
+    if (i.scene_read && edit->revision != i.edit_revision) i.channels_listed = false;
+    try {
+      // a scene with large meshes takes longer than a short call to describe
+      omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.long_call_timeout_ms));
+      ReadScene();
+      i.scene_read = true;
+      i.edit_scene = status.scene;
+      i.edit_revision = edit->revision;
+    } catch (const M::NotAvailable&) {
+      // no scene (a load in progress): read it at the next poll
+    } catch (const M::EditRefused&) {
+      // a body went away between the description and its shapes: read it again
+    }
+    omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.call_timeout_ms));
+  }
+  *edit_info = FromIdl(edit.in());
+  *selection_info = SelectionInfo{selection->kind.in(), selection->name.in(), selection->index,
+                                  selection->revision};
+  return true;
+}
+
+void ModelLink::PollModel(const std::vector<std::string>& watched) {
+  Impl& i = *impl_;
+  M::SimulationStatus_var s = i.model->status();
+  const ModelStatus status = FromIdl(s.in());
+  std::vector<Channel> channels;
+  const bool relist = ListChannels(status.scene, &channels);
+  std::map<std::string, double> values;
+  if (!watched.empty() && !relist) values = ReadValues(watched);
+  EditInfo edit;
+  SelectionInfo selection;
+  const bool editing = ReadEditing(status, &edit, &selection);
+
+  // the recording and the replay (a Model built before recordings has neither)
+  bool recordings = false;
+  RecordInfo record;
+  ReplayInfo replay;
+  try {
+    record = FromIdl(M::RecordStatus_var(i.model->recording_status()).in());
+    replay = FromIdl(M::ReplayStatus_var(i.model->replay_status()).in());
+    recordings = true;
+  } catch (const CORBA::BAD_OPERATION&) {
+  }
+  std::string write_dir;
+  if (!i.files_read) {
+    write_dir = M::FileAccess_var(i.model->file_access())->write_dir.in();
+  }
+
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!i.files_read) {
+    snapshot_.write_dir = write_dir;
+    i.files_read = true;
+  }
+  snapshot_.recordings = recordings;
+  snapshot_.record = record;
+  snapshot_.replay = replay;
+  snapshot_.editing = editing;
+  if (editing) {
+    snapshot_.edit = edit;
+    snapshot_.selection = selection;
+  }
+  snapshot_.connected = true;
+  snapshot_.connection_message.clear();
+  snapshot_.status = status;
+  if (relist) {
+    snapshot_.channels = std::move(channels);
+    ++snapshot_.channels_version;
+    snapshot_.values.clear();
+  }
+  for (auto& [id, v] : values) snapshot_.values[id] = v;
 }
 
 }  // namespace caliper::main_window

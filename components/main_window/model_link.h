@@ -1,19 +1,18 @@
 #pragma once
-// The Main Window's connection to the Model: a worker thread that finds `model0` in the naming
-// service, polls its status and the watched parameter values, and runs the queued commands. The
-// GUI only reads snapshots and queues commands, so a dead or slow Model never blocks it. No Qt
-// here; CORBA stays in the .cc file.
+// The Main Window's connection to the Model: a worker thread (client::Worker) that finds `model0`
+// in the naming service, polls its status and the watched parameter values, and runs the queued
+// commands. The GUI only reads snapshots and queues commands, so a dead or slow Model never
+// blocks it. No Qt here; CORBA stays in the .cc file.
 
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "caliper/client/worker.h"
 
 namespace caliper::main_window {
 
@@ -254,20 +253,32 @@ class ModelLink {
   void Queue(std::string what, std::function<void(Impl&)> call, bool needs_model = true);
   /// An edit: `call` returns the Model's EditStatus, which the snapshot takes at once.
   void QueueEdit(std::string what, std::function<EditInfo(Impl&)> call);
-  /// Reads the scene, its actuators and the bodies' shapes; on the worker thread only.
+  // on the worker thread only, from here on
+  void RunCommand(const Command& command);
+  /// Reads the scene, its actuators and the bodies' shapes.
   void ReadScene();
   void ListComponents();
-  void Run();
+  /// Lists the components when a component action ran or the components period passed.
+  void ListComponentsIfDue();
+  /// A tick: looks the Model up while there is none, then polls it.
+  void Poll();
+  bool LookUp();
+  void PollModel(const std::vector<std::string>& watched);
+  /// Lists the channels when the scene changed (or they were never listed); true when it did.
+  bool ListChannels(const std::string& scene, std::vector<Channel>* channels);
+  std::map<std::string, double> ReadValues(const std::vector<std::string>& watched);
+  /// The edit history and the selection (false: a Model without scene editing); reads the
+  /// scene again after an edit or with a new scene.
+  bool ReadEditing(const ModelStatus& status, EditInfo* edit, SelectionInfo* selection);
+  /// Forgets the Model after a system exception: it is looked up again.
+  void Lost(const std::string& why);
 
   std::unique_ptr<Impl> impl_;
   Options options_;
-  mutable std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
-  std::deque<Command> queue_;
+  mutable std::mutex mutex_;  // guards the fields below
   std::vector<std::string> watched_;
   Snapshot snapshot_;
-  std::thread worker_;
+  std::unique_ptr<client::Worker> worker_;  // its hooks and jobs use everything above
 };
 
 }  // namespace caliper::main_window

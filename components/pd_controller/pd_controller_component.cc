@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "caliper/client/model.h"
 #include "caliper/logging/log.h"
 #include "caliper/rtc/naming.h"
 
@@ -33,9 +34,8 @@ PdControllerComponent::PdControllerComponent(rtc::Runtime& runtime) : runtime_(r
 rtc::ReturnCode PdControllerComponent::OnActivated() {
   const auto& c = runtime_.config();
   CosNaming::NamingContext_var root = rtc::ResolveRoot(runtime_.orb(), runtime_.naming_address());
-  const rtc::ComponentEntry entry = rtc::FindComponent(root, c.GetString("controller.model"));
-  model_ = M::Model::_narrow(entry.object);
-  if (CORBA::is_nil(model_)) throw std::runtime_error(entry.path + " is not a Model");
+  // the client library finds it (host/instance too) and says what is wrong when it cannot
+  model_ = client::FindModel(root, c.GetString("controller.model")).model._retn();
   // channel ids are <model name>.<joint>.position: find the joint's among the Model's channels
   D::ChannelInfoSeq_var channels = model_->list(("*." + c.GetString("controller.joint") + ".position").c_str());
   if (channels->length() == 0)

@@ -1,8 +1,10 @@
 #include "daq_link.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <map>
 #include <set>
@@ -136,6 +138,30 @@ struct DaqLink::Shared {
     held_values = 0;
   }
 
+  // a subscribe call ended: `id` (0: none) becomes the current subscription, laid out as
+  // `id_layout`; the batches that came meanwhile are taken in or their subscriptions ended
+  void Settle(uint64_t id, const std::shared_ptr<const std::vector<SubscribedId>>& id_layout) {
+    std::lock_guard<std::mutex> lock(mutex);
+    subscribing = false;
+    if (id != 0) {
+      current = id;
+      layout = id_layout;
+      next_batch = 1;
+      last_sample_time = kNaN;
+      model_layout = 0;  // a new subscription starts at the Model's layout 1
+      last_batch_wall = Clock::now();
+    }
+    for (auto& [sub, batches] : pending) {
+      if (sub == id) {
+        for (auto& b : batches) Accept(std::move(b));
+      } else {
+        foreign.insert(sub);
+      }
+    }
+    pending.clear();
+    pending_count = 0;
+  }
+
   void Receive(ReceivedBatch&& b) {
     std::lock_guard<std::mutex> lock(mutex);
     if (current != 0 && b.subscription == current) {
@@ -150,7 +176,7 @@ struct DaqLink::Shared {
 };
 
 // The worker's CORBA state; touched by the worker thread only (and the constructor), but for
-// `servant`, whose counter status() reads.
+// `servant`, whose counter status() reads, and `has_model`.
 struct DaqLink::Impl {
   CORBA::ORB_var orb;
   PortableServer::POA_var poa;
@@ -167,6 +193,9 @@ struct DaqLink::Impl {
   std::vector<std::string> subscribed;  // ids of the current subscription
   uint32_t subscribed_every = 0;
   std::unique_ptr<StreamWatch> watch;  // of the current subscription
+  std::atomic<bool> has_model{false};  // `model` is not nil: a wanted change wakes the worker
+  uint64_t seen_version = 0;           // the wanted_version_ of the last poll
+  uint64_t layout_resubscriptions = 0;
 };
 
 DaqLink::DaqLink(Options options)
@@ -191,16 +220,24 @@ DaqLink::DaqLink(Options options)
   i.servant = servant;
   CORBA::Object_var ref = i.poa->id_to_reference(i.oid);
   i.consumer = D::DataConsumer::_narrow(ref);
-  worker_ = std::thread([this] { Run(); });
+  // the hooks use `this`: the destructor waits for the worker (its calls are bounded)
+  const auto timeout_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
+  client::Worker::Hooks hooks;
+  hooks.start = [timeout_ms] {
+    omniORB::setClientConnectTimeout(timeout_ms);
+    omniORB::setClientThreadCallTimeout(timeout_ms);
+  };
+  hooks.tick = [this] { Tick(); };
+  hooks.finish = [this] { Close(); };
+  worker_ = std::make_unique<client::Worker>(
+      client::Worker::Options{std::chrono::milliseconds(options_.poll_period_ms),
+                              client::Worker::kForever},
+      std::move(hooks));
+  worker_->Start();
 }
 
 DaqLink::~DaqLink() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  worker_.join();
+  worker_->Stop(client::Worker::kForever);
   try {
     impl_->poa->deactivate_object(impl_->oid);
   } catch (const CORBA::Exception&) {
@@ -229,7 +266,7 @@ void DaqLink::Want(std::vector<std::string> ids, uint32_t every_n_steps) {
     every_n_steps_ = every;
     ++wanted_version_;
   }
-  wake_.notify_all();
+  if (impl_->has_model) worker_->TickIn(std::chrono::milliseconds(0));
 }
 
 std::vector<ReceivedBatch> DaqLink::TakeBatches() {
@@ -246,7 +283,7 @@ void DaqLink::Relist() {
     std::lock_guard<std::mutex> lock(mutex_);
     relist_ = true;
   }
-  wake_.notify_all();
+  worker_->TickIn(std::chrono::milliseconds(0));
 }
 
 void DaqLink::Resubscribe(uint64_t subscription, const std::string& why) {
@@ -257,338 +294,338 @@ void DaqLink::Resubscribe(uint64_t subscription, const std::string& why) {
     resubscribe_ = subscription;
     resubscribe_why_ = why;
   }
-  wake_.notify_all();
+  if (impl_->has_model) worker_->TickIn(std::chrono::milliseconds(0));
 }
 
-void DaqLink::Run() {
-  // per-thread call timeouts need an omni_thread
-  omni_thread* self = omni_thread::create_dummy();
+// What the GUI asked for since the last poll.
+struct DaqLink::Request {
+  std::vector<std::string> wanted;
+  uint32_t every = 1;
+  bool relist = false;
+  uint64_t renew = 0;  // a subscription whose batches the GUI cannot read
+  std::string renew_why;
+};
+
+namespace {
+
+// what the worker reads of the current subscription's stream
+struct Stream {
+  uint64_t current = 0;
+  std::shared_ptr<const std::vector<SubscribedId>> layout;
+  bool checking = false;
+  double last_sample = kNaN;
+  Clock::time_point last_batch_wall;
+};
+
+// the wanted ids the Model has (in the order wanted) and those it has not
+void SplitWanted(const std::vector<std::string>& wanted, const std::vector<ChannelEntry>& channels,
+                 std::vector<std::string>* target, std::vector<std::string>* missing) {
+  target->clear();
+  missing->clear();
+  for (const auto& id : wanted) {
+    const bool known = std::any_of(channels.begin(), channels.end(),
+                                   [&](const ChannelEntry& c) { return c.id == id; });
+    (known ? target : missing)->push_back(id);
+  }
+}
+
+Stream CurrentStream(DaqLink::Shared& sh) {
+  std::lock_guard<std::mutex> lock(sh.mutex);
+  return Stream{sh.current, sh.layout, sh.checking, sh.last_sample_time, sh.last_batch_wall};
+}
+
+}  // namespace
+
+void DaqLink::Tick() {
+  PollOnce();
+  // what the GUI asked for meanwhile comes at once
+  bool again = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    again = relist_ || ((wanted_version_ != impl_->seen_version || resubscribe_ != 0) &&
+                        !CORBA::is_nil(impl_->model));
+  }
+  if (again) worker_->TickIn(std::chrono::milliseconds(0));
+}
+
+DaqLink::Request DaqLink::TakeRequest() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Request r;
+  r.wanted = wanted_;
+  r.every = every_n_steps_;
+  impl_->seen_version = wanted_version_;
+  r.relist = relist_;
+  relist_ = false;
+  r.renew = resubscribe_;
+  r.renew_why = resubscribe_why_;
+  resubscribe_ = 0;
+  return r;
+}
+
+void DaqLink::CheckClosing() const {
+  if (worker_->stopping()) throw Closing{};
+}
+
+void DaqLink::SetMessage(const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  status_.message = message;
+}
+
+void DaqLink::Lost(const std::string& why) {
   Impl& i = *impl_;
   Shared& sh = *shared_;
+  i.model = M::Model::_nil();
+  i.has_model = false;
+  i.channels_listed = false;
+  i.subscribed.clear();
+  {
+    std::lock_guard<std::mutex> lock(sh.mutex);
+    sh.current = 0;
+    sh.layout.reset();
+    sh.subscribing = false;
+    sh.Discard();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  status_.connected = false;
+  status_.state.clear();
+  status_.subscription = 0;
+  status_.subscribed.clear();
+  status_.missing.clear();
+  status_.message = "no Model reachable: " + why;
+}
+
+void DaqLink::PollOnce() {
+  const Request request = TakeRequest();
+  omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.call_timeout_ms));
+  try {
+    if (CORBA::is_nil(impl_->model) && !LookUp()) return;
+    Poll(request);
+  } catch (const Closing&) {
+    // the worker ends: no further call
+  } catch (const CORBA::Exception& e) {
+    Lost(rtc::Describe(e));
+  } catch (const std::exception& e) {
+    SetMessage(e.what());
+  }
+}
+
+bool DaqLink::LookUp() {
+  // not more often than the reconnect period
+  Impl& i = *impl_;
+  if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
+    return false;
+  i.last_lookup = Clock::now();
   const auto timeout_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
-  omniORB::setClientConnectTimeout(timeout_ms);
-  omniORB::setClientThreadCallTimeout(timeout_ms);
-  const auto period = std::chrono::milliseconds(options_.poll_period_ms);
-  auto next_poll = Clock::now();
-  uint64_t seen_version = 0;
-  uint64_t layout_resubscriptions = 0;
-
-  // before each call of a poll: a closing link makes no further call
-  auto check_closing = [&] {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (stopping_) throw Closing{};
-  };
-
-  auto set_message = [&](const std::string& message) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    status_.message = message;
-  };
-
-  // forgets the Model after a system exception: it is looked up again
-  auto lost = [&](const std::string& why) {
-    i.model = M::Model::_nil();
+  try {
+    CosNaming::NamingContext_var root =
+        rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
+    omniORB::setClientCallTimeout(root, timeout_ms);
+    CheckClosing();
+    M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
+    if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
+    // the reference's own timeout bounds every call to the Model (omniORB honours the
+    // per-thread one only with -ORBsupportPerThreadTimeOut 1)
+    omniORB::setClientCallTimeout(model, timeout_ms);
+    i.model = model;
+    i.has_model = true;
     i.channels_listed = false;
-    i.subscribed.clear();
-    {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      sh.current = 0;
-      sh.layout.reset();
-      sh.subscribing = false;
-      sh.Discard();
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    status_.connected = false;
-    status_.state.clear();
-    status_.subscription = 0;
-    status_.subscribed.clear();
-    status_.missing.clear();
-    status_.message = "no Model reachable: " + why;
-  };
+    i.steps = 0;
+    return true;
+  } catch (const CORBA::Exception& e) {
+    Lost(rtc::Describe(e));
+  } catch (const std::exception& e) {
+    Lost(e.what());
+  }
+  return false;
+}
 
-  // the Model's channels now; true when they differ from the last listing
-  auto list_channels = [&](const std::string& scene) {
-    check_closing();
-    D::ChannelInfoSeq_var infos = i.model->channels("*");
-    std::vector<ChannelEntry> channels;
-    channels.reserve(infos->length());
-    for (CORBA::ULong k = 0; k < infos->length(); ++k) {
-      const D::ChannelInfo& c = infos[k];
-      channels.push_back(ChannelEntry{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.is_static),
-                                      c.description.in()});
-    }
-    const bool changed = !i.channels_listed || !SameChannels(channels, i.channels);
-    i.channels = std::move(channels);
-    i.channels_listed = true;
-    i.scene = scene;
-    i.last_listing = Clock::now();
-    return changed;
-  };
+bool DaqLink::ListChannels(const std::string& scene) {
+  Impl& i = *impl_;
+  CheckClosing();
+  D::ChannelInfoSeq_var infos = i.model->channels("*");
+  std::vector<ChannelEntry> channels;
+  channels.reserve(infos->length());
+  for (CORBA::ULong k = 0; k < infos->length(); ++k) {
+    const D::ChannelInfo& c = infos[k];
+    channels.push_back(ChannelEntry{c.id.in(), c.unit.in(), c.rows, c.cols, bool(c.is_static),
+                                    c.description.in()});
+  }
+  const bool changed = !i.channels_listed || !SameChannels(channels, i.channels);
+  i.channels = std::move(channels);
+  i.channels_listed = true;
+  i.scene = scene;
+  i.last_listing = Clock::now();
+  return changed;
+}
 
-  // ends the current subscription and makes one for `ids` (none when empty) laid out as the
-  // channels listed last say; a system exception propagates (the Model is gone)
-  auto resubscribe = [&](const std::vector<std::string>& ids, uint32_t every, double sim_time) {
-    uint64_t old = 0;
-    {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      old = sh.current;
-      sh.current = 0;
-      sh.layout.reset();
-      sh.Discard();
-    }
-    i.subscribed.clear();
-    if (old != 0) {
-      check_closing();
-      try {
-        i.model->unsubscribe(old);
-      } catch (const CORBA::UserException&) {
-        // gone already
-      }
-    }
-    if (ids.empty()) return;
-    check_closing();
+void DaqLink::EndForeignSubscriptions() {
+  // subscriptions that are not ours any more but still send: end them
+  Shared& sh = *shared_;
+  std::set<uint64_t> foreign;
+  {
+    std::lock_guard<std::mutex> lock(sh.mutex);
+    foreign.swap(sh.foreign);
+    foreign.erase(sh.current);
+  }
+  for (const uint64_t f : foreign) {
+    CheckClosing();
+    impl_->model->unsubscribe(f);
+  }
+}
 
-    auto layout = std::make_shared<const std::vector<SubscribedId>>(LayoutOf(ids, i.channels));
-    S::StringSeq seq;
-    seq.length(static_cast<CORBA::ULong>(ids.size()));
-    for (size_t k = 0; k < ids.size(); ++k) seq[static_cast<CORBA::ULong>(k)] = ids[k].c_str();
-    {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      sh.subscribing = true;
-      sh.pending.clear();
-      sh.pending_count = 0;
-    }
-    // whatever happens, the batches held meanwhile are settled
-    auto settle = [&](uint64_t id) {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      sh.subscribing = false;
-      if (id != 0) {
-        sh.current = id;
-        sh.layout = layout;
-        sh.next_batch = 1;
-        sh.last_sample_time = kNaN;
-        sh.model_layout = 0;  // a new subscription starts at the Model's layout 1
-        sh.last_batch_wall = Clock::now();
-      }
-      for (auto& [sub, batches] : sh.pending) {
-        if (sub == id) {
-          for (auto& b : batches) sh.Accept(std::move(b));
-        } else {
-          sh.foreign.insert(sub);
-        }
-      }
-      sh.pending.clear();
-      sh.pending_count = 0;
-    };
-    CORBA::ULongLong id = 0;
+void DaqLink::Subscribe(const std::vector<std::string>& ids, uint32_t every, double sim_time) {
+  Impl& i = *impl_;
+  Shared& sh = *shared_;
+  uint64_t old = 0;
+  {
+    std::lock_guard<std::mutex> lock(sh.mutex);
+    old = sh.current;
+    sh.current = 0;
+    sh.layout.reset();
+    sh.Discard();
+  }
+  i.subscribed.clear();
+  if (old != 0) {
+    CheckClosing();
     try {
-      id = i.model->subscribe(seq, every, i.consumer);
-    } catch (const D::UnknownId& e) {
-      settle(0);
-      i.channels_listed = false;  // the scene changed under us: list again
-      set_message("subscribing: " + std::string(e.reason.in()));
-      return;
-    } catch (const D::InvalidParameter& e) {
-      settle(0);
-      set_message("subscribing: " + std::string(e.reason.in()));
-      return;
-    } catch (const D::NotAvailable& e) {
-      settle(0);
-      set_message("the Model takes no subscription now: " + std::string(e.reason.in()));
-      return;
-    } catch (...) {
-      settle(0);
-      throw;
-    }
-    settle(id);
-    i.subscribed = ids;
-    i.subscribed_every = every;
-    i.watch->Start(sim_time, every, Clock::now());
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++status_.subscriptions_made;
-    status_.message.clear();
-  };
-
-  for (;;) {
-    std::vector<std::string> wanted;
-    uint32_t every = 1;
-    bool relist_asked = false;
-    uint64_t renew_asked = 0;  // a subscription whose batches the GUI cannot read
-    std::string renew_asked_why;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait_until(lock, next_poll, [&] {
-        return stopping_ || relist_ ||
-               ((wanted_version_ != seen_version || resubscribe_ != 0) && !CORBA::is_nil(i.model));
-      });
-      if (stopping_) break;
-      wanted = wanted_;
-      every = every_n_steps_;
-      seen_version = wanted_version_;
-      relist_asked = relist_;
-      relist_ = false;
-      renew_asked = resubscribe_;
-      renew_asked_why = resubscribe_why_;
-      resubscribe_ = 0;
-    }
-    next_poll = Clock::now() + period;
-    omniORB::setClientThreadCallTimeout(timeout_ms);
-
-    try {
-      // look the Model up (not more often than the reconnect period)
-      if (CORBA::is_nil(i.model)) {
-        if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
-          continue;
-        i.last_lookup = Clock::now();
-        try {
-          CosNaming::NamingContext_var root =
-              rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-          omniORB::setClientCallTimeout(root, timeout_ms);
-          check_closing();
-          M::Model_var model =
-              M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
-          if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
-          // the reference's own timeout bounds every call to the Model (omniORB honours the
-          // per-thread one only with -ORBsupportPerThreadTimeOut 1)
-          omniORB::setClientCallTimeout(model, timeout_ms);
-          i.model = model;
-          i.channels_listed = false;
-          i.steps = 0;
-        } catch (const CORBA::Exception& e) {
-          lost(rtc::Describe(e));
-          continue;
-        } catch (const std::exception& e) {
-          lost(e.what());
-          continue;
-        }
-      }
-
-      check_closing();
-      M::SimulationStatus_var s = i.model->status();
-      const std::string scene = s->scene.in();
-      const bool rewound = s->steps < i.steps;
-      i.steps = s->steps;
-      {
-        // subscriptions that are not ours any more but still send: end them
-        std::set<uint64_t> foreign;
-        {
-          std::lock_guard<std::mutex> lock(sh.mutex);
-          foreign.swap(sh.foreign);
-          foreign.erase(sh.current);
-        }
-        for (const uint64_t f : foreign) {
-          check_closing();
-          i.model->unsubscribe(f);
-        }
-      }
-
-      uint64_t current = 0;
-      std::shared_ptr<const std::vector<SubscribedId>> layout;
-      bool checking = false;
-      double last_sample = kNaN;
-      Clock::time_point last_batch_wall;
-      {
-        std::lock_guard<std::mutex> lock(sh.mutex);
-        current = sh.current;
-        layout = sh.layout;
-        checking = sh.checking;
-        last_sample = sh.last_sample_time;
-        last_batch_wall = sh.last_batch_wall;
-      }
-      const bool renew_asked_now = renew_asked != 0 && renew_asked == current;
-
-      // a new scene, a reset, a periodic listing, held batches or unreadable ones: list again
-      bool listed = false;  // the GUI gets the new list
-      bool fresh = false;   // listed in this poll
-      const bool due =
-          Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.relist_period_ms);
-      if (!i.channels_listed || scene != i.scene || rewound || relist_asked || due || checking ||
-          renew_asked_now) {
-        listed = list_channels(scene);
-        fresh = true;
-      }
-
-      // the wanted ids the Model has (in the order wanted) and those it has not
-      std::vector<std::string> target, missing;
-      auto split_wanted = [&] {
-        target.clear();
-        missing.clear();
-        for (const auto& id : wanted) {
-          const bool known = std::any_of(i.channels.begin(), i.channels.end(),
-                                         [&](const ChannelEntry& c) { return c.id == id; });
-          (known ? target : missing).push_back(id);
-        }
-      };
-      split_wanted();
-      // ids that vanished stay subscribed (their values come as NaN, marked stale, and come back
-      // when a scene has them again); a new wanted id, a removed one or a new rate subscribe anew
-      bool renew = (current == 0 && !target.empty()) || !Subset(target, i.subscribed) ||
-                   !Subset(i.subscribed, wanted) || (current != 0 && every != i.subscribed_every);
-      std::string why;
-      // the scene gave subscribed ids another shape or unit: the values moved within a sample
-      if (fresh && current != 0 && layout) {
-        const std::string change = LayoutChange(*layout, i.channels);
-        if (!change.empty()) {
-          renew = true;
-          why = "the scene changed (" + change + "): subscribed again";
-          ++layout_resubscriptions;
-        } else if (checking) {
-          std::lock_guard<std::mutex> lock(sh.mutex);
-          if (sh.current == current) sh.Release();
-        }
-      }
-      if (renew_asked_now && why.empty()) {
-        renew = true;
-        why = renew_asked_why + ": subscribed again";
-      }
-      // a stream gone quiet while the Model runs (e.g. the Model dropped us): subscribe again
-      if (current != 0 &&
-          i.watch->Quiet(s->state == M::RUNNING, s->sim_time, s->time_step, last_sample,
-                         last_batch_wall, Clock::now()) &&
-          !renew) {
-        renew = true;
-        why = "no samples for " + std::to_string(i.watch->quiet_for()) +
-              " s of simulated time: subscribed again";
-      }
-      if (renew) {
-        // the layout comes from a listing of now
-        if (!fresh) {
-          listed |= list_channels(scene);
-          fresh = true;
-          split_wanted();
-        }
-        resubscribe(target, every, s->sim_time);
-      }
-
-      std::lock_guard<std::mutex> lock(mutex_);
-      status_.connected = true;
-      if (!why.empty()) status_.message = why;
-      if (status_.message.rfind("no Model", 0) == 0) status_.message.clear();
-      status_.state = rtc::Name(s->state);
-      status_.scene = scene;
-      status_.sim_time = s->sim_time;
-      status_.time_step = s->time_step;
-      if (listed) {
-        status_.channels = i.channels;
-        ++status_.channels_version;
-      }
-      status_.subscribed = i.subscribed;
-      status_.missing = missing;
-      status_.layout_resubscriptions = layout_resubscriptions;
-      {
-        std::lock_guard<std::mutex> shared_lock(sh.mutex);
-        status_.subscription = sh.current;
-      }
-    } catch (const Closing&) {
-      break;
-    } catch (const CORBA::Exception& e) {
-      lost(rtc::Describe(e));
-    } catch (const std::exception& e) {
-      set_message(e.what());
+      i.model->unsubscribe(old);
+    } catch (const CORBA::UserException&) {
+      // gone already
     }
   }
+  if (ids.empty()) return;
+  CheckClosing();
 
+  auto layout = std::make_shared<const std::vector<SubscribedId>>(LayoutOf(ids, i.channels));
+  S::StringSeq seq;
+  seq.length(static_cast<CORBA::ULong>(ids.size()));
+  for (size_t k = 0; k < ids.size(); ++k) seq[static_cast<CORBA::ULong>(k)] = ids[k].c_str();
+  {
+    std::lock_guard<std::mutex> lock(sh.mutex);
+    sh.subscribing = true;
+    sh.pending.clear();
+    sh.pending_count = 0;
+  }
+  // whatever happens, the batches held meanwhile are settled
+  CORBA::ULongLong id = 0;
+  try {
+    id = i.model->subscribe(seq, every, i.consumer);
+  } catch (const D::UnknownId& e) {
+    sh.Settle(0, layout);
+    i.channels_listed = false;  // the scene changed under us: list again
+    SetMessage("subscribing: " + std::string(e.reason.in()));
+    return;
+  } catch (const D::InvalidParameter& e) {
+    sh.Settle(0, layout);
+    SetMessage("subscribing: " + std::string(e.reason.in()));
+    return;
+  } catch (const D::NotAvailable& e) {
+    sh.Settle(0, layout);
+    SetMessage("the Model takes no subscription now: " + std::string(e.reason.in()));
+    return;
+  } catch (...) {
+    sh.Settle(0, layout);
+    throw;
+  }
+  sh.Settle(id, layout);
+  i.subscribed = ids;
+  i.subscribed_every = every;
+  i.watch->Start(sim_time, every, Clock::now());
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++status_.subscriptions_made;
+  status_.message.clear();
+}
+
+void DaqLink::Poll(const Request& request) {
+  Impl& i = *impl_;
+  Shared& sh = *shared_;
+  CheckClosing();
+  M::SimulationStatus_var s = i.model->status();
+  const std::string scene = s->scene.in();
+  const bool rewound = s->steps < i.steps;
+  i.steps = s->steps;
+  EndForeignSubscriptions();
+  const Stream stream = CurrentStream(sh);
+  const uint64_t current = stream.current;
+  const bool renew_asked_now = request.renew != 0 && request.renew == current;
+
+  // a new scene, a reset, a periodic listing, held batches or unreadable ones: list again
+  bool listed = false;  // the GUI gets the new list
+  bool fresh = false;   // listed in this poll
+  const bool due =
+      Clock::now() - i.last_listing >= std::chrono::milliseconds(options_.relist_period_ms);
+  if (!i.channels_listed || scene != i.scene || rewound || request.relist || due ||
+      stream.checking || renew_asked_now) {
+    listed = ListChannels(scene);
+    fresh = true;
+  }
+
+  std::vector<std::string> target, missing;
+  SplitWanted(request.wanted, i.channels, &target, &missing);
+  // ids that vanished stay subscribed (their values come as NaN, marked stale, and come back
+  // when a scene has them again); a new wanted id, a removed one or a new rate subscribe anew
+  bool renew = (current == 0 && !target.empty()) || !Subset(target, i.subscribed) ||
+               !Subset(i.subscribed, request.wanted) ||
+               (current != 0 && request.every != i.subscribed_every);
+  std::string why;
+  // the scene gave subscribed ids another shape or unit: the values moved within a sample
+  if (fresh && current != 0 && stream.layout) {
+    const std::string change = LayoutChange(*stream.layout, i.channels);
+    if (!change.empty()) {
+      renew = true;
+      why = "the scene changed (" + change + "): subscribed again";
+      ++i.layout_resubscriptions;
+    } else if (stream.checking) {
+      std::lock_guard<std::mutex> lock(sh.mutex);
+      if (sh.current == current) sh.Release();
+    }
+  }
+  if (renew_asked_now && why.empty()) {
+    renew = true;
+    why = request.renew_why + ": subscribed again";
+  }
+  // a stream gone quiet while the Model runs (e.g. the Model dropped us): subscribe again
+  if (current != 0 &&
+      i.watch->Quiet(s->state == M::RUNNING, s->sim_time, s->time_step, stream.last_sample,
+                     stream.last_batch_wall, Clock::now()) &&
+      !renew) {
+    renew = true;
+    why = "no samples for " + std::to_string(i.watch->quiet_for()) +
+          " s of simulated time: subscribed again";
+  }
+  if (renew) {
+    // the layout comes from a listing of now
+    if (!fresh) {
+      listed |= ListChannels(scene);
+      SplitWanted(request.wanted, i.channels, &target, &missing);
+    }
+    Subscribe(target, request.every, s->sim_time);
+  }
+
+  std::lock_guard<std::mutex> lock(mutex_);
+  status_.connected = true;
+  if (!why.empty()) status_.message = why;
+  if (status_.message.rfind("no Model", 0) == 0) status_.message.clear();
+  status_.state = rtc::Name(s->state);
+  status_.scene = scene;
+  status_.sim_time = s->sim_time;
+  status_.time_step = s->time_step;
+  if (listed) {
+    status_.channels = i.channels;
+    ++status_.channels_version;
+  }
+  status_.subscribed = i.subscribed;
+  status_.missing = missing;
+  status_.layout_resubscriptions = i.layout_resubscriptions;
+  std::lock_guard<std::mutex> shared_lock(sh.mutex);
+  status_.subscription = sh.current;
+}
+
+void DaqLink::Close() {
   // closing: one short call ends the subscription so that the Model stops sending; none when the
   // Model was found gone (a Model drops a consumer that no longer answers anyway)
+  Impl& i = *impl_;
+  Shared& sh = *shared_;
   uint64_t current = 0;
   {
     std::lock_guard<std::mutex> lock(sh.mutex);
@@ -608,7 +645,7 @@ void DaqLink::Run() {
     }
   }
   i.model = M::Model::_nil();
-  if (self != nullptr) omni_thread::release_dummy();
+  i.has_model = false;
 }
 
 }  // namespace caliper::plotter

@@ -1,5 +1,6 @@
 #pragma once
-// The Graph Plotter's connection to the Model's data acquisition: a worker thread that finds the
+// The Graph Plotter's connection to the Model's data acquisition: a worker thread (client::Worker,
+// polling at poll_period_ms, at once when the GUI asks for something new) that finds the
 // Model (`model0`) in the naming service, lists its channels, keeps one DAQ subscription for the
 // ids being plotted and re-makes it when the ids change, when the Model is restarted or reloaded,
 // when batches stop coming while the Model runs, and when a reloaded scene gives subscribed ids
@@ -9,15 +10,13 @@
 // listing). The GUI only reads status snapshots, takes batches and says which ids it wants, so a
 // dead or slow Model never blocks it. No Qt here; CORBA stays in the .cc files.
 
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "caliper/client/worker.h"
 #include "channel_layout.h"
 
 namespace caliper::plotter {
@@ -66,9 +65,9 @@ class DaqLink {
     /// Every call to the Model (set on its reference) and to the naming service's root context;
     /// the naming service's other contexts follow the ORB's own call timeout.
     int call_timeout_ms = 1500;
-    int poll_period_ms = 250;         ///< status (and channels when the scene changed)
-    int reconnect_period_ms = 1000;   ///< looking the Model up again while none is reachable
-    int relist_period_ms = 5000;      ///< listing the channels again (also on a new scene)
+    int poll_period_ms = 250;        ///< status (and channels when the scene changed)
+    int reconnect_period_ms = 1000;  ///< looking the Model up again while none is reachable
+    int relist_period_ms = 5000;     ///< listing the channels again (also on a new scene)
     /// Re-subscribe when the Model runs and this much simulated (and wall) time passed without a
     /// batch [s]; longer when samples are sparse (see QuietThreshold).
     double silence_s = 2.0;
@@ -107,14 +106,33 @@ class DaqLink {
   struct Shared;  ///< shared with the consumer servant
 
  private:
-  void Run();
+  struct Request;  ///< what the GUI asked for since the last poll
+  // on the worker thread only, from here on
+  /// A tick: polls, then asks for the next at once when the GUI asked for something meanwhile.
+  void Tick();
+  void PollOnce();
+  Request TakeRequest();
+  /// Throws when the link closes: a poll makes no further call.
+  void CheckClosing() const;
+  void SetMessage(const std::string& message);
+  /// Forgets the Model after a system exception: it is looked up again.
+  void Lost(const std::string& why);
+  /// Looks the Model up, not more often than reconnect_period_ms; true when found.
+  bool LookUp();
+  void Poll(const Request& request);
+  /// The Model's channels now; true when they differ from the last listing.
+  bool ListChannels(const std::string& scene);
+  void EndForeignSubscriptions();
+  /// Ends the current subscription and makes one for `ids` (none when empty) laid out as the
+  /// channels listed last say; a system exception propagates (the Model is gone).
+  void Subscribe(const std::vector<std::string>& ids, uint32_t every, double sim_time);
+  /// Ends the subscription when closing.
+  void Close();
 
   Options options_;
   std::unique_ptr<Impl> impl_;
   std::shared_ptr<Shared> shared_;
   mutable std::mutex mutex_;  // guards the fields below
-  std::condition_variable wake_;
-  bool stopping_ = false;
   bool relist_ = false;
   uint64_t resubscribe_ = 0;  // the subscription to replace (0: none)
   std::string resubscribe_why_;
@@ -122,7 +140,7 @@ class DaqLink {
   uint32_t every_n_steps_ = 1;
   uint64_t wanted_version_ = 0;
   LinkStatus status_;
-  std::thread worker_;
+  std::unique_ptr<client::Worker> worker_;  // its hooks use everything above
 };
 
 }  // namespace caliper::plotter

@@ -1,5 +1,7 @@
 #include "renderer_component.h"
 
+#include "caliper/client/model.h"
+
 #include "caliper/logging/log.h"
 #include "caliper/rtc/naming.h"
 #include "observer_servant.h"
@@ -71,7 +73,7 @@ void RendererComponent::CheckRegistration() {
   M::Model_var found;
   try {
     CosNaming::NamingContext_var root = rtc::ResolveRoot(runtime_.orb(), runtime_.naming_address());
-    found = M::Model::_narrow(rtc::FindComponent(root, name).object);
+    found = client::FindModel(root, name).model._retn();
   } catch (const CORBA::Exception& e) {
     if (!reported_missing_) log.info("no Model '%s' yet: %s", name.c_str(), rtc::Describe(e).c_str());
     reported_missing_ = true;

@@ -177,6 +177,20 @@ ctl managers >"$WORK/managers.out" 2>&1
 if grep -q "killed by signal 9" "$WORK/managers.out"; then pass "hostb's manager reports its Model killed by signal 9"
 else cat "$WORK/managers.out"; fail "the manager does not report the killed Model"; fi
 
+# ---------------------------------------------------------------- a host's Models by glob
+# `*@hostc` matches hostc's manager too: the pool takes only Models (no retry spent on it)
+cat >"$WORK/two.json" <<JSON
+{"name": "two", "scene": "$SRC/models/ecce_arm.dae", "duration_s": 0.5,
+ "record": ["ecce_arm.elbow.position"], "sweep": {"ecce_arm.forearm.mass": [0.30, 0.31]}}
+JSON
+ctl batch "$WORK/two.json" --models '*@hostc' --out "$WORK/hostc" >"$WORK/hostc.out" 2>&1
+models=$(tail -n +2 "$WORK/hostc/summary.csv" 2>/dev/null | cut -d, -f3 | sort -u | xargs)
+retries=$(tail -n +2 "$WORK/hostc/summary.csv" 2>/dev/null | cut -d, -f11 | grep -c . || true)
+if [ -n "$models" ] && ! grep -q "manager\|BAD_OPERATION" "$WORK/hostc.out" "$WORK/hostc/summary.csv" &&
+  [ "$retries" -eq 0 ] && [ -z "$(tr ' ' '\n' <<<"$models" | grep -v '^model[0-9]*@hostc$')" ]; then
+  pass "--models '*@hostc' ran on hostc's Models only ($models), no retry"
+else cat "$WORK/hostc.out" "$WORK/hostc/summary.csv"; fail "--models '*@hostc' took more than hostc's Models"; fi
+
 # ---------------------------------------------------------------- the naming service restarts
 kill -TERM "$NAMING_PID" 2>/dev/null
 sleep 0.5

@@ -10,8 +10,13 @@ namespace caliper::client {
 
 namespace M = ::Caliper::Simulation;
 
-ModelRef ConnectModel(Session& session, const std::string& name) {
-  rtc::ComponentEntry e = session.Find(name);
+ModelRef FindModel(CosNaming::NamingContext_ptr root, const std::string& name) {
+  rtc::ComponentEntry e;
+  try {
+    e = rtc::FindComponent(root, name);
+  } catch (const rtc::NotFound& error) {
+    throw Failure(error.what());
+  }
   ModelRef ref;
   ref.name = name;
   ref.path = e.path;
@@ -23,6 +28,11 @@ ModelRef ConnectModel(Session& session, const std::string& name) {
   }
   if (CORBA::is_nil(ref.model)) throw Failure(e.path + " is not a Model (caliper-model)");
   return ref;
+}
+
+ModelRef ConnectModel(Session& session, const std::string& name) {
+  CosNaming::NamingContext_var root = session.Root();
+  return FindModel(root, name);
 }
 
 M::SimulationStatus* StatusOf(const ModelRef& m) {

@@ -9,8 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <map>
-#include <set>
 #include <thread>
 
 #include "caliper/collada/exporter.h"
@@ -76,7 +74,7 @@ std::unique_lock<std::mutex> ModelCore::Lock() const {
 
 void ModelCore::CancelExperiment() {
   cancel_ = true;
-  NotifyRoom();  // a step waiting for a lossless consumer looks again
+  feeds_.NotifyRoom();  // a step waiting for a lossless consumer looks again
 }
 
 bool ModelCore::EndExperimentLocked(const std::string& request) {
@@ -237,10 +235,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   replay_.reset();
   fork_reset_every_ = 0;
   BuildLocked(std::move(loaded));
-  undo_.clear();
-  redo_.clear();
-  removed_actuators_.clear();
-  last_edit_.clear();
+  history_.Forget();
   state_ = RunState::kPaused;
   last_error_.clear();
   result.load_wall_s = std::chrono::duration<double>(Clock::now() - load_begin).count();
@@ -352,11 +347,8 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;
   last_error_.clear();
-  undo_.clear();
-  redo_.clear();
-  removed_actuators_.clear();
-  last_edit_.clear();
-  selection_ = {"", "", 0, selection_.revision + 1};
+  history_.Forget();
+  history_.ClearSelection();
   logging::Get("model").notice("loaded %s: %zu bodies, %zu tendons, %zu actuators", source.c_str(),
                                scene.bodies.size(), scene.tendons.size(), scene.actuators.size());
 }
@@ -419,7 +411,7 @@ void ModelCore::Pause() {
     if (!EndExperimentLocked("pause") && state_ == RunState::kRunning)
       state_ = RunState::kPaused;  // a step request ends paused
   }
-  NotifyRoom();  // a step waiting for a lossless consumer ends
+  feeds_.NotifyRoom();  // a step waiting for a lossless consumer ends
 }
 
 void ModelCore::Stop() {
@@ -436,7 +428,7 @@ void ModelCore::Stop() {
       state_ = RunState::kStopped;
     }
   }
-  NotifyRoom();  // a step waiting for a lossless consumer ends
+  feeds_.NotifyRoom();  // a step waiting for a lossless consumer ends
 }
 
 void ModelCore::Reset() {
@@ -590,7 +582,7 @@ void ModelCore::StepLocked() {
   try {
     loaded_->sampler->Refresh();
     AfterStepLocked();
-    recorder_.OnStep(loaded_->physics->steps(), loaded_->physics->time());
+    feeds_.OnStep(loaded_->physics->steps(), loaded_->physics->time());
     PublishLocked();
   } catch (const std::exception& e) {
     FaultLocked(std::string("after step ") + std::to_string(loaded_->physics->steps()) +
@@ -795,218 +787,49 @@ uint64_t ModelCore::Subscribe(const std::vector<std::string>& ids, uint32_t ever
                               size_t batch_steps, std::chrono::milliseconds lossless_wait) {
   const auto lock = Lock();
   Require(true);
-  if (every_n_steps == 0) throw InvalidValue("every_n_steps must be at least 1");
-  if (ids.empty()) throw InvalidValue("subscribe to at least one id");
-  if (ids.size() > limits_.ids_per_call)
-    throw LimitExceeded(std::to_string(ids.size()) + " ids in one subscription; at most " +
-                        std::to_string(limits_.ids_per_call), limits_.ids_per_call);
-  // every subscribed value is read at every sampled step with the lock held: bound them all
-  size_t values = 0;
-  for (const auto& id : ids) {
-    if (!registry_.Contains(id)) throw UnknownId("unknown id '" + id + "'", id);
-    values += registry_.Info(id).shape.size();
-  }
-  if (subscribed_values_ + values > limits_.subscribed_values)
-    throw LimitExceeded("subscribing " + std::to_string(values) + " values to the " +
-                        std::to_string(subscribed_values_) + " subscribed already: at most " +
-                        std::to_string(limits_.subscribed_values) +
-                        " values in all subscriptions together",
-                        limits_.subscribed_values);
-  daq::SubscriptionOptions options;
-  options.ids = ids;
-  options.every_n_steps = every_n_steps;
-  options.batch_steps = std::max<size_t>(1, batch_steps);
-  // the batches waiting for slow consumers stay within kQueuedBytes in all (each queue gets the
-  // share of a subscription holding every value allowed)
-  const double batch_bytes =
-      8.0 * static_cast<double>(limits_.subscribed_values) * options.batch_steps;
-  options.queue_capacity = static_cast<size_t>(
-      std::clamp(static_cast<double>(limits_.queued_bytes) / batch_bytes, 2.0, 64.0));
-  try {
-    const uint64_t id = recorder_.Subscribe(options);
-    subscribed_values_ += values;
-    subscription_values_[id] = values;
-    Feed& feed = feeds_[id];
-    feed.capacity = options.queue_capacity;
-    if (lossless_wait.count() > 0) {
-      feed.lossless_wait = lossless_wait;
-      ++lossless_;
-    }
-    return id;
-  } catch (const daq::UnknownId& e) {
-    throw UnknownId(e.what(), e.id());
-  } catch (const std::invalid_argument& e) {
-    throw InvalidValue(e.what());
-  }
+  return feeds_.Subscribe(ids, every_n_steps, batch_steps, lossless_wait);
 }
 
 void ModelCore::Unsubscribe(uint64_t subscription, const std::string& reason) {
   {
     const auto lock = Lock();
-    UnsubscribeLocked(subscription, reason);
+    feeds_.Unsubscribe(subscription, reason);
   }
-  NotifyRoom();
-}
-
-void ModelCore::UnsubscribeLocked(uint64_t subscription, const std::string& reason) {
-  const auto feed = feeds_.find(subscription);
-  if (feed == feeds_.end()) return;  // already gone
-  const std::string kind = feed->second.lossless_wait.count() > 0 ? "lossless " : "";
-  try {
-    const daq::SubscriptionStats stats = recorder_.Stats(subscription);
-    uint64_t unsent = 0;  // queued, and the partial batch
-    for (const daq::Batch& b : recorder_.Unsubscribe(subscription)) unsent += b.step_count;
-    const uint64_t dropped = stats.dropped_samples + feed->second.undelivered_samples;
-    auto& log = logging::Get("daq");
-    if (!reason.empty())
-      log.warn("%ssubscription %llu ended by the Model after %llu samples (%llu never sent): %s",
-               kind.c_str(), static_cast<unsigned long long>(subscription),
-               static_cast<unsigned long long>(stats.samples),
-               static_cast<unsigned long long>(dropped + unsent), reason.c_str());
-    else if (dropped > 0)
-      log.notice("%ssubscription %llu ended: %llu samples taken, %llu of them dropped (the "
-                 "consumer was slower than the simulation ran)",
-                 kind.c_str(), static_cast<unsigned long long>(subscription),
-                 static_cast<unsigned long long>(stats.samples),
-                 static_cast<unsigned long long>(dropped));
-  } catch (const daq::UnknownId&) {
-    // already gone
-  }
-  if (feed->second.lossless_wait.count() > 0) --lossless_;
-  feeds_.erase(feed);
-  if (!reason.empty()) {
-    ended_[subscription] = reason;
-    if (ended_.size() > 64) ended_.erase(ended_.begin());
-  }
-  const auto it = subscription_values_.find(subscription);
-  if (it != subscription_values_.end()) {
-    subscribed_values_ -= it->second;
-    subscription_values_.erase(it);
-  }
+  feeds_.NotifyRoom();
 }
 
 FeedStatus ModelCore::SubscriptionStatus(uint64_t subscription) const {
   const auto lock = Lock();
-  const auto feed = feeds_.find(subscription);
-  if (feed == feeds_.end()) {
-    const auto ended = ended_.find(subscription);
-    const std::string id = std::to_string(subscription);
-    throw UnknownId(ended != ended_.end()
-                        ? "subscription " + id + " was ended by the Model: " + ended->second
-                        : "no subscription " + id,
-                    id);
-  }
-  const daq::SubscriptionStats stats = recorder_.Stats(subscription);
-  FeedStatus out;
-  out.lossless = feed->second.lossless_wait.count() > 0;
-  out.samples = stats.samples;
-  out.batches = stats.batches;
-  out.dropped_batches = stats.dropped + feed->second.undelivered_batches;
-  out.dropped_samples = stats.dropped_samples + feed->second.undelivered_samples;
-  out.queued = stats.queued;
-  out.waited_s = feed->second.waited_s;
-  return out;
+  return feeds_.Status(subscription);
 }
 
 void ModelCore::NoteUndelivered(uint64_t subscription, uint64_t batches, uint64_t samples) {
   const auto lock = Lock();
-  const auto feed = feeds_.find(subscription);
-  if (feed == feeds_.end()) return;
-  feed->second.undelivered_batches += batches;
-  feed->second.undelivered_samples += samples;
+  feeds_.NoteUndelivered(subscription, batches, samples);
 }
 
 void ModelCore::SetConsumerWake(std::function<void(uint64_t)> wake) {
   const auto lock = Lock();
-  consumer_wake_ = std::move(wake);
-}
-
-void ModelCore::NotifyRoom() {
-  {
-    std::lock_guard<std::mutex> room(room_mutex_);
-    ++room_events_;
-  }
-  room_.notify_all();
+  feeds_.SetConsumerWake(std::move(wake));
 }
 
 bool ModelCore::AwaitConsumersLocked(std::unique_lock<std::mutex>& lock) {
-  if (lossless_ == 0) return false;
+  if (feeds_.lossless() == 0) return false;
   // what ends the wait besides room: a stop, pause, load or shutdown meanwhile
   const RunState state = state_;
   const uint64_t generation = restarts_;
-  bool released = false;
-  uint64_t waiting_for = 0;  // the subscription waited for now (0: none yet)
-  Clock::time_point since;
-  for (;;) {
-    // read before looking at the queues: a take after the look changes it
-    uint64_t seen;
-    {
-      std::lock_guard<std::mutex> room(room_mutex_);
-      seen = room_events_;
-    }
-    uint64_t blocked = 0;
-    for (const auto& [id, feed] : feeds_) {
-      if (feed.lossless_wait.count() == 0) continue;
-      // one step queues at most two batches (one on a layout change, one full)
-      if (recorder_.Stats(id).queued + 2 > feed.capacity) {
-        blocked = id;
-        break;
-      }
-    }
-    if (blocked == 0) return released;
-    Feed& feed = feeds_[blocked];
-    const auto now = Clock::now();
-    if (blocked != waiting_for) {
-      waiting_for = blocked;
-      since = now;
-      if (consumer_wake_) consumer_wake_(blocked);
-    }
-    const auto deadline = since + feed.lossless_wait;
-    if (now >= deadline) {
-      UnsubscribeLocked(
-          blocked, "its consumer took no batch for " +
-                       std::to_string(feed.lossless_wait.count()) +
-                       " ms while the simulation waited for it (lossless); the Model goes on "
-                       "without it");
-      waiting_for = 0;
-      continue;
-    }
-    lock.unlock();
-    released = true;
-    {
-      std::unique_lock<std::mutex> room(room_mutex_);
-      room_.wait_until(room, deadline, [&] { return room_events_ != seen; });
-    }
-    lock.lock();
-    const auto it = feeds_.find(blocked);
-    if (it != feeds_.end())
-      it->second.waited_s += std::chrono::duration<double>(Clock::now() - now).count();
-    if (state_ != state || restarts_ != generation || !end_request_.empty() || cancel_)
-      return true;
-  }
+  return feeds_.AwaitRoom(lock, [&] {
+    return state_ != state || restarts_ != generation || !end_request_.empty() || cancel_;
+  });
 }
 
 std::vector<daq::Batch> ModelCore::TakeBatches(uint64_t subscription, bool* gone,
                                                uint64_t* dropped_samples) {
-  if (gone != nullptr) *gone = false;
-  try {
-    std::vector<daq::Batch> batches = recorder_.TakeBatches(subscription);
-    if (!batches.empty()) NotifyRoom();
-    if (dropped_samples != nullptr)
-      *dropped_samples = recorder_.Stats(subscription).dropped_samples;
-    return batches;
-  } catch (const daq::UnknownId&) {
-    if (gone != nullptr) *gone = true;
-    return {};
-  }
+  return feeds_.TakeBatches(subscription, gone, dropped_samples);
 }
 
 bool ModelCore::WaitForBatches(uint64_t subscription, std::chrono::milliseconds timeout) {
-  try {
-    return recorder_.WaitForBatches(subscription, timeout);
-  } catch (const daq::UnknownId&) {
-    return false;
-  }
+  return feeds_.WaitForBatches(subscription, timeout);
 }
 
 void ModelCore::AddListener(CoreListener* listener) {
@@ -1081,37 +904,13 @@ ModelCore::EditStatus ModelCore::ApplyEdit(const Rebuild& rebuild) {
 void ModelCore::SwapEditedLocked(std::shared_ptr<const sgal::Scene> base,
                                  std::unique_ptr<sgal::PhysicsScene> physics,
                                  const std::string& what) {
-  // the dynamic state now (the engine stepped while the edit was built), matched by name:
-  // bodies and constraints are never added by an edit; an actuator that an edit removes keeps
-  // its state and command aside, for the undo that brings it back
+  // the dynamic state now (the engine stepped while the edit was built), matched by name; an
+  // actuator that an edit removes keeps its state and command aside, for the undo that brings
+  // it back
   const sgal::Scene& current = physics->description();
-  const sgal::DynamicState old_state = loaded_->physics->SaveDynamicState();
   const sgal::Scene& old_scene = loaded_->physics->description();
-  sgal::DynamicState state = old_state;
-  state.engine.clear();  // the engine's own numbers belong to the scene before the edit
-  state.actuators.assign(current.actuators.size(), {});
-  state.commands.assign(current.actuators.size(), 0.0);
-  std::map<std::string, size_t> before;
-  for (size_t j = 0; j < old_scene.actuators.size(); ++j) before[old_scene.actuators[j].name] = j;
-  std::set<std::string> kept;
-  for (size_t k = 0; k < current.actuators.size(); ++k) {
-    const sgal::Actuator& a = current.actuators[k];
-    const auto was = before.find(a.name);
-    if (was != before.end() && old_scene.actuators[was->second].kind == a.kind) {
-      state.actuators[k] = old_state.actuators[was->second];
-      state.commands[k] = old_state.commands[was->second];
-      kept.insert(a.name);
-    } else if (const auto aside = removed_actuators_.find(a.name);
-               aside != removed_actuators_.end() && aside->second.kind == a.kind) {
-      state.actuators[k] = aside->second.state;
-      state.commands[k] = aside->second.command;
-      removed_actuators_.erase(aside);
-    }
-  }
-  for (const auto& [name, j] : before)
-    if (kept.count(name) == 0 && removed_actuators_.size() < 256)
-      removed_actuators_[name] = {old_scene.actuators[j].kind, old_state.actuators[j],
-                                  old_state.commands[j]};
+  const sgal::DynamicState state =
+      history_.CarryOver(old_scene, loaded_->physics->SaveDynamicState(), current);
   try {
     physics->RestoreDynamicState(state);
   } catch (const std::exception& e) {
@@ -1141,52 +940,27 @@ void ModelCore::SwapEditedLocked(std::shared_ptr<const sgal::Scene> base,
                                  last_error_.c_str(), loaded_->physics->time());
     last_error_.clear();
   }
-  ++edit_revision_;
-  last_edit_ = what;
+  history_.Applied(what);
   if (recorder_session_) {
     // the edited scene from this step on, and a keyframe of the engine built from it
-    Recorder& r = *recorder_session_;
-    r.writer->AddScene({++r.scene_version, loaded_->physics->steps(), loaded_->name + ".dae",
-                        ColladaBytesOf(loaded_->physics->description())});
+    SessionRecorder& r = *recorder_session_;
+    r.AddScene(loaded_->physics->steps(), loaded_->name + ".dae",
+               ColladaBytesOf(loaded_->physics->description()));
     RecordEventLocked("edit", what, {});
-    RecordKeyframeLocked();
-    ResolveRecordedChannelsLocked();
+    r.AddKeyframe(*loaded_->physics);
+    r.ResolveChannels();  // the channels were registered anew
   }
-  const sgal::Scene& edited = *loaded_->description;
-  // a selection of what the edit removed is gone; a selected path element that an insert or a
-  // removal before it shifted keeps pointing at the same element
-  if ((selection_.kind == "tendon" || selection_.kind == "path_point") &&
-      edited.FindTendon(selection_.name) == nullptr)
-    selection_ = {"", "", 0, selection_.revision + 1};
-  if (selection_.kind == "path_point") {
-    const auto& now = edited.FindTendon(selection_.name)->path;
-    const sgal::Tendon* was = old_base->FindTendon(selection_.name);
-    if (was != nullptr && was->path.size() != now.size() && selection_.index < was->path.size()) {
-      const sgal::PathElement& e = was->path[selection_.index];
-      const auto same = [&](const sgal::PathElement& x) {
-        return x.kind == e.kind && x.body == e.body && x.position == e.position &&
-               x.obstacle == e.obstacle;
-      };
-      const auto found = std::find_if(now.begin(), now.end(), same);
-      if (found == now.end())
-        selection_ = {"", "", 0, selection_.revision + 1};
-      else if (static_cast<uint32_t>(found - now.begin()) != selection_.index)
-        selection_ = {"path_point", selection_.name, static_cast<uint32_t>(found - now.begin()),
-                      selection_.revision + 1};
-    }
-  }
-  if (selection_.kind == "obstacle" && edited.FindObstacle(selection_.name) == nullptr)
-    selection_ = {"", "", 0, selection_.revision + 1};
+  history_.FollowEdit(*old_base, *loaded_->description);
   logging::Get("model").notice("scene edit: %s (t = %.3f s)", what.c_str(),
                                loaded_->physics->time());
 }
 
 ModelCore::EditStatus ModelCore::EditStatusLocked() const {
   EditStatus s;
-  s.revision = edit_revision_;
-  s.last = last_edit_;
-  if (!undo_.empty()) s.undo = undo_.back().base.label;
-  if (!redo_.empty()) s.redo = redo_.back().base.label;
+  s.revision = history_.revision();
+  s.last = history_.last();
+  s.undo = history_.undo_label();
+  s.redo = history_.redo_label();
   return s;
 }
 
@@ -1194,17 +968,15 @@ ModelCore::EditStatus ModelCore::Edit(
     const std::function<sgal::SceneEdit(const sgal::Scene&)>& make) {
   // one edit per scene, each made against its own scene: its revert puts back exactly what
   // that scene held (the engine's copy has tuned parameters the loaded scene lacks)
-  std::shared_ptr<HistoryEntry> entry;
+  std::shared_ptr<EditHistory::Entry> entry;
   const EditStatus status = ApplyEdit([&](sgal::Scene& base, sgal::Scene& current) {
-    entry = std::make_shared<HistoryEntry>(HistoryEntry{make(base), make(current)});
+    entry = std::make_shared<EditHistory::Entry>(EditHistory::Entry{make(base), make(current)});
     entry->base.apply(base);
     entry->current.apply(current);
     return entry->base.label;
   });
   const auto lock = Lock();
-  undo_.push_back(std::move(*entry));
-  if (undo_.size() > 200) undo_.erase(undo_.begin());  // a bounded history
-  redo_.clear();
+  history_.Push(std::move(*entry));
   return EditStatusLocked();
 }
 
@@ -1213,27 +985,19 @@ ModelCore::EditStatus ModelCore::Undo() { return Walk(true); }
 ModelCore::EditStatus ModelCore::Redo() { return Walk(false); }
 
 ModelCore::EditStatus ModelCore::Walk(bool undo) {
-  std::vector<HistoryEntry>* from = undo ? &undo_ : &redo_;
-  std::vector<HistoryEntry>* to = undo ? &redo_ : &undo_;
   size_t depth = 0;
   const EditStatus status = ApplyEdit([&](sgal::Scene& base, sgal::Scene& current) {
-    HistoryEntry entry;
+    EditHistory::Entry entry;
     {
       const auto lock = Lock();
-      if (from->empty()) throw sgal::EditError(undo ? "nothing to undo" : "nothing to redo");
-      entry = from->back();
-      depth = from->size();
+      entry = history_.Next(undo, &depth);
     }
     (undo ? entry.base.revert : entry.base.apply)(base);
     (undo ? entry.current.revert : entry.current.apply)(current);
     return (undo ? "undo " : "redo ") + entry.base.label;
   });
   const auto lock = Lock();
-  // the entry walked is the last one, unless a load emptied the history meanwhile
-  if (from->size() == depth) {
-    to->push_back(std::move(from->back()));
-    from->pop_back();
-  }
+  history_.Walked(undo, depth);
   (void)status;
   return EditStatusLocked();
 }
@@ -1312,37 +1076,14 @@ void ModelCore::ReleasePull() {
 
 void ModelCore::Select(const std::string& kind, const std::string& name, uint32_t index) {
   const auto lock = Lock();
-  if (!kind.empty()) {
-    Require(true);
-    const sgal::Scene& s = *loaded_->description;
-    bool found = false;
-    if (kind == "body") {
-      found = s.FindBody(name) != nullptr;
-    } else if (kind == "tendon") {
-      found = s.FindTendon(name) != nullptr;
-    } else if (kind == "path_point") {
-      const sgal::Tendon* t = s.FindTendon(name);
-      found = t != nullptr && index < t->path.size();
-    } else if (kind == "obstacle") {
-      found = s.FindObstacle(name) != nullptr;
-    } else if (kind == "constraint") {
-      found = std::any_of(s.constraints.begin(), s.constraints.end(),
-                          [&](const sgal::Constraint& c) { return c.name == name; });
-    } else {
-      throw sgal::EditError("select: unknown kind '" + kind +
-                            "' (body, tendon, path_point, obstacle, constraint, or '' for none)");
-    }
-    if (!found)
-      throw sgal::EditError("select: the scene has no " + kind + " '" + name + "'" +
-                            (kind == "path_point" ? " with element " + std::to_string(index) : ""));
-  }
-  selection_ = {kind, kind.empty() ? "" : name, kind == "path_point" ? index : 0,
-                selection_.revision + 1};
+  if (!kind.empty()) Require(true);
+  history_.Select(loaded_ ? loaded_->description.get() : nullptr, kind, name, index);
 }
 
 ModelCore::Selection ModelCore::selection() const {
   const auto lock = Lock();
-  return selection_;
+  const EditHistory::Selection& s = history_.selection();
+  return {s.kind, s.name, s.index, s.revision};
 }
 
 }  // namespace caliper::simulation

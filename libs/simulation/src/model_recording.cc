@@ -86,51 +86,18 @@ void ModelCore::RequireNotReplaying(const char* what) const {
 void ModelCore::RecordEventLocked(const std::string& kind, const std::string& target,
                                   std::vector<double> values) {
   if (!recorder_session_ || !loaded_) return;
-  recorder_session_->writer->AddEvent(
-      {loaded_->physics->steps(), kind, target, std::move(values)});
-}
-
-void ModelCore::RecordKeyframeLocked() {
-  Recorder& r = *recorder_session_;
-  sgal::PhysicsScene& physics = *loaded_->physics;
-  recording::Keyframe k;
-  k.step = physics.steps();
-  k.time = physics.time();
-  k.scene_version = r.scene_version;
-  k.state = physics.SaveDynamicState();
-  r.writer->AddKeyframe(k);
-  // where the keyframe falls among the events of its step: a replay restoring it applies only
-  // the events after this mark
-  r.writer->AddEvent({k.step, "keyframe", "", {}});
-  physics.ResetCaches();  // as a replay restoring this keyframe will
-  r.last_keyframe = k.step;
-}
-
-void ModelCore::ResolveRecordedChannelsLocked() {
-  Recorder& r = *recorder_session_;
-  size_t offset = 0;
-  r.columns.clear();
-  r.missing.clear();
-  for (const auto& c : r.writer_channels) {
-    if (registry_.Contains(c.id)) {
-      r.columns.emplace_back(registry_.Resolve(c.id), offset);
-    } else {
-      // an edit removed it (its tendon): NaN from here on
-      r.missing.emplace_back(offset, static_cast<size_t>(c.rows) * c.cols);
-    }
-    offset += static_cast<size_t>(c.rows) * c.cols;
-  }
+  recorder_session_->AddEvent(loaded_->physics->steps(), kind, target, std::move(values));
 }
 
 void ModelCore::EndRecordingLocked(const std::string& why) {
   if (!recorder_session_) return;
   Appender().Attach(nullptr);
-  const std::string path = recorder_session_->writer->path();
+  const std::string path = recorder_session_->writer().path();
   // the last step recorded, so that a replay plays to here (samples and keyframes may end before)
   RecordEventLocked("end", why, {});
-  recorder_session_->writer->Flush();
-  last_recording_bytes_ = recorder_session_->writer->bytes_written();
-  last_recording_error_ = recorder_session_->writer->error();
+  recorder_session_->writer().Flush();
+  last_recording_bytes_ = recorder_session_->writer().bytes_written();
+  last_recording_error_ = recorder_session_->writer().error();
   recorder_session_.reset();  // commits and closes
   logging::Get("model").notice("recording %s ended: %s", path.c_str(), why.c_str());
 }
@@ -141,7 +108,7 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   Require(true);
   RequireNoExperiment();
   if (recorder_session_)
-    throw NotAvailable("already recording to " + recorder_session_->writer->path() +
+    throw NotAvailable("already recording to " + recorder_session_->writer().path() +
                        "; stop that first");
   RequireNotReplaying("record");
   // a seek re-simulates up to one interval while holding the Model: keep it short
@@ -157,8 +124,6 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   if (options.channels.size() > limits_.ids_per_call)
     throw InvalidValue(std::to_string(options.channels.size()) + " channels; a recording takes at "
                        "most " + std::to_string(limits_.ids_per_call));
-  auto r = std::make_unique<Recorder>();
-  r->options = options;
   recording::Header header;
   header.model_name = loaded_->name;
   header.time_step = loaded_->physics->description().settings.time_step;
@@ -170,10 +135,7 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
     if (!registry_.Contains(id)) throw UnknownId("record: unknown id '" + id + "'", id);
     const daq::ChannelInfo& info = registry_.Info(id);
     header.channels.push_back({id, info.unit, info.shape.rows, info.shape.cols});
-    r->columns.emplace_back(registry_.Resolve(id), r->values);
-    r->values += info.shape.size();
   }
-  r->writer_channels = header.channels;
   // the scene as the engine runs it (tuned parameters included), as a COLLADA file
   recording::SceneVersion scene;
   scene.version = 0;
@@ -181,21 +143,17 @@ ModelCore::RecordStatus ModelCore::StartRecording(const std::string& path,
   scene.file_name = loaded_->name + ".dae";
   scene.bytes = ColladaBytesOf(loaded_->physics->description());
   header.scene_file_name = scene.file_name;
-  r->writer = std::make_unique<recording::Writer>(path, header, scene,
-                                                  std::chrono::milliseconds(500),
-                                                  options.max_bytes != 0
-                                                      ? options.max_bytes
-                                                      : limits_.recording_bytes);
-  r->first_step = header.first_step;
-  recorder_session_ = std::move(r);
+  recorder_session_ = std::make_unique<SessionRecorder>(
+      path, header, scene,
+      options.max_bytes != 0 ? options.max_bytes : limits_.recording_bytes, registry_);
   last_recording_error_.clear();
   // the pull and the commands in force are part of the keyframe or recorded now
   if (pull_)
     RecordEventLocked("pull", loaded_->physics->description().bodies.at(pull_->body).name,
                       {pull_->point.x(), pull_->point.y(), pull_->point.z(), pull_->target.x(),
                        pull_->target.y(), pull_->target.z(), pull_->stiffness, pull_->damping});
-  RecordKeyframeLocked();
-  if (!session_log_) Appender().Attach(recorder_session_->writer.get());
+  recorder_session_->AddKeyframe(*loaded_->physics);
+  if (!session_log_) Appender().Attach(&recorder_session_->writer());
   logging::Get("model").notice("recording to %s from step %llu (keyframes every %u steps, %zu "
                                "channels)",
                                path.c_str(), static_cast<unsigned long long>(header.first_step),
@@ -214,8 +172,8 @@ ModelCore::RecordStatus ModelCore::StopRecording() {
     s.error = last_recording_error_;
     return s;
   }
-  s.path = recorder_session_->writer->path();
-  s.first_step = recorder_session_->first_step;
+  s.path = recorder_session_->writer().path();
+  s.first_step = recorder_session_->first_step();
   s.steps = loaded_ ? loaded_->physics->steps() - s.first_step : 0;
   EndRecordingLocked("stopped");
   s.error = last_recording_error_;
@@ -228,12 +186,13 @@ ModelCore::RecordStatus ModelCore::recording_status() const {
   RecordStatus s;
   s.error = last_recording_error_;
   if (!recorder_session_) return s;
-  s.recording = recorder_session_->writer->error().empty();
-  s.path = recorder_session_->writer->path();
-  s.first_step = recorder_session_->first_step;
+  const recording::Writer& writer = recorder_session_->writer();
+  s.recording = writer.error().empty();
+  s.path = writer.path();
+  s.first_step = recorder_session_->first_step();
   s.steps = loaded_ ? loaded_->physics->steps() - s.first_step : 0;
-  s.bytes = recorder_session_->writer->bytes_written();
-  if (!s.recording) s.error = recorder_session_->writer->error();
+  s.bytes = writer.bytes_written();
+  if (!s.recording) s.error = writer.error();
   return s;
 }
 
@@ -241,14 +200,14 @@ void ModelCore::BeforeStepLocked() {
   sgal::PhysicsScene& physics = *loaded_->physics;
   const uint64_t step = physics.steps();
   if (recorder_session_) {
-    Recorder& r = *recorder_session_;
-    if (r.writer->stopped()) {
+    SessionRecorder& r = *recorder_session_;
+    if (r.writer().stopped()) {
       // a full disk or a vanished file: the recording ends, the simulation goes on
-      logging::Get("model").error("%s", r.writer->error().c_str());
+      logging::Get("model").error("%s", r.writer().error().c_str());
       EndRecordingLocked("write failed");
       return;
     }
-    if (step % r.options.keyframe_every == 0 && step != r.last_keyframe) RecordKeyframeLocked();
+    if (r.KeyframeDue(step)) r.AddKeyframe(physics);
   }
   if (fork_reset_every_ != 0 && !recorder_session_ && step % fork_reset_every_ == 0)
     physics.ResetCaches();
@@ -291,21 +250,8 @@ void ModelCore::BeforeStepLocked() {
 }
 
 void ModelCore::AfterStepLocked() {
-  if (recorder_session_ && recorder_session_->values > 0) {
-    Recorder& r = *recorder_session_;
-    const uint64_t step = loaded_->physics->steps();
-    if ((step - r.first_step) % r.options.channels_every == 0) {
-      recording::Sample sample;
-      sample.step = step;
-      sample.time = loaded_->physics->time();
-      sample.values.resize(r.values);
-      for (const auto& [handle, offset] : r.columns) registry_.Read(handle, &sample.values[offset]);
-      for (const auto& [offset, count] : r.missing)
-        std::fill_n(sample.values.begin() + static_cast<long>(offset), count,
-                    std::numeric_limits<double>::quiet_NaN());
-      r.writer->AddSample(std::move(sample));
-    }
-  }
+  if (recorder_session_)
+    recorder_session_->AfterStep(loaded_->physics->steps(), loaded_->physics->time());
   if (replay_ && loaded_->physics->steps() >= replay_->reader->last_step() &&
       state_ == RunState::kRunning) {
     state_ = RunState::kPaused;  // the end of the recording
@@ -438,8 +384,7 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
     replay_ = std::move(previous);
     throw;
   }
-  undo_.clear();
-  redo_.clear();
+  history_.ClearUndo();
   state_ = RunState::kPaused;
   last_error_.clear();
   logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(),
@@ -498,13 +443,13 @@ void ModelCore::SetReplayKeyframeHook(KeyframeHook hook) {
 
 void ModelCore::AddSessionLog(const recording::LogRecord& record) {
   const auto lock = Lock();
-  if (recorder_session_) recorder_session_->writer->AddLog(record);
+  if (recorder_session_) recorder_session_->writer().AddLog(record);
 }
 
 void ModelCore::UseSessionLog(bool on) {
   const auto lock = Lock();
   session_log_ = on;
-  if (recorder_session_) Appender().Attach(on ? nullptr : recorder_session_->writer.get());
+  if (recorder_session_) Appender().Attach(on ? nullptr : &recorder_session_->writer());
 }
 
 sgal::DynamicState ModelCore::dynamic_state() const {

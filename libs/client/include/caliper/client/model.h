@@ -19,8 +19,13 @@ struct ModelRef {
   ::Caliper::Simulation::Model_var model;
 };
 
-/// The Model bound as `name`; Failure when it is not bound or not a Model, ConnectionError when
-/// it cannot be reached.
+/// The Model bound as `name` (model0, host/model0 or a naming path; this host's first) in the
+/// naming context `root`; Failure when it is not bound or not a Model, ConnectionError when it
+/// cannot be reached. For processes with an ORB of their own (components); clients with a
+/// Session call ConnectModel.
+ModelRef FindModel(CosNaming::NamingContext_ptr root, const std::string& name);
+
+/// The Model bound as `name` in the session's naming service (FindModel).
 ModelRef ConnectModel(Session& session, const std::string& name);
 
 /// Runs calls on the Model and turns what they raise into the library's errors: a user

@@ -2,10 +2,12 @@
 // The Model's data and simulation loop, without CORBA: the loaded scene, its physics, commands
 // and parameter writes queued for the next step boundary, run control with a real-time factor,
 // and snapshots for observers. Every public method is thread-safe; a step never overlaps a call.
+// Three concerns live in parts it owns, each tested on its own and called with its lock held:
+// Feeds (data subscriptions and the lossless wait), EditHistory (undo/redo, removed actuators,
+// the selection) and SessionRecorder (a recording being written).
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -17,6 +19,10 @@
 #include <vector>
 
 #include "caliper/recording/recording.h"
+#include "caliper/simulation/core_types.h"
+#include "caliper/simulation/edit_history.h"
+#include "caliper/simulation/feeds.h"
+#include "caliper/simulation/session_recorder.h"
 #include "caliper/sgal/edits.h"
 #include "caliper/daq/daq_scene.h"
 #include "caliper/daq/recorder.h"
@@ -29,53 +35,6 @@ namespace caliper::simulation {
 
 enum class RunState { kEmpty, kStopped, kRunning, kPaused, kFaulted };
 const char* ToString(RunState state);
-
-/// The operation is not possible now (no scene, faulted, running); the message says why.
-class NotAvailable : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-/// A bad value (NaN, out of range, wrong shape); the message says which and why.
-class InvalidValue : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
-};
-
-/// An id (actuator, channel) that does not exist; `id()` names it.
-class UnknownId : public std::out_of_range {
- public:
-  UnknownId(const std::string& what, std::string id) : std::out_of_range(what), id_(std::move(id)) {}
-  const std::string& id() const { return id_; }
-
- private:
-  std::string id_;
-};
-
-/// A request above what one call may ask for or one queue may hold; `limit()` is the bound.
-class LimitExceeded : public std::length_error {
- public:
-  LimitExceeded(const std::string& what, uint64_t limit) : std::length_error(what), limit_(limit) {}
-  uint64_t limit() const { return limit_; }
-
- private:
-  uint64_t limit_;
-};
-
-/// Bounds of what one client call may ask the Model to do (each refused above with
-/// LimitExceeded naming the bound).
-struct Limits {
-  size_t ids_per_call = 100000;          // ids in one get/sample or subscribe
-  size_t channels_per_list = 200000;     // channels one list/channels reply may hold
-  size_t pattern_length = 1024;          // characters of a list/channels glob
-  size_t pattern_stars = 8;              // '*' in a list/channels glob
-  uint64_t experiment_steps = 100000000;  // steps of one run_experiment (28 h at 1 ms)
-  size_t pending_writes = 100000;        // motor commands queued for the next step
-  size_t subscribed_values = 100000;     // values of all data subscriptions together
-  size_t queued_bytes = size_t{256} << 20;  // batches waiting for slow consumers, in all
-  std::chrono::milliseconds pull_lease{2000};  // a pull not renewed for this long ends
-  uint64_t recording_bytes = uint64_t{4} << 30;  // the largest recording file (a client's 0 = this)
-};
 
 /// Wall time a step request or an experiment holds the lock before letting other calls in.
 constexpr std::chrono::milliseconds kSlice{10};
@@ -125,17 +84,6 @@ struct Snapshot {
   double time = 0;          // [s]
   std::vector<sgal::BodyState> bodies;
   std::vector<sgal::TendonState> tendons;
-};
-
-/// The counters of one data subscription.
-struct FeedStatus {
-  bool lossless = false;         // the stepping waits for its consumer (see Subscribe)
-  uint64_t samples = 0;          // taken so far
-  uint64_t batches = 0;          // completed so far
-  uint64_t dropped_batches = 0;  // never delivered: the queue was full or their push failed
-  uint64_t dropped_samples = 0;  // the samples those batches held
-  uint64_t queued = 0;           // batches waiting to be taken
-  double waited_s = 0;           // wall time the stepping waited for the consumer [s]
 };
 
 /// Told about scenes and steps; implemented by the servant's observer senders. Called with the
@@ -355,18 +303,6 @@ class ModelCore {
   /// Ends a pull its client stopped renewing.
   void ExpirePullLocked();
   // recording and replay (model_recording.cc)
-  struct Recorder {
-    std::unique_ptr<recording::Writer> writer;
-    RecordOptions options;
-    std::vector<std::pair<daq::Handle, size_t>> columns;  // handle, first value in a sample
-    std::vector<recording::Channel> writer_channels;       // as in the file's header
-    std::vector<std::pair<size_t, size_t>> missing;        // first value, count: gone (NaN)
-    size_t values = 0;
-    uint64_t first_step = 0;
-    uint64_t last_keyframe = UINT64_MAX;
-    uint32_t scene_version = 0;
-  };
-
   struct Replay {
     std::unique_ptr<recording::Reader> reader;
     std::string path;
@@ -382,9 +318,6 @@ class ModelCore {
 
   void RecordEventLocked(const std::string& kind, const std::string& target,
                          std::vector<double> values);
-  void RecordKeyframeLocked();
-  /// After an edit: the recorded channels' handles again (the channels were registered anew).
-  void ResolveRecordedChannelsLocked();
   /// Before a step: replayed events due, keyframes (recording) or cache resets (replay).
   void BeforeStepLocked();
   /// After a step: the channels' sample, the end of a replay.
@@ -395,7 +328,7 @@ class ModelCore {
   /// before it, the pull then).
   void RestoreReplayLocked(uint64_t step);
   ReplayStatus ReplayStatusLocked() const;
-  std::unique_ptr<Recorder> recorder_session_;
+  std::unique_ptr<SessionRecorder> recorder_session_;
   std::unique_ptr<Replay> replay_;
   std::string last_recording_error_;
   uint64_t last_recording_bytes_ = 0;
@@ -416,14 +349,10 @@ class ModelCore {
   void RequireNoExperiment() const;
   /// Lets waiting calls take the lock, then takes it back (between slices of long work).
   void HandOverLocked(std::unique_lock<std::mutex>& lock);
-  /// Before a step of a lock-step or as-fast-as-possible run: waits, with the lock released,
-  /// until every lossless subscription's queue has room for the batches of one step, ending one
-  /// whose consumer takes none for its wait. True when the lock was let go meanwhile (the caller
-  /// checks what changed).
+  /// Before a step of a lock-step or as-fast-as-possible run: Feeds::AwaitRoom, which gives up
+  /// on a stop, pause, load or shutdown meanwhile. True when the lock was let go meanwhile (the
+  /// caller checks what changed).
   bool AwaitConsumersLocked(std::unique_lock<std::mutex>& lock);
-  /// Wakes AwaitConsumersLocked: a sender took batches or a subscription ended.
-  void NotifyRoom();
-  void UnsubscribeLocked(uint64_t subscription, const std::string& reason);
   /// The simulation stops at the start of the failing step: FAULTED with `reason`, one error
   /// record, queued commands dropped (they were for steps that will not come).
   void FaultLocked(const std::string& reason);
@@ -445,27 +374,12 @@ class ModelCore {
   PhysicsFactory factory_;
   mutable std::mutex mutex_;
   daq::Registry registry_;
-  daq::Recorder recorder_{registry_};
+  Feeds feeds_{registry_, limits_};  // after registry_, which its subscriptions read
   std::unique_ptr<Loaded> loaded_;
   uint64_t generation_ = 0;  // of the scene observers see: every load, rewind and edit
   uint64_t restarts_ = 0;    // loads and rewinds (a step request ends on one, not on an edit)
-  // an edit of the scene as loaded and the same edit of the engine's copy, each made against its
-  // own scene (its revert restores exactly that scene's values)
-  struct HistoryEntry {
-    sgal::SceneEdit base, current;
-  };
-  std::vector<HistoryEntry> undo_, redo_;  // of the loaded scene; cleared by a load
-  // actuators an edit removed: their state and command, for the undo that brings them back
-  struct RemovedActuator {
-    std::string kind;
-    std::vector<double> state;
-    double command = 0;
-  };
-  std::map<std::string, RemovedActuator> removed_actuators_;
+  EditHistory history_;  // undo/redo, removed actuators, the last edit, the selection
   std::chrono::steady_clock::time_point pull_until_;
-  uint64_t edit_revision_ = 0;
-  std::string last_edit_;
-  Selection selection_;
   std::optional<sgal::Pull> pull_;  // carried over edits; ended by a rewind or load
   RunState state_ = RunState::kEmpty;
   std::string experiment_;  // the experiment running now ("" when none)
@@ -481,23 +395,6 @@ class ModelCore {
   std::string last_error_;
   std::vector<std::pair<std::string, double>> pending_commands_;
   std::vector<CoreListener*> listeners_;
-  size_t subscribed_values_ = 0;                    // of all subscriptions
-  std::map<uint64_t, size_t> subscription_values_;  // per subscription
-  // what the Model keeps of a subscription beside the recorder's counters
-  struct Feed {
-    std::chrono::milliseconds lossless_wait{0};  // 0: lossy
-    size_t capacity = 0;                         // of its queue [batches]
-    double waited_s = 0;                         // [s]
-    uint64_t undelivered_batches = 0, undelivered_samples = 0;  // failed pushes
-  };
-  std::map<uint64_t, Feed> feeds_;
-  size_t lossless_ = 0;                      // feeds with a lossless_wait
-  std::map<uint64_t, std::string> ended_;    // why the Model ended subscriptions (the last 64)
-  std::function<void(uint64_t)> consumer_wake_;
-  // AwaitConsumersLocked sleeps on room_ until room_events_ changes
-  std::mutex room_mutex_;
-  std::condition_variable room_;
-  uint64_t room_events_ = 0;
   // real-time pacing: wall clock and sim time when the current run began
   std::chrono::steady_clock::time_point run_wall_start_;
   double run_sim_start_ = 0;
