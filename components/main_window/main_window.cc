@@ -97,7 +97,29 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   setWindowTitle("Caliper");
   auto* central = new QWidget(this);
   auto* layout = new QVBoxLayout(central);
+  BuildControls(central, layout);
+  BuildTimeline(central, layout);
+  BuildSettingsRow(central, layout);
+  BuildNoModelRow(central, layout);
+  BuildParameterTree(central, layout);
+  setCentralWidget(central);
 
+  QDockWidget* components_dock = BuildComponentsDock();
+  BuildSelectionDock(components_dock);
+  BuildFileAndEditMenus();
+  BuildToolsMenu(components_dock);
+  BuildStatusBar();
+  ConnectControls();
+
+  timer_ = new QTimer(this);
+  connect(timer_, &QTimer::timeout, this, [this] { Refresh(); });
+  timer_->start(static_cast<int>(1000.0 / std::max(refresh_hz, 0.1)));
+  resize(1180, 760);
+  RestoreSettings(restore_tools);
+  Refresh();
+}
+
+void MainWindow::BuildControls(QWidget* central, QVBoxLayout* layout) {
   // simulation controls
   auto* controls = new QHBoxLayout;
   open_ = Button("Open model...", "open", central);
@@ -136,7 +158,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
     controls->addWidget(w);
   controls->addStretch();
   layout->addLayout(controls);
+}
 
+void MainWindow::BuildTimeline(QWidget* central, QVBoxLayout* layout) {
   // the replay's timeline: shown while the Model replays a recording
   timeline_ = new QWidget(central);
   timeline_->setObjectName("timeline");
@@ -161,6 +185,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   seek_timer_ = new QTimer(this);
   seek_timer_->setSingleShot(true);
   seek_timer_->setInterval(kSeekPeriodMs);
+}
+
+void MainWindow::BuildSettingsRow(QWidget* central, QVBoxLayout* layout) {
   auto* settings = new QHBoxLayout;
   settings->addWidget(new QLabel("Time step", central));
   settings->addWidget(time_step_);
@@ -173,7 +200,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   settings->addWidget(record_);
   settings->addStretch();
   layout->addLayout(settings);
+}
 
+void MainWindow::BuildNoModelRow(QWidget* central, QVBoxLayout* layout) {
   no_model_ = new QLabel(central);
   no_model_->setObjectName("no_model");
   no_model_->setStyleSheet("QLabel { color: #b00020; font-weight: bold; }");
@@ -184,7 +213,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   no_model_row->addWidget(no_model_, 1);
   no_model_row->addWidget(start_model_);
   layout->addLayout(no_model_row);
+}
 
+void MainWindow::BuildParameterTree(QWidget* central, QVBoxLayout* layout) {
   // parameter browser
   tree_ = new QTreeWidget(central);
   tree_->setObjectName("parameters");
@@ -198,8 +229,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   tree_->header()->setStretchLastSection(false);
   tree_->setColumnWidth(2, 90);
   layout->addWidget(tree_);
-  setCentralWidget(central);
+}
 
+QDockWidget* MainWindow::BuildComponentsDock() {
   // components panel: everything in the naming service with its lifecycle state
   auto* dock = new QDockWidget("Components", this);
   dock->setObjectName("components_dock");
@@ -224,7 +256,10 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   panel_layout->addLayout(actions);
   dock->setWidget(panel);
   addDockWidget(Qt::BottomDockWidgetArea, dock);
+  return dock;
+}
 
+void MainWindow::BuildSelectionDock(QDockWidget* components_dock) {
   // the selection shared with the renderer, and its edits
   auto* selection_dock = new QDockWidget("Selection", this);
   selection_dock->setObjectName("selection_dock");
@@ -239,9 +274,11 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   // a tab beside the components: a narrow arranged window keeps its tree wide; a new
   // selection brings the tab up
   addDockWidget(Qt::BottomDockWidgetArea, selection_dock);
-  tabifyDockWidget(dock, selection_dock);
+  tabifyDockWidget(components_dock, selection_dock);
   selection_dock_ = selection_dock;
+}
 
+void MainWindow::BuildFileAndEditMenus() {
   QMenu* file = menuBar()->addMenu("&File");
   open_recording_ = file->addAction("Open &recording...");
   open_recording_->setObjectName("open_recording");
@@ -269,8 +306,10 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   add_tendon->setObjectName("add_tendon_action");
   connect(add_tendon, &QAction::triggered, this, [this] { selection_panel_->OpenAddTendon(); });
   edit->addSeparator();
-  edit->addAction(selection_dock->toggleViewAction());
+  edit->addAction(selection_dock_->toggleViewAction());
+}
 
+void MainWindow::BuildToolsMenu(QDockWidget* components_dock) {
   // menus: tools as their own processes, and the panels
   QMenu* tools = menuBar()->addMenu("&Tools");
   for (const ToolSpec& t : kTools) {
@@ -287,9 +326,10 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   model->setObjectName("tool_model");
   connect(model, &QAction::triggered, this, [this] { StartModel(); });
   tools->addSeparator();
-  tools->addAction(dock->toggleViewAction());
+  tools->addAction(components_dock->toggleViewAction());
+}
 
-  // status bar
+void MainWindow::BuildStatusBar() {
   recording_ = new QLabel(this);
   recording_->setObjectName("recording");
   statusBar()->addPermanentWidget(recording_);
@@ -302,7 +342,9 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
   achieved_ = new QLabel(this);
   achieved_->setObjectName("achieved_rtf");
   for (QLabel* l : {state_, sim_time_, steps_, achieved_}) statusBar()->addPermanentWidget(l);
+}
 
+void MainWindow::ConnectControls() {
   connect(open_, &QPushButton::clicked, this, [this] { OpenModelFile(); });
   connect(start_model_, &QPushButton::clicked, this, [this] { StartModel(); });
   connect(start_, &QPushButton::clicked, this, [this] { link_->Start(); });
@@ -340,13 +382,6 @@ MainWindow::MainWindow(std::unique_ptr<ModelLink> link, double refresh_hz, QWidg
           [this](QTreeWidgetItem* item, int column) { OnItemChanged(item, column); });
   connect(tree_, &QTreeWidget::currentItemChanged, this,
           [this](QTreeWidgetItem* item, QTreeWidgetItem*) { OnCurrentItemChanged(item); });
-
-  timer_ = new QTimer(this);
-  connect(timer_, &QTimer::timeout, this, [this] { Refresh(); });
-  timer_->start(static_cast<int>(1000.0 / std::max(refresh_hz, 0.1)));
-  resize(1180, 760);
-  RestoreSettings(restore_tools);
-  Refresh();
 }
 
 MainWindow::~MainWindow() {

@@ -26,6 +26,7 @@ class QSpinBox;
 class QTimer;
 class QTreeWidget;
 class QTreeWidgetItem;
+class QVBoxLayout;
 
 namespace caliper::main_window {
 
@@ -99,6 +100,20 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
+  // the parts of the window, built in this order by the constructor
+  void BuildControls(QWidget* central, QVBoxLayout* layout);
+  void BuildTimeline(QWidget* central, QVBoxLayout* layout);
+  void BuildSettingsRow(QWidget* central, QVBoxLayout* layout);
+  void BuildNoModelRow(QWidget* central, QVBoxLayout* layout);
+  void BuildParameterTree(QWidget* central, QVBoxLayout* layout);
+  QDockWidget* BuildComponentsDock();
+  void BuildSelectionDock(QDockWidget* components_dock);
+  void BuildFileAndEditMenus();
+  void BuildToolsMenu(QDockWidget* components_dock);
+  void BuildStatusBar();
+  /// Connects the controls, the timeline, the settings and the parameter tree.
+  void ConnectControls();
+
   void BuildTree(const Snapshot& s);
   /// Edit menu: Undo and Redo named after what they would do, enabled when there is something.
   void RefreshEditActions(const Snapshot& s);

@@ -67,11 +67,34 @@ QString Grouped(unsigned long long n) { return QLocale(QLocale::English).toStrin
 PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWidget* parent)
     : QMainWindow(parent), link_(std::move(link)) {
   setWindowTitle("Caliper Graph Plotter");
+  BuildPlotArea(BuildSidePanel());
+  BuildMenus(BuildToolBar());
+  BuildStatusBar();
 
+  NewPlot();
+  UpdateTargets();
+  RebuildCurves();
+  UpdateBufferLimit();
+  RefreshStatus();
+  resize(1280, 800);
+
+  timer_ = new QTimer(this);
+  timer_->setInterval(std::max(1, static_cast<int>(1000.0 / std::max(1.0, frame_hz))));
+  connect(timer_, &QTimer::timeout, this, [this] { Tick(); });
+  timer_->start();
+}
+
+QWidget* PlotterWindow::BuildSidePanel() {
   // left: the Model's channels, the curves of each plot
   auto* side = new QWidget;
   auto* sv = new QVBoxLayout(side);
   sv->setContentsMargins(4, 4, 4, 4);
+  BuildChannelList(sv);
+  BuildCurveList(sv);
+  return side;
+}
+
+void PlotterWindow::BuildChannelList(QVBoxLayout* sv) {
   search_ = new QLineEdit;
   search_->setObjectName("search");
   search_->setPlaceholderText("search ids: text, or a glob with * and ?");
@@ -102,6 +125,9 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   add_row->addWidget(target_, 1);
   add_row->addWidget(add_);
   sv->addLayout(add_row);
+}
+
+void PlotterWindow::BuildCurveList(QVBoxLayout* sv) {
   curves_tree_ = new QTreeWidget;
   curves_tree_->setObjectName("curves");
   curves_tree_->setHeaderLabels({"curve", "style"});
@@ -155,7 +181,9 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
     Redraw(true);
   });
   connect(remove_, &QPushButton::clicked, this, [this] { RemoveSelected(); });
+}
 
+void PlotterWindow::BuildPlotArea(QWidget* side) {
   // right: the stacked plots
   plot_splitter_ = new QSplitter(Qt::Vertical);
   plot_splitter_->setObjectName("plots");
@@ -167,7 +195,9 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   main->setStretchFactor(1, 1);
   main->setSizes({420, 860});
   setCentralWidget(main);
+}
 
+std::vector<QAction*> PlotterWindow::BuildToolBar() {
   // tool bar and menus
   auto* tools = addToolBar("Plot");
   tools->setObjectName("toolbar");
@@ -185,6 +215,18 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   autoscale->setObjectName("autoscale");
   autoscale->setToolTip("Fit every value axis to the data drawn and keep following it");
   tools->addSeparator();
+  AddBufferSettings(tools);
+  tools->addSeparator();
+  QAction* new_plot = tools->addAction("New plot", this, [this] {
+    NewPlot();
+    LayoutChanged();
+    Redraw();
+  });
+  new_plot->setObjectName("new_plot");
+  return {pause_, clear, autoscale, new_plot};
+}
+
+void PlotterWindow::AddBufferSettings(QToolBar* tools) {
   tools->addWidget(new QLabel(" window "));
   window_spin_ = new QDoubleSpinBox;
   window_spin_->setObjectName("window_s");
@@ -218,14 +260,9 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   connect(every_spin_, &QSpinBox::editingFinished, this,
           [this] { SetEveryNSteps(static_cast<uint32_t>(every_spin_->value())); });
   tools->addWidget(every_spin_);
-  tools->addSeparator();
-  QAction* new_plot = tools->addAction("New plot", this, [this] {
-    NewPlot();
-    LayoutChanged();
-    Redraw();
-  });
-  new_plot->setObjectName("new_plot");
+}
 
+void PlotterWindow::BuildMenus(const std::vector<QAction*>& view_actions) {
   QMenu* file = menuBar()->addMenu("&File");
   file->addAction(
       "&Load layout...", this, [this] { LoadLayoutDialog(); }, QKeySequence::Open);
@@ -240,11 +277,10 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   file->addAction(
       "&Quit", this, [this] { close(); }, QKeySequence::Quit);
   QMenu* view = menuBar()->addMenu("&View");
-  view->addAction(pause_);
-  view->addAction(clear);
-  view->addAction(autoscale);
-  view->addAction(new_plot);
+  for (QAction* action : view_actions) view->addAction(action);
+}
 
+void PlotterWindow::BuildStatusBar() {
   connection_ = new QLabel;
   connection_->setObjectName("connection");
   rate_ = new QLabel;
@@ -255,18 +291,6 @@ PlotterWindow::PlotterWindow(std::unique_ptr<DaqLink> link, double frame_hz, QWi
   statusBar()->addPermanentWidget(connection_, 1);
   statusBar()->addPermanentWidget(rate_);
   statusBar()->addPermanentWidget(held_);
-
-  NewPlot();
-  UpdateTargets();
-  RebuildCurves();
-  UpdateBufferLimit();
-  RefreshStatus();
-  resize(1280, 800);
-
-  timer_ = new QTimer(this);
-  timer_->setInterval(std::max(1, static_cast<int>(1000.0 / std::max(1.0, frame_hz))));
-  connect(timer_, &QTimer::timeout, this, [this] { Tick(); });
-  timer_->start();
 }
 
 PlotterWindow::~PlotterWindow() {

@@ -30,8 +30,10 @@ class QPushButton;
 class QSpinBox;
 class QSplitter;
 class QTimer;
+class QToolBar;
 class QTreeWidget;
 class QTreeWidgetItem;
+class QVBoxLayout;
 
 namespace caliper::plotter {
 
@@ -118,6 +120,16 @@ class PlotterWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
+  // the parts of the window, built in this order by the constructor
+  QWidget* BuildSidePanel();  // the channel list and the curve list
+  void BuildChannelList(QVBoxLayout* sv);
+  void BuildCurveList(QVBoxLayout* sv);
+  void BuildPlotArea(QWidget* side);
+  std::vector<QAction*> BuildToolBar();     // returns the actions the View menu repeats
+  void AddBufferSettings(QToolBar* tools);  // window span, buffer, every n steps
+  void BuildMenus(const std::vector<QAction*>& view_actions);
+  void BuildStatusBar();
+
   void BuildChannels(const LinkStatus& s);
   void FilterChannels();
   void AddSelected();

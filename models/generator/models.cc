@@ -298,18 +298,19 @@ void SetShockCord(sgal::Actuator* a, double area, double rest_length, double pre
   a->parameters["pretension"] = pretension;
 }
 
-}  // namespace
+// Landmarks of the ECCE arm at rest [m]: sternoclavicular joint, glenohumeral (shoulder) centre,
+// elbow, wrist; x forward, y left, z up; the right arm hangs at y = -0.24.
+struct ArmLandmarks {
+  Vector3d sc = Vector3d(0, -0.06, 1.47);
+  Vector3d gh = Vector3d(0, -0.24, 1.47);
+  Vector3d elbow = Vector3d(0, -0.24, 1.17);
+  Vector3d wrist = Vector3d(0, -0.24, 0.92);
+};
 
-sgal::Scene MakeEcceArm() {
-  Builder b("ecce_arm", 1e-3, 50);
-  b.AddMaterial("polymorph", 0.6, 0.1);
+// The ECCE arm's bodies: torso, shoulder girdle, shoulder housing, upper arm, forearm, hand.
+void AddEcceBodies(Builder& b, const ArmLandmarks& at) {
   const auto kDynamic = sgal::BodyType::kDynamic;
-  const Vector3d x = Vector3d::UnitX(), y = Vector3d::UnitY();
-
-  // landmarks at rest [m]: sternoclavicular joint, glenohumeral (shoulder) centre, elbow, wrist;
-  // x forward, y left, z up; the right arm hangs at y = -0.24
-  const Vector3d sc(0, -0.06, 1.47), gh(0, -0.24, 1.47), elbow(0, -0.24, 1.17),
-      wrist(0, -0.24, 0.92);
+  const Vector3d y = Vector3d::UnitY();
 
   // torso: static chest and neck post, the motor banks and a stand drawn only
   b.AddBody("torso", sgal::BodyType::kStatic, Vector3d(0, 0, 1.15));
@@ -325,9 +326,9 @@ sgal::Scene MakeEcceArm() {
 
   // girdle: clavicle from the sternoclavicular joint to the shoulder, acromion on top, scapula
   // plate behind
-  b.AddBody("girdle", kDynamic, sc);
-  b.AddShape("girdle", "clavicle", sgal::Capsule{0.02, 0.14}, (sc + gh) / 2, ZTo(y), kGirdleGroup,
-             0, kBoneColor, "polymorph");
+  b.AddBody("girdle", kDynamic, at.sc);
+  b.AddShape("girdle", "clavicle", sgal::Capsule{0.02, 0.14}, (at.sc + at.gh) / 2, ZTo(y),
+             kGirdleGroup, 0, kBoneColor, "polymorph");
   b.AddShape("girdle", "acromion", sgal::Box{Vector3d(0.08, 0.05, 0.03)}, Vector3d(0, -0.24, 1.535),
              Quaterniond::Identity(), kGirdleGroup, 0, kBoneColor, "polymorph");
   b.AddShape("girdle", "scapula", sgal::Box{Vector3d(0.015, 0.07, 0.12)},
@@ -337,46 +338,54 @@ sgal::Scene MakeEcceArm() {
                Vector3d(0.0025, 0.0008, 0.0025).asDiagonal());
 
   // shoulder housing between the two shoulder hinges: drawn, not colliding
-  b.AddBody("shoulder", kDynamic, gh);
-  b.AddVisual("shoulder", "housing", sgal::Sphere{0.045}, gh, Quaterniond::Identity(),
+  b.AddBody("shoulder", kDynamic, at.gh);
+  b.AddVisual("shoulder", "housing", sgal::Sphere{0.045}, at.gh, Quaterniond::Identity(),
               kHousingColor);
-  b.SetInertia("shoulder", 0.4, gh, SolidSphere(0.4, 0.05));
+  b.SetInertia("shoulder", 0.4, at.gh, SolidSphere(0.4, 0.05));
 
   // upper arm 0.30 m, forearm 0.25 m, hand
-  b.AddBody("upper_arm", kDynamic, gh);
+  b.AddBody("upper_arm", kDynamic, at.gh);
   b.AddShape("upper_arm", "humerus", sgal::Capsule{0.035, 0.23}, Vector3d(0, -0.24, 1.32),
              Quaterniond::Identity(), kUpperArmGroup, kHandGroup, kBoneColor, "polymorph");
   b.SetInertia("upper_arm", 1.6, Vector3d(0, -0.24, 1.33), SolidCylinderZ(1.6, 0.035, 0.30));
 
-  b.AddBody("forearm", kDynamic, elbow);
+  b.AddBody("forearm", kDynamic, at.elbow);
   b.AddShape("forearm", "ulna", sgal::Capsule{0.03, 0.19}, Vector3d(0, -0.24, 1.045),
              Quaterniond::Identity(), kForearmGroup, kTorsoGroup, kBoneColor, "polymorph");
   b.SetInertia("forearm", 1.0, Vector3d(0, -0.24, 1.06), SolidCylinderZ(1.0, 0.03, 0.25));
 
-  b.AddBody("hand", kDynamic, wrist);
+  b.AddBody("hand", kDynamic, at.wrist);
   b.AddShape("hand", "palm", sgal::Box{Vector3d(0.03, 0.08, 0.15)}, Vector3d(0, -0.24, 0.825),
              Quaterniond::Identity(), kHandGroup, kTorsoGroup | kUpperArmGroup, kBoneColor,
              "polymorph");
   b.AddVisual("hand", "thumb", sgal::Capsule{0.01, 0.04}, Vector3d(0.02, -0.19, 0.86),
               Quaterniond::Identity(), kBoneColor);
   b.SetInertia("hand", 0.45, Vector3d(0, -0.24, 0.83), SolidBox(0.45, Vector3d(0.03, 0.08, 0.15)));
+}
 
+// The ECCE arm's hinges and the pulleys on their axes.
+void AddEcceJoints(Builder& b, const ArmLandmarks& at) {
+  const Vector3d x = Vector3d::UnitX(), y = Vector3d::UnitY();
   // joints: positive girdle elevation lifts the shoulder, positive abduction swings the arm out,
   // positive flexion forward; limits [deg], damping [N m s/rad]
-  b.AddHinge("girdle_elevation", "girdle", "torso", sc, -x, -10, 25, 0.5);
-  b.AddHinge("shoulder_abduction", "shoulder", "girdle", gh, -x, -10, 100, 0.1);
-  b.AddHinge("shoulder_flexion", "upper_arm", "shoulder", gh, -y, -40, 150, 0.1);
-  b.AddHinge("elbow", "forearm", "upper_arm", elbow, -y, 0, 145, 0.3);
-  b.AddHinge("wrist", "hand", "forearm", wrist, -y, -70, 70, 0.02);
+  b.AddHinge("girdle_elevation", "girdle", "torso", at.sc, -x, -10, 25, 0.5);
+  b.AddHinge("shoulder_abduction", "shoulder", "girdle", at.gh, -x, -10, 100, 0.1);
+  b.AddHinge("shoulder_flexion", "upper_arm", "shoulder", at.gh, -y, -40, 150, 0.1);
+  b.AddHinge("elbow", "forearm", "upper_arm", at.elbow, -y, 0, 145, 0.3);
+  b.AddHinge("wrist", "hand", "forearm", at.wrist, -y, -70, 70, 0.02);
 
   // pulleys on the joint axes: the tendons wrap them, so that their moment arms stay put
-  b.AddPulley("shoulder_abduction_pulley", "girdle", gh, x, 0.05, 0.08);
-  b.AddPulley("shoulder_flexion_pulley", "shoulder", gh, y, 0.05, 0.08);
-  b.AddPulley("elbow_pulley", "upper_arm", elbow, y, 0.04, 0.06);
-  b.AddPulley("wrist_pulley", "forearm", wrist, y, 0.036, 0.05);
-  const Vector3d front(0.1, 0, 0), back(-0.1, 0, 0), lateral(0, -0.1, 0);
+  b.AddPulley("shoulder_abduction_pulley", "girdle", at.gh, x, 0.05, 0.08);
+  b.AddPulley("shoulder_flexion_pulley", "shoulder", at.gh, y, 0.05, 0.08);
+  b.AddPulley("elbow_pulley", "upper_arm", at.elbow, y, 0.04, 0.06);
+  b.AddPulley("wrist_pulley", "forearm", at.wrist, y, 0.036, 0.05);
+}
 
-  // tendon paths (world points at rest, 5-10 mm off the surfaces)
+// The ECCE arm's tendon paths (world points at rest, 5-10 mm off the surfaces): the motors'
+// antagonistic pairs, the ligaments and the biceps.
+void AddEcceTendons(Builder& b, const ArmLandmarks& at) {
+  const Vector3d front(0.1, 0, 0), back(-0.1, 0, 0), lateral(0, -0.1, 0);
+  const Vector3d &gh = at.gh, &elbow = at.elbow, &wrist = at.wrist;
   b.AddTendon("girdle_elevator", {b.Point("torso", Vector3d(-0.02, -0.05, 1.62)),
                                   b.Point("girdle", Vector3d(0, -0.20, 1.495))});
   b.AddTendon("girdle_depressor", {b.Point("torso", Vector3d(0, -0.16, 1.25)),
@@ -425,7 +434,10 @@ sgal::Scene MakeEcceArm() {
                          b.Point("upper_arm", Vector3d(0.042, -0.23, 1.24), 0.05),
                          b.Wrap("elbow_pulley", elbow + front),
                          b.Point("forearm", Vector3d(0.035, -0.23, 1.10))});
+}
 
+// The ECCE arm's ten motors in five antagonistic pairs, with the pretensions that hold it at rest.
+void AddEcceMotors(Builder& b) {
   // the girdle hangs on its elevator: a pretension that balances gravity on the girdle and the
   // arm, and the depressor's
   const double depressor_pretension = 10;  // [N]
@@ -443,8 +455,7 @@ sgal::Scene MakeEcceArm() {
       b.MomentArm("shoulder_abduction", Vector3d(0, -0.20, 1.35), Vector3d(0, -0.17, 1.44));
   const double adductor_pretension = pair_pretension * 0.05 / std::abs(adductor_arm);
 
-  // ten motors in five antagonistic pairs; the girdle, shoulder and elbow on steel springs, the
-  // wrist on shock cord (a 10 mm cord)
+  // the girdle, shoulder and elbow on steel springs, the wrist on shock cord (a 10 mm cord)
   struct Motor {
     const char* name;
     double stiffness;   // [N/m]; 0: shock cord
@@ -471,7 +482,10 @@ sgal::Scene MakeEcceArm() {
     else
       SetShockCord(&a, kPi * 0.01 * 0.01 / 4, 0.04, m.pretension);
   }
+}
 
+// The ECCE arm's passive ligaments and its biceps muscle.
+void AddEcceLigamentsAndBiceps(Builder& b) {
   // ligaments: slack at rest except the costoclavicular one (taut at its rest path length)
   sgal::Actuator& costoclavicular = b.AddActuator("costoclavicular", "ligament", "costoclavicular");
   costoclavicular.parameters = {{"stiffness", 3000}, {"damping", 5}, {"rest_length", 0}};
@@ -496,6 +510,19 @@ sgal::Scene MakeEcceArm() {
                        {"max_contraction_velocity", 10},
                        {"activation_time_constant", 0.015},
                        {"deactivation_time_constant", 0.05}};
+}
+
+}  // namespace
+
+sgal::Scene MakeEcceArm() {
+  Builder b("ecce_arm", 1e-3, 50);
+  b.AddMaterial("polymorph", 0.6, 0.1);
+  const ArmLandmarks at;
+  AddEcceBodies(b, at);
+  AddEcceJoints(b, at);
+  AddEcceTendons(b, at);
+  AddEcceMotors(b);
+  AddEcceLigamentsAndBiceps(b);
   return b.Take();
 }
 

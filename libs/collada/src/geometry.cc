@@ -123,85 +123,107 @@ std::string Fragment(const std::string& url) {
   return url.empty() || url[0] != '#' ? url : url.substr(1);
 }
 
-}  // namespace
-
-const GeometryData& GeometryLibrary::Get(const Element& geometry) {
-  const auto it = cache_.find(&geometry);
-  if (it != cache_.end()) return it->second;
-  // a placeholder first: convex_hull_of cycles end here
-  cache_[&geometry] = GeometryData{};
-  GeometryData data = Read(geometry);
-  return cache_[&geometry] = std::move(data);
-}
-
-GeometryData GeometryLibrary::Read(const Element& geometry) {
-  GeometryData data;
-  // what a Caliper exporter noted about a tessellated primitive
+// Reads the primitive a Caliper exporter noted about a tessellated geometry into `data`.
+void ReadCaliperPrimitive(Context& ctx, const Element& geometry, GeometryData* data) {
   for (const Element* technique : CaliperTechniques(geometry)) {
     for (const auto& c : technique->children) {
       if (c->local_name() != "primitive") {
-        ctx_.Warn(c.get(), "unknown element <" + std::string(c->local_name()) +
-                               "> in a geometry's Caliper technique");
+        ctx.Warn(c.get(), "unknown element <" + std::string(c->local_name()) +
+                              "> in a geometry's Caliper technique");
         continue;
       }
       const std::string kind = c->Attribute("kind");
-      const auto v = ctx_.Numbers(*c);
+      const auto v = ctx.Numbers(*c);
       auto need = [&](size_t k) {
         if (v.size() != k)
-          ctx_.Fail(c.get(), "a " + kind + " needs " + std::to_string(k) + " numbers");
+          ctx.Fail(c.get(), "a " + kind + " needs " + std::to_string(k) + " numbers");
       };
-      const double s = ctx_.meter;
+      const double s = ctx.meter;
       if (kind == "box") {
         need(3);
-        data.primitive = sgal::Box{Eigen::Vector3d(v[0], v[1], v[2]) * s};
+        data->primitive = sgal::Box{Eigen::Vector3d(v[0], v[1], v[2]) * s};
       } else if (kind == "sphere") {
         need(1);
-        data.primitive = sgal::Sphere{v[0] * s};
+        data->primitive = sgal::Sphere{v[0] * s};
       } else if (kind == "capsule") {
         need(2);
-        data.primitive = sgal::Capsule{v[0] * s, v[1] * s};
+        data->primitive = sgal::Capsule{v[0] * s, v[1] * s};
       } else if (kind == "cylinder") {
         need(2);
-        data.primitive = sgal::Cylinder{v[0] * s, v[1] * s};
+        data->primitive = sgal::Cylinder{v[0] * s, v[1] * s};
       } else if (kind == "cone") {
         need(2);
-        data.primitive = sgal::Cone{v[0] * s, v[1] * s};
+        data->primitive = sgal::Cone{v[0] * s, v[1] * s};
       } else if (kind == "plane") {
         need(4);
-        data.primitive = sgal::Plane{Eigen::Vector3d(v[0], v[1], v[2]).normalized(), v[3] * s};
+        data->primitive = sgal::Plane{Eigen::Vector3d(v[0], v[1], v[2]).normalized(), v[3] * s};
       } else {
-        ctx_.Fail(c.get(), "unknown primitive kind '" + kind +
-                               "' (box, sphere, capsule, cylinder, cone, plane)");
+        ctx.Fail(c.get(), "unknown primitive kind '" + kind +
+                              "' (box, sphere, capsule, cylinder, cone, plane)");
       }
     }
   }
-  const Element* mesh = geometry.Child("mesh");
-  const Element* convex = geometry.Child("convex_mesh");
-  if (convex != nullptr && convex->HasAttribute("convex_hull_of")) {
-    const Element& of = ctx_.Resolve(*convex, convex->Attribute("convex_hull_of"));
-    if (of.local_name() != "geometry")
-      ctx_.Fail(convex, "convex_hull_of '" + convex->Attribute("convex_hull_of") + "' is a <" +
-                            std::string(of.local_name()) + ">, not a <geometry>");
-    data = Get(of);
-    data.convex = true;
-    return data;
-  }
-  if (mesh == nullptr) mesh = convex;
-  if (mesh == nullptr) {
-    std::string kind = geometry.children.empty()
-                           ? "nothing"
-                           : "<" + std::string(geometry.children[0]->local_name()) + ">";
-    ctx_.Warn(&geometry,
-              "holds " + kind + "; only <mesh> and <convex_mesh> are read, so it is not shown");
-    return data;
-  }
-  data.convex = mesh == convex;
+}
 
-  std::map<const Element*, SourceData> sources;
-  auto source = [&](const Element& from, const std::string& url) -> const SourceData& {
+// The 3D vectors a <source> holds, times `scale`.
+std::vector<Eigen::Vector3d> Vectors(const SourceData& d, double scale) {
+  std::vector<Eigen::Vector3d> out(d.count);
+  for (size_t i = 0; i < d.count; ++i) {
+    const double* v = d.values->data() + d.offset + i * d.stride;
+    out[i] = Eigen::Vector3d(v[0], v[1], v[2]) * scale;
+  }
+  return out;
+}
+
+// The triangles of a mesh, one group per primitive element, over its positions.
+struct MeshTriangles {
+  std::vector<Eigen::Vector3d> positions;       // [m]
+  std::vector<Eigen::Vector3d> vertex_normals;  // one per position, or none
+  std::vector<Group> groups;                    // one per primitive element
+  // the normals each group's corners index (nullptr: none of its own)
+  std::vector<const std::vector<Eigen::Vector3d>*> group_normals;
+  std::map<const Element*, std::vector<Eigen::Vector3d>> normal_sources;  // by <source>
+};
+
+// Reads the triangles of a <mesh> or <convex_mesh>: its <vertices>, then each primitive element
+// (<triangles>, <polylist>, <polygons>, <tristrips>, <trifans>).
+class MeshReader {
+ public:
+  MeshReader(Context& ctx, const Element& mesh, const Element& vertices, MeshTriangles* out)
+      : ctx_(ctx), mesh_(mesh), vertices_(vertices), out_(*out) {}
+
+  void Read() {
+    ReadVertices();
+    for (const auto& prim : mesh_.children) {
+      const std::string_view kind = prim->local_name();
+      if (kind != "triangles" && kind != "polylist" && kind != "polygons" && kind != "tristrips" &&
+          kind != "trifans")
+        continue;
+      ReadPrimitive(*prim);
+    }
+    if (failed_polygons_ > 0)
+      ctx_.Warn(&mesh_,
+                std::to_string(failed_polygons_) +
+                    " polygon(s) could not be ear-clipped (self-intersecting?) and were fanned");
+    if (holes_ > 0)
+      ctx_.Warn(&mesh_,
+                std::to_string(holes_) + " polygon hole(s) ignored: the outer outlines are filled");
+  }
+
+ private:
+  // where a primitive element's index tuples hold what
+  struct Layout {
+    size_t stride = 0;                                      // indices per corner
+    size_t vertex_offset = 0;                               // of the VERTEX input
+    size_t normal_offset = 0;                               // of the NORMAL input
+    const std::vector<Eigen::Vector3d>* normals = nullptr;  // of the NORMAL input, if any
+  };
+
+  // a <source> read through its accessor (each read once)
+  const SourceData& Source(const Element& from, const std::string& url) {
     const Element& s = ctx_.Resolve(from, url);
-    const auto found = sources.find(&s);
-    if (found != sources.end()) return found->second;
+    const auto found = sources_.find(&s);
+    if (found != sources_.end()) return found->second;
     SourceData d;
     const Element* array = s.Child("float_array");
     if (s.local_name() != "source" || array == nullptr)
@@ -228,45 +250,26 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
         (d.count > 0 && d.offset + (d.count - 1) * d.stride + 3 > d.values->size()))
       ctx_.Fail(&s, "its accessor reads " + std::to_string(d.count) + " vectors past the end of " +
                         std::to_string(d.values->size()) + " values");
-    return sources[&s] = d;
-  };
-  auto vectors = [&](const SourceData& d, double scale) {
-    std::vector<Eigen::Vector3d> out(d.count);
-    for (size_t i = 0; i < d.count; ++i) {
-      const double* v = d.values->data() + d.offset + i * d.stride;
-      out[i] = Eigen::Vector3d(v[0], v[1], v[2]) * scale;
+    return sources_[&s] = d;
+  }
+
+  // positions and per-vertex normals from <vertices>
+  void ReadVertices() {
+    for (const Element* in : vertices_.Children("input")) {
+      const std::string semantic = in->Attribute("semantic");
+      if (semantic == "POSITION")
+        out_.positions = Vectors(Source(*in, in->Attribute("source")), ctx_.meter);
+      else if (semantic == "NORMAL")
+        out_.vertex_normals = Vectors(Source(*in, in->Attribute("source")), 1.0);
     }
-    return out;
-  };
-
-  const Element* vertices = mesh->Child("vertices");
-  if (vertices == nullptr) {
-    ctx_.Warn(mesh, "has no <vertices>; not shown");
-    return data;
+    if (!out_.vertex_normals.empty() && out_.vertex_normals.size() != out_.positions.size())
+      out_.vertex_normals.clear();
   }
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Eigen::Vector3d> vertex_normals;
-  for (const Element* in : vertices->Children("input")) {
-    const std::string semantic = in->Attribute("semantic");
-    if (semantic == "POSITION")
-      positions = vectors(source(*in, in->Attribute("source")), ctx_.meter);
-    else if (semantic == "NORMAL")
-      vertex_normals = vectors(source(*in, in->Attribute("source")), 1.0);
-  }
-  if (!vertex_normals.empty() && vertex_normals.size() != positions.size()) vertex_normals.clear();
 
-  std::vector<Group> groups;
-  std::map<const Element*, std::vector<Eigen::Vector3d>> normal_sources;
-  std::vector<std::vector<Eigen::Vector3d>*> group_normals;
-  size_t failed_polygons = 0, holes = 0;
-  for (const auto& prim_ptr : mesh->children) {
-    const Element& prim = *prim_ptr;
-    const std::string_view kind = prim.local_name();
-    if (kind != "triangles" && kind != "polylist" && kind != "polygons" && kind != "tristrips" &&
-        kind != "trifans")
-      continue;
+  // the inputs of a primitive element; its normals read on first use
+  Layout ReadLayout(const Element& prim) {
     std::vector<Input> inputs;
-    size_t stride = 0;
+    Layout layout;
     const Input* vertex_input = nullptr;
     const Input* normal_input = nullptr;
     for (const Element* in : prim.Children("input")) {
@@ -274,7 +277,7 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
       input.semantic = in->Attribute("semantic");
       input.offset = ctx_.Count(*in, "offset", 0);
       input.source = in;
-      stride = std::max(stride, input.offset + 1);
+      layout.stride = std::max(layout.stride, input.offset + 1);
       inputs.push_back(input);
     }
     for (const auto& in : inputs) {
@@ -282,92 +285,91 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
       if (in.semantic == "NORMAL" && normal_input == nullptr) normal_input = &in;
     }
     if (vertex_input == nullptr) ctx_.Fail(&prim, "has no VERTEX input");
-    if (Fragment(vertex_input->source->Attribute("source")) != vertices->Attribute("id"))
+    layout.vertex_offset = vertex_input->offset;
+    if (Fragment(vertex_input->source->Attribute("source")) != vertices_.Attribute("id"))
       ctx_.Resolve(*vertex_input->source, vertex_input->source->Attribute("source"));
-    std::vector<Eigen::Vector3d>* normals = nullptr;
     if (normal_input != nullptr) {
+      layout.normal_offset = normal_input->offset;
       const Element& s =
           ctx_.Resolve(*normal_input->source, normal_input->source->Attribute("source"));
-      auto found = normal_sources.find(&s);
-      if (found == normal_sources.end())
-        found = normal_sources
-                    .emplace(&s, vectors(source(*normal_input->source,
+      auto found = out_.normal_sources.find(&s);
+      if (found == out_.normal_sources.end())
+        found = out_.normal_sources
+                    .emplace(&s, Vectors(Source(*normal_input->source,
                                                 normal_input->source->Attribute("source")),
                                          1.0))
                     .first;
-      normals = &found->second;
+      layout.normals = &found->second;
     }
+    return layout;
+  }
+
+  // corner `k` of the index tuples `p`
+  Corner CornerAt(const Element& prim, const Layout& layout, const std::vector<double>& p,
+                  size_t k) const {
+    Corner c;
+    const size_t base = k * layout.stride;
+    const double vi = p[base + layout.vertex_offset];
+    if (!(vi >= 0) || vi >= static_cast<double>(out_.positions.size()))
+      ctx_.Fail(&prim, "vertex index " + FormatNumber(vi) + " out of range (" +
+                           std::to_string(out_.positions.size()) + " positions)");
+    c.position = static_cast<int64_t>(vi);
+    if (layout.normals != nullptr) {
+      const double ni = p[base + layout.normal_offset];
+      c.normal = ni >= 0 && ni < static_cast<double>(layout.normals->size())
+                     ? static_cast<int64_t>(ni)
+                     : -1;
+    } else if (!out_.vertex_normals.empty()) {
+      c.normal = c.position;
+    }
+    return c;
+  }
+
+  // the corners of a <p>
+  std::vector<Corner> CornersOf(const Element& prim, const Layout& layout, const Element& p) const {
+    std::vector<double> values = p.numeric ? p.numbers : ctx_.Numbers(p);
+    if (values.size() % layout.stride != 0)
+      ctx_.Fail(&p, std::to_string(values.size()) + " indices is not a multiple of the " +
+                        std::to_string(layout.stride) + " inputs");
+    std::vector<Corner> corners;
+    corners.reserve(values.size() / layout.stride);
+    for (size_t k = 0; k < values.size() / layout.stride; ++k)
+      corners.push_back(CornerAt(prim, layout, values, k));
+    return corners;
+  }
+
+  void AddPolygon(const std::vector<Corner>& poly, Group* group) {
+    if (!Triangulate(poly, out_.positions, &group->triangles)) ++failed_polygons_;
+  }
+
+  // one primitive element as a group of triangles
+  void ReadPrimitive(const Element& prim) {
+    const std::string_view kind = prim.local_name();
+    const Layout layout = ReadLayout(prim);
     Group group;
     group.material = prim.Attribute("material");
-    auto corner = [&](const std::vector<double>& p, size_t k) {
-      Corner c;
-      const size_t base = k * stride;
-      const double vi = p[base + vertex_input->offset];
-      if (!(vi >= 0) || vi >= static_cast<double>(positions.size()))
-        ctx_.Fail(&prim, "vertex index " + FormatNumber(vi) + " out of range (" +
-                             std::to_string(positions.size()) + " positions)");
-      c.position = static_cast<int64_t>(vi);
-      if (normals != nullptr) {
-        const double ni = p[base + normal_input->offset];
-        c.normal =
-            ni >= 0 && ni < static_cast<double>(normals->size()) ? static_cast<int64_t>(ni) : -1;
-      } else if (!vertex_normals.empty()) {
-        c.normal = c.position;
-      }
-      return c;
-    };
-    auto corners_of = [&](const Element& p) {
-      std::vector<double> values = p.numeric ? p.numbers : ctx_.Numbers(p);
-      if (values.size() % stride != 0)
-        ctx_.Fail(&p, std::to_string(values.size()) + " indices is not a multiple of the " +
-                          std::to_string(stride) + " inputs");
-      std::vector<Corner> corners;
-      corners.reserve(values.size() / stride);
-      for (size_t k = 0; k < values.size() / stride; ++k) corners.push_back(corner(values, k));
-      return corners;
-    };
-    auto add_polygon = [&](const std::vector<Corner>& poly) {
-      if (!Triangulate(poly, positions, &group.triangles)) ++failed_polygons;
-    };
     if (kind == "triangles") {
       if (const Element* p = prim.Child("p"); p != nullptr) {
-        const auto corners = corners_of(*p);
+        const auto corners = CornersOf(prim, layout, *p);
         for (size_t i = 0; i + 2 < corners.size(); i += 3)
           group.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
       }
     } else if (kind == "polylist") {
-      const Element* p = prim.Child("p");
-      const Element* vcount = prim.Child("vcount");
-      if (p != nullptr && vcount != nullptr) {
-        const auto corners = corners_of(*p);
-        const std::vector<double> counts =
-            vcount->numeric ? vcount->numbers : ctx_.Numbers(*vcount);
-        size_t at = 0;
-        for (double c : counts) {
-          if (!(c >= 0) || c > static_cast<double>(corners.size()))
-            ctx_.Fail(vcount, "corner count " + FormatNumber(c) + " is out of range");
-          const size_t k = static_cast<size_t>(c);
-          if (at + k > corners.size())
-            ctx_.Fail(vcount, "counts " + std::to_string(at + k) + " corners, <p> has " +
-                                  std::to_string(corners.size()));
-          add_polygon(std::vector<Corner>(corners.begin() + static_cast<std::ptrdiff_t>(at),
-                                          corners.begin() + static_cast<std::ptrdiff_t>(at + k)));
-          at += k;
-        }
-      }
+      ReadPolylist(prim, layout, &group);
     } else if (kind == "polygons") {
       for (const auto& c : prim.children) {
         if (c->local_name() == "p") {
-          add_polygon(corners_of(*c));
+          AddPolygon(CornersOf(prim, layout, *c), &group);
         } else if (c->local_name() == "ph") {
-          if (const Element* p = c->Child("p"); p != nullptr) add_polygon(corners_of(*p));
-          holes += c->Children("h").size();
+          if (const Element* p = c->Child("p"); p != nullptr)
+            AddPolygon(CornersOf(prim, layout, *p), &group);
+          holes_ += c->Children("h").size();
         }
       }
     } else {
       const bool strip = kind == "tristrips";
       for (const Element* p : prim.Children("p")) {
-        const auto corners = corners_of(*p);
+        const auto corners = CornersOf(prim, layout, *p);
         for (size_t i = 2; i < corners.size(); ++i) {
           if (!strip)
             group.triangles.push_back({corners[0], corners[i - 1], corners[i]});
@@ -378,18 +380,46 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
         }
       }
     }
-    groups.push_back(std::move(group));
-    group_normals.push_back(normals);
+    out_.groups.push_back(std::move(group));
+    out_.group_normals.push_back(layout.normals);
   }
-  if (failed_polygons > 0)
-    ctx_.Warn(mesh,
-              std::to_string(failed_polygons) +
-                  " polygon(s) could not be ear-clipped (self-intersecting?) and were fanned");
-  if (holes > 0)
-    ctx_.Warn(mesh,
-              std::to_string(holes) + " polygon hole(s) ignored: the outer outlines are filled");
 
-  // positions that are not finite take their triangles with them
+  // a <polylist>: its <p> cut into polygons by <vcount>
+  void ReadPolylist(const Element& prim, const Layout& layout, Group* group) {
+    const Element* p = prim.Child("p");
+    const Element* vcount = prim.Child("vcount");
+    if (p == nullptr || vcount == nullptr) return;
+    const auto corners = CornersOf(prim, layout, *p);
+    const std::vector<double> counts = vcount->numeric ? vcount->numbers : ctx_.Numbers(*vcount);
+    size_t at = 0;
+    for (double c : counts) {
+      if (!(c >= 0) || c > static_cast<double>(corners.size()))
+        ctx_.Fail(vcount, "corner count " + FormatNumber(c) + " is out of range");
+      const size_t k = static_cast<size_t>(c);
+      if (at + k > corners.size())
+        ctx_.Fail(vcount, "counts " + std::to_string(at + k) + " corners, <p> has " +
+                              std::to_string(corners.size()));
+      AddPolygon(std::vector<Corner>(corners.begin() + static_cast<std::ptrdiff_t>(at),
+                                     corners.begin() + static_cast<std::ptrdiff_t>(at + k)),
+                 group);
+      at += k;
+    }
+  }
+
+  Context& ctx_;
+  const Element& mesh_;
+  const Element& vertices_;
+  MeshTriangles& out_;
+  std::map<const Element*, SourceData> sources_;
+  size_t failed_polygons_ = 0;
+  size_t holes_ = 0;
+};
+
+// Drops the degenerate triangles of the groups and those at positions that are not finite (with
+// a warning on `mesh`); returns every triangle left over all the positions.
+std::shared_ptr<sgal::Mesh> KeepFiniteTriangles(Context& ctx, const Element& mesh,
+                                                MeshTriangles* tris) {
+  const std::vector<Eigen::Vector3d>& positions = tris->positions;
   size_t dropped = 0;
   auto finite = [&](const std::array<Corner, 3>& t) {
     for (const auto& c : t)
@@ -399,7 +429,7 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
   auto all = std::make_shared<sgal::Mesh>();
   all->vertices.reserve(positions.size());
   for (const auto& p : positions) all->vertices.push_back(p.cast<float>());
-  for (auto& g : groups) {
+  for (auto& g : tris->groups) {
     std::vector<std::array<Corner, 3>> kept;
     kept.reserve(g.triangles.size());
     for (const auto& t : g.triangles) {
@@ -418,44 +448,108 @@ GeometryData GeometryLibrary::Read(const Element& geometry) {
     g.triangles = std::move(kept);
   }
   if (dropped > 0)
-    ctx_.Warn(mesh, std::to_string(dropped) + " triangle(s) with non-finite positions dropped");
-  data.all = all;
-  data.usable = !all->vertices.empty() && (data.convex || !all->triangles.empty());
-  for (size_t gi = 0; gi < groups.size(); ++gi) {
-    const Group& g = groups[gi];
+    ctx.Warn(&mesh, std::to_string(dropped) + " triangle(s) with non-finite positions dropped");
+  return all;
+}
+
+// A group's own mesh: one vertex per (position, normal) pair it uses.
+std::shared_ptr<sgal::Mesh> PartMesh(const Group& g, const std::vector<Eigen::Vector3d>& positions,
+                                     const std::vector<Eigen::Vector3d>* normals) {
+  auto part = std::make_shared<sgal::Mesh>();
+  std::unordered_map<uint64_t, uint32_t> index;
+  const uint64_t nn = normals == nullptr ? 1 : normals->size() + 1;
+  for (const auto& t : g.triangles) {
+    std::array<uint32_t, 3> tri{};
+    for (int k = 0; k < 3; ++k) {
+      const Corner& c = t[k];
+      const int64_t ni = normals == nullptr ? -1 : c.normal;
+      const uint64_t key = static_cast<uint64_t>(c.position) * nn + static_cast<uint64_t>(ni + 1);
+      auto [it, inserted] = index.emplace(key, static_cast<uint32_t>(part->vertices.size()));
+      if (inserted) {
+        part->vertices.push_back(positions[c.position].cast<float>());
+        if (normals != nullptr) {
+          Eigen::Vector3d n = ni >= 0 ? (*normals)[ni] : Eigen::Vector3d::Zero();
+          if (n.norm() > 0) n.normalize();
+          part->normals.push_back(n.cast<float>());
+        }
+      }
+      tri[k] = it->second;
+    }
+    part->triangles.push_back(tri);
+  }
+  return part;
+}
+
+// The parts to draw, by material: the whole mesh `all` for a single group without normals.
+std::vector<MeshPart> PartsByMaterial(const MeshTriangles& tris,
+                                      const std::shared_ptr<const sgal::Mesh>& all) {
+  std::vector<MeshPart> parts;
+  for (size_t gi = 0; gi < tris.groups.size(); ++gi) {
+    const Group& g = tris.groups[gi];
     if (g.triangles.empty()) continue;
-    const std::vector<Eigen::Vector3d>* normals = group_normals[gi] != nullptr ? group_normals[gi]
-                                                  : vertex_normals.empty()     ? nullptr
-                                                                               : &vertex_normals;
-    if (normals == nullptr && groups.size() == 1) {
-      data.parts.push_back({g.material, all});
+    const std::vector<Eigen::Vector3d>* normals =
+        tris.group_normals[gi] != nullptr ? tris.group_normals[gi]
+        : tris.vertex_normals.empty()     ? nullptr
+                                          : &tris.vertex_normals;
+    if (normals == nullptr && tris.groups.size() == 1) {
+      parts.push_back({g.material, all});
       continue;
     }
-    // the part's own vertices: one per (position, normal) pair it uses
-    auto part = std::make_shared<sgal::Mesh>();
-    std::unordered_map<uint64_t, uint32_t> index;
-    const uint64_t nn = normals == nullptr ? 1 : normals->size() + 1;
-    for (const auto& t : g.triangles) {
-      std::array<uint32_t, 3> tri{};
-      for (int k = 0; k < 3; ++k) {
-        const Corner& c = t[k];
-        const int64_t ni = normals == nullptr ? -1 : c.normal;
-        const uint64_t key = static_cast<uint64_t>(c.position) * nn + static_cast<uint64_t>(ni + 1);
-        auto [it, inserted] = index.emplace(key, static_cast<uint32_t>(part->vertices.size()));
-        if (inserted) {
-          part->vertices.push_back(positions[c.position].cast<float>());
-          if (normals != nullptr) {
-            Eigen::Vector3d n = ni >= 0 ? (*normals)[ni] : Eigen::Vector3d::Zero();
-            if (n.norm() > 0) n.normalize();
-            part->normals.push_back(n.cast<float>());
-          }
-        }
-        tri[k] = it->second;
-      }
-      part->triangles.push_back(tri);
-    }
-    data.parts.push_back({g.material, part});
+    parts.push_back({g.material, PartMesh(g, tris.positions, normals)});
   }
+  return parts;
+}
+
+}  // namespace
+
+const GeometryData& GeometryLibrary::Get(const Element& geometry) {
+  const auto it = cache_.find(&geometry);
+  if (it != cache_.end()) return it->second;
+  // a placeholder first: convex_hull_of cycles end here
+  cache_[&geometry] = GeometryData{};
+  GeometryData data = Read(geometry);
+  return cache_[&geometry] = std::move(data);
+}
+
+GeometryData GeometryLibrary::Read(const Element& geometry) {
+  GeometryData data;
+  // what a Caliper exporter noted about a tessellated primitive
+  ReadCaliperPrimitive(ctx_, geometry, &data);
+  const Element* mesh = geometry.Child("mesh");
+  const Element* convex = geometry.Child("convex_mesh");
+  if (convex != nullptr && convex->HasAttribute("convex_hull_of")) {
+    const Element& of = ctx_.Resolve(*convex, convex->Attribute("convex_hull_of"));
+    if (of.local_name() != "geometry")
+      ctx_.Fail(convex, "convex_hull_of '" + convex->Attribute("convex_hull_of") + "' is a <" +
+                            std::string(of.local_name()) + ">, not a <geometry>");
+    data = Get(of);
+    data.convex = true;
+    return data;
+  }
+  if (mesh == nullptr) mesh = convex;
+  if (mesh == nullptr) {
+    std::string kind = geometry.children.empty()
+                           ? "nothing"
+                           : "<" + std::string(geometry.children[0]->local_name()) + ">";
+    ctx_.Warn(&geometry,
+              "holds " + kind + "; only <mesh> and <convex_mesh> are read, so it is not shown");
+    return data;
+  }
+  data.convex = mesh == convex;
+
+  const Element* vertices = mesh->Child("vertices");
+  if (vertices == nullptr) {
+    ctx_.Warn(mesh, "has no <vertices>; not shown");
+    return data;
+  }
+  MeshTriangles tris;
+  MeshReader(ctx_, *mesh, *vertices, &tris).Read();
+
+  // positions that are not finite take their triangles with them
+  std::shared_ptr<sgal::Mesh> all = KeepFiniteTriangles(ctx_, *mesh, &tris);
+  data.all = all;
+  data.usable = !all->vertices.empty() && (data.convex || !all->triangles.empty());
+  data.parts = PartsByMaterial(tris, all);
   return data;
 }
 

@@ -508,56 +508,37 @@ class PhysicsReader {
     body->shapes.push_back(std::move(shape));
   }
 
-  void ReadConstraint(const Element& rc,
-                      const std::function<const Element*(const std::string&)>& find_body,
+  // each side of a constraint: its body ("" for the world) and its frame in that body
+  struct Side {
+    std::string body;
+    sgal::Pose frame;  // in the body (world frame for the world)
+    bool present = false;
+  };
+
+  // limits: [min, max] per degree of freedom; min > max is free, min == max locked
+  struct DofLimits {
+    double lower[6] = {0, 0, 0, 0, 0, 0};
+    double upper[6] = {0, 0, 0, 0, 0, 0};
+    bool locked(int i) const {
+      return std::abs(upper[i] - lower[i]) <= 1e-12 * (1 + std::abs(lower[i]));
+    }
+    bool free(int i) const { return lower[i] > upper[i]; }
+  };
+
+  using FindBody = std::function<const Element*(const std::string&)>;
+
+  void ReadConstraint(const Element& rc, const FindBody& find_body,
                       const std::map<const Element*, std::string>& instanced,
                       const std::map<std::string, BodyFrame>& frames) {
     sgal::Constraint c;
-    c.name = CaliperName(rc);
-    if (c.name.empty()) c.name = rc.Attribute("name");
-    if (c.name.empty()) c.name = rc.Attribute("sid");
-    if (c.name.empty()) c.name = "constraint";
-    for (int i = 2; ctx_.constraint_source.count(c.name) > 0; ++i)
-      c.name = (rc.Attribute("name").empty() ? rc.Attribute("sid") : rc.Attribute("name")) + "_" +
-               std::to_string(i);
-    // each side: its body ("" for the world) and its frame in that body
-    struct Side {
-      std::string body;
-      sgal::Pose frame;  // in the body (world frame for the world)
-      bool present = false;
-    };
-    auto side = [&](const Element* a) {
-      Side s;
-      if (a == nullptr) return s;
-      s.present = true;
-      const Eigen::Affine3d local = Placement(visual_, *a);
-      const std::string ref = a->Attribute("rigid_body");
-      if (ref.empty()) {
-        s.frame = RigidPose(visual_.Root() * local);
-        return s;
-      }
-      const Element* rb = find_body(ref);
-      if (rb == nullptr)
-        ctx_.Fail(a, "dangling reference: no rigid body '" + ref + "' in the physics model");
-      const auto it = instanced.find(rb);
-      if (it == instanced.end())
-        ctx_.Fail(a, "rigid body '" + ref + "' is not instantiated in the physics scene");
-      s.body = it->second;
-      const BodyFrame& f = frames.at(s.body);
-      s.frame = Place(f.body_world, f.frame_world, local).pose;
-      return s;
-    };
-    Side ref = side(rc.Child("ref_attachment"));
-    Side att = side(rc.Child("attachment"));
+    c.name = ConstraintName(rc);
+    Side ref = ReadSide(rc.Child("ref_attachment"), find_body, instanced, frames);
+    Side att = ReadSide(rc.Child("attachment"), find_body, instanced, frames);
     if (!ref.present && !att.present)
       ctx_.Fail(&rc, "has neither <ref_attachment> nor <attachment>");
     // a missing side is the world, where the other side's frame is at the start
-    auto world_frame = [&](const Side& other) {
-      if (other.body.empty()) return other.frame;
-      return ctx_.scene.bodies[ctx_.scene.BodyIndex(other.body)].pose * other.frame;
-    };
-    if (!ref.present) ref.frame = world_frame(att);
-    if (!att.present) att.frame = world_frame(ref);
+    if (!ref.present) ref.frame = WorldFrame(att);
+    if (!att.present) att.frame = WorldFrame(ref);
     if (ref.body.empty() && att.body.empty()) ctx_.Fail(&rc, "attaches no rigid body");
     const Element* tc = rc.Child("technique_common");
     if (tc != nullptr && !ctx_.Bool(tc->Child("enabled"), true)) {
@@ -565,52 +546,10 @@ class PhysicsReader {
       return;
     }
     c.collide_connected = tc != nullptr && ctx_.Bool(tc->Child("interpenetrate"), false);
-    // limits: [min, max] per degree of freedom; min > max is free, min == max locked
-    double lower[6] = {0, 0, 0, 0, 0, 0}, upper[6] = {0, 0, 0, 0, 0, 0};
-    const Element* limits = tc == nullptr ? nullptr : tc->Child("limits");
-    if (limits != nullptr) {
-      auto read = [&](const char* group, int first, double scale) {
-        const Element* g = limits->Child(group);
-        if (g == nullptr) return;
-        if (const Element* mn = g->Child("min"); mn != nullptr) {
-          const Eigen::Vector3d v = ctx_.Vector3(*mn);
-          for (int i = 0; i < 3; ++i) lower[first + i] = v[i] * scale;
-        }
-        if (const Element* mx = g->Child("max"); mx != nullptr) {
-          const Eigen::Vector3d v = ctx_.Vector3(*mx);
-          for (int i = 0; i < 3; ++i) upper[first + i] = v[i] * scale;
-        }
-      };
-      read("linear", 0, ctx_.meter);
-      read("swing_cone_and_twist", 3, kDegree);
-    }
+    const DofLimits limits = ReadLimits(tc);
     // springs: one linear and one angular law for all the free degrees of freedom
     sgal::JointSpring linear, angular;
-    if (const Element* spring = tc == nullptr ? nullptr : tc->Child("spring"); spring != nullptr) {
-      if (const Element* l = spring->Child("linear"); l != nullptr) {
-        linear.stiffness = ctx_.Number(l->Child("stiffness"), 0) / ctx_.meter;
-        linear.damping = ctx_.Number(l->Child("damping"), 0) / ctx_.meter;
-        linear.rest = ctx_.Number(l->Child("target_value"), 0) * ctx_.meter;
-      }
-      if (const Element* a = spring->Child("angular"); a != nullptr) {
-        // torque per degree in document units -> N m/rad
-        angular.stiffness = ctx_.Number(a->Child("stiffness"), 0) * ctx_.meter / kDegree;
-        angular.damping = ctx_.Number(a->Child("damping"), 0) * ctx_.meter / kDegree;
-        angular.rest = ctx_.Number(a->Child("target_value"), 0) * kDegree;
-      }
-    }
-    auto locked = [&](int i) {
-      return std::abs(upper[i] - lower[i]) <= 1e-12 * (1 + std::abs(lower[i]));
-    };
-    auto free = [&](int i) { return lower[i] > upper[i]; };
-    std::vector<int> open_linear, open_angular;
-    bool offset_lock = false;
-    for (int i = 0; i < 6; ++i) {
-      if (!locked(i))
-        (i < 3 ? open_linear : open_angular).push_back(i);
-      else if (std::abs(lower[i]) > 1e-12)
-        offset_lock = true;
-    }
+    ReadSprings(tc, &linear, &angular);
     // frames: ref_attachment is the reference (sgal's a); the constraint acts on attachment (b)
     Side a = ref, b = att;
     bool flipped = false;
@@ -625,63 +564,171 @@ class PhysicsReader {
     c.frame_a = a.frame;
     c.frame_b = b.frame;
     const bool kind_given = ReadConstraintExtra(ctx_, rc, &c);
-    Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();
     int dof = -1;
     if (!kind_given) {
-      if (offset_lock) {
-        c.kind = sgal::ConstraintKind::kGeneric6Dof;
-      } else if (open_linear.empty() && open_angular.empty()) {
-        c.kind = sgal::ConstraintKind::kFixed;
-      } else if (open_linear.empty() && open_angular.size() == 1) {
-        c.kind = sgal::ConstraintKind::kHinge;
-        dof = open_angular[0];
-      } else if (open_angular.empty() && open_linear.size() == 1) {
-        c.kind = sgal::ConstraintKind::kSlider;
-        dof = open_linear[0];
-      } else if (open_linear.empty() && open_angular.size() == 3 && free(3) && free(4) && free(5)) {
-        c.kind = sgal::ConstraintKind::kBall;
-      } else {
-        c.kind = sgal::ConstraintKind::kGeneric6Dof;
-      }
-      // hinges and sliders act along z: turn both frames so that z is the open axis
-      if (dof >= 0) {
-        const int axis = dof % 3;
-        if (axis == 0) turn = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY());
-        if (axis == 1) turn = Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX());
-        c.frame_a.orientation = (c.frame_a.orientation * turn).normalized();
-        c.frame_b.orientation = (c.frame_b.orientation * turn).normalized();
-      }
+      dof = ChooseKind(limits, &c);
     } else if (c.kind == sgal::ConstraintKind::kHinge) {
       dof = 5;
     } else if (c.kind == sgal::ConstraintKind::kSlider) {
       dof = 2;
     }
+    SetLimitsAndSprings(limits, dof, flipped, linear, angular, &c);
+    ctx_.constraint_source[c.name] = &rc;
+    ctx_.scene.constraints.push_back(std::move(c));
+  }
+
+  // a constraint's name, unique among those read so far
+  std::string ConstraintName(const Element& rc) const {
+    std::string name = CaliperName(rc);
+    if (name.empty()) name = rc.Attribute("name");
+    if (name.empty()) name = rc.Attribute("sid");
+    if (name.empty()) name = "constraint";
+    for (int i = 2; ctx_.constraint_source.count(name) > 0; ++i)
+      name = (rc.Attribute("name").empty() ? rc.Attribute("sid") : rc.Attribute("name")) + "_" +
+             std::to_string(i);
+    return name;
+  }
+
+  // the side an <attachment> or <ref_attachment> (nullptr: absent) gives
+  Side ReadSide(const Element* a, const FindBody& find_body,
+                const std::map<const Element*, std::string>& instanced,
+                const std::map<std::string, BodyFrame>& frames) const {
+    Side s;
+    if (a == nullptr) return s;
+    s.present = true;
+    const Eigen::Affine3d local = Placement(visual_, *a);
+    const std::string ref = a->Attribute("rigid_body");
+    if (ref.empty()) {
+      s.frame = RigidPose(visual_.Root() * local);
+      return s;
+    }
+    const Element* rb = find_body(ref);
+    if (rb == nullptr)
+      ctx_.Fail(a, "dangling reference: no rigid body '" + ref + "' in the physics model");
+    const auto it = instanced.find(rb);
+    if (it == instanced.end())
+      ctx_.Fail(a, "rigid body '" + ref + "' is not instantiated in the physics scene");
+    s.body = it->second;
+    const BodyFrame& f = frames.at(s.body);
+    s.frame = Place(f.body_world, f.frame_world, local).pose;
+    return s;
+  }
+
+  // the frame of the world side of a constraint: where the other side's frame is at the start
+  sgal::Pose WorldFrame(const Side& other) const {
+    if (other.body.empty()) return other.frame;
+    return ctx_.scene.bodies[ctx_.scene.BodyIndex(other.body)].pose * other.frame;
+  }
+
+  // the <limits> of a constraint's <technique_common> (nullptr: none), in SI units
+  DofLimits ReadLimits(const Element* tc) const {
+    DofLimits limits;
+    const Element* e = tc == nullptr ? nullptr : tc->Child("limits");
+    if (e == nullptr) return limits;
+    auto read = [&](const char* group, int first, double scale) {
+      const Element* g = e->Child(group);
+      if (g == nullptr) return;
+      if (const Element* mn = g->Child("min"); mn != nullptr) {
+        const Eigen::Vector3d v = ctx_.Vector3(*mn);
+        for (int i = 0; i < 3; ++i) limits.lower[first + i] = v[i] * scale;
+      }
+      if (const Element* mx = g->Child("max"); mx != nullptr) {
+        const Eigen::Vector3d v = ctx_.Vector3(*mx);
+        for (int i = 0; i < 3; ++i) limits.upper[first + i] = v[i] * scale;
+      }
+    };
+    read("linear", 0, ctx_.meter);
+    read("swing_cone_and_twist", 3, kDegree);
+    return limits;
+  }
+
+  // the <spring> of a constraint's <technique_common> (nullptr: none), in SI units
+  void ReadSprings(const Element* tc, sgal::JointSpring* linear, sgal::JointSpring* angular) const {
+    const Element* spring = tc == nullptr ? nullptr : tc->Child("spring");
+    if (spring == nullptr) return;
+    if (const Element* l = spring->Child("linear"); l != nullptr) {
+      linear->stiffness = ctx_.Number(l->Child("stiffness"), 0) / ctx_.meter;
+      linear->damping = ctx_.Number(l->Child("damping"), 0) / ctx_.meter;
+      linear->rest = ctx_.Number(l->Child("target_value"), 0) * ctx_.meter;
+    }
+    if (const Element* a = spring->Child("angular"); a != nullptr) {
+      // torque per degree in document units -> N m/rad
+      angular->stiffness = ctx_.Number(a->Child("stiffness"), 0) * ctx_.meter / kDegree;
+      angular->damping = ctx_.Number(a->Child("damping"), 0) * ctx_.meter / kDegree;
+      angular->rest = ctx_.Number(a->Child("target_value"), 0) * kDegree;
+    }
+  }
+
+  // The kind the limits make of a constraint whose Caliper extra named none; hinges and sliders
+  // have their frames turned so that z is the open axis. Returns the open degree of freedom of a
+  // hinge or a slider, -1 for the other kinds.
+  static int ChooseKind(const DofLimits& limits, sgal::Constraint* c) {
+    std::vector<int> open_linear, open_angular;
+    bool offset_lock = false;
+    for (int i = 0; i < 6; ++i) {
+      if (!limits.locked(i))
+        (i < 3 ? open_linear : open_angular).push_back(i);
+      else if (std::abs(limits.lower[i]) > 1e-12)
+        offset_lock = true;
+    }
+    int dof = -1;
+    if (offset_lock) {
+      c->kind = sgal::ConstraintKind::kGeneric6Dof;
+    } else if (open_linear.empty() && open_angular.empty()) {
+      c->kind = sgal::ConstraintKind::kFixed;
+    } else if (open_linear.empty() && open_angular.size() == 1) {
+      c->kind = sgal::ConstraintKind::kHinge;
+      dof = open_angular[0];
+    } else if (open_angular.empty() && open_linear.size() == 1) {
+      c->kind = sgal::ConstraintKind::kSlider;
+      dof = open_linear[0];
+    } else if (open_linear.empty() && open_angular.size() == 3 && limits.free(3) &&
+               limits.free(4) && limits.free(5)) {
+      c->kind = sgal::ConstraintKind::kBall;
+    } else {
+      c->kind = sgal::ConstraintKind::kGeneric6Dof;
+    }
+    // hinges and sliders act along z: turn both frames so that z is the open axis
+    if (dof >= 0) {
+      Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();
+      const int axis = dof % 3;
+      if (axis == 0) turn = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY());
+      if (axis == 1) turn = Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitX());
+      c->frame_a.orientation = (c->frame_a.orientation * turn).normalized();
+      c->frame_b.orientation = (c->frame_b.orientation * turn).normalized();
+    }
+    return dof;
+  }
+
+  // The limits of the constraint's kind (those of `dof` for a hinge or a slider), and the spring
+  // laws unless its Caliper extra gave springs; `flipped`: the sides were swapped.
+  static void SetLimitsAndSprings(const DofLimits& limits, int dof, bool flipped,
+                                  const sgal::JointSpring& linear, const sgal::JointSpring& angular,
+                                  sgal::Constraint* c) {
     auto set = [&](int slot, int i) {
-      double lo = lower[i], hi = upper[i];
+      double lo = limits.lower[i], hi = limits.upper[i];
       if (lo <= hi && flipped) std::tie(lo, hi) = std::make_pair(-hi, -lo);
-      c.limits[slot].lower = lo;
-      c.limits[slot].upper = hi;
+      c->limits[slot].lower = lo;
+      c->limits[slot].upper = hi;
     };
     const bool springs_given =
-        std::any_of(c.springs.begin(), c.springs.end(), [](const sgal::JointSpring& s) {
+        std::any_of(c->springs.begin(), c->springs.end(), [](const sgal::JointSpring& s) {
           return s.stiffness != 0 || s.damping != 0 || s.rest != 0;
         });
     auto spring = [&](int slot, const sgal::JointSpring& law) {
       if (springs_given) return;
-      c.springs[slot] = law;
-      if (flipped) c.springs[slot].rest = -law.rest;
+      c->springs[slot] = law;
+      if (flipped) c->springs[slot].rest = -law.rest;
     };
-    if (c.kind == sgal::ConstraintKind::kHinge || c.kind == sgal::ConstraintKind::kSlider) {
+    if (c->kind == sgal::ConstraintKind::kHinge || c->kind == sgal::ConstraintKind::kSlider) {
       set(0, dof);
-      spring(0, c.kind == sgal::ConstraintKind::kHinge ? angular : linear);
-    } else if (c.kind == sgal::ConstraintKind::kGeneric6Dof) {
+      spring(0, c->kind == sgal::ConstraintKind::kHinge ? angular : linear);
+    } else if (c->kind == sgal::ConstraintKind::kGeneric6Dof) {
       for (int i = 0; i < 6; ++i) {
         set(i, i);
-        if (!locked(i)) spring(i, i < 3 ? linear : angular);
+        if (!limits.locked(i)) spring(i, i < 3 ? linear : angular);
       }
     }
-    ctx_.constraint_source[c.name] = &rc;
-    ctx_.scene.constraints.push_back(std::move(c));
   }
 
   Context& ctx_;

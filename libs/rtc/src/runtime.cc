@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include "caliper/core/arguments.h"
@@ -253,17 +254,17 @@ void Runtime::Unbind() {
   }
 }
 
-int RunComponent(int argc, char** argv, const ComponentType& type,
-                 const ComponentFactory& make_component, const ServantFactory& make_servant) {
-  SignalWatcher::BlockSignals();  // before any thread exists, so that all inherit the mask
-  const std::string program = "caliper-" + type.name;
+namespace {
 
-  core::Config config(CommonKeys(type.name));
-  config.AddKeys(type.config_keys);
-  std::vector<std::string> orb_args{argv[0]};
+// Reads the default configuration file, the environment and the command line into `config`;
+// the words for omniORB go to `orb_args`. Returns the exit code when the process ends here
+// (--help, or a bad option), nothing when it goes on.
+std::optional<int> ReadCommandLine(int argc, char** argv, const ComponentType& type,
+                                   const std::string& program, core::Config* config,
+                                   std::vector<std::string>* orb_args) {
   try {
     const std::string default_file = ConfigDirectory() + "/" + type.name + ".conf";
-    if (access(default_file.c_str(), R_OK) == 0) config.LoadFile(default_file);
+    if (access(default_file.c_str(), R_OK) == 0) config->LoadFile(default_file);
     std::vector<std::string> overrides;
     if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
       overrides.push_back("corba.endpoint=" + ListenEndpoint(listen));
@@ -275,7 +276,7 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     const std::vector<std::string> words(argv + 1, argv + argc);
     const core::Arguments args = core::ParseArguments(words, spec);
     if (args.help) {
-      PrintUsage(type, config);
+      PrintUsage(type, *config);
       return 0;
     }
     // a component takes no positional word: the first one comes before where the parser stopped
@@ -285,7 +286,7 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     if (!args.missing_value.empty()) throw core::ConfigError(args.Error());
     for (const auto& [option, value] : args.options) {
       if (option == "-f")
-        config.LoadFile(value);
+        config->LoadFile(value);
       else if (option == "-o")
         overrides.push_back(value);
       else if (option == "--nameservice")
@@ -297,8 +298,8 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
       else
         overrides.push_back("naming.instance=" + value);
     }
-    for (const size_t i : args.passed) orb_args.push_back(words[i]);
-    for (const auto& o : overrides) config.SetAssignment(o, "-o");
+    for (const size_t i : args.passed) orb_args->push_back(words[i]);
+    for (const auto& o : overrides) config->SetAssignment(o, "-o");
   } catch (const core::ConfigError& e) {
     std::cerr << program << ": error: " << e.what() << "\n";
     return 2;
@@ -306,6 +307,103 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     std::cerr << program << ": error: --listen / CALIPER_LISTEN: " << e.what() << "\n";
     return 2;
   }
+  return std::nullopt;
+}
+
+// Loopback, or network mode over TLS (the default) or plain (--insecure), as the configuration
+// and the omniORB words say. Throws what ResolveSecurity throws.
+TransportSecurity ChooseTransport(const core::Config& config, const std::string& naming_address,
+                                  const std::vector<std::string>& orb_args) {
+  SecurityRequest request;
+  request.endpoint = config.GetString("corba.endpoint");
+  request.naming_address = naming_address;
+  // endpoints passed through to omniORB (-ORBendPoint giop:tcp::) count as its own
+  for (size_t i = 1; i + 1 < orb_args.size(); ++i)
+    if (strcasecmp(orb_args[i].c_str(), "-ORBendPoint") == 0 ||
+        strcasecmp(orb_args[i].c_str(), "-ORBendPointNoPublish") == 0)
+      request.extra_endpoints.push_back(orb_args[i + 1]);
+  request.insecure = config.GetBool("corba.insecure");
+  request.pki_dir = config.GetString("corba.tls.pki_dir");
+  request.identity = config.GetString("corba.tls.identity");
+  request.component = true;
+  return ResolveSecurity(request);
+}
+
+// Says which transport the process uses: loudly when it is insecure.
+void ReportTransport(const std::string& program, const TransportSecurity& security,
+                     log4cpp::Category& log) {
+  if (security.transport == Transport::kInsecure) {
+    WarnInsecure(program, security.endpoint);
+    log.warn("INSECURE network mode: plain GIOP without TLS on %s, no authentication",
+             security.endpoint.c_str());
+  } else if (security.transport == Transport::kTls) {
+    log.notice("network mode over TLS on %s as %s; peers need a certificate of %s",
+               security.endpoint.c_str(), security.key_file.c_str(), security.ca_file.c_str());
+  }
+}
+
+// The transport (ChooseTransport), said and installed for the process; nothing when it cannot
+// be had (the reason logged and printed, the logging shut down).
+std::optional<TransportSecurity> SetUpTransport(const std::string& program,
+                                                const core::Config& config,
+                                                const std::string& naming_address,
+                                                const std::vector<std::string>& orb_args,
+                                                log4cpp::Category& log) {
+  TransportSecurity security;
+  try {
+    security = ChooseTransport(config, naming_address, orb_args);
+  } catch (const std::exception& e) {
+    log.error("%s", e.what());
+    std::cerr << program << ": error: " << e.what() << "\n";
+    logging::Shutdown();
+    return std::nullopt;
+  }
+  ReportTransport(program, security, log);
+  InstallProcessSecurity(security);
+  return security;
+}
+
+// The omniORB options of the transport, the call timeout and the largest message.
+void AddOrbOptions(const core::Config& config, const TransportSecurity& security,
+                   std::vector<std::string>* orb_args) {
+  // no clientConnectTimeOutPeriod: omniORB stretches the deadline of a call that opens a
+  // connection to it, so a shorter per-object deadline (the Model's pushes to observers) would
+  // not hold; without it a connect is bounded by the call's own deadline
+  const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
+  for (const auto& option : SecurityOrbOptions(security)) orb_args->push_back(option);
+  orb_args->insert(orb_args->end(),
+                   {"-ORBendPoint", security.endpoint, "-ORBclientCallTimeOutPeriod",
+                    std::to_string(timeout_ms), "-ORBgiopMaxMsgSize",
+                    std::to_string(static_cast<long>(config.GetDouble("corba.max_message_size") *
+                                                     1024 * 1024))});
+}
+
+// Sends the log records to the Logging component too (spooled while it is unreachable).
+void AddRemoteLogging(const ComponentType& type, const core::Config& config, CORBA::ORB_ptr orb,
+                      const std::string& naming_address) {
+  logging::AppenderOptions options;
+  options.spool_dir = core::ExpandHome(config.GetString("log.spool_dir"));
+  options.spool_name = type.name + "-" + std::to_string(getpid());
+  options.max_spool_bytes = static_cast<uint64_t>(config.GetDouble("log.spool_max") * 1024 * 1024);
+  logging::AddAppender(new logging::BatchingAppender(
+      "log-service",
+      std::make_unique<LogServiceSink>(orb, naming_address, config.GetString("log.service")),
+      options));
+}
+
+}  // namespace
+
+int RunComponent(int argc, char** argv, const ComponentType& type,
+                 const ComponentFactory& make_component, const ServantFactory& make_servant) {
+  SignalWatcher::BlockSignals();  // before any thread exists, so that all inherit the mask
+  const std::string program = "caliper-" + type.name;
+
+  core::Config config(CommonKeys(type.name));
+  config.AddKeys(type.config_keys);
+  std::vector<std::string> orb_args{argv[0]};
+  if (const std::optional<int> done =
+          ReadCommandLine(argc, argv, type, program, &config, &orb_args))
+    return *done;
 
   int console_priority = logging::kInfo;
   logging::ParsePriority(config.GetString("log.level"), &console_priority);
@@ -317,53 +415,16 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
   runtime.naming_address_ = NamingAddress(config.GetString("naming.service"));
 
   // loopback, or network mode over TLS (the default) or plain (--insecure)
-  TransportSecurity security;
-  try {
-    SecurityRequest request;
-    request.endpoint = config.GetString("corba.endpoint");
-    request.naming_address = runtime.naming_address_;
-    // endpoints passed through to omniORB (-ORBendPoint giop:tcp::) count as its own
-    for (size_t i = 1; i + 1 < orb_args.size(); ++i)
-      if (strcasecmp(orb_args[i].c_str(), "-ORBendPoint") == 0 ||
-          strcasecmp(orb_args[i].c_str(), "-ORBendPointNoPublish") == 0)
-        request.extra_endpoints.push_back(orb_args[i + 1]);
-    request.insecure = config.GetBool("corba.insecure");
-    request.pki_dir = config.GetString("corba.tls.pki_dir");
-    request.identity = config.GetString("corba.tls.identity");
-    request.component = true;
-    security = ResolveSecurity(request);
-  } catch (const std::exception& e) {
-    log.error("%s", e.what());
-    std::cerr << program << ": error: " << e.what() << "\n";
-    logging::Shutdown();
-    return 2;
-  }
-  if (security.transport == Transport::kInsecure) {
-    WarnInsecure(program, security.endpoint);
-    log.warn("INSECURE network mode: plain GIOP without TLS on %s, no authentication",
-             security.endpoint.c_str());
-  } else if (security.transport == Transport::kTls) {
-    log.notice("network mode over TLS on %s as %s; peers need a certificate of %s",
-               security.endpoint.c_str(), security.key_file.c_str(), security.ca_file.c_str());
-  }
-  InstallProcessSecurity(security);
+  const std::optional<TransportSecurity> security =
+      SetUpTransport(program, config, runtime.naming_address_, orb_args, log);
+  if (!security) return 2;
   {
     std::lock_guard<std::mutex> lock(runtime.mutex_);
     runtime.instance_ = config.GetString("naming.instance");
   }
   logging::SetInstance(runtime.instance());
 
-  // no clientConnectTimeOutPeriod: omniORB stretches the deadline of a call that opens a
-  // connection to it, so a shorter per-object deadline (the Model's pushes to observers) would
-  // not hold; without it a connect is bounded by the call's own deadline
-  const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
-  for (const auto& option : SecurityOrbOptions(security)) orb_args.push_back(option);
-  orb_args.insert(orb_args.end(),
-                  {"-ORBendPoint", security.endpoint,
-                   "-ORBclientCallTimeOutPeriod", std::to_string(timeout_ms),
-                   "-ORBgiopMaxMsgSize",
-                   std::to_string(static_cast<long>(config.GetDouble("corba.max_message_size") *
-                                                    1024 * 1024))});
+  AddOrbOptions(config, *security, &orb_args);
   std::vector<char*> orb_argv;
   for (auto& a : orb_args) orb_argv.push_back(a.data());
   int orb_argc = static_cast<int>(orb_argv.size());
@@ -376,18 +437,7 @@ int RunComponent(int argc, char** argv, const ComponentType& type,
     runtime.poa_ = PortableServer::POA::_narrow(poa_obj);
     runtime.poa_->the_POAManager()->activate();
 
-    if (type.remote_logging) {
-      logging::AppenderOptions options;
-      options.spool_dir = core::ExpandHome(config.GetString("log.spool_dir"));
-      options.spool_name = type.name + "-" + std::to_string(getpid());
-      options.max_spool_bytes =
-          static_cast<uint64_t>(config.GetDouble("log.spool_max") * 1024 * 1024);
-      logging::AddAppender(new logging::BatchingAppender(
-          "log-service",
-          std::make_unique<LogServiceSink>(runtime.orb_, runtime.naming_address_,
-                                           config.GetString("log.service")),
-          options));
-    }
+    if (type.remote_logging) AddRemoteLogging(type, config, runtime.orb_, runtime.naming_address_);
 
     runtime.component_ = make_component(runtime);
     runtime.lifecycle_ = std::make_unique<Lifecycle>(runtime.component_.get());

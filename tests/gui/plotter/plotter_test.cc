@@ -221,119 +221,94 @@ class PlotterTest : public ::testing::Test {
   int models_ = 0;
 };
 
-TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
-  auto process = StartModel(Models() + "/pendulum_tendon.dae");
-  M::Model_var model = WaitForModel();
-  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
-  auto w = Window(naming_->address());
-  ASSERT_TRUE(WaitInGui([&] { return ChannelItem(*w, kAngle) != nullptr; }, seconds(10)))
-      << "the channel list is filled from the Model";
-
-  // the search box: text matches anywhere (any case), a glob matches the whole id
-  auto* search = w->findChild<QLineEdit*>("search");
-  const int all = VisibleChannels(*w).size();
+// The search box: text matches anywhere (any case), a glob matches the whole id.
+void CheckSearchBox(PlotterWindow& w) {
+  auto* search = w.findChild<QLineEdit*>("search");
+  const int all = VisibleChannels(w).size();
   QTest::keyClicks(search, "MOTOR.C");
-  QStringList shown = VisibleChannels(*w);
+  QStringList shown = VisibleChannels(w);
   EXPECT_GE(shown.size(), 2) << shown.join(" ").toStdString();
   EXPECT_LT(shown.size(), all);
   for (const QString& id : shown) EXPECT_TRUE(id.contains("motor.c")) << id.toStdString();
   EXPECT_TRUE(shown.contains(kCurrent));
-  EXPECT_TRUE(ChannelItem(*w, kAngle)->isHidden());
+  EXPECT_TRUE(ChannelItem(w, kAngle)->isHidden());
   search->clear();
   QTest::keyClicks(search, "*.pivot.?osition");
-  shown = VisibleChannels(*w);
+  shown = VisibleChannels(w);
   EXPECT_EQ(shown, QStringList{kAngle}) << shown.join(" ").toStdString();
   search->clear();
   QTest::keyClicks(search, "*.pivot.*");
-  shown = VisibleChannels(*w);
+  shown = VisibleChannels(w);
   EXPECT_GE(shown.size(), 2) << "position and velocity at least";
   for (const QString& id : shown)
     EXPECT_TRUE(id.startsWith("pendulum_tendon.pivot.")) << id.toStdString();
-  EXPECT_EQ(ChannelItem(*w, kAngle)->text(1), "rad") << "units are shown";
+  EXPECT_EQ(ChannelItem(w, kAngle)->text(1), "rad") << "units are shown";
   search->clear();
-  EXPECT_EQ(VisibleChannels(*w).size(), all);
+  EXPECT_EQ(VisibleChannels(w).size(), all);
+}
 
-  // two ids into plot 1, one into a new plot 2, then a vector element into plot 2
-  auto* channels = w->findChild<QTreeWidget*>("channels");
-  auto* target = w->findChild<QComboBox*>("target_plot");
-  auto* add = w->findChild<QPushButton*>("add");
+// Two ids into plot 1, one into a new plot 2, then a vector element into plot 2.
+void AddCurvesToTwoPlots(PlotterWindow& w) {
+  auto* channels = w.findChild<QTreeWidget*>("channels");
+  auto* target = w.findChild<QComboBox*>("target_plot");
+  auto* add = w.findChild<QPushButton*>("add");
   channels->clearSelection();
-  ChannelItem(*w, kAngle)->setSelected(true);
-  ChannelItem(*w, kCurrent)->setSelected(true);
+  ChannelItem(w, kAngle)->setSelected(true);
+  ChannelItem(w, kCurrent)->setSelected(true);
   target->setCurrentIndex(0);
   QTest::mouseClick(add, Qt::LeftButton);
-  ASSERT_EQ(w->plot_count(), 1);
-  EXPECT_TRUE(w->plot(0)->HasCurve(kAngle));
-  EXPECT_TRUE(w->plot(0)->HasCurve(kCurrent));
+  ASSERT_EQ(w.plot_count(), 1);
+  EXPECT_TRUE(w.plot(0)->HasCurve(kAngle));
+  EXPECT_TRUE(w.plot(0)->HasCurve(kCurrent));
   channels->clearSelection();
-  ChannelItem(*w, kTension)->setSelected(true);
+  ChannelItem(w, kTension)->setSelected(true);
   target->setCurrentIndex(target->count() - 1);
   EXPECT_EQ(target->currentText(), "New plot");
   QTest::mouseClick(add, Qt::LeftButton);
-  ASSERT_EQ(w->plot_count(), 2);
-  EXPECT_TRUE(w->plot(1)->HasCurve(kTension));
+  ASSERT_EQ(w.plot_count(), 2);
+  EXPECT_TRUE(w.plot(1)->HasCurve(kTension));
   EXPECT_EQ(target->currentIndex(), 1) << "the new plot becomes the target";
   channels->clearSelection();
-  ASSERT_NE(ChannelItem(*w, kHeight), nullptr) << "vector ids offer their elements";
-  ChannelItem(*w, kHeight)->setSelected(true);
+  ASSERT_NE(ChannelItem(w, kHeight), nullptr) << "vector ids offer their elements";
+  ChannelItem(w, kHeight)->setSelected(true);
   QTest::mouseClick(add, Qt::LeftButton);
-  EXPECT_TRUE(w->plot(1)->HasCurve(kHeight));
-  EXPECT_EQ(w->plot(0)->legend_titles(), (QStringList{"pendulum_tendon.pivot.position [rad]",
-                                                      "pendulum_tendon.motor.current [A]"}));
+  EXPECT_TRUE(w.plot(1)->HasCurve(kHeight));
+  EXPECT_EQ(w.plot(0)->legend_titles(), (QStringList{"pendulum_tendon.pivot.position [rad]",
+                                                     "pendulum_tendon.motor.current [A]"}));
+}
 
-  // run: the tendon pulls the pendulum up, then lets it swing
-  SetCommand(model, 12.0);
-  model->start();
-  ASSERT_TRUE(WaitInGui(
-      [&] {
-        return w->store().size() > 500 && w->plot(0)->points(kAngle) > 100 &&
-               w->plot(1)->points(kTension) > 100;
-      },
-      seconds(15)))
-      << "held " << w->store().size() << "; " << process->Output();
-  EXPECT_TRUE(w->findChild<QLabel*>("connection")->text().startsWith("connected to model0"))
-      << w->findChild<QLabel*>("connection")->text().toStdString();
-  ASSERT_TRUE(WaitInGui([&] { return w->sample_rate() > 100; }, seconds(5)));
-  SetCommand(model, 0.0);
-
-  // pause: the view stops (the buffer keeps filling); resume: it follows again
-  ClickAction(*w, "pause");
-  EXPECT_TRUE(w->paused());
-  const double frozen = w->plot(0)->last_drawn_time(kAngle);
-  const size_t frozen_points = w->plot(0)->points(kAngle);
-  const size_t held = w->store().size();
+// Pause: the view stops (the buffer keeps filling); resume: it follows again. Then clear while
+// streaming: empty at once, then only newer samples.
+void CheckPauseResumeAndClear(PlotterWindow& w) {
+  ClickAction(w, "pause");
+  EXPECT_TRUE(w.paused());
+  const double frozen = w.plot(0)->last_drawn_time(kAngle);
+  const size_t frozen_points = w.plot(0)->points(kAngle);
+  const size_t held = w.store().size();
   Pump(milliseconds(700));
-  EXPECT_EQ(w->plot(0)->last_drawn_time(kAngle), frozen);
-  EXPECT_EQ(w->plot(0)->points(kAngle), frozen_points);
-  EXPECT_GT(w->store().size(), held + 200) << "samples are still recorded while paused";
-  EXPECT_TRUE(w->findChild<QLabel*>("rate")->text().contains("paused"));
-  ClickAction(*w, "pause");
-  EXPECT_FALSE(w->paused());
+  EXPECT_EQ(w.plot(0)->last_drawn_time(kAngle), frozen);
+  EXPECT_EQ(w.plot(0)->points(kAngle), frozen_points);
+  EXPECT_GT(w.store().size(), held + 200) << "samples are still recorded while paused";
+  EXPECT_TRUE(w.findChild<QLabel*>("rate")->text().contains("paused"));
+  ClickAction(w, "pause");
+  EXPECT_FALSE(w.paused());
   EXPECT_TRUE(
-      WaitInGui([&] { return w->plot(0)->last_drawn_time(kAngle) > frozen + 0.5; }, seconds(5)));
+      WaitInGui([&] { return w.plot(0)->last_drawn_time(kAngle) > frozen + 0.5; }, seconds(5)));
 
-  // clear while streaming: empty at once, then only newer samples
-  const double cleared_at = w->store().last_time();
-  ClickAction(*w, "clear");
-  EXPECT_TRUE(w->store().empty());
-  EXPECT_EQ(w->plot(0)->points(kAngle), 0u);
-  ASSERT_TRUE(WaitInGui([&] { return w->store().size() > 1500; }, seconds(10)));
-  EXPECT_GT(w->store().first_time(), cleared_at);
+  const double cleared_at = w.store().last_time();
+  ClickAction(w, "clear");
+  EXPECT_TRUE(w.store().empty());
+  EXPECT_EQ(w.plot(0)->points(kAngle), 0u);
+  ASSERT_TRUE(WaitInGui([&] { return w.store().size() > 1500; }, seconds(10)));
+  EXPECT_GT(w.store().first_time(), cleared_at);
+}
 
-  // the screenshot
-  SetCommand(model, 12.0);
-  Pump(milliseconds(400));
-  SetCommand(model, 0.0);
-  Pump(milliseconds(600));
-  const std::string png = ArtifactPath("plotter.png", dir_.path());
-  EXPECT_TRUE(w->grab().save(QString::fromStdString(png))) << png;
-
-  // CSV: the header with units, one row per sample held, every simulation step present
-  const QString csv = QString::fromStdString(dir_.path() + "/data.csv");
-  QString error;
-  ClickAction(*w, "pause");  // the view only; the samples held now are what gets written
-  const size_t rows = w->store().size();
-  ASSERT_TRUE(w->ExportCsv(csv, &error)) << error.toStdString();
+// CSV: the header with units, one row per sample held, every simulation step present.
+void CheckCsvExport(PlotterWindow& w, const std::string& dir, QString* error) {
+  const QString csv = QString::fromStdString(dir + "/data.csv");
+  ClickAction(w, "pause");  // the view only; the samples held now are what gets written
+  const size_t rows = w.store().size();
+  ASSERT_TRUE(w.ExportCsv(csv, error)) << error->toStdString();
   std::ifstream in(csv.toStdString());
   std::string line;
   std::getline(in, line);
@@ -356,12 +331,15 @@ TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
   EXPECT_EQ(n, rows);
   EXPECT_EQ(n, static_cast<size_t>(std::llround((last - first) / 0.001)) + 1)
       << "one row per 1 ms step from " << first << " to " << last << " s";
-  EXPECT_EQ(w->link().status().batches_missing, 0u);
-  ClickAction(*w, "pause");
+  EXPECT_EQ(w.link().status().batches_missing, 0u);
+  ClickAction(w, "pause");
+}
 
-  // the plot as SVG (valid XML with an <svg> root), PDF and PNG
-  const QString svg = QString::fromStdString(dir_.path() + "/plot.svg");
-  ASSERT_TRUE(w->ExportPlot(svg, &error)) << error.toStdString();
+// The plot as SVG (valid XML with an <svg> root), PDF and PNG; unknown suffixes and unwritable
+// paths fail with a reason.
+void CheckPlotExports(PlotterWindow& w, const std::string& dir, QString* error) {
+  const QString svg = QString::fromStdString(dir + "/plot.svg");
+  ASSERT_TRUE(w.ExportPlot(svg, error)) << error->toStdString();
   QFile svg_file(svg);
   ASSERT_TRUE(svg_file.open(QIODevice::ReadOnly));
   QXmlStreamReader xml(&svg_file);
@@ -376,13 +354,13 @@ TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
   EXPECT_TRUE(ReadFile(svg.toStdString()).find("pendulum_tendon.pivot.position [rad]") !=
               std::string::npos)
       << "the legend is in the drawing";
-  const QString pdf = QString::fromStdString(dir_.path() + "/plot.pdf");
-  ASSERT_TRUE(w->ExportPlot(pdf, &error)) << error.toStdString();
+  const QString pdf = QString::fromStdString(dir + "/plot.pdf");
+  ASSERT_TRUE(w.ExportPlot(pdf, error)) << error->toStdString();
   const std::string pdf_bytes = ReadFile(pdf.toStdString());
   EXPECT_GT(pdf_bytes.size(), 1000u);
   EXPECT_EQ(pdf_bytes.rfind("%PDF", 0), 0u);
-  const QString exported_png = QString::fromStdString(dir_.path() + "/plot.png");
-  ASSERT_TRUE(w->ExportPlot(exported_png, &error)) << error.toStdString();
+  const QString exported_png = QString::fromStdString(dir + "/plot.png");
+  ASSERT_TRUE(w.ExportPlot(exported_png, error)) << error->toStdString();
   const QImage image(exported_png);
   ASSERT_FALSE(image.isNull());
   int coloured = 0;  // pixels of the curves' colours (not grey, not white)
@@ -392,112 +370,168 @@ TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
       coloured += c.saturation() > 100 ? 1 : 0;
     }
   EXPECT_GT(coloured, 200) << "the curves are drawn";
-  EXPECT_FALSE(w->ExportPlot(QString::fromStdString(dir_.path() + "/plot.bmp"), &error));
-  EXPECT_TRUE(error.contains("use .png, .svg or .pdf")) << error.toStdString();
-  EXPECT_FALSE(w->ExportCsv("/nonexistent/dir/data.csv", &error));
-  EXPECT_TRUE(error.startsWith("cannot write /nonexistent/dir/data.csv")) << error.toStdString();
+  EXPECT_FALSE(w.ExportPlot(QString::fromStdString(dir + "/plot.bmp"), error));
+  EXPECT_TRUE(error->contains("use .png, .svg or .pdf")) << error->toStdString();
+  EXPECT_FALSE(w.ExportCsv("/nonexistent/dir/data.csv", error));
+  EXPECT_TRUE(error->startsWith("cannot write /nonexistent/dir/data.csv")) << error->toStdString();
+}
 
-  // printing: to a PDF printer
-  const QString printed = QString::fromStdString(dir_.path() + "/printed.pdf");
+// Printing: to a PDF printer.
+void CheckPrinting(PlotterWindow& w, const std::string& dir) {
+  const QString printed = QString::fromStdString(dir + "/printed.pdf");
   {
     QPrinter printer(QPrinter::HighResolution);
     printer.setOutputFormat(QPrinter::PdfFormat);
     printer.setOutputFileName(printed);
-    w->Print(&printer);
+    w.Print(&printer);
   }
   const std::string printed_bytes = ReadFile(printed.toStdString());
   EXPECT_GT(printed_bytes.size(), 1000u);
   EXPECT_EQ(printed_bytes.rfind("%PDF", 0), 0u);
+}
 
-  // zoom: dragging a rectangle on plot 1 pauses the view and gives both plots its time range
-  ASSERT_FALSE(w->paused());
-  QWidget* canvas = w->plot(0)->canvas();
+// Zoom: dragging a rectangle on plot 1 pauses the view and gives both plots its time range;
+// pan: Shift + drag; autoscale; resume.
+void CheckZoomPanAndAutoscale(PlotterWindow& w) {
+  ASSERT_FALSE(w.paused());
+  QWidget* canvas = w.plot(0)->canvas();
   const QRect area = canvas->contentsRect();
-  const QwtInterval live = w->plot(0)->axisInterval(QwtPlot::xBottom);
+  const QwtInterval live = w.plot(0)->axisInterval(QwtPlot::xBottom);
   const QPoint from(area.left() + area.width() / 4, area.top() + 10);
   const QPoint to(area.left() + area.width() / 2, area.bottom() - 10);
   Drag(canvas, from, to, Qt::NoModifier);
-  EXPECT_TRUE(w->paused());
-  const QwtInterval zoomed = w->plot(0)->axisInterval(QwtPlot::xBottom);
+  EXPECT_TRUE(w.paused());
+  const QwtInterval zoomed = w.plot(0)->axisInterval(QwtPlot::xBottom);
   EXPECT_NEAR(zoomed.width(), live.width() / 4, live.width() / 20);
   EXPECT_NEAR(zoomed.minValue(), live.minValue() + live.width() / 4, live.width() / 20);
-  EXPECT_EQ(w->plot(1)->axisInterval(QwtPlot::xBottom), zoomed) << "one time axis for all plots";
-  EXPECT_GT(w->plot(1)->points(kTension), 0u);
-  EXPECT_LE(w->plot(1)->last_drawn_time(kTension), zoomed.maxValue() + 0.01)
+  EXPECT_EQ(w.plot(1)->axisInterval(QwtPlot::xBottom), zoomed) << "one time axis for all plots";
+  EXPECT_GT(w.plot(1)->points(kTension), 0u);
+  EXPECT_LE(w.plot(1)->last_drawn_time(kTension), zoomed.maxValue() + 0.01)
       << "plot 2 is drawn anew for the zoomed range";
   // pan: Shift + drag to the right shows earlier times, in both plots
   const QPoint grab(area.center());
   const QPoint drop(grab.x() + area.width() / 5, grab.y());
   Drag(canvas, grab, drop, Qt::ShiftModifier);
-  const QwtInterval panned = w->plot(0)->axisInterval(QwtPlot::xBottom);
+  const QwtInterval panned = w.plot(0)->axisInterval(QwtPlot::xBottom);
   EXPECT_NEAR(panned.minValue(), zoomed.minValue() - zoomed.width() / 5, zoomed.width() / 20);
   EXPECT_NEAR(panned.width(), zoomed.width(), 1e-9);
-  EXPECT_EQ(w->plot(1)->axisInterval(QwtPlot::xBottom), panned);
-  EXPECT_TRUE(w->paused());
+  EXPECT_EQ(w.plot(1)->axisInterval(QwtPlot::xBottom), panned);
+  EXPECT_TRUE(w.paused());
   // autoscale fits the value axis of the zoomed plot to its data again
-  ClickAction(*w, "autoscale");
+  ClickAction(w, "autoscale");
   double lo = 1e300, hi = -1e300;
-  const auto [in_first, in_last] = w->store().IndexRange(panned.minValue(), panned.maxValue());
+  const auto [in_first, in_last] = w.store().IndexRange(panned.minValue(), panned.maxValue());
   for (const char* key : {kAngle, kCurrent})
-    w->store().ForEach(static_cast<size_t>(w->store().Find(key)), in_first, in_last,
-                       [&](double, double v) {
-                         lo = std::min(lo, v);
-                         hi = std::max(hi, v);
-                       });
+    w.store().ForEach(static_cast<size_t>(w.store().Find(key)), in_first, in_last,
+                      [&](double, double v) {
+                        lo = std::min(lo, v);
+                        hi = std::max(hi, v);
+                      });
   ASSERT_LT(lo, hi);
-  const QwtInterval y = w->plot(0)->axisInterval(QwtPlot::yLeft);
+  const QwtInterval y = w.plot(0)->axisInterval(QwtPlot::yLeft);
   EXPECT_LE(y.minValue(), lo);
   EXPECT_GE(y.maxValue(), hi);
   EXPECT_LT(y.width(), 1.2 * (hi - lo)) << "fitted: " << lo << " .. " << hi;
   // resume: the live window again
-  ClickAction(*w, "pause");
-  EXPECT_FALSE(w->paused());
-  EXPECT_NEAR(w->plot(0)->axisInterval(QwtPlot::xBottom).width(), 10.0, 1e-9);
+  ClickAction(w, "pause");
+  EXPECT_FALSE(w.paused());
+  EXPECT_NEAR(w.plot(0)->axisInterval(QwtPlot::xBottom).width(), 10.0, 1e-9);
+}
 
-  // a curve drawn as scatter, another removed (its samples go with it)
-  auto* curves = w->findChild<QTreeWidget*>("curves");
-  auto* style = w->findChild<QComboBox*>("style");
+// A curve drawn as scatter, another removed (its samples go with it).
+void CheckCurveStyleAndRemoval(PlotterWindow& w) {
+  auto* curves = w.findChild<QTreeWidget*>("curves");
+  auto* style = w.findChild<QComboBox*>("style");
   QTreeWidgetItem* current_row = curves->topLevelItem(0)->child(1);
   ASSERT_EQ(current_row->text(0), kCurrent);
   curves->setCurrentItem(current_row);
   EXPECT_TRUE(style->isEnabled());
   style->setCurrentIndex(1);
   emit style->activated(1);
-  EXPECT_EQ(w->plot(0)->spec().curves[1].style, plotter::CurveStyle::kScatter);
-  EXPECT_EQ(w->plot(0)->curve(kCurrent)->style(), QwtPlotCurve::NoCurve);
-  ASSERT_NE(w->plot(0)->curve(kCurrent)->symbol(), nullptr);
+  EXPECT_EQ(w.plot(0)->spec().curves[1].style, plotter::CurveStyle::kScatter);
+  EXPECT_EQ(w.plot(0)->curve(kCurrent)->style(), QwtPlotCurve::NoCurve);
+  ASSERT_NE(w.plot(0)->curve(kCurrent)->symbol(), nullptr);
   curves->setCurrentItem(curves->topLevelItem(1)->child(1));
   ASSERT_EQ(curves->currentItem()->text(0), kHeight);
-  QTest::mouseClick(w->findChild<QPushButton*>("remove"), Qt::LeftButton);
-  EXPECT_FALSE(w->plot(1)->HasCurve(kHeight));
-  EXPECT_LT(w->store().Find(kHeight), 0);
+  QTest::mouseClick(w.findChild<QPushButton*>("remove"), Qt::LeftButton);
+  EXPECT_FALSE(w.plot(1)->HasCurve(kHeight));
+  EXPECT_LT(w.store().Find(kHeight), 0);
   EXPECT_EQ(curves->topLevelItem(1)->childCount(), 1);
+}
 
-  // the layout round trip through the window: the recorded samples stay
-  const Layout layout = w->CurrentLayout();
+// The layout round trip through the window: the recorded samples stay; another layout: the
+// angle keeps its samples, the curves it lacks go, a new one has none yet.
+void CheckLayoutRoundTrip(PlotterWindow& w) {
+  const Layout layout = w.CurrentLayout();
   ASSERT_EQ(layout.plots.size(), 2u);
   EXPECT_EQ(layout.Keys(), (std::vector<std::string>{kAngle, kCurrent, kTension}));
-  const size_t held_now = w->store().size();
-  const std::vector<double> angles = Values(*w, kAngle);
-  const std::vector<double> currents = Values(*w, kCurrent);
+  const size_t held_now = w.store().size();
+  const std::vector<double> angles = Values(w, kAngle);
+  const std::vector<double> currents = Values(w, kCurrent);
   ASSERT_GT(held_now, 1000u);
-  w->ApplyLayout(layout);
-  EXPECT_EQ(w->CurrentLayout(), layout);
-  EXPECT_EQ(w->store().size(), held_now);
-  EXPECT_EQ(Values(*w, kAngle), angles) << "loading a layout keeps the recorded data";
-  EXPECT_EQ(Values(*w, kCurrent), currents);
-  // another layout: the angle keeps its samples, the curves it lacks go, a new one has none yet
+  w.ApplyLayout(layout);
+  EXPECT_EQ(w.CurrentLayout(), layout);
+  EXPECT_EQ(w.store().size(), held_now);
+  EXPECT_EQ(Values(w, kAngle), angles) << "loading a layout keeps the recorded data";
+  EXPECT_EQ(Values(w, kCurrent), currents);
   Layout other;
   plotter::AddPlot(&other, {kAngle});
   plotter::AddPlot(&other, {kHeight});
-  w->ApplyLayout(other);
-  EXPECT_EQ(w->CurrentLayout(), other);
-  EXPECT_EQ(Values(*w, kAngle), angles);
-  EXPECT_LT(w->store().Find(kCurrent), 0);
-  EXPECT_LT(w->store().Find(kTension), 0);
-  const std::vector<double> heights = Values(*w, kHeight);
+  w.ApplyLayout(other);
+  EXPECT_EQ(w.CurrentLayout(), other);
+  EXPECT_EQ(Values(w, kAngle), angles);
+  EXPECT_LT(w.store().Find(kCurrent), 0);
+  EXPECT_LT(w.store().Find(kTension), 0);
+  const std::vector<double> heights = Values(w, kHeight);
   ASSERT_EQ(heights.size(), held_now);
   EXPECT_TRUE(std::all_of(heights.begin(), heights.end(), [](double v) { return std::isnan(v); }));
+}
+
+// One window on one Model throughout, phase after phase (the checks above); a fatal failure in
+// a phase ends the test.
+TEST_F(PlotterTest, PicksIdsStreamsPausesClearsAndExports) {
+  auto process = StartModel(Models() + "/pendulum_tendon.dae");
+  M::Model_var model = WaitForModel();
+  ASSERT_FALSE(CORBA::is_nil(model)) << process->Output();
+  auto w = Window(naming_->address());
+  ASSERT_TRUE(WaitInGui([&] { return ChannelItem(*w, kAngle) != nullptr; }, seconds(10)))
+      << "the channel list is filled from the Model";
+
+  ASSERT_NO_FATAL_FAILURE(CheckSearchBox(*w));
+  ASSERT_NO_FATAL_FAILURE(AddCurvesToTwoPlots(*w));
+
+  // run: the tendon pulls the pendulum up, then lets it swing
+  SetCommand(model, 12.0);
+  model->start();
+  ASSERT_TRUE(WaitInGui(
+      [&] {
+        return w->store().size() > 500 && w->plot(0)->points(kAngle) > 100 &&
+               w->plot(1)->points(kTension) > 100;
+      },
+      seconds(15)))
+      << "held " << w->store().size() << "; " << process->Output();
+  EXPECT_TRUE(w->findChild<QLabel*>("connection")->text().startsWith("connected to model0"))
+      << w->findChild<QLabel*>("connection")->text().toStdString();
+  ASSERT_TRUE(WaitInGui([&] { return w->sample_rate() > 100; }, seconds(5)));
+  SetCommand(model, 0.0);
+
+  ASSERT_NO_FATAL_FAILURE(CheckPauseResumeAndClear(*w));
+
+  // the screenshot
+  SetCommand(model, 12.0);
+  Pump(milliseconds(400));
+  SetCommand(model, 0.0);
+  Pump(milliseconds(600));
+  const std::string png = ArtifactPath("plotter.png", dir_.path());
+  EXPECT_TRUE(w->grab().save(QString::fromStdString(png))) << png;
+
+  QString error;
+  ASSERT_NO_FATAL_FAILURE(CheckCsvExport(*w, dir_.path(), &error));
+  ASSERT_NO_FATAL_FAILURE(CheckPlotExports(*w, dir_.path(), &error));
+  ASSERT_NO_FATAL_FAILURE(CheckPrinting(*w, dir_.path()));
+  ASSERT_NO_FATAL_FAILURE(CheckZoomPanAndAutoscale(*w));
+  ASSERT_NO_FATAL_FAILURE(CheckCurveStyleAndRemoval(*w));
+  ASSERT_NO_FATAL_FAILURE(CheckLayoutRoundTrip(*w));
 
   model->pause();
   w.reset();
