@@ -356,54 +356,16 @@ std::string Progress(const CsvRecording& r, double start, double duration) {
   return s.str();
 }
 
-int Record(Client& client, std::vector<std::string>& args) {
-  const std::string name = TakeModel(args);
-  std::string value, csv_path;
-  CORBA::ULong every = 1;
-  double duration = std::numeric_limits<double>::infinity();
-  if (TakeOption(args, "--every", &value)) every = ParseCount(value, "--every");
-  if (TakeOption(args, "--duration", &value)) {
-    duration = ParseNumber(value, "--duration");
-    if (!(duration > 0) || !std::isfinite(duration))
-      throw UsageError("--duration wants seconds of simulated time > 0, got '" + value + "'");
-  }
-  if (!TakeOption(args, "--csv", &csv_path)) throw UsageError("--csv FILE is required");
-  RejectOptions(args);
-  if (args.empty()) throw UsageError("expected at least one ID");
+// How a recording's wait ended: what was shown last, and why it stopped early (if it did).
+struct RecordEnd {
+  std::string shown, lost, interrupted, ended;
+  D::SubscriptionStatus counts{};  // the Model's, as last read
+};
 
-  ModelRef m = Connect(client, name);
-  const S::StringSeq ids = ToSeq(args);
-  // shapes (and an unknown id, named by the Model) from one sample; units from the list
-  D::ValueSeq_var now = Call(m, [&] { return m.model->get(ids); });
-  const auto channels = Channels(m, "*");
-  std::vector<RecordedChannel> columns;
-  for (CORBA::ULong i = 0; i < now->length() && i < args.size(); ++i)
-    columns.push_back({args[i], UnitOf(channels, args[i]), now[i].rows, now[i].cols});
-  M::SimulationStatus_var status = StatusOf(m);
-  const double start = status->sim_time;
-
-  std::ofstream file(csv_path);
-  if (!file) throw Failure("cannot write " + csv_path + ": " + std::strerror(errno));
-  CsvRecording recording(file, columns, start + duration);
-
-  // lossless: stepping in lock-step or as fast as possible, the Model waits for this recorder;
-  // the batches come on ORB threads
-  client::DataFeed feed(client, m, args, every, true, [&](const client::Batch& b) {
-    recording.Add(b.number, b.times, b.count, b.data, b.values_per_sample);
-  });
-  std::cerr << "recording " << args.size() << " id" << (args.size() == 1 ? "" : "s") << " ("
-            << recording.values_per_sample() << " columns) every " << every << " step"
-            << (every == 1 ? "" : "s") << " (" << Num(every * status->time_step) << " s) "
-            << (std::isfinite(duration) ? "for " + Num(duration) + " s of simulated time"
-                                        : "until Ctrl-C")
-            << " to " << csv_path << "\n";
-  std::cerr << "lossless: " << name << " waits for this recorder when it steps (step N, "
-            << "lock-step, as fast as possible); at a real-time factor it does not, and samples "
-            << "it drops are counted\n";
-  if (status->state != M::RUNNING)
-    std::cerr << name << " is " << rtc::Name(status->state)
-              << ": samples come once it runs (caliper-ctl start) or steps\n";
-
+// Shows the progress until the recording is complete, Ctrl-C, or the Model is lost or ends the
+// subscription; then reads the Model's counts for the report.
+RecordEnd WaitForRecording(const ModelRef& m, const std::string& name, client::DataFeed& feed,
+                           const CsvRecording& recording, double start, double duration) {
   // Ctrl-C and SIGTERM are blocked in every thread (Main) and taken here
   sigset_t signals;
   sigemptyset(&signals);
@@ -412,12 +374,16 @@ int Record(Client& client, std::vector<std::string>& args) {
   using Clock = std::chrono::steady_clock;
   auto last_progress = Clock::now() - std::chrono::seconds(1);
   auto last_check = Clock::now();
-  std::string shown, lost, interrupted, ended;
+  RecordEnd end;
+  std::string& shown = end.shown;
+  std::string& lost = end.lost;
+  std::string& interrupted = end.interrupted;
+  std::string& ended = end.ended;
   // why no samples come, shown after the progress: a Model that is not running sends none, and
   // a recording with a duration would otherwise wait without a word until someone starts it
   std::string idle_note;
   uint64_t samples_at_check = 0;
-  D::SubscriptionStatus counts{};  // the Model's, as last read
+  D::SubscriptionStatus& counts = end.counts;  // the Model's, as last read
   auto read_counts = [&] {
     try {
       counts = feed.Status();
@@ -484,6 +450,61 @@ int Record(Client& client, std::vector<std::string>& args) {
       lost = e.what();
     }
   }
+  return end;
+}
+
+int Record(Client& client, std::vector<std::string>& args) {
+  const std::string name = TakeModel(args);
+  std::string value, csv_path;
+  CORBA::ULong every = 1;
+  double duration = std::numeric_limits<double>::infinity();
+  if (TakeOption(args, "--every", &value)) every = ParseCount(value, "--every");
+  if (TakeOption(args, "--duration", &value)) {
+    duration = ParseNumber(value, "--duration");
+    if (!(duration > 0) || !std::isfinite(duration))
+      throw UsageError("--duration wants seconds of simulated time > 0, got '" + value + "'");
+  }
+  if (!TakeOption(args, "--csv", &csv_path)) throw UsageError("--csv FILE is required");
+  RejectOptions(args);
+  if (args.empty()) throw UsageError("expected at least one ID");
+
+  ModelRef m = Connect(client, name);
+  const S::StringSeq ids = ToSeq(args);
+  // shapes (and an unknown id, named by the Model) from one sample; units from the list
+  D::ValueSeq_var now = Call(m, [&] { return m.model->get(ids); });
+  const auto channels = Channels(m, "*");
+  std::vector<RecordedChannel> columns;
+  for (CORBA::ULong i = 0; i < now->length() && i < args.size(); ++i)
+    columns.push_back({args[i], UnitOf(channels, args[i]), now[i].rows, now[i].cols});
+  M::SimulationStatus_var status = StatusOf(m);
+  const double start = status->sim_time;
+
+  std::ofstream file(csv_path);
+  if (!file) throw Failure("cannot write " + csv_path + ": " + std::strerror(errno));
+  CsvRecording recording(file, columns, start + duration);
+
+  // lossless: stepping in lock-step or as fast as possible, the Model waits for this recorder;
+  // the batches come on ORB threads
+  client::DataFeed feed(client, m, args, every, true, [&](const client::Batch& b) {
+    recording.Add(b.number, b.times, b.count, b.data, b.values_per_sample);
+  });
+  std::cerr << "recording " << args.size() << " id" << (args.size() == 1 ? "" : "s") << " ("
+            << recording.values_per_sample() << " columns) every " << every << " step"
+            << (every == 1 ? "" : "s") << " (" << Num(every * status->time_step) << " s) "
+            << (std::isfinite(duration) ? "for " + Num(duration) + " s of simulated time"
+                                        : "until Ctrl-C")
+            << " to " << csv_path << "\n";
+  std::cerr << "lossless: " << name << " waits for this recorder when it steps (step N, "
+            << "lock-step, as fast as possible); at a real-time factor it does not, and samples "
+            << "it drops are counted\n";
+  if (status->state != M::RUNNING)
+    std::cerr << name << " is " << rtc::Name(status->state)
+              << ": samples come once it runs (caliper-ctl start) or steps\n";
+
+  RecordEnd end = WaitForRecording(m, name, feed, recording, start, duration);
+  const std::string &shown = end.shown, &lost = end.lost, &interrupted = end.interrupted,
+                    &ended = end.ended;
+  const D::SubscriptionStatus& counts = end.counts;
   feed.Close();
   file.flush();
   const bool written = static_cast<bool>(file);
@@ -561,6 +582,137 @@ void NeedArgs(const std::vector<std::string>& args, size_t n, const std::string&
   if (args.size() != n) throw UsageError("expected: edit " + usage);
 }
 
+// `edit` alone: the history and the selection.
+int EditShowStatus(const ModelRef& m) {
+  M::EditStatus_var s = Call(m, [&] { return m.model->edit_status(); });
+  PrintEditStatus(s.in());
+  M::Selection_var sel = Call(m, [&] { return m.model->current_selection(); });
+  std::cout << "selected: "
+            << (std::strlen(sel->kind.in()) == 0
+                    ? std::string("(nothing)")
+                    : std::string(sel->kind.in()) + " " + sel->name.in() +
+                          (std::string(sel->kind.in()) == "path_point"
+                               ? " element " + std::to_string(sel->index)
+                               : ""))
+            << "\n";
+  return 0;
+}
+
+// `edit path TENDON`: its declared path in millimetres.
+int EditShowPath(const ModelRef& m, const std::vector<std::string>& a) {
+  NeedArgs(a, 1, "path TENDON");
+  S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
+  for (CORBA::ULong i = 0; i < d->tendons.length(); ++i) {
+    if (a[0] != d->tendons[i].name.in()) continue;
+    const S::PathPointSeq& path = d->tendons[i].path;
+    // millimetres to read; the edits take metres, as every length of the IDL
+    std::cout << "ELEMENT  BODY / OBSTACLE        X [mm]      Y [mm]      Z [mm]   (edits take m)\n";
+    for (CORBA::ULong k = 0; k < path.length(); ++k) {
+      const bool wrap = std::strlen(path[k].obstacle.in()) > 0;
+      std::cout << std::left << std::setw(9) << k << std::setw(22)
+                << (wrap ? "wrap " + std::string(path[k].obstacle.in())
+                         : std::strlen(path[k].body.in()) ? std::string(path[k].body.in())
+                                                          : std::string("world"));
+      if (!wrap)
+        std::cout << std::right << std::setw(10) << Num(path[k].x * 1000, 4) << std::setw(12)
+                  << Num(path[k].y * 1000, 4) << std::setw(12) << Num(path[k].z * 1000, 4)
+                  << std::left;
+      std::cout << "\n";
+    }
+    return 0;
+  }
+  throw Failure(m.name + ": no tendon '" + a[0] + "'");
+}
+
+// `edit kinds`: the actuator kinds with their parameters' defaults.
+int EditShowKinds(const ModelRef& m, const std::vector<std::string>& a) {
+  NeedArgs(a, 0, "kinds");
+  M::ActuatorKindSeq_var kinds = Call(m, [&] { return m.model->actuator_kinds(); });
+  for (CORBA::ULong i = 0; i < kinds->length(); ++i) {
+    std::cout << kinds[i].kind.in()
+              << (std::strlen(kinds[i].command_unit.in()) ? " (command in " +
+                                                                 std::string(kinds[i].command_unit.in()) + ")"
+                                                           : std::string(" (passive)"))
+              << "\n";
+    for (CORBA::ULong p = 0; p < kinds[i].parameters.length(); ++p)
+      std::cout << "  " << kinds[i].parameters[p].in() << " = " << Num(kinds[i].defaults[p])
+                << " " << kinds[i].units[p].in() << "\n";
+  }
+  return 0;
+}
+
+// `edit shapes BODY`: a body's collision shapes, in set_shape_dims' order.
+int EditShowShapes(const ModelRef& m, const std::vector<std::string>& a) {
+  NeedArgs(a, 1, "shapes BODY");
+  S::VisualSeq_var shapes = Call(m, [&] { return m.model->body_shapes(a[0].c_str()); });
+  static const char* const kKinds[] = {"box",  "sphere", "capsule",     "cylinder",
+                                       "cone", "plane",  "convex_hull", "triangle_mesh"};
+  for (CORBA::ULong i = 0; i < shapes->length(); ++i) {
+    std::cout << i << " " << kKinds[shapes[i].geometry.kind] << " " << shapes[i].name.in();
+    for (CORBA::ULong k = 0; k < shapes[i].geometry.dims.length(); ++k)
+      std::cout << " " << Num(shapes[i].geometry.dims[k]);
+    std::cout << (shapes[i].geometry.dims.length() ? " m" : "") << "\n";
+  }
+  return 0;
+}
+
+// `edit obstacle NAME BODY KIND X Y Z RADIUS [LENGTH]`: the obstacle to set.
+S::Obstacle ObstacleArgs(const ModelRef& m, const std::vector<std::string>& a) {
+  if (a.size() != 7 && a.size() != 8)
+    throw UsageError("expected: edit obstacle NAME BODY sphere|cylinder X Y Z RADIUS [LENGTH]");
+  S::Obstacle o;
+  o.name = a[0].c_str();
+  o.body = (a[1] == "world" ? "" : a[1]).c_str();
+  o.kind = a[2].c_str();
+  o.pose = {ParseNumber(a[3], "X [m]"), ParseNumber(a[4], "Y [m]"), ParseNumber(a[5], "Z [m]"),
+            1, 0, 0, 0};
+  // an obstacle moved and resized keeps its orientation (a cylinder's axis)
+  S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
+  for (CORBA::ULong i = 0; i < d->obstacles.length(); ++i)
+    if (a[0] == d->obstacles[i].name.in()) {
+      o.pose.qw = d->obstacles[i].pose.qw;
+      o.pose.qx = d->obstacles[i].pose.qx;
+      o.pose.qy = d->obstacles[i].pose.qy;
+      o.pose.qz = d->obstacles[i].pose.qz;
+    }
+  o.radius = ParseNumber(a[6], "RADIUS [m]");
+  o.length = a.size() == 8 ? ParseNumber(a[7], "LENGTH [m]") : 0.0;
+  return o;
+}
+
+// `edit pull BODY X Y Z`: a spring on the body's origin toward the target, renewed until the
+// time is up or Ctrl-C, then released.
+int EditPull(const ModelRef& m, const std::vector<std::string>& a,
+             const std::string& stiffness_text, const std::string& hold_text) {
+  NeedArgs(a, 4, "pull BODY X Y Z [--stiffness N_PER_M] (target, world metres)");
+  M::Vector3 point{0, 0, 0};
+  M::Vector3 target{ParseNumber(a[1], "X [m]"), ParseNumber(a[2], "Y [m]"),
+                    ParseNumber(a[3], "Z [m]")};
+  const double k = ParseNumber(stiffness_text, "--stiffness [N/m]");
+  const double hold = ParseNumber(hold_text, "--for [s]");
+  if (!(hold >= 0)) throw UsageError("--for needs seconds >= 0 (0: until Ctrl-C)");
+  // the Model ends a pull that is not renewed within 2 s (a client gone mid-drag): renew it
+  // every half second while this runs, and release it at the end
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
+  std::cerr << "pulling " << a[0] << "'s origin toward " << a[1] << " " << a[2] << " " << a[3]
+            << " m " << (hold > 0 ? "for " + Num(hold) + " s" : std::string("until Ctrl-C"))
+            << "\n";
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(hold);
+  while (hold == 0 || std::chrono::steady_clock::now() < until) {
+    const timespec wait = {0, 500 * 1000 * 1000};
+    const int sig = sigtimedwait(&signals, nullptr, &wait);
+    if (sig == SIGINT || sig == SIGTERM) break;
+    Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
+  }
+  Call(m, [&] { m.model->release_pull(); });
+  std::cerr << "pull released\n";
+  return 0;
+}
+
 int Edit(Client& client, std::vector<std::string>& args) {
   const std::string name = TakeModel(args);
   std::string stiffness_text = "0", hold_text = "0";
@@ -568,60 +720,14 @@ int Edit(Client& client, std::vector<std::string>& args) {
   TakeOption(args, "--for", &hold_text);
   RejectOptions(args);
   ModelRef m = Connect(client, name);
-  if (args.empty()) {
-    M::EditStatus_var s = Call(m, [&] { return m.model->edit_status(); });
-    PrintEditStatus(s.in());
-    M::Selection_var sel = Call(m, [&] { return m.model->current_selection(); });
-    std::cout << "selected: "
-              << (std::strlen(sel->kind.in()) == 0
-                      ? std::string("(nothing)")
-                      : std::string(sel->kind.in()) + " " + sel->name.in() +
-                            (std::string(sel->kind.in()) == "path_point"
-                                 ? " element " + std::to_string(sel->index)
-                                 : ""))
-              << "\n";
-    return 0;
-  }
+  if (args.empty()) return EditShowStatus(m);
   const std::string what = args[0];
   std::vector<std::string> a(args.begin() + 1, args.end());
   M::EditStatus_var s;
   if (what == "path") {
-    NeedArgs(a, 1, "path TENDON");
-    S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
-    for (CORBA::ULong i = 0; i < d->tendons.length(); ++i) {
-      if (a[0] != d->tendons[i].name.in()) continue;
-      const S::PathPointSeq& path = d->tendons[i].path;
-      // millimetres to read; the edits take metres, as every length of the IDL
-      std::cout << "ELEMENT  BODY / OBSTACLE        X [mm]      Y [mm]      Z [mm]   (edits take m)\n";
-      for (CORBA::ULong k = 0; k < path.length(); ++k) {
-        const bool wrap = std::strlen(path[k].obstacle.in()) > 0;
-        std::cout << std::left << std::setw(9) << k << std::setw(22)
-                  << (wrap ? "wrap " + std::string(path[k].obstacle.in())
-                           : std::strlen(path[k].body.in()) ? std::string(path[k].body.in())
-                                                            : std::string("world"));
-        if (!wrap)
-          std::cout << std::right << std::setw(10) << Num(path[k].x * 1000, 4) << std::setw(12)
-                    << Num(path[k].y * 1000, 4) << std::setw(12) << Num(path[k].z * 1000, 4)
-                    << std::left;
-        std::cout << "\n";
-      }
-      return 0;
-    }
-    throw Failure(m.name + ": no tendon '" + a[0] + "'");
+    return EditShowPath(m, a);
   } else if (what == "kinds") {
-    NeedArgs(a, 0, "kinds");
-    M::ActuatorKindSeq_var kinds = Call(m, [&] { return m.model->actuator_kinds(); });
-    for (CORBA::ULong i = 0; i < kinds->length(); ++i) {
-      std::cout << kinds[i].kind.in()
-                << (std::strlen(kinds[i].command_unit.in()) ? " (command in " +
-                                                                   std::string(kinds[i].command_unit.in()) + ")"
-                                                             : std::string(" (passive)"))
-                << "\n";
-      for (CORBA::ULong p = 0; p < kinds[i].parameters.length(); ++p)
-        std::cout << "  " << kinds[i].parameters[p].in() << " = " << Num(kinds[i].defaults[p])
-                  << " " << kinds[i].units[p].in() << "\n";
-    }
-    return 0;
+    return EditShowKinds(m, a);
   } else if (what == "move" || what == "insert") {
     if (a.size() == 4 && what == "insert" && a[2] == "--wrap") a.erase(a.begin() + 2);
     if (what == "insert" && a.size() == 3) {
@@ -655,25 +761,7 @@ int Edit(Client& client, std::vector<std::string>& args) {
     NeedArgs(a, 1, "remove-tendon TENDON");
     s = Call(m, [&] { return m.model->remove_tendon(a[0].c_str()); });
   } else if (what == "obstacle") {
-    if (a.size() != 7 && a.size() != 8)
-      throw UsageError("expected: edit obstacle NAME BODY sphere|cylinder X Y Z RADIUS [LENGTH]");
-    S::Obstacle o;
-    o.name = a[0].c_str();
-    o.body = (a[1] == "world" ? "" : a[1]).c_str();
-    o.kind = a[2].c_str();
-    o.pose = {ParseNumber(a[3], "X [m]"), ParseNumber(a[4], "Y [m]"), ParseNumber(a[5], "Z [m]"),
-              1, 0, 0, 0};
-    // an obstacle moved and resized keeps its orientation (a cylinder's axis)
-    S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
-    for (CORBA::ULong i = 0; i < d->obstacles.length(); ++i)
-      if (a[0] == d->obstacles[i].name.in()) {
-        o.pose.qw = d->obstacles[i].pose.qw;
-        o.pose.qx = d->obstacles[i].pose.qx;
-        o.pose.qy = d->obstacles[i].pose.qy;
-        o.pose.qz = d->obstacles[i].pose.qz;
-      }
-    o.radius = ParseNumber(a[6], "RADIUS [m]");
-    o.length = a.size() == 8 ? ParseNumber(a[7], "LENGTH [m]") : 0.0;
+    const S::Obstacle o = ObstacleArgs(m, a);
     s = Call(m, [&] { return m.model->set_obstacle(o); });
   } else if (what == "remove-obstacle") {
     NeedArgs(a, 1, "remove-obstacle NAME");
@@ -686,17 +774,7 @@ int Edit(Client& client, std::vector<std::string>& args) {
       dims[static_cast<CORBA::ULong>(i - 2)] = ParseNumber(a[i], "DIM [m]");
     s = Call(m, [&] { return m.model->set_shape_dims(a[0].c_str(), IndexArg(a[1]), dims); });
   } else if (what == "shapes") {
-    NeedArgs(a, 1, "shapes BODY");
-    S::VisualSeq_var shapes = Call(m, [&] { return m.model->body_shapes(a[0].c_str()); });
-    static const char* const kKinds[] = {"box",  "sphere", "capsule",     "cylinder",
-                                         "cone", "plane",  "convex_hull", "triangle_mesh"};
-    for (CORBA::ULong i = 0; i < shapes->length(); ++i) {
-      std::cout << i << " " << kKinds[shapes[i].geometry.kind] << " " << shapes[i].name.in();
-      for (CORBA::ULong k = 0; k < shapes[i].geometry.dims.length(); ++k)
-        std::cout << " " << Num(shapes[i].geometry.dims[k]);
-      std::cout << (shapes[i].geometry.dims.length() ? " m" : "") << "\n";
-    }
-    return 0;
+    return EditShowShapes(m, a);
   } else if (what == "mass") {
     NeedArgs(a, 2, "mass BODY KG");
     s = Call(m, [&] { return m.model->set_mass(a[0].c_str(), ParseNumber(a[1], "KG")); });
@@ -704,33 +782,7 @@ int Edit(Client& client, std::vector<std::string>& args) {
     NeedArgs(a, 0, what);
     s = Call(m, [&] { return what == "undo" ? m.model->undo() : m.model->redo(); });
   } else if (what == "pull") {
-    NeedArgs(a, 4, "pull BODY X Y Z [--stiffness N_PER_M] (target, world metres)");
-    M::Vector3 point{0, 0, 0};
-    M::Vector3 target{ParseNumber(a[1], "X [m]"), ParseNumber(a[2], "Y [m]"),
-                      ParseNumber(a[3], "Z [m]")};
-    const double k = ParseNumber(stiffness_text, "--stiffness [N/m]");
-    const double hold = ParseNumber(hold_text, "--for [s]");
-    if (!(hold >= 0)) throw UsageError("--for needs seconds >= 0 (0: until Ctrl-C)");
-    // the Model ends a pull that is not renewed within 2 s (a client gone mid-drag): renew it
-    // every half second while this runs, and release it at the end
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
-    std::cerr << "pulling " << a[0] << "'s origin toward " << a[1] << " " << a[2] << " " << a[3]
-              << " m " << (hold > 0 ? "for " + Num(hold) + " s" : std::string("until Ctrl-C"))
-              << "\n";
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(hold);
-    while (hold == 0 || std::chrono::steady_clock::now() < until) {
-      const timespec wait = {0, 500 * 1000 * 1000};
-      const int sig = sigtimedwait(&signals, nullptr, &wait);
-      if (sig == SIGINT || sig == SIGTERM) break;
-      Call(m, [&] { m.model->pull(a[0].c_str(), point, target, k); });
-    }
-    Call(m, [&] { m.model->release_pull(); });
-    std::cerr << "pull released\n";
-    return 0;
+    return EditPull(m, a, stiffness_text, hold_text);
   } else if (what == "select") {
     if (a.empty() || a.size() > 3) throw UsageError("expected: edit select KIND NAME [INDEX] or none");
     if (a[0] == "none") a = {"", "", "0"};

@@ -39,6 +39,7 @@ constexpr double kSubstepTolerance = 1e-3;
 // beyond |1000 i w + 10| > 40 the switch is exactly 0 or 1 in rho (tanh is +-1 to the last bit
 // from |500 i w + 5| > 19.1): no exp needed
 constexpr double kSwitchSaturation = 40;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // (tanh(-500 i w - 5) + 1) / 2 written as 1 / (1 + exp(1000 i w + 10))
 inline double SwitchBlend(double current_times_speed) {
@@ -271,19 +272,15 @@ DcMotor::Stage DcMotor::StageAt(const DcMotorState& a, double voltage, double w)
   return s;
 }
 
-double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load, double w0,
-                           const SpoolLoad& load) const {
-  const StageConstants& k = constants_;
-  const double current0 = k.current_base * a.current + k.current_drive * voltage;  // at w = 0
-  const double limit = parameters_.current_limit;
-  const double efficiency = parameters_.efficiency;
-  const double angle0 = a.spool_angle;
-  const double speed0 = a.spool_speed;
-  constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  // The residual R(w) = w - a.w - C k_t i + (C / N) tau / rho, C = c / (N J), with
-  // 1 / rho = (1 + e) / D, D = eta (1 + e) + 1/eta - eta, e = exp(x), x = 1000 i w + 10; with
-  // its slope, both times D^2 > 0 (1 where the switch is saturated) so that a Newton step costs
-  // one division; and what bounds its curvature.
+// One implicit stage of SolveStage, w = a.w + c f(w), at the stage's base a, voltage and load.
+// The residual R(w) = w - a.w - C k_t i + (C / N) tau / rho, C = c / (N J), with
+// 1 / rho = (1 + e) / D, D = eta (1 + e) + 1/eta - eta, e = exp(x), x = 1000 i w + 10; with
+// its slope, both times D^2 > 0 (1 where the switch is saturated) so that a Newton step costs
+// one division; and what bounds its curvature.
+// SolveStage's Newton loop calls its member functions at every iteration: they are inlined there
+// (as the lambdas they were).
+class DcMotor::StageEquation {
+ public:
   struct Value {
     double residual, slope;          // R D^2, dR/dw D^2
     double scale;                    // D^2
@@ -294,28 +291,42 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
     double d_current;                // di/dw (0 while the current is limited)
     int regime;  // -1, +1: saturated (rho = eta + (1/eta - eta), eta exactly); 0; kUnloaded
   };
-  constexpr int kUnloaded = 2;  // no torque, no slope: the switch does not matter
+  static constexpr int kUnloaded = 2;  // no torque, no slope: the switch does not matter
+
+  StageEquation(const DcMotor& motor, const DcMotorState& a, double voltage, double h_load,
+                const SpoolLoad& load)
+      : motor_(motor),
+        k_(motor.constants_),
+        current0_(k_.current_base * a.current + k_.current_drive * voltage),
+        limit_(motor.parameters_.current_limit),
+        efficiency_(motor.parameters_.efficiency),
+        angle0_(a.spool_angle),
+        speed0_(a.spool_speed),
+        h_load_(h_load),
+        load_(load) {}
+
   // the current at the end of the stage and the switch regime at a spool speed w
-  auto state_at = [&](double w, double* current, double* x) {
-    double i = current0 + k.current_slope * w;
-    bool limited = limit > 0 && std::abs(i) > limit;
-    if (limited) i = std::copysign(limit, i);
+  [[gnu::always_inline]] inline int StateAt(double w, double* current, double* x) const {
+    double i = current0_ + k_.current_slope * w;
+    bool limited = limit_ > 0 && std::abs(i) > limit_;
+    if (limited) i = std::copysign(limit_, i);
     *current = i;
     *x = 2 * (kSwitchSharpness * (i * w) + kSwitchOffset);
     const int regime = *x > kSwitchSaturation ? 1 : (*x < -kSwitchSaturation ? -1 : 0);
     return limited ? regime + 4 : regime;  // both in one number
-  };
-  auto evaluate = [&](double w, Value* v) {
+  }
+
+  [[gnu::always_inline]] inline int Evaluate(double w, Value* v) const {
     double current;
     double x;
-    const int state = state_at(w, &current, &x);
+    const int state = StateAt(w, &current, &x);
     v->regime = state > 2 ? state - 4 : state;
-    v->d_current = state > 2 ? 0.0 : k.current_slope;
-    v->torque = load.TorqueAlong(angle0 + k.c * w, w, h_load, k.c, &v->d_torque, &v->affine_low,
-                                 &v->affine_high);
+    v->d_current = state > 2 ? 0.0 : k_.current_slope;
+    v->torque = load_.TorqueAlong(angle0_ + k_.c * w, w, h_load_, k_.c, &v->d_torque,
+                                  &v->affine_low, &v->affine_high);
     v->x_slope = 2 * kSwitchSharpness * (v->d_current * w + current);
-    const double linear = w - speed0 - k.c_torque * current;
-    const double d_linear = 1 - k.c_torque * v->d_current;
+    const double linear = w - speed0_ - k_.c_torque * current;
+    const double d_linear = 1 - k_.c_torque * v->d_current;
     if (v->torque == 0 && v->d_torque == 0) {
       // unloaded (a slack line): rho does not matter
       v->regime = kUnloaded;
@@ -324,40 +335,42 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
       v->residual = linear;
       v->slope = d_linear;
     } else if (v->regime == 0) {
-      const double e = Exp(x);
-      const double d = efficiency * (1 + e) + k.spread;
+      const double e = motor_.Exp(x);
+      const double d = efficiency_ * (1 + e) + k_.spread;
       const double rho_d = (1 + e) * d;  // D^2 / rho
       v->scale = d * d;
-      v->d_inverse_x = k.spread * e;
-      v->residual = linear * v->scale + k.c_ratio * v->torque * rho_d;
+      v->d_inverse_x = k_.spread * e;
+      v->residual = linear * v->scale + k_.c_ratio * v->torque * rho_d;
       v->slope = d_linear * v->scale +
-                 k.c_ratio * (v->d_torque * rho_d + v->torque * v->d_inverse_x * v->x_slope);
+                 k_.c_ratio * (v->d_torque * rho_d + v->torque * v->d_inverse_x * v->x_slope);
     } else {
-      const double inverse_rho = v->regime > 0 ? k.inverse_rho_driving : k.inverse_rho_driven;
+      const double inverse_rho = v->regime > 0 ? k_.inverse_rho_driving : k_.inverse_rho_driven;
       v->scale = 1;
       v->d_inverse_x = 0;
-      v->residual = linear + k.c_ratio * v->torque * inverse_rho;
-      v->slope = d_linear + k.c_ratio * v->d_torque * inverse_rho;
+      v->residual = linear + k_.c_ratio * v->torque * inverse_rho;
+      v->slope = d_linear + k_.c_ratio * v->d_torque * inverse_rho;
     }
     return state;
-  };
+  }
+
   // A bound of |R(w + step)| D^2 [rad/s] from the value at w, where R is linear in the step but
   // for the switch (bounded through |d^n(1/rho)/dx^n| <= |d(1/rho)/dx|, which grows at most as
   // e^|dx|; x is quadratic in w) and the load (evaluated at w + step and compared with its
   // tangent); infinite when the current limit or the switch's saturation changes over the step.
-  auto bound_after = [&](const Value& v, int state, double w, double step) {
+  [[gnu::always_inline]] inline double BoundAfter(const Value& v, int state, double w,
+                                                  double step) const {
     const double next = w + step;
     double current;
     double x;
-    const int next_state = state_at(next, &current, &x);
+    const int next_state = StateAt(next, &current, &x);
     if (v.regime == kUnloaded ? (next_state > 2) != (state > 2) : next_state != state)
       return kInfinity;
     // the load off its tangent, seen through 1/rho <= 1/eta
     double bound = 0;
     if (!(step >= v.affine_low && step <= v.affine_high)) {
-      const double torque = load.TorqueAt(angle0 + k.c * next, next, h_load);
-      bound = k.c_ratio * k.inverse_rho_driving * std::abs(torque - v.torque - v.d_torque * step) *
-              v.scale;
+      const double torque = load_.TorqueAt(angle0_ + k_.c * next, next, h_load_);
+      bound = k_.c_ratio * k_.inverse_rho_driving *
+              std::abs(torque - v.torque - v.d_torque * step) * v.scale;
     }
     if (v.regime == 0) {
       const double ds = std::abs(step);
@@ -370,10 +383,10 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
       // max |d2(tau / rho)/dw2| D^2 with d2(tau)/dw2 = 0
       const double curvature =
           sigma * (tau * (x_slope * x_slope + x_curvature) + 2 * std::abs(v.d_torque) * x_slope);
-      bound += 0.5 * k.c_ratio * curvature * ds * ds;
+      bound += 0.5 * k_.c_ratio * curvature * ds * ds;
     }
     return bound;
-  };
+  }
 
   // Whether a solution w* is the first from the base speed a.w, as the bracketing search finds
   // it: R increases between them. The only term of dR/dw that can be negative is
@@ -382,32 +395,33 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
   // and is too small when (C/N) max|tau| (1/eta - eta)/4 max|x'| < 1/2 (|tau| taken at the ends).
   // Otherwise the stage may have several solutions (a current against the load while the speed
   // crosses zero) and the bracketing search decides.
-  auto first_from_base = [&](const Value& v, double w_eval, double step) {
+  [[gnu::always_inline]] inline bool FirstFromBase(const Value& v, double w_eval,
+                                                   double step) const {
     const double w_star = w_eval + step;
-    const int sign = load_sign_;
+    const int sign = motor_.load_sign_;
     double tau = -1;  // max |tau| at the ends, once known
     auto max_torque = [&] {
       if (tau < 0) {
-        const double back = speed0 - w_eval;  // to the base speed
+        const double back = speed0_ - w_eval;  // to the base speed
         const double torque0 = back >= v.affine_low && back <= v.affine_high
                                    ? v.torque + v.d_torque * back
-                                   : load.TorqueAt(angle0 + k.c * speed0, speed0, h_load);
+                                   : load_.TorqueAt(angle0_ + k_.c * speed0_, speed0_, h_load_);
         tau = std::max(std::abs(v.torque) + std::abs(v.d_torque * step), std::abs(torque0));
       }
       return tau;
     };
-    if (limit == 0) {
+    if (limit_ == 0) {
       // x' = 1000 (i0 + 2 s w) is affine: its values at the ends bound it
-      const double x_slope0 = 2 * kSwitchSharpness * (current0 + 2 * k.current_slope * speed0);
-      const double x_slope1 = 2 * kSwitchSharpness * (current0 + 2 * k.current_slope * w_star);
+      const double x_slope0 = 2 * kSwitchSharpness * (current0_ + 2 * k_.current_slope * speed0_);
+      const double x_slope1 = 2 * kSwitchSharpness * (current0_ + 2 * k_.current_slope * w_star);
       if (sign > 0 ? (x_slope0 >= 0 && x_slope1 >= 0)
                    : (sign < 0 && x_slope0 <= 0 && x_slope1 <= 0))
         return true;
       const double x_slope = std::max(std::abs(x_slope0), std::abs(x_slope1));
-      if (k.c_ratio * max_torque() * 0.25 * k.spread * x_slope < 0.5) return true;
+      if (k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5) return true;
     }
-    const double lo = std::min(speed0, w_star);
-    const double hi = std::max(speed0, w_star);
+    const double lo = std::min(speed0_, w_star);
+    const double hi = std::max(speed0_, w_star);
     double x_min = kInfinity;
     double x_max = -kInfinity;
     double x_slope_min = kInfinity;
@@ -420,34 +434,50 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
     auto visit = [&](double w) {
       double current;
       double x;
-      const int state = state_at(w, &current, &x);
+      const int state = StateAt(w, &current, &x);
       x_min = std::min(x_min, x);
       x_max = std::max(x_max, x);
-      x_slope_at(current, state > 2 ? 0.0 : k.current_slope, w);
+      x_slope_at(current, state > 2 ? 0.0 : k_.current_slope, w);
     };
     visit(lo);
     visit(hi);
     // x = 1000 i w + 10 is quadratic in w where the current is not limited: its vertex
-    const double vertex = -current0 / (2 * k.current_slope);
+    const double vertex = -current0_ / (2 * k_.current_slope);
     if (vertex > lo && vertex < hi) visit(vertex);
     // where the limit starts, both sides
-    if (limit > 0) {
-      for (const double bound : {limit, -limit}) {
-        const double w = (bound - current0) / k.current_slope;
+    if (limit_ > 0) {
+      for (const double bound : {limit_, -limit_}) {
+        const double w = (bound - current0_) / k_.current_slope;
         if (!(w > lo && w < hi)) continue;
         const double x = 2 * (kSwitchSharpness * (bound * w) + kSwitchOffset);
         x_min = std::min(x_min, x);
         x_max = std::max(x_max, x);
         x_slope_at(bound, 0.0, w);
-        x_slope_at(bound, k.current_slope, w);
+        x_slope_at(bound, k_.current_slope, w);
       }
     }
     if (x_min > kSwitchSaturation || x_max < -kSwitchSaturation) return true;
     if ((sign > 0 && x_slope_min >= 0) || (sign < 0 && x_slope_max <= 0)) return true;
     const double x_slope = std::max(std::abs(x_slope_min), std::abs(x_slope_max));
-    return k.c_ratio * max_torque() * 0.25 * k.spread * x_slope < 0.5;
-  };
+    return k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5;
+  }
 
+ private:
+  const DcMotor& motor_;
+  const StageConstants& k_;
+  const double current0_;    // the current at the end of the stage at w = 0 [A]
+  const double limit_;       // current_limit [A]
+  const double efficiency_;  // [-]
+  const double angle0_;      // the base's spool angle [rad]
+  const double speed0_;      // the base's spool speed [rad/s]
+  const double h_load_;      // the stage's end after the last sub-step [s]
+  const SpoolLoad& load_;
+};
+
+double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load, double w0,
+                           const SpoolLoad& load) const {
+  const StageConstants& k = constants_;
+  const StageEquation stage(*this, a, voltage, h_load, load);
   // Safeguarded Newton: the residual increases with w, so each value narrows a bracket. It stops
   // when the bound of the residual after the step puts the speed within the tolerance of the
   // stage's solution, usually after the first step from the guess.
@@ -455,14 +485,14 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
   double high = kInfinity;
   double w = w0;
   for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
-    Value v;
-    const int state = evaluate(w, &v);
+    StageEquation::Value v;
+    const int state = stage.Evaluate(w, &v);
     if (!std::isfinite(v.residual) || !(v.slope > 0) || !std::isfinite(v.slope)) break;
     const double step = v.residual == 0 ? 0.0 : -v.residual / v.slope;
     const double tolerance = k.tolerance + kNewtonTolerance * std::abs(w);  // [rad/s]
     if (std::abs(step) <= kRoundingStep * tolerance ||
-        bound_after(v, state, w, step) <= tolerance * v.slope) {
-      if (!first_from_base(v, w, step)) break;
+        stage.BoundAfter(v, state, w, step) <= tolerance * v.slope) {
+      if (!stage.FirstFromBase(v, w, step)) break;
       return w + step;
     }
     (v.residual < 0 ? low : high) = w;

@@ -1,6 +1,6 @@
 #pragma once
 // What the Hill muscle parameter sets of `hill_muscle` (Thelen2003, Millard2012) require alike,
-// in one place for muscle.cc and millard.cc. Private to libs/actuators.
+// in one place for muscle_parameters.cc and millard.cc. Private to libs/actuators.
 
 #include <cmath>
 #include <sstream>

@@ -235,6 +235,8 @@ class DcMotor {
   double Exp(double x) const;
   // the stage at spool speed w from the base a (current limited, voltage lowered)
   Stage StageAt(const DcMotorState& a, double voltage, double w) const;
+  // one implicit stage's residual and the checks of SolveStage's Newton steps (dc_motor.cc)
+  class StageEquation;
   // Solves w = a.w + c f(w) for one implicit stage whose end lies h_load after the last
   // sub-step, starting from the guess w0.
   double SolveStage(const DcMotorState& a, double voltage, double h_load, double w0,
