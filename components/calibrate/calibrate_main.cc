@@ -192,6 +192,72 @@ std::vector<Plot> WriteChannels(const Options& o, const Spec& spec, const Evalua
   return plots;
 }
 
+// --dry-run: the initial cost per channel and its plots, no search.
+int DryRun(const Options& o, const Spec& spec, const Evaluation& before) {
+  auto plots = WriteChannels(o, spec, before, nullptr);
+  const std::string png = o.out + "/report.png";
+  const std::string why = WritePng(png, plots);
+  std::cout << "initial cost " << Format(before.cost, 6) << " (dry run: no search)\n";
+  for (const auto& c : before.channels)
+    std::cout << "  " << std::left << std::setw(44) << c.column << " rms " << Format(c.rms)
+              << " of a range of " << Format(c.range) << "\n";
+  std::cout << (why.empty() ? "plots: " + png : "no plots: " + why) << "\nchannels: " << o.out
+            << "/channels-*.csv\n";
+  return 0;
+}
+
+// parameters.csv, cost.csv and the cost curve's plot.
+std::vector<Plot> WriteParameters(const Options& o, const Spec& spec,
+                                  const std::vector<double>& initial,
+                                  const std::vector<double>& fitted, const Progress& p) {
+  core::WriteFileReplacing(o.out + "/parameters.csv", [&](std::ostream& out) {
+    out << "id,initial,fitted,lower,upper,scale,change [%]\n" << std::setprecision(10);
+    for (size_t i = 0; i < fitted.size(); ++i)
+      out << spec.parameters[i].id << "," << initial[i] << "," << fitted[i] << ","
+          << spec.parameters[i].lower << "," << spec.parameters[i].upper << ","
+          << (spec.parameters[i].log_scale ? "log" : "linear") << ","
+          << 100 * (fitted[i] - initial[i]) / initial[i] << "\n";
+  });
+  core::WriteFileReplacing(o.out + "/cost.csv", [&](std::ostream& out) {
+    out << "evaluations,best cost [-]\n" << std::setprecision(10);
+    for (const auto& [n, c] : p.history) out << n << "," << c << "\n";
+  });
+  std::vector<Plot> plots;
+  Plot cost{"best cost", "evaluations", "cost [-] (normalised RMS)", {}, true};
+  Curve curve{"best", {}, {}};
+  for (const auto& [n, c] : p.history) {
+    curve.x.push_back(static_cast<double>(n));
+    curve.y.push_back(c);
+  }
+  cost.curves.push_back(curve);
+  plots.push_back(cost);
+  return plots;
+}
+
+// The tuned scene as a .dae (a run with the fitted values leaves it loaded in a Model, which
+// exports it); "" when written, else why not.
+std::string ExportTuned(client::ModelPool& pool, const Spec& spec,
+                        const std::vector<double>& fitted, const std::string& tuned) {
+  std::string export_error;
+  try {
+    pool.WithModel([&](M::Model_ptr model) {
+      const auto e = WithParameters(spec.experiments.front(), spec.parameters, fitted);
+      M::Recording_var ignored = model->run_experiment(
+          client::ToIdl(e, client::ReadScene(e.scene)));  // leaves the tuned scene loaded
+      M::Octets_var data = model->export_scene();
+      core::WriteFileReplacing(tuned, [&](std::ostream& out) {
+        out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
+      });
+    });
+  } catch (const std::exception& e) {
+    export_error = e.what();
+  } catch (const CORBA::Exception& e) {
+    export_error = rtc::Describe(e);
+  }
+
+  return export_error;
+}
+
 int Run(const Options& o) {
   Spec spec = LoadSpec(o.file);
   if (o.generations) spec.optimiser.generations = o.generations;
@@ -239,18 +305,7 @@ int Run(const Options& o) {
             << " parameters, " << models << " Model(s); initial cost " << Format(before.cost)
             << "\n";
 
-  if (o.dry_run) {
-    auto plots = WriteChannels(o, spec, before, nullptr);
-    const std::string png = o.out + "/report.png";
-    const std::string why = WritePng(png, plots);
-    std::cout << "initial cost " << Format(before.cost, 6) << " (dry run: no search)\n";
-    for (const auto& c : before.channels)
-      std::cout << "  " << std::left << std::setw(44) << c.column << " rms " << Format(c.rms)
-                << " of a range of " << Format(c.range) << "\n";
-    std::cout << (why.empty() ? "plots: " + png : "no plots: " + why) << "\nchannels: " << o.out
-              << "/channels-*.csv\n";
-    return 0;
-  }
+  if (o.dry_run) return DryRun(o, spec, before);
 
   const unsigned islands = o.islands ? o.islands : static_cast<unsigned>(models);
   std::unique_ptr<Search> search;
@@ -293,48 +348,13 @@ int Run(const Options& o) {
   const Progress& p = search->progress();
   const std::vector<double> fitted = evaluator.ValuesOf(p.best_unit);
   const Evaluation after = evaluator.Evaluate(fitted, true);
-  core::WriteFileReplacing(o.out + "/parameters.csv", [&](std::ostream& out) {
-    out << "id,initial,fitted,lower,upper,scale,change [%]\n" << std::setprecision(10);
-    for (size_t i = 0; i < fitted.size(); ++i)
-      out << spec.parameters[i].id << "," << initial[i] << "," << fitted[i] << ","
-          << spec.parameters[i].lower << "," << spec.parameters[i].upper << ","
-          << (spec.parameters[i].log_scale ? "log" : "linear") << ","
-          << 100 * (fitted[i] - initial[i]) / initial[i] << "\n";
-  });
-  core::WriteFileReplacing(o.out + "/cost.csv", [&](std::ostream& out) {
-    out << "evaluations,best cost [-]\n" << std::setprecision(10);
-    for (const auto& [n, c] : p.history) out << n << "," << c << "\n";
-  });
-  std::vector<Plot> plots;
-  Plot cost{"best cost", "evaluations", "cost [-] (normalised RMS)", {}, true};
-  Curve curve{"best", {}, {}};
-  for (const auto& [n, c] : p.history) {
-    curve.x.push_back(static_cast<double>(n));
-    curve.y.push_back(c);
-  }
-  cost.curves.push_back(curve);
-  plots.push_back(cost);
+  std::vector<Plot> plots = WriteParameters(o, spec, initial, fitted, p);
   for (auto& plot : WriteChannels(o, spec, before, &after)) plots.push_back(plot);
   const std::string png = o.out + "/report.png";
   const std::string why = WritePng(png, plots);
   // the tuned scene last: whatever fails there, the results above are written
   const std::string tuned = o.out + "/tuned.dae";
-  std::string export_error;
-  try {
-    pool.WithModel([&](M::Model_ptr model) {
-      const auto e = WithParameters(spec.experiments.front(), spec.parameters, fitted);
-      M::Recording_var ignored = model->run_experiment(
-          client::ToIdl(e, client::ReadScene(e.scene)));  // leaves the tuned scene loaded
-      M::Octets_var data = model->export_scene();
-      core::WriteFileReplacing(tuned, [&](std::ostream& out) {
-        out.write(reinterpret_cast<const char*>(data->get_buffer()), data->length());
-      });
-    });
-  } catch (const std::exception& e) {
-    export_error = e.what();
-  } catch (const CORBA::Exception& e) {
-    export_error = rtc::Describe(e);
-  }
+  const std::string export_error = ExportTuned(pool, spec, fitted, tuned);
 
   std::cout << "cost " << Format(before.cost, 6) << " -> " << Format(after.cost, 6) << " ("
             << Format(before.cost / std::max(after.cost, 1e-300), 3) << "x lower) after "
