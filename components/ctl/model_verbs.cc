@@ -87,17 +87,33 @@ void PrintValue(const std::string& id, const std::string& unit, const D::Value& 
 
 // ------------------------------------------------------------------------ simulation control
 
-int Load(Client& client, std::vector<std::string>& args) {
-  const std::string name = TakeModel(args);
+// `VERB FILE [--send] [--model NAME]`: the Model, FILE made absolute here (the Model's process
+// has another working directory), and whether it travels by content (client::SendsByContent).
+struct FileVerb {
+  std::string name, path;
+  ModelRef m;
+  bool by_content = false;
+};
+FileVerb TakeFileVerb(Client& client, std::vector<std::string>& args,
+                      core::ConfinedPaths::Access access) {
+  FileVerb v;
+  v.name = TakeModel(args);
   const bool send_flag = TakeFlag(args, "--send");
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one FILE");
-  const std::string path = Absolute(args[0]);
-  ModelRef m = Connect(client, name);
-  const bool send = Call(m, [&] {
-    return client::SendsByContent(m.model, path, m.local, send_flag,
-                                  core::ConfinedPaths::Access::kRead);
+  v.path = Absolute(args[0]);
+  v.m = Connect(client, v.name);
+  v.by_content = Call(v.m, [&] {
+    return client::SendsByContent(v.m.model, v.path, v.m.local, send_flag, access);
   });
+  return v;
+}
+
+int Load(Client& client, std::vector<std::string>& args) {
+  const FileVerb v = TakeFileVerb(client, args, core::ConfinedPaths::Access::kRead);
+  const std::string &name = v.name, &path = v.path;
+  const ModelRef& m = v.m;
+  const bool send = v.by_content;
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   client::SentScene sent;
   Call(m, [&] {
@@ -188,16 +204,10 @@ int Status(Client& client, std::vector<std::string>& args) {
 }
 
 int Save(Client& client, std::vector<std::string>& args) {
-  const std::string name = TakeModel(args);
-  const bool send_flag = TakeFlag(args, "--send");
-  RejectOptions(args);
-  if (args.size() != 1) throw UsageError("expected one FILE");
-  const std::string path = Absolute(args[0]);
-  ModelRef m = Connect(client, name);
-  const bool fetch = Call(m, [&] {
-    return client::SendsByContent(m.model, path, m.local, send_flag,
-                                  core::ConfinedPaths::Access::kWrite);
-  });
+  const FileVerb v = TakeFileVerb(client, args, core::ConfinedPaths::Access::kWrite);
+  const std::string &name = v.name, &path = v.path;
+  const ModelRef& m = v.m;
+  const bool fetch = v.by_content;
   omniORB::setClientCallTimeout(m.model, kLongCallMs);
   if (fetch) {
     M::Octets_var data = Call(m, [&] { return m.model->export_scene(); });

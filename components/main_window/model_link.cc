@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "caliper/client/model.h"
 #include "caliper/client/scene_transfer.h"
 #include "caliper/core/confined_path.h"
 #include "caliper/model.hh"
@@ -588,19 +589,15 @@ bool ModelLink::LookUp() {
   if (Clock::now() - i.last_lookup < std::chrono::milliseconds(options_.reconnect_period_ms))
     return false;
   i.last_lookup = Clock::now();
-  try {
-    CosNaming::NamingContext_var root =
-        rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-    M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
-    if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
-    i.model = model;
-    return true;
-  } catch (const CORBA::Exception& e) {
-    Lost(rtc::Describe(e));
-  } catch (const std::exception& e) {
-    Lost(e.what());
+  std::string why;
+  M::Model_var model =
+      client::TryLookUpModel(i.orb, options_.nameservice, options_.instance, 0, &why);
+  if (CORBA::is_nil(model)) {
+    Lost(why);
+    return false;
   }
-  return false;
+  i.model = model;
+  return true;
 }
 
 void ModelLink::Poll() {

@@ -12,8 +12,6 @@ namespace caliper::model {
 
 namespace S = ::Caliper::Scene;
 namespace D = ::Caliper::Daq;
-namespace M = ::Caliper::Simulation;
-using rtc::ClientOf;
 using rtc::PeerGone;
 using simulation::ModelCore;
 using simulation::Snapshot;

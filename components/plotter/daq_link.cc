@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "caliper/client/model.h"
 #include "caliper/model.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/idl_names.h"
@@ -128,6 +129,17 @@ struct DaqLink::Shared {
     for (auto& b : held) Deliver(std::move(b));
     held.clear();
     held_values = 0;
+  }
+
+  // the current subscription ends here (its layout too when `layout_too`): returns its id (0:
+  // none); what it holds cannot be read
+  uint64_t EndCurrent(bool layout_too) {
+    std::lock_guard<std::mutex> lock(mutex);
+    const uint64_t id = current;
+    current = 0;
+    if (layout_too) layout.reset();
+    Discard();
+    return id;
   }
 
   // with the mutex held: the subscription ends, what it holds cannot be read
@@ -416,27 +428,18 @@ bool DaqLink::LookUp() {
     return false;
   i.last_lookup = Clock::now();
   const auto timeout_ms = static_cast<CORBA::ULong>(options_.call_timeout_ms);
-  try {
-    CosNaming::NamingContext_var root =
-        rtc::ResolveRoot(i.orb, rtc::NamingAddress(options_.nameservice));
-    omniORB::setClientCallTimeout(root, timeout_ms);
-    CheckClosing();
-    M::Model_var model = M::Model::_narrow(rtc::FindComponent(root, options_.instance).object);
-    if (CORBA::is_nil(model)) throw std::runtime_error(options_.instance + " is not a Model");
-    // the reference's own timeout bounds every call to the Model (omniORB honours the
-    // per-thread one only with -ORBsupportPerThreadTimeOut 1)
-    omniORB::setClientCallTimeout(model, timeout_ms);
-    i.model = model;
-    i.has_model = true;
-    i.channels_listed = false;
-    i.steps = 0;
-    return true;
-  } catch (const CORBA::Exception& e) {
-    Lost(rtc::Describe(e));
-  } catch (const std::exception& e) {
-    Lost(e.what());
+  CheckClosing();
+  std::string why;
+  i.model =
+      client::TryLookUpModel(i.orb, options_.nameservice, options_.instance, timeout_ms, &why);
+  if (CORBA::is_nil(i.model)) {
+    Lost(why);
+    return false;
   }
-  return false;
+  i.has_model = true;
+  i.channels_listed = false;
+  i.steps = 0;
+  return true;
 }
 
 bool DaqLink::ListChannels(const std::string& scene) {
@@ -476,14 +479,7 @@ void DaqLink::EndForeignSubscriptions() {
 void DaqLink::Subscribe(const std::vector<std::string>& ids, uint32_t every, double sim_time) {
   Impl& i = *impl_;
   Shared& sh = *shared_;
-  uint64_t old = 0;
-  {
-    std::lock_guard<std::mutex> lock(sh.mutex);
-    old = sh.current;
-    sh.current = 0;
-    sh.layout.reset();
-    sh.Discard();
-  }
+  const uint64_t old = sh.EndCurrent(true);
   i.subscribed.clear();
   if (old != 0) {
     CheckClosing();
@@ -626,13 +622,7 @@ void DaqLink::Close() {
   // Model was found gone (a Model drops a consumer that no longer answers anyway)
   Impl& i = *impl_;
   Shared& sh = *shared_;
-  uint64_t current = 0;
-  {
-    std::lock_guard<std::mutex> lock(sh.mutex);
-    current = sh.current;
-    sh.current = 0;
-    sh.Discard();
-  }
+  const uint64_t current = sh.EndCurrent(false);
   if (current != 0 && !CORBA::is_nil(i.model)) {
     const auto final_ms = static_cast<CORBA::ULong>(
         std::clamp(options_.final_call_timeout_ms, 1, options_.call_timeout_ms));

@@ -30,6 +30,31 @@ ModelRef FindModel(CosNaming::NamingContext_ptr root, const std::string& name) {
   return ref;
 }
 
+ModelRef LookUpModel(CORBA::ORB_ptr orb, const std::string& nameservice, const std::string& name,
+                     unsigned long call_timeout_ms) {
+  CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
+  const auto ms = static_cast<CORBA::ULong>(call_timeout_ms);
+  if (ms > 0) omniORB::setClientCallTimeout(root, ms);
+  ModelRef ref = FindModel(root, name);
+  // the reference's own timeout bounds every call to the Model (omniORB honours the per-thread
+  // one only with -ORBsupportPerThreadTimeOut 1)
+  if (ms > 0) omniORB::setClientCallTimeout(ref.model, ms);
+  return ref;
+}
+
+M::Model_ptr TryLookUpModel(CORBA::ORB_ptr orb, const std::string& nameservice,
+                            const std::string& name, unsigned long call_timeout_ms,
+                            std::string* why) {
+  try {
+    return LookUpModel(orb, nameservice, name, call_timeout_ms).model._retn();
+  } catch (const CORBA::Exception& e) {
+    *why = rtc::Describe(e);
+  } catch (const std::exception& e) {
+    *why = e.what();
+  }
+  return M::Model::_nil();
+}
+
 ModelRef ConnectModel(Session& session, const std::string& name) {
   CosNaming::NamingContext_var root = session.Root();
   return FindModel(root, name);

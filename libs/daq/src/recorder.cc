@@ -390,12 +390,16 @@ size_t Recorder::Deliver(SubscriptionId id, size_t max) {
   const auto queue = FindQueue(id);
   if (!queue->consumer)
     throw std::logic_error("subscription " + std::to_string(id) + " has no consumer");
+  return DeliverFrom(*queue, max);
+}
+
+size_t Recorder::DeliverFrom(Queue& queue, size_t max) {
   size_t delivered = 0;
   while (delivered < max) {
-    auto one = queue->Take(1);
+    auto one = queue.Take(1);
     if (one.empty()) break;
-    queue->consumer(one.front());
-    queue->Recycle(std::move(one.front()));
+    queue.consumer(one.front());
+    queue.Recycle(std::move(one.front()));
     ++delivered;
   }
   return delivered;
@@ -409,15 +413,7 @@ size_t Recorder::DeliverAll() {
       if (s->queue->consumer) queues.push_back(s->queue);
   }
   size_t delivered = 0;
-  for (const auto& queue : queues) {
-    for (;;) {
-      auto one = queue->Take(1);
-      if (one.empty()) break;
-      queue->consumer(one.front());
-      queue->Recycle(std::move(one.front()));
-      ++delivered;
-    }
-  }
+  for (const auto& queue : queues) delivered += DeliverFrom(*queue, SIZE_MAX);
   return delivered;
 }
 

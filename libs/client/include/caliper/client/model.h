@@ -25,6 +25,19 @@ struct ModelRef {
 /// Session call ConnectModel.
 ModelRef FindModel(CosNaming::NamingContext_ptr root, const std::string& name);
 
+/// FindModel in the naming service at `nameservice` ("" for $CALIPER_NAMESERVICE or the
+/// default) through the process's ORB `orb`, for links that keep their own ORB (the GUI tools).
+/// With `call_timeout_ms` > 0, the naming service's root and the Model's reference get that
+/// deadline for every call on them. FindModel's errors; CORBA's while the naming service is away.
+ModelRef LookUpModel(CORBA::ORB_ptr orb, const std::string& nameservice, const std::string& name,
+                     unsigned long call_timeout_ms = 0);
+
+/// LookUpModel saying why instead of throwing: the Model, or nil with `*why` set (FindModel's
+/// message, or the CORBA exception while the naming service is away).
+::Caliper::Simulation::Model_ptr TryLookUpModel(CORBA::ORB_ptr orb, const std::string& nameservice,
+                                               const std::string& name,
+                                               unsigned long call_timeout_ms, std::string* why);
+
 /// The Model bound as `name` in the session's naming service (FindModel).
 ModelRef ConnectModel(Session& session, const std::string& name);
 

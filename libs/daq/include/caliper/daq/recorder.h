@@ -132,6 +132,8 @@ class Recorder {
   struct Subscription;
 
   std::shared_ptr<Queue> FindQueue(SubscriptionId id) const;
+  /// Hands up to `max` of the queue's batches to its consumer, one at a time.
+  static size_t DeliverFrom(Queue& queue, size_t max);
   Subscription& Find(SubscriptionId id);
   void Resolve(Subscription& s, bool initial);
   void Plan(Subscription& s);
