@@ -15,6 +15,7 @@
 #include "caliper/client/experiments.h"
 #include "caliper/client/model_pool.h"
 #include "caliper/client/scene_transfer.h"
+#include "caliper/client/session.h"
 #include "caliper/core/arguments.h"
 #include "caliper/core/system.h"
 #include "caliper/logging/log.h"
@@ -267,7 +268,7 @@ int Run(const Options& o) {
     throw std::runtime_error("--resume: no checkpoint at " + checkpoint);
 
   rtc::OmniThread omni;
-  const std::string address = rtc::NamingAddress(o.nameservice);
+  const std::string address = client::ResolveNamingAddress(o.nameservice);
   CORBA::ORB_var orb = rtc::ClientOrb("caliper-calibrate", 10, address);  // TLS when on a network
   client::ModelPool::Options pool_options;
   pool_options.run_timeout_s = o.run_timeout_s;

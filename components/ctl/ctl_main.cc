@@ -312,9 +312,10 @@ std::map<std::string, Verb> Verbs() {
 void PrintHelp(const std::map<std::string, Verb>& verbs) {
   std::cout << "Usage: caliper-ctl [--nameservice corbaname::HOST:PORT] [--timeout S] VERB ...\n\n"
             << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
-            << "$CALIPER_NAMESERVICE, else corbaname::127.0.0.1:2809. NAME is an instance name\n"
-            << "(model0), host/model0, or host.host_cxt/model0.rtc. `inspect` reads a file\n"
-            << "and needs no session.\n";
+            << "$CALIPER_NAMESERVICE, else the newest session launch/caliper started that still\n"
+            << "runs, else corbaname::127.0.0.1:2809. NAME is an instance name (model0),\n"
+            << "host/model0, or host.host_cxt/model0.rtc. `inspect` reads a file and needs no\n"
+            << "session.\n";
   const std::pair<const char*, const char*> groups[] = {
       {"components", "Components"},
       {"model", "Model (model0, or --model NAME on each verb)"},

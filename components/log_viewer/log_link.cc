@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "caliper/client/session.h"
 #include "caliper/logging.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
@@ -246,7 +247,7 @@ void LogLink::Impl::Connect() {
   try {
     Limit(short_ms);
     CosNaming::NamingContext_var root =
-        rtc::ResolveRoot(orb, rtc::NamingAddress(options.nameservice));
+        rtc::ResolveRoot(orb, client::ResolveNamingAddress(options.nameservice));
     rtc::ComponentEntry entry = rtc::FindComponent(root, name);
     Limit(short_ms, entry.object);
     L::LogService_var found = L::LogService::_narrow(entry.object);
@@ -320,7 +321,7 @@ bool LogLink::Impl::Check() {
   if (Stopping()) return true;
   try {
     CosNaming::NamingContext_var root =
-        rtc::ResolveRoot(orb, rtc::NamingAddress(options.nameservice));
+        rtc::ResolveRoot(orb, client::ResolveNamingAddress(options.nameservice));
     rtc::ComponentEntry entry = rtc::FindComponent(root, name);
     if (!entry.object->_is_equivalent(bound)) {
       Drop(name + " was started again; registering again");

@@ -12,6 +12,7 @@
 
 #include "caliper/client/model.h"
 #include "caliper/client/scene_transfer.h"
+#include "caliper/client/session.h"
 #include "caliper/core/confined_path.h"
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
@@ -43,7 +44,7 @@ struct ModelLink::Impl {
   bool relist_components = false;  // a component action ran since the last listing
 
   CosNaming::NamingContext_ptr Root(const std::string& nameservice) {
-    if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
+    if (CORBA::is_nil(root)) root = rtc::ResolveRoot(orb, client::ResolveNamingAddress(nameservice));
     return root.in();
   }
 };

@@ -456,37 +456,8 @@ M::EditStatus* ModelServant::add_tendon(const char* tendon, const S::PathPoint& 
     t.name = tendon;
     t.radius = radius_m;
     t.path = {FromIdl(from), FromIdl(to)};
-    const std::vector<std::string> kinds = actuators::Kinds();
-    if (std::find(kinds.begin(), kinds.end(), std::string(kind)) == kinds.end()) {
-      std::string known;
-      for (const auto& k : kinds) known += (known.empty() ? "" : ", ") + k;
-      throw sgal::EditError("add_tendon: no actuator kind '" + std::string(kind) + "' (" + known +
-                            ")");
-    }
-    sgal::Actuator a;
-    a.name = actuator;
-    a.kind = kind;
-    // a parameter without a default (a ligament's stiffness, a muscle's force) is taken from
-    // the scene's first actuator of the kind that has it; tune it afterwards as any parameter
-    const auto scene = core_.description();
-    std::string missing;
-    for (const auto& p : actuators::KindParameters(kind)) {
-      if (!p.required) {
-        a.parameters[p.name] = p.default_value;
-        continue;
-      }
-      bool found = false;
-      for (const auto& other : scene ? scene->actuators : std::vector<sgal::Actuator>{})
-        if (other.kind == kind && other.parameters.count(p.name) != 0 && !found) {
-          a.parameters[p.name] = other.parameters.at(p.name);
-          found = true;
-        }
-      if (!found) missing += (missing.empty() ? "" : ", ") + p.name;
-    }
-    if (!missing.empty())
-      throw sgal::EditError("add_tendon: a " + std::string(kind) + " needs " + missing +
-                            ", which have no default and no " + kind +
-                            " in the scene to copy from: declare it in the model file");
+    // a parameter without a default is copied from the scene's first actuator of the kind
+    const sgal::Actuator a = NewActuator(core_.description().get(), actuator, kind);
     return ToIdl(core_.Edit([&](const sgal::Scene& s) { return sgal::AddTendon(s, t, a); }));
   });
 }

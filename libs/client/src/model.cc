@@ -32,7 +32,7 @@ ModelRef FindModel(CosNaming::NamingContext_ptr root, const std::string& name) {
 
 ModelRef LookUpModel(CORBA::ORB_ptr orb, const std::string& nameservice, const std::string& name,
                      unsigned long call_timeout_ms) {
-  CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, rtc::NamingAddress(nameservice));
+  CosNaming::NamingContext_var root = rtc::ResolveRoot(orb, ResolveNamingAddress(nameservice));
   const auto ms = static_cast<CORBA::ULong>(call_timeout_ms);
   if (ms > 0) omniORB::setClientCallTimeout(root, ms);
   ModelRef ref = FindModel(root, name);

@@ -1,8 +1,35 @@
 #include "caliper/client/session.h"
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include "caliper/core/system.h"
 #include "caliper/rtc/client_orb.h"
 
 namespace caliper::client {
+
+std::string LatestSession() {
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  const std::string file = std::string(runtime != nullptr && *runtime != '\0' ? runtime : "/tmp") +
+                           "/caliper-" + std::to_string(getuid()) + "/latest-session";
+  std::ifstream in(file);
+  std::string address, pid;
+  if (!std::getline(in, address) || !std::getline(in, pid) || address.empty()) return "";
+  char* end = nullptr;
+  const long id = std::strtol(pid.c_str(), &end, 10);
+  if (end == pid.c_str() || *end != '\0' || id <= 0 || !core::ProcessAlive(id)) return "";
+  return address;
+}
+
+std::string ResolveNamingAddress(const std::string& option) {
+  if (!option.empty()) return option;
+  const char* env = std::getenv("CALIPER_NAMESERVICE");
+  if (env != nullptr && *env != '\0') return env;
+  const std::string latest = LatestSession();
+  return latest.empty() ? rtc::NamingAddress("") : latest;
+}
 
 Session::~Session() {
   if (CORBA::is_nil(orb_)) return;
@@ -80,7 +107,7 @@ const std::string& Session::address() {
 
 void Session::Connect() {
   if (!CORBA::is_nil(orb_)) return;
-  address_ = rtc::NamingAddress(options_.nameservice);
+  address_ = ResolveNamingAddress(options_.nameservice);
   // TLS when on a network
   orb_ = rtc::ClientOrb(options_.program.c_str(), options_.timeout_s, address_);
 }

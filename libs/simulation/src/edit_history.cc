@@ -4,6 +4,9 @@
 #include <set>
 #include <utility>
 
+#include "caliper/actuators/actuator.h"
+#include "caliper/sgal/edits.h"
+
 namespace caliper::simulation {
 
 void EditHistory::Forget() {
@@ -136,6 +139,38 @@ void EditHistory::FollowEdit(const sgal::Scene& before, const sgal::Scene& edite
   }
   if (selection_.kind == "obstacle" && edited.FindObstacle(selection_.name) == nullptr)
     ClearSelection();
+}
+
+sgal::Actuator NewActuator(const sgal::Scene* scene, const std::string& name,
+                           const std::string& kind) {
+  const std::vector<std::string> kinds = actuators::Kinds();
+  if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
+    std::string known;
+    for (const auto& k : kinds) known += (known.empty() ? "" : ", ") + k;
+    throw sgal::EditError("add_tendon: no actuator kind '" + kind + "' (" + known + ")");
+  }
+  sgal::Actuator a;
+  a.name = name;
+  a.kind = kind;
+  std::string missing;
+  for (const auto& p : actuators::KindParameters(kind)) {
+    if (!p.required) {
+      a.parameters[p.name] = p.default_value;
+      continue;
+    }
+    bool found = false;
+    for (const auto& other : scene ? scene->actuators : std::vector<sgal::Actuator>{})
+      if (other.kind == kind && other.parameters.count(p.name) != 0 && !found) {
+        a.parameters[p.name] = other.parameters.at(p.name);
+        found = true;
+      }
+    if (!found) missing += (missing.empty() ? "" : ", ") + p.name;
+  }
+  if (!missing.empty())
+    throw sgal::EditError("add_tendon: a " + kind + " needs " + missing +
+                          ", which have no default and no " + kind +
+                          " in the scene to copy from: declare it in the model file");
+  return a;
 }
 
 }  // namespace caliper::simulation

@@ -1,6 +1,6 @@
 // The client library's half of the path-or-bytes rule that needs no Model: what is sent for a
 // scene file by content, under which name, and the refusal of a file one message cannot carry.
-#include "caliper/client/scene_transfer.h"
+#include "caliper/client/client.h"  // the umbrella header compiles on its own
 
 #include <gtest/gtest.h>
 

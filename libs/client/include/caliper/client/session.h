@@ -19,8 +19,18 @@
 
 namespace caliper::client {
 
+/// The naming service of the newest session the launcher started on this host for this user and
+/// that still runs (`launch/caliper session` or `demo` writes it to
+/// ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID/latest-session: the address, the naming service's pid,
+/// the session's directory); "" when there is none or its naming service has ended.
+std::string LatestSession();
+
+/// Where a session's naming service is: `option` when given, else $CALIPER_NAMESERVICE, else
+/// the latest session (LatestSession), else corbaname::127.0.0.1:2809.
+std::string ResolveNamingAddress(const std::string& option);
+
 struct SessionOptions {
-  /// corbaname::HOST:PORT; "" for $CALIPER_NAMESERVICE or else corbaname::127.0.0.1:2809.
+  /// corbaname::HOST:PORT; "" for ResolveNamingAddress's choice.
   std::string nameservice;
   /// Every call's deadline [s]; 0 for none.
   double timeout_s = 5.0;

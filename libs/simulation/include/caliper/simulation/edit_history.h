@@ -102,4 +102,11 @@ class EditHistory {
   Selection selection_;
 };
 
+/// The actuator of a tendon an edit adds: `kind` (a registered actuator kind) with its
+/// parameters' defaults, and a parameter without a default (a ligament's stiffness, a muscle's
+/// force) copied from `scene`'s first actuator of that kind that has it. Throws sgal::EditError
+/// for an unknown kind, listing the known ones, or for a parameter it cannot fill.
+sgal::Actuator NewActuator(const sgal::Scene* scene, const std::string& name,
+                           const std::string& kind);
+
 }  // namespace caliper::simulation
