@@ -172,18 +172,6 @@ sgal::Scene ModelCore::ImportBytes(const std::string& file_name, const std::stri
   return scene;
 }
 
-std::shared_ptr<const sgal::Scene> ModelCore::ImportCached(const std::string& file_name,
-                                                           const std::string& bytes) {
-  // the importer is deterministic, so an equal file gives an equal scene
-  if (!imported_ || file_name != imported_name_ || bytes != imported_bytes_) {
-    imported_.reset();
-    imported_ = std::make_shared<const sgal::Scene>(ImportBytes(file_name, bytes));
-    imported_name_ = file_name;
-    imported_bytes_ = bytes;
-  }
-  return imported_;
-}
-
 void ModelCore::LoadData(const std::string& file_name, const std::string& bytes) {
   {
     const auto lock = Lock();
@@ -222,7 +210,10 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
 
   RunResult result;
   const auto load_begin = Clock::now();
-  const std::shared_ptr<const sgal::Scene> scene = ImportCached(file_name, scene_bytes);
+  const std::shared_ptr<const sgal::Scene> scene = imported_.Get(
+      file_name, scene_bytes, [this](const std::string& name, const std::string& bytes) {
+        return ImportBytes(name, bytes);
+      });
   // build outside the lock; a fresh world and no command carried over from the last scene
   auto loaded = std::make_unique<Loaded>();
   loaded->description = scene;
@@ -241,79 +232,26 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   result.load_wall_s = std::chrono::duration<double>(Clock::now() - load_begin).count();
 
   // overrides, the recorded ids and the schedule's actuators are checked before any step
-  for (const auto& o : e.overrides) {
-    if (!registry_.Contains(o.id)) throw UnknownId("experiment '" + e.name + "': unknown id '" +
-                                                       o.id + "' in set", o.id);
-    try {
-      registry_.Set(o.id, o.values);
-    } catch (const std::exception& error) {
-      throw InvalidValue("experiment '" + e.name + "': set " + o.id + ": " + error.what());
-    }
-  }
+  ApplyOverrides(e, registry_);
   loaded_->sampler->Refresh();
-  experiment::Recording& rec = result.recording;
-  // resolved once: sampling reads through handles (no hashing, no allocation per sample)
-  std::vector<std::pair<daq::Handle, size_t>> columns;  // handle, first value in a sample
-  for (const auto& id : e.record) {
-    if (!registry_.Contains(id))
-      throw UnknownId("experiment '" + e.name + "': unknown id '" + id + "' in record", id);
-    const daq::ChannelInfo& info = registry_.Info(id);
-    rec.channels.push_back({id, info.unit, info.shape.rows, info.shape.cols});
-    columns.emplace_back(registry_.Resolve(id), rec.values_per_sample);
-    rec.values_per_sample += info.shape.size();
-  }
-  const auto& actuators = loaded_->description->actuators;
-  for (const auto& c : e.schedule)
-    if (std::none_of(actuators.begin(), actuators.end(),
-                     [&](const sgal::Actuator& a) { return a.name == c.actuator; }))
-      throw UnknownId("experiment '" + e.name + "': no actuator '" + c.actuator + "'", c.actuator);
-
   sgal::PhysicsScene& physics = *loaded_->physics;
-  const double dt = physics.description().settings.time_step;
-  const uint64_t steps = experiment::StepCount(e.duration_s, dt);
-  if (steps > limits_.experiment_steps)
-    throw InvalidValue("experiment '" + e.name + "': " + std::to_string(steps) + " steps of " +
-                       std::to_string(dt) + " s; one run takes at most " +
-                       std::to_string(limits_.experiment_steps) +
-                       " (split it, or use a longer time step)");
-  const uint64_t samples = steps / e.every_n_steps + 1;
-  // the recording travels in one message: refuse what cannot arrive before spending the run
-  const double bytes = static_cast<double>(samples) * (rec.values_per_sample + 1) * 8;
-  if (bytes > kMaxRecordingBytes)
-    throw InvalidValue("experiment '" + e.name + "': " + std::to_string(samples) +
-                       " samples of " + std::to_string(rec.values_per_sample) + " values are " +
-                       std::to_string(static_cast<long>(bytes / (1 << 20))) +
-                       " MiB, more than one reply carries (" +
-                       std::to_string(kMaxRecordingBytes >> 20) +
-                       " MiB): sample less often (every_n_steps) or record fewer ids");
-  rec.times.reserve(samples);
-  rec.data.reserve(samples * rec.values_per_sample);
-  auto sample = [&] {
-    rec.times.push_back(physics.time());
-    const size_t at = rec.data.size();
-    rec.data.resize(at + rec.values_per_sample);
-    for (const auto& [handle, offset] : columns) registry_.Read(handle, &rec.data[at + offset]);
-  };
+  ExperimentRunner run(e, registry_, loaded_->description->actuators,
+                       physics.description().settings.time_step, limits_.experiment_steps,
+                       kMaxRecordingBytes);
+  const uint64_t steps = run.steps();
   const auto step_begin = Clock::now();
   rate_wall_ = step_begin;
   rate_sim_ = physics.time();
-  size_t next_command = 0;
-  sample();
+  run.Sample(physics.time());
   auto slice_end = Clock::now() + kSlice;
   for (uint64_t k = 1; k <= steps; ++k) {
     AwaitConsumersLocked(lock);  // the experiment flag keeps control calls out meanwhile
-    // commands due by the start of this step (a part per billion of a step counts as due)
-    const double now = physics.time() + 1e-9 * dt;
-    for (; next_command < e.schedule.size() && e.schedule[next_command].time_s <= now;
-         ++next_command) {
-      const auto& c = e.schedule[next_command];
-      pending_commands_.emplace_back(c.actuator, c.value);
-    }
+    run.TakeDueCommands(physics.time(), &pending_commands_);
     StepLocked();
     if (state_ == RunState::kFaulted)
       throw RunFailed("experiment '" + e.name + "' faulted at t = " + std::to_string(physics.time()) +
                       " s (step " + std::to_string(k) + "): " + last_error_);
-    if (k % e.every_n_steps == 0) sample();
+    if (run.SampleDue(k)) run.Sample(physics.time());
     if (k % 16 == 0 && Clock::now() > slice_end) {
       // let status() and readers in between; the experiment flag keeps control calls out
       MeasureRateLocked(0.5);
@@ -325,6 +263,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
                            (cancel_ ? "the Model is shutting down" : end_request_));
     }
   }
+  result.recording = std::move(run.recording());
   result.step_wall_s = std::chrono::duration<double>(Clock::now() - step_begin).count();
   result.steps = steps;
   logging::Get("model").info("experiment %s: %llu steps in %.3f s of wall time", e.name.c_str(),
@@ -422,7 +361,7 @@ void ModelCore::Stop() {
       EndRecordingLocked("the simulation was stopped (rewound)");
       // a step request running sees the new scene generation and ends without another step
       if (replay_)
-        RestoreReplayLocked(replay_->reader->header().first_step);  // the replay's start
+        RestoreReplayLocked(replay_->first_step());  // the replay's start
       else
         RewindLocked();
       state_ = RunState::kStopped;
@@ -438,7 +377,7 @@ void ModelCore::Reset() {
   const RunState keep = state_ == RunState::kFaulted ? RunState::kStopped : state_;
   EndRecordingLocked("the simulation was reset (rewound)");
   if (replay_)
-    RestoreReplayLocked(replay_->reader->header().first_step);
+    RestoreReplayLocked(replay_->first_step());
   else
     RewindLocked();
   state_ = keep;

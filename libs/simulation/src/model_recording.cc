@@ -25,8 +25,6 @@ namespace caliper::simulation {
 
 namespace {
 
-constexpr uint32_t kMaxKeyframeEvery = 1000;
-
 // the Model's own log records, into the recording while one runs
 class RecordingAppender : public log4cpp::AppenderSkeleton {
  public:
@@ -79,7 +77,7 @@ std::string ColladaBytesOf(const sgal::Scene& scene) {
 
 void ModelCore::RequireNotReplaying(const char* what) const {
   if (replay_)
-    throw NotAvailable(std::string(what) + ": the Model replays " + replay_->path +
+    throw NotAvailable(std::string(what) + ": the Model replays " + replay_->path() +
                        "; fork it first (caliper-ctl replay --fork) to change the simulation");
 }
 
@@ -211,121 +209,38 @@ void ModelCore::BeforeStepLocked() {
   }
   if (fork_reset_every_ != 0 && !recorder_session_ && step % fork_reset_every_ == 0)
     physics.ResetCaches();
-  if (replay_) {
-    Replay& p = *replay_;
-    for (; p.next < p.events.size() && p.events[p.next].step <= step; ++p.next) {
-      const recording::Event& e = p.events[p.next];
-      if (e.kind == "keyframe" && p.keyframe_hook) p.keyframe_hook(step, physics);
-      if (e.kind == "keyframe" || e.kind == "end") continue;
-      if (e.kind == "command") {
-        physics.SetCommand(e.target, e.values.at(0));
-        loaded_->commands[e.target] = e.values.at(0);
-      } else if (e.kind == "parameter") {
-        registry_.Set(e.target, e.values);
-      } else if (e.kind == "pull") {
-        sgal::Pull pull;
-        pull.body = physics.description().BodyIndex(e.target);
-        pull.point = {e.values.at(0), e.values.at(1), e.values.at(2)};
-        pull.target = {e.values.at(3), e.values.at(4), e.values.at(5)};
-        pull.stiffness = e.values.at(6);
-        pull.damping = e.values.size() > 7
-                           ? e.values[7]
-                           : 2 * std::sqrt(pull.stiffness *
-                                           physics.description().bodies.at(pull.body).inertia.mass);
-        physics.SetPull(pull);
-      } else if (e.kind == "release") {
-        physics.ClearPull();
-      } else if (e.kind == "edit") {
-        // the edited scene and its keyframe at this step
-        RestoreReplayLocked(step);
-        BeforeStepLocked();  // the events after that keyframe's mark
-        return;
-      }
-    }
-    if (step % p.keyframe_every == 0 && step != p.last_reset) {
-      loaded_->physics->ResetCaches();
-      p.last_reset = step;
-    }
+  if (replay_ && replay_->BeforeStep(step, physics, registry_, loaded_->commands) ==
+                     Replayer::Due::kEdit) {
+    // the edited scene and its keyframe at this step
+    RestoreReplayLocked(step);
+    BeforeStepLocked();  // the events after that keyframe's mark
   }
 }
 
 void ModelCore::AfterStepLocked() {
   if (recorder_session_)
     recorder_session_->AfterStep(loaded_->physics->steps(), loaded_->physics->time());
-  if (replay_ && loaded_->physics->steps() >= replay_->reader->last_step() &&
+  if (replay_ && loaded_->physics->steps() >= replay_->last_step() &&
       state_ == RunState::kRunning) {
     state_ = RunState::kPaused;  // the end of the recording
-    logging::Get("model").notice("replay of %s: at its end (t = %.3f s)", replay_->path.c_str(),
+    logging::Get("model").notice("replay of %s: at its end (t = %.3f s)", replay_->path().c_str(),
                                  loaded_->physics->time());
   }
 }
 
 void ModelCore::RestoreReplayLocked(uint64_t step) {
-  Replay& p = *replay_;
-  const recording::Keyframe k = p.reader->KeyframeAtOrBefore(step);
-  const recording::SceneVersion* version = nullptr;
-  for (const auto& v : p.scenes)
-    if (v.version == k.scene_version) version = &v;
-  if (version == nullptr)
-    throw recording::RecordingError(p.path + ": keyframe at step " + std::to_string(k.step) +
-                                    " names scene version " + std::to_string(k.scene_version) +
-                                    ", which the file lacks");
-  std::shared_ptr<const sgal::Scene>& cached = p.imported[version->version];
-  if (!cached)
-    cached = std::make_shared<const sgal::Scene>(ImportBytes(version->file_name, version->bytes));
-  const sgal::Scene& scene = *cached;
+  const Replayer::Start start =
+      replay_->StartAt(step, [this](const std::string& file_name, const std::string& bytes) {
+        return ImportBytes(file_name, bytes);
+      });
   auto loaded = std::make_unique<Loaded>();
-  loaded->description = cached;
-  loaded->source = p.path + " (replay)";
-  loaded->name = p.reader->header().model_name;
-  loaded->physics = MakePhysics(scene);
+  loaded->description = start.scene;
+  loaded->source = replay_->path() + " (replay)";
+  loaded->name = replay_->header().model_name;
+  loaded->physics = MakePhysics(*start.scene);
   // as an edit does: a step request playing on goes on across a replayed edit
   BuildLocked(std::move(loaded), /*edit=*/true);
-  // the keyframe's mark among the events: what came before it is in the keyframe's state or
-  // (parameter writes, the pull) applied here; what came after is applied by the steps
-  size_t mark = 0;
-  bool marked = false;
-  for (size_t i = 0; i < p.events.size(); ++i)
-    if (p.events[i].kind == "keyframe" && p.events[i].step == k.step) {
-      mark = i;
-      marked = true;
-    }
-  if (!marked)
-    throw recording::RecordingError(p.path + ": the keyframe at step " + std::to_string(k.step) +
-                                    " has no mark among the events (a damaged file)");
-  // parameter writes since the scene version began are not in a keyframe: apply them first
-  for (size_t i = 0; i < mark; ++i) {
-    const auto& e = p.events[i];
-    if (e.kind == "parameter" && e.step >= version->step) registry_.Set(e.target, e.values);
-  }
-  try {
-    loaded_->physics->RestoreDynamicState(k.state);
-  } catch (const std::exception& e) {
-    throw recording::RecordingError(
-        p.path + ": the keyframe at step " + std::to_string(k.step) + " does not fit its scene " +
-        "(a recording of another scene version or another Caliper build): " + e.what());
-  }
-  // the pull in force then
-  const recording::Event* pull = nullptr;
-  for (size_t i = 0; i < mark; ++i) {
-    const auto& e = p.events[i];
-    // across scene versions: a pull held through an edit goes on in the edited scene
-    if (e.kind == "pull" || e.kind == "release") pull = &e;
-  }
-  if (pull != nullptr && pull->kind == "pull") {
-    sgal::Pull x;
-    x.body = scene.BodyIndex(pull->target);
-    x.point = {pull->values.at(0), pull->values.at(1), pull->values.at(2)};
-    x.target = {pull->values.at(3), pull->values.at(4), pull->values.at(5)};
-    x.stiffness = pull->values.at(6);
-    x.damping = pull->values.size() > 7
-                    ? pull->values[7]
-                    : 2 * std::sqrt(x.stiffness * scene.bodies.at(x.body).inertia.mass);
-    loaded_->physics->SetPull(x);
-  }
-  loaded_->physics->ResetCaches();
-  p.last_reset = k.step;
-  p.next = mark + 1;
+  replay_->Restore(start, *loaded_->physics, registry_);
   loaded_->sampler->Refresh();
   PublishLocked();
 }
@@ -333,53 +248,27 @@ void ModelCore::RestoreReplayLocked(uint64_t step) {
 ModelCore::ReplayStatus ModelCore::ReplayStatusLocked() const {
   ReplayStatus s;
   if (!replay_) return s;
-  const recording::Header& h = replay_->reader->header();
   s.replaying = true;
-  s.path = replay_->path;
-  s.first_step = h.first_step;
-  s.last_step = replay_->reader->last_step();
+  s.path = replay_->path();
+  s.first_step = replay_->first_step();
+  s.last_step = replay_->last_step();
   s.step = loaded_ ? loaded_->physics->steps() : 0;
-  s.start_time = replay_->reader->KeyframeAtOrBefore(h.first_step).time;
-  s.end_time = s.start_time + (s.last_step - s.first_step) * h.time_step;
+  s.start_time = replay_->start_time();
+  s.end_time = s.start_time + (s.last_step - s.first_step) * replay_->header().time_step;
   s.time = loaded_ ? loaded_->physics->time() : 0;
   return s;
 }
 
 ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
-  auto replay = std::make_unique<Replay>();
-  replay->reader = std::make_unique<recording::Reader>(path);
-  replay->path = path;
-  const uint64_t last = replay->reader->last_step();
-  replay->events = replay->reader->Events(0, last + 1);
-  replay->scenes = replay->reader->scenes();
-  replay->keyframe_every = replay->reader->header().keyframe_every;
-  // a seek re-simulates from the keyframe before it while holding the Model: a file whose
-  // keyframes lie far apart would hold it that long
-  {
-    uint64_t previous = replay->reader->header().first_step, widest = 0;
-    for (uint64_t k : replay->reader->keyframe_steps()) {
-      widest = std::max(widest, k - std::min(k, previous));
-      previous = k;
-    }
-    widest = std::max(widest, last - std::min(last, previous));
-    if (widest > kMaxKeyframeEvery)
-      throw recording::RecordingError(path + ": its keyframes lie up to " + std::to_string(widest) +
-                                      " steps apart; a replay takes at most " +
-                                      std::to_string(kMaxKeyframeEvery));
-  }
-  const std::string& engine = replay->reader->header().engine;
-  if (!engine.empty() && engine != physics_bullet::EngineId())
-    throw recording::RecordingError(path + " was recorded with " + engine + "; this build runs " +
-                                    physics_bullet::EngineId() +
-                                    ": its replay would not give the recording again");
+  auto replay = std::make_unique<Replayer>(path);
   const auto lock = Lock();
   RequireIdle();
   if (recorder_session_) EndRecordingLocked("a replay was opened");
-  std::unique_ptr<Replay> previous = std::move(replay_);
+  std::unique_ptr<Replayer> previous = std::move(replay_);
   replay_ = std::move(replay);
   fork_reset_every_ = 0;
   try {
-    RestoreReplayLocked(replay_->reader->header().first_step);
+    RestoreReplayLocked(replay_->first_step());
   } catch (...) {
     replay_ = std::move(previous);
     throw;
@@ -387,9 +276,8 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   history_.ClearUndo();
   state_ = RunState::kPaused;
   last_error_.clear();
-  logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(),
-                               replay_->reader->duration(),
-                               replay_->reader->header().model_name.c_str());
+  logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(), replay_->duration(),
+                               replay_->header().model_name.c_str());
   return ReplayStatusLocked();
 }
 
@@ -398,17 +286,12 @@ ModelCore::ReplayStatus ModelCore::Seek(double time_s) {
   if (!replay_) throw NotAvailable("seek: no replay is open (caliper-ctl replay FILE)");
   RequireIdle();
   if (!std::isfinite(time_s)) throw InvalidValue("seek: the time is not finite");
-  const ReplayStatus now = ReplayStatusLocked();
-  const double dt = replay_->reader->header().time_step;
-  const double clamped = std::min(std::max(time_s, now.start_time), now.end_time);
-  const uint64_t target = std::min(
-      now.last_step,
-      now.first_step + static_cast<uint64_t>(std::llround((clamped - now.start_time) / dt)));
+  const uint64_t target = replay_->StepNearest(time_s);
   const RunState keep = state_;
   // from the current state when the target lies ahead within a keyframe interval, else from the
   // keyframe at or before it
   const uint64_t at = loaded_->physics->steps();
-  const uint64_t keyframe = replay_->reader->KeyframeAtOrBefore(target).step;
+  const uint64_t keyframe = replay_->KeyframeStepAtOrBefore(target);
   if (!(target >= at && keyframe <= at)) RestoreReplayLocked(target);
   while (loaded_->physics->steps() < target && state_ != RunState::kFaulted) StepLocked();
   state_ = keep == RunState::kRunning ? RunState::kRunning : RunState::kPaused;
@@ -425,9 +308,9 @@ ModelCore::ReplayStatus ModelCore::replay_status() const {
 void ModelCore::Fork() {
   const auto lock = Lock();
   if (!replay_) throw NotAvailable("fork: no replay is open");
-  const std::string path = replay_->path;
+  const std::string path = replay_->path();
   loaded_->source = path + " (forked at t = " + std::to_string(loaded_->physics->time()) + " s)";
-  fork_reset_every_ = replay_->keyframe_every;  // as the recorded run did, so it goes on alike
+  fork_reset_every_ = replay_->keyframe_every();  // as the recorded run did, so it goes on alike
   replay_.reset();
   loaded_->physics->ClearPull();  // a replayed pull ends: its client was the recording
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
@@ -438,7 +321,7 @@ void ModelCore::Fork() {
 void ModelCore::SetReplayKeyframeHook(KeyframeHook hook) {
   const auto lock = Lock();
   if (!replay_) throw NotAvailable("no replay is open");
-  replay_->keyframe_hook = std::move(hook);
+  replay_->set_keyframe_hook(std::move(hook));
 }
 
 void ModelCore::AddSessionLog(const recording::LogRecord& record) {

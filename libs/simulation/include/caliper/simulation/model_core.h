@@ -2,9 +2,10 @@
 // The Model's data and simulation loop, without CORBA: the loaded scene, its physics, commands
 // and parameter writes queued for the next step boundary, run control with a real-time factor,
 // and snapshots for observers. Every public method is thread-safe; a step never overlaps a call.
-// Three concerns live in parts it owns, each tested on its own and called with its lock held:
+// The concerns below live in parts it owns, each tested on its own and called with its lock held:
 // Feeds (data subscriptions and the lossless wait), EditHistory (undo/redo, removed actuators,
-// the selection) and SessionRecorder (a recording being written).
+// the selection), SessionRecorder (a recording being written), Replayer (one being replayed) and
+// ExperimentRunner with ImportCache (an experiment run's checks, schedule and samples).
 
 #include <atomic>
 #include <chrono>
@@ -21,7 +22,9 @@
 #include "caliper/recording/recording.h"
 #include "caliper/simulation/core_types.h"
 #include "caliper/simulation/edit_history.h"
+#include "caliper/simulation/experiment_runner.h"
 #include "caliper/simulation/feeds.h"
+#include "caliper/simulation/replayer.h"
 #include "caliper/simulation/session_recorder.h"
 #include "caliper/sgal/edits.h"
 #include "caliper/daq/daq_scene.h"
@@ -303,19 +306,6 @@ class ModelCore {
   /// Ends a pull its client stopped renewing.
   void ExpirePullLocked();
   // recording and replay (model_recording.cc)
-  struct Replay {
-    std::unique_ptr<recording::Reader> reader;
-    std::string path;
-    std::vector<recording::Event> events;          // all, in order
-    std::vector<recording::SceneVersion> scenes;
-    size_t next = 0;                               // the next event to apply
-    uint64_t last_reset = UINT64_MAX;              // the step caches were last reset at
-    uint32_t keyframe_every = 100;
-    // each scene version imported once (a seek then builds only the engine)
-    std::map<uint32_t, std::shared_ptr<const sgal::Scene>> imported;
-    KeyframeHook keyframe_hook;
-  };
-
   void RecordEventLocked(const std::string& kind, const std::string& target,
                          std::vector<double> values);
   /// Before a step: replayed events due, keyframes (recording) or cache resets (replay).
@@ -329,7 +319,7 @@ class ModelCore {
   void RestoreReplayLocked(uint64_t step);
   ReplayStatus ReplayStatusLocked() const;
   std::unique_ptr<SessionRecorder> recorder_session_;
-  std::unique_ptr<Replay> replay_;
+  std::unique_ptr<Replayer> replay_;  // the recording replayed (none: not replaying)
   std::string last_recording_error_;
   uint64_t last_recording_bytes_ = 0;
   bool session_log_ = false;  // records come through AddSessionLog
@@ -365,9 +355,6 @@ class ModelCore {
   /// between slices, hands it over (a plain mutex does not: re-locking at once starves callers).
   std::unique_lock<std::mutex> Lock() const;
   sgal::Scene ImportBytes(const std::string& file_name, const std::string& bytes) const;
-  /// ImportBytes, remembering the last result (only RunExperiment's thread calls it).
-  std::shared_ptr<const sgal::Scene> ImportCached(const std::string& file_name,
-                                                  const std::string& bytes);
 
   physics_bullet::Options options_;
   Limits limits_;
@@ -388,9 +375,9 @@ class ModelCore {
   uint64_t step_request_ = 0;           // steps asked of the step request running now (0: none)
   uint64_t step_done_ = 0;              // of those, done so far
   mutable std::atomic<int> waiting_{0};  // calls waiting for the lock (see Lock)
-  // the last scene imported from bytes: batches send the same file run after run
-  std::string imported_name_, imported_bytes_;
-  std::shared_ptr<const sgal::Scene> imported_;
+  // the last scene imported from bytes: batches send the same file run after run (only
+  // RunExperiment's thread uses it)
+  ImportCache imported_;
   double real_time_factor_ = 1.0;
   std::string last_error_;
   std::vector<std::pair<std::string, double>> pending_commands_;
