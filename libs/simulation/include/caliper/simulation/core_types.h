@@ -1,7 +1,7 @@
 #pragma once
-// What ModelCore and the parts it owns (Feeds, EditHistory) share: the errors they raise, the
-// bounds of what one client may ask, and the counters of a data subscription. model_core.h
-// includes it: its users need not.
+// What ModelCore and the parts it owns (Feeds, EditHistory, Replayer, ExperimentRunner) share: the
+// errors they raise, the bounds of what one client may ask, and the counters of a data
+// subscription. model_core.h includes it: its users need not.
 
 #include <chrono>
 #include <cstddef>
