@@ -36,7 +36,7 @@ const char kUsage[] =
     "Usage: caliper-calibrate FILE [--out DIR] [--dry-run] [--resume] [--generations N]\n"
     "                         [--models GLOB] [--islands N] [--run-timeout S]\n"
     "                         [--nameservice corbaname::HOST:PORT]\n"
-    "Fits the parameters named in FILE (a calibration file: README, Calibration) so that the\n"
+    "Fits the parameters named in FILE (a calibration file: docs/calibration.md) so that the\n"
     "simulated experiments match the measured CSVs, with pagmo's CMA-ES (or xNES) on one island\n"
     "per Model of the session (every Model whose name matches --models, default model*).\n"
     "  --out DIR        results (default FILE's name + -calibration): parameters.csv, cost.csv,\n"

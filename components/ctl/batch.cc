@@ -534,7 +534,7 @@ void AddBatchVerb(std::map<std::string, Verb>* verbs) {
       Batch, "cluster",
       "  FILE is JSON: a scene, parameter overrides (\"set\"), a command schedule (\"commands\"\n"
       "  or \"commands_csv\"), the ids to \"record\", \"duration_s\", \"every_n_steps\", a\n"
-      "  \"sweep\" over values, and a list of \"experiments\" (README: Batch runs). Scenes are\n"
+      "  \"sweep\" over values, and a list of \"experiments\" (docs/cluster.md). Scenes are\n"
       "  sent by content: the Models need no shared disk (a .urdf scene is imported here, meshes\n"
       "  included, and sent as COLLADA). Each Model runs one experiment at a time from a fresh\n"
       "  load, so results are bit-identical wherever they run.\n"

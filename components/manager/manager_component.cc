@@ -92,7 +92,7 @@ ChildStatus ManagerComponent::Create(
     if (key == "corba.endpoint" || key == "naming.service")
       throw StartFailed("the key '" + key + "' is set by the manager (" +
                         "its Models listen and register where it does)");
-    // the directories paths may lead into are the host's choice (README, "Trust model")
+    // the directories paths may lead into are the host's choice (docs/cluster.md, "Trust model")
     if (key == "model.read_dirs" || key == "model.write_dir" || key == "model.confine_scene")
       throw StartFailed("the key '" + key + "' is set on the manager's host, not by a client " +
                         "(it bounds the files a Model reads and writes for its clients)");

@@ -66,15 +66,16 @@ M::SimulationStatus* StatusOf(const ModelRef& m) {
 
 namespace {
 
-// Whether a bound object is a Model: its reference names the type (no call), or else it is
-// asked; one that does not answer counts as a Model, for the caller to probe.
+// Whether a bound object is a Model, from the type its reference names (no call: a discovery
+// loop must not wait on a peer that does not answer). No interface derives from Model, so a
+// reference naming another type is not one; only a reference naming none is asked.
 bool IsModel(CORBA::Object_ptr object) {
   const char* type = object->_PR_getobj()->_mostDerivedRepoId();
-  if (type != nullptr && std::strcmp(type, M::Model::_PD_repoId) == 0) return true;
+  if (type != nullptr && *type != '\0') return std::strcmp(type, M::Model::_PD_repoId) == 0;
   try {
     return object->_is_a(M::Model::_PD_repoId);
   } catch (const CORBA::SystemException&) {
-    return true;
+    return true;  // the caller's pool sets it aside and probes it
   }
 }
 

@@ -281,15 +281,15 @@ TEST(Recording, ExportsChannelsAsCsvWithUnits) {
   EXPECT_THROW(Reader(empty).ExportCsv(dir.path() + "/none.csv"), RecordingError);
 }
 
-// the ```python block of README.md's "### The file", run as written
+// the ```python block of docs/recording.md's "## The file", run as written
 TEST(Recording, ReadmePythonExampleReadsAChannel) {
   const char* source = std::getenv("CALIPER_SOURCE_DIR");
   ASSERT_NE(source, nullptr) << "run through ctest (it sets CALIPER_SOURCE_DIR)";
-  const std::string readme = ReadFile(std::string(source) + "/README.md");
-  const size_t section = readme.find("\n### The file\n");
-  ASSERT_NE(section, std::string::npos) << "README.md has no '### The file'";
+  const std::string readme = ReadFile(std::string(source) + "/docs/recording.md");
+  const size_t section = readme.find("\n## The file\n");
+  ASSERT_NE(section, std::string::npos) << "docs/recording.md has no '## The file'";
   const size_t begin = readme.find("```python\n", section);
-  ASSERT_NE(begin, std::string::npos) << "no python example after '### The file'";
+  ASSERT_NE(begin, std::string::npos) << "no python example after '## The file'";
   const size_t end = readme.find("```\n", begin + 10);
   ASSERT_NE(end, std::string::npos);
   const std::string script = readme.substr(begin + 10, end - begin - 10);

@@ -87,10 +87,9 @@ struct ModelEntry {
 };
 
 /// The Models whose instance (model1) or INSTANCE@HOST matches the glob. Only Models: another
-/// component matching the glob (a host's manager for `*@hostb`) is left out, judged by its name
-/// (model instances are called model<N> or named by their creator) and, where the name does not
-/// tell, by asking the object whether it is a Model. An object that does not answer is kept (a
-/// pool sets it aside and probes it).
+/// component matching the glob (a host's manager for `*@hostb`) is left out, judged by the type
+/// its reference names, without a call; a reference that names no type is asked, and kept when
+/// it does not answer (a pool sets it aside and probes it).
 std::vector<ModelEntry> FindModels(CosNaming::NamingContext_ptr root, const std::string& glob);
 
 }  // namespace caliper::client

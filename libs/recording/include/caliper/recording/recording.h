@@ -3,8 +3,8 @@
 // keyframes, every command and parameter write with the step at which it took effect, the log
 // records and optionally chosen channels. Written from the simulation thread through a queue and
 // committed by a writer thread at least every 0.5 s, so a killed Model loses at most that; read
-// back for replay, verification, forks and CSV export. No CORBA here. The schema is in README.md
-// ("Record and replay").
+// back for replay, verification, forks and CSV export. No CORBA here. The schema is in
+// docs/recording.md ("The file").
 
 #include <chrono>
 #include <cstdint>
