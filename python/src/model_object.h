@@ -1,0 +1,47 @@
+#pragma once
+// caliper.Model's C++ side: a Model of a session, called with the session's deadline and the
+// GIL released.
+
+#include <map>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "binding.h"
+
+namespace caliper::python {
+
+struct ModelObject {
+  SessionHandle s;
+  client::ModelRef ref;
+  /// Channel shapes by id (rows, cols), learnt from the Model's channel list; cleared on load.
+  std::mutex shapes_mutex;
+  std::map<std::string, std::pair<uint32_t, uint32_t>> shapes;
+
+  /// Runs `f` on the Model with the GIL released and a call deadline of `timeout_s` (the
+  /// session's when < 0), the Model's exceptions turned into the library's (client::Call).
+  template <class F>
+  auto Run(F&& f, double timeout_s = -1) -> decltype(f()) {
+    py::gil_scoped_release release;
+    CallScope scope(timeout_s < 0 ? s.timeout_s : timeout_s);
+    return client::Call(ref, std::forward<F>(f));
+  }
+  /// The shapes of `ids` (one channel list call for those not known yet); GIL held.
+  std::vector<std::pair<uint32_t, uint32_t>> Shapes(const std::vector<std::string>& ids);
+};
+
+/// Session.model(name): the Model bound as `name` (model1@hostb is hostb/model1).
+std::shared_ptr<ModelObject> OpenModel(SessionHandle& s, const std::string& name);
+
+/// A Python Channel for a DAQ channel description.
+py::object ChannelObject(const ::Caliper::Daq::ChannelInfo& c);
+
+/// The values of one channel as a numpy array of its shape (ChannelShape).
+py::array_t<double> ChannelArray(const double* values, uint32_t rows, uint32_t cols);
+
+/// Model methods bound by other files: scene editing and pulls (edit.cc), recordings and replay
+/// (session_recording.cc). Records and streams are caliper.Model's Python methods on _Feed.
+void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c);
+void BindSessionRecording(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c);
+
+}  // namespace caliper::python
