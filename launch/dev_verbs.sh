@@ -6,13 +6,15 @@
 # their lines of `launch/caliper help`, between deps and ctl
 dev_usage() {
   cat <<'USAGE'
-  bench [physics|collada|model|gui|cluster|calibration|all]
+  bench [physics|collada|model|gui|cluster|calibration|python|all]
                           build and run the benchmarks (all by default; physics: the engine
                           against raw Bullet and MuJoCo, collada: COLLADA and URDF load
                           times, model: the control cycle and DAQ, gui: plotter drawing, log
                           viewer filtering,
                           cluster: batch throughput with 1 and 2 Models, per-run overhead,
-                          calibration: evaluations/s with 1 and 2 Models); one line
+                          calibration: evaluations/s with 1 and 2 Models, python: the
+                          package's control cycle against C++, record rate, vector
+                          environment with 2 Models against 1); one line
                           per figure: RATIO <name> <value> (target <target>)
   faults [--freeze S]     the fault suite on a GUI session with a controller (Xvfb when there is no
                           display): renderer and plotter stopped for S s (default 30), renderer,
@@ -52,8 +54,8 @@ cmd_bench() {
   [ $# -gt 0 ] && shift
   cmd_build
   case "$which" in
-    physics|collada|model|gui|cluster|calibration|all) ;;
-    *) die "bench physics|collada|model|gui|cluster|calibration|all" ;;
+    physics|collada|model|gui|cluster|calibration|python|all) ;;
+    *) die "bench physics|collada|model|gui|cluster|calibration|python|all" ;;
   esac
   if [ "$which" = physics ] || [ "$which" = all ]; then
     say "physics benchmarks (a minute or two)"
@@ -76,6 +78,11 @@ cmd_bench() {
   if [ "$which" = calibration ] || [ "$which" = all ]; then
     say "calibration benchmarks (a minute; --example adds the example's wall time, minutes)"
     CALIPER_BIN_DIR=$BIN bash "$ROOT/bench/calibration_bench.sh" "$@"
+  fi
+  if [ "$which" = python ] || [ "$which" = all ]; then
+    say "python benchmarks (about a minute)"
+    PYTHONPATH=$BUILD/python CALIPER_BIN_DIR=$BIN /usr/bin/python3 "$ROOT/bench/python_bench.py" \
+      --cpp-cycle "$BUILD/bench/control_cycle_bench"
   fi
   if [ "$which" = gui ] || [ "$which" = all ]; then
     # offscreen: no display needed

@@ -17,19 +17,21 @@ from .errors import (ConnectionError, EditRefused, Error, FormatError, InvalidPa
                      LimitExceeded, LoadFailed, NotAvailable, RecordingError, RunFailed,
                      SetupError, UnknownId)
 from .session import Component, LocalSession, Session, binary, connect
-from .model import (Actuator, ActuatorState, Channel, Data, EditStatus, Model, RecordStatus,
+from .model import (Actuator, ActuatorState, Channel, Data, EditStatus, Feed, Model, RecordStatus,
                     ReplayStatus, Status)
 from .recording import Event, LogRecord, Recording, SceneVersion, verify
 from .experiments import Batch, load_experiments, run_batch
 from .calibration import Calibration, Evaluation
+from .env import TendonEnv, VectorEnv
+from .spaces import Box
 
 __version__ = "0.1.0"
 
 __all__ = [
     "connect", "Session", "LocalSession", "Component", "Model", "Status", "Channel", "Actuator",
-    "ActuatorState", "EditStatus", "RecordStatus", "ReplayStatus", "Data", "Recording", "Event",
+    "ActuatorState", "EditStatus", "RecordStatus", "ReplayStatus", "Data", "Feed", "Recording", "Event",
     "LogRecord", "SceneVersion", "verify", "load_experiments", "run_batch", "Batch",
-    "Calibration", "Evaluation", "binary", "errors", "Error", "ConnectionError", "UnknownId",
+    "Calibration", "Evaluation", "TendonEnv", "VectorEnv", "Box", "binary", "errors", "Error", "ConnectionError", "UnknownId",
     "InvalidParameter", "NotAvailable", "LoadFailed", "LimitExceeded", "RunFailed",
     "EditRefused", "SetupError", "FormatError", "RecordingError",
 ]

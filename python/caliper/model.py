@@ -16,7 +16,7 @@ import numpy as np
 from . import _caliper
 
 __all__ = ["Status", "Channel", "Actuator", "ActuatorState", "EditStatus", "RecordStatus",
-           "ReplayStatus", "Data", "Model"]
+           "ReplayStatus", "Data", "Feed", "Model"]
 
 
 class Status(NamedTuple):
@@ -129,6 +129,36 @@ class Data:
 Model = _caliper.Model
 
 
+class Feed:
+    """A lossless subscription to channels of a Model (``Model.feed``): the Model's stepping
+    waits for this client, so no sample is lost. :meth:`step` steps the Model itself and returns
+    the samples of those steps; :meth:`take` returns what arrived while something else (a
+    controller, ``start()``) ran it. Close it (or use ``with``) to end the subscription."""
+
+    def __init__(self, model: Model, ids: Union[str, Sequence[str]], every: int = 1):
+        self._feed = _caliper._Feed(model, ids, every)
+        #: the channels, in the order of a sample's values
+        self.channels: List[Channel] = list(self._feed.channels)
+
+    def step(self, steps: int) -> Data:
+        """Steps the Model `steps` times and returns the samples taken meanwhile."""
+        return Data(self.channels, *self._feed.step(steps))
+
+    def take(self, wait_s: float = 1.0) -> Data:
+        """The samples that arrived since the last take, after waiting up to `wait_s` [s] for
+        those the Model has already taken."""
+        return Data(self.channels, *self._feed.take(wait_s))
+
+    def close(self) -> None:
+        self._feed.close()
+
+    def __enter__(self) -> "Feed":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
 def _steps_for(model: Model, steps: Optional[int], duration_s: Optional[float]) -> int:
     if (steps is None) == (duration_s is None):
         raise TypeError("give steps or duration_s (one of them)")
@@ -148,12 +178,8 @@ def _record(self: Model, ids: Union[str, Sequence[str]], steps: Optional[int] = 
     :class:`Data`: time first, then each channel in its shape and unit. The Model must not be
     running (lock-step). Ctrl-C stops it between pieces of 20,000 steps."""
     n = _steps_for(self, steps, duration_s)
-    feed = _caliper._Feed(self, ids, every)
-    try:
-        time, values = feed.step(n)
-        return Data(feed.channels, time, values)
-    finally:
-        feed.close()
+    with Feed(self, ids, every) as feed:
+        return feed.step(n)
 
 
 def _stream(self: Model, ids: Union[str, Sequence[str]], block_steps: int = 1000,
@@ -162,15 +188,11 @@ def _stream(self: Model, ids: Union[str, Sequence[str]], block_steps: int = 1000
     block, losslessly, `blocks` times (forever when None: stop iterating to end it)."""
     if block_steps < 1:
         raise ValueError("block_steps must be >= 1")
-    feed = _caliper._Feed(self, ids, every)
-    try:
+    with Feed(self, ids, every) as feed:
         done = 0
         while blocks is None or done < blocks:
-            time, values = feed.step(block_steps)
-            yield Data(feed.channels, time, values)
+            yield feed.step(block_steps)
             done += 1
-    finally:
-        feed.close()
 
 
 def _run_experiment(self: Model, experiment) -> Data:
@@ -184,6 +206,19 @@ def _run_experiment(self: Model, experiment) -> Data:
     return Data(*_caliper._run_on(self, runs[0]))
 
 
+def _feed(self: Model, ids: Union[str, Sequence[str]], every: int = 1) -> Feed:
+    """A lossless :class:`Feed` of the channels `ids`, every `every` steps."""
+    return Feed(self, ids, every)
+
+
+def _fault(self: Model) -> Optional[str]:
+    """Why the simulation faulted (the Model's report), or None when it runs normally."""
+    s = self.status()
+    return s.last_error if s.state == "FAULTED" else None
+
+
 Model.record = _record
+Model.feed = _feed
+Model.fault = property(_fault)
 Model.stream = _stream
 Model.run_experiment = _run_experiment
