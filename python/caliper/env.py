@@ -178,6 +178,7 @@ class TendonEnv(_EnvBase):  # type: ignore[misc,valid-type]
         return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
 
     def close(self) -> None:
+        """Switches the environment's actuators off."""
         try:
             self.model.set_commands({a: 0.0 for a in self.actuators})
         except Exception:  # the Model may be gone; nothing left to switch off
@@ -251,6 +252,8 @@ class VectorEnv:
 
     def step(self, actions) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                      Dict[str, Any]]:
+        """Steps every environment with its row of `actions` (N x action size), in parallel;
+        returns stacked (observations, rewards, terminated, truncated, infos)."""
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != self.action_space.shape:
             raise ValueError(f"actions must have shape {self.action_space.shape}, not "
@@ -278,6 +281,7 @@ class VectorEnv:
         return out
 
     def close(self) -> None:
+        """Closes every environment and the worker threads."""
         for e in self.envs:
             e.close()
         self._executor.shutdown()

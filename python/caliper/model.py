@@ -119,6 +119,7 @@ class Data:
         return len(self.time)
 
     def ids(self) -> List[str]:
+        """The channel ids, in order."""
         return list(self._columns)
 
     def __repr__(self) -> str:
@@ -150,6 +151,7 @@ class Feed:
         return Data(self.channels, *self._feed.take(wait_s))
 
     def close(self) -> None:
+        """Ends the subscription (idempotent)."""
         self._feed.close()
 
     def __enter__(self) -> "Feed":

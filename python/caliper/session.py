@@ -162,6 +162,8 @@ class LocalSession:
         self._processes[index].wait()
 
     def close(self) -> None:
+        """Stops the Models and the naming service (TERM, then KILL after 10 s) and removes
+        the directory unless `keep`."""
         for p in reversed(self._processes):
             if p.poll() is None:
                 p.terminate()

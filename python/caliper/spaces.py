@@ -35,6 +35,7 @@ except ImportError:
             self.np_random = np.random.default_rng(seed)
 
         def seed(self, seed: Optional[int] = None) -> list:
+            """Reseeds sample()'s generator."""
             self.np_random = np.random.default_rng(seed)
             return [seed]
 
@@ -54,6 +55,7 @@ except ImportError:
             return out
 
         def contains(self, x) -> bool:
+            """Whether `x` has the box's shape and lies within its bounds."""
             x = np.asarray(x)
             return bool(x.shape == self.shape and np.can_cast(x.dtype, self.dtype) and
                         np.all(x >= self.low) and np.all(x <= self.high))
@@ -62,6 +64,7 @@ except ImportError:
             return self.contains(x)
 
         def is_bounded(self, manner: str = "both") -> bool:
+            """Whether every dimension is bounded ("both", "below" or "above")."""
             below, above = np.all(np.isfinite(self.low)), np.all(np.isfinite(self.high))
             return {"both": below and above, "below": below, "above": above}[manner]
 

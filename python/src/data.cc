@@ -29,7 +29,7 @@ py::tuple Block(std::vector<double>& times, std::vector<double>& data, size_t wi
 // this consumer when it steps or runs as fast as possible).
 class Feed {
  public:
-  Feed(std::shared_ptr<ModelObject> model, const py::handle& ids, uint32_t every)
+  Feed(std::shared_ptr<ModelObject> model, const py::object& ids, uint32_t every)
       : model_(std::move(model)), ids_(IdList(ids, "ids")) {
     if (ids_.empty()) throw py::value_error("ids must name at least one channel");
     if (every < 1) throw py::value_error("every must be >= 1 step");
@@ -182,7 +182,7 @@ void BindRecordingFile(py::module_& m) {
 
 void BindData(py::module_& m) {
   py::class_<Feed>(m, "_Feed")
-      .def(py::init<std::shared_ptr<ModelObject>, const py::handle&, uint32_t>(), py::arg("model"),
+      .def(py::init<std::shared_ptr<ModelObject>, const py::object&, uint32_t>(), py::arg("model"),
            py::arg("ids"), py::arg("every") = 1)
       .def_property_readonly("channels", &Feed::channels)
       .def("step", &Feed::Step, py::arg("steps"))

@@ -64,8 +64,8 @@ auto Edit(F f) {
 }
 
 py::object SetObstacle(ModelObject& m, const std::string& name, const std::string& body,
-                       const std::string& kind, const py::handle& position_m,
-                       const py::handle& quaternion, double radius_m, double length_m) {
+                       const std::string& kind, const py::object& position_m,
+                       const py::object& quaternion, double radius_m, double length_m) {
   const auto p = Vector(position_m, "position_m");
   const std::vector<double> q = FiniteValues(quaternion, "quaternion");
   if (q.size() != 4) throw py::value_error("quaternion must have 4 elements (w, x, y, z)");
@@ -84,7 +84,7 @@ py::object SetObstacle(ModelObject& m, const std::string& name, const std::strin
 
 void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
   c.def("move_path_point",
-        [](ModelObject& m, const std::string& tendon, uint32_t index, const py::handle& point) {
+        [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
           const S::PathPoint p = Point(point, "point");
           return Edit([&](M::Model_ptr r) {
             return r->move_path_point(tendon.c_str(), index, p);
@@ -94,7 +94,7 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
         "Moves a tendon's path point `index` to `point`: (body, (x, y, z)) in the body's frame "
         "[m], or an obstacle's name.")
       .def("insert_path_point",
-           [](ModelObject& m, const std::string& tendon, uint32_t index, const py::handle& point) {
+           [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
              const S::PathPoint p = Point(point, "point");
              return Edit([&](M::Model_ptr r) {
                return r->insert_path_point(tendon.c_str(), index, p);
@@ -110,8 +110,8 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
            },
            py::arg("tendon"), py::arg("index"), "Removes a tendon's path point.")
       .def("add_tendon",
-           [](ModelObject& m, const std::string& tendon, const py::handle& start,
-              const py::handle& end, double radius_m, const std::string& actuator,
+           [](ModelObject& m, const std::string& tendon, const py::object& start,
+              const py::object& end, double radius_m, const std::string& actuator,
               const std::string& kind) {
              const S::PathPoint a = Point(start, "start"), b = Point(end, "end");
              if (!(radius_m > 0) || radius_m > 1) throw py::value_error("radius_m must be in (0, 1] m");
@@ -145,7 +145,7 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
            },
            py::arg("body"), py::arg("mass_kg"), "Sets a body's mass [kg].")
       .def("set_shape_dims",
-           [](ModelObject& m, const std::string& body, uint32_t index, const py::handle& dims) {
+           [](ModelObject& m, const std::string& body, uint32_t index, const py::object& dims) {
              const std::vector<double> d = FiniteValues(dims, "dims_m");
              S::DoubleSeq seq;
              seq.length(static_cast<CORBA::ULong>(d.size()));
@@ -175,8 +175,8 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
            },
            "The actuator kinds add_tendon knows: {kind: {parameter: (default, unit)}}.")
       .def("pull",
-           [](ModelObject& m, const std::string& body, const py::handle& point,
-              const py::handle& target, double stiffness_n_per_m) {
+           [](ModelObject& m, const std::string& body, const py::object& point,
+              const py::object& target, double stiffness_n_per_m) {
              const M::Vector3 p = ToVector3(point, "point_m"), t = ToVector3(target, "target_m");
              if (!std::isfinite(stiffness_n_per_m) || stiffness_n_per_m <= 0)
                throw py::value_error("stiffness_n_per_m must be > 0 and finite");

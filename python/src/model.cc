@@ -95,14 +95,14 @@ M::CommandSeq Commands(const py::handle& commands) {
   return seq;
 }
 
-void SetCommand(ModelObject& m, const std::string& actuator, const py::handle& value) {
+void SetCommand(ModelObject& m, const std::string& actuator, const py::object& value) {
   const std::vector<double> v = FiniteValues(value, "value");
   if (v.size() != 1)
     throw py::value_error("value must be one number, not " + std::to_string(v.size()));
   m.Run([&] { m.ref.model->set_command(actuator.c_str(), v[0]); });
 }
 
-void SetCommands(ModelObject& m, const py::handle& commands) {
+void SetCommands(ModelObject& m, const py::object& commands) {
   const M::CommandSeq seq = Commands(commands);
   m.Run([&] { m.ref.model->set_commands(seq); });
 }
@@ -119,7 +119,7 @@ py::list Channels(ModelObject& m, const std::string& pattern) {
 }
 
 // get(): one id gives one array, a list of ids a list of arrays (each in its channel's shape)
-py::object Get(ModelObject& m, const py::handle& ids) {
+py::object Get(ModelObject& m, const py::object& ids) {
   const std::vector<std::string> list = IdList(ids, "ids");
   const S::StringSeq seq = ToSeq(list);
   D::ValueSeq_var values = m.Run([&] { return m.ref.model->get(seq); });
@@ -131,7 +131,7 @@ py::object Get(ModelObject& m, const py::handle& ids) {
 }
 
 // get_values(): every value of the ids, one after the other, in one flat array (control loops)
-py::array_t<double> GetValues(ModelObject& m, const py::handle& ids) {
+py::array_t<double> GetValues(ModelObject& m, const py::object& ids) {
   const std::vector<std::string> list = IdList(ids, "ids");
   const S::StringSeq seq = ToSeq(list);
   std::vector<double> flat;
@@ -146,7 +146,7 @@ py::array_t<double> GetValues(ModelObject& m, const py::handle& ids) {
   return out;
 }
 
-void Set(ModelObject& m, const std::string& id, const py::handle& value) {
+void Set(ModelObject& m, const std::string& id, const py::object& value) {
   const std::vector<double> v = FiniteValues(value, "value");
   const auto shape = m.Shapes({id})[0];
   if (v.size() != static_cast<size_t>(shape.first) * shape.second)

@@ -22,7 +22,7 @@ py::object ReplayStatusObject(const M::ReplayStatus& r) {
                             r.first_step, r.last_step, r.step, r.start_time, r.end_time, r.time);
 }
 
-py::object StartRecording(ModelObject& m, const std::string& path, const py::handle& channels,
+py::object StartRecording(ModelObject& m, const std::string& path, const py::object& channels,
                           uint32_t every, uint32_t keyframe_every, uint64_t max_bytes) {
   if (every < 1) throw py::value_error("every must be >= 1 step");
   if (keyframe_every < 1 || keyframe_every > 1000)
