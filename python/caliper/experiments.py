@@ -25,9 +25,14 @@ ExperimentLike = Union[str, "os.PathLike[str]", Dict[str, Any], Experiment,
                        List[Union[Dict[str, Any], Experiment]]]
 
 
-def load_experiments(path: "str | os.PathLike[str]") -> List[Experiment]:
-    """The runs of an experiment file (JSON; sweeps expanded). FormatError names the file, the
-    experiment and the key that is wrong."""
+def load_experiments(experiments: ExperimentLike) -> List[Experiment]:
+    """The runs (sweeps expanded) of an experiment file (JSON), of a dict in the file's format
+    (paths relative to the working directory), or of a list of these. FormatError names the
+    file, the experiment and the key that is wrong."""
+    return experiments_of(experiments)
+
+
+def _load_file(path: "str | os.PathLike[str]") -> List[Experiment]:
     return _caliper._load_experiments(os.path.abspath(os.fspath(path)))
 
 
@@ -48,13 +53,13 @@ def experiments_of(x: ExperimentLike) -> List[Experiment]:
     if isinstance(x, Experiment):
         return [x]
     if isinstance(x, (str, os.PathLike)):
-        return load_experiments(x)
+        return _load_file(x)
     if isinstance(x, dict):
         with tempfile.TemporaryDirectory(prefix="caliper-experiments-") as d:
             path = os.path.join(d, "experiments.json")
             with open(path, "w") as f:
                 json.dump(_absolute(x, os.getcwd()), f)
-            return load_experiments(path)
+            return _load_file(path)
     if isinstance(x, (list, tuple)):
         return [run for item in x for run in experiments_of(item)]
     raise TypeError(f"experiments must be a file, a dict, an Experiment or a list of them, not "
@@ -65,9 +70,11 @@ class Batch:
     """What :func:`run_batch` returns: ``results`` (run name to :class:`caliper.Data`), in the
     order of the runs; ``failures`` (run name to the reason) for runs that failed on every
     attempt or cannot run (a physics fault, a scene that does not load); ``lost`` (what each
-    lost Model said); ``wall_s``."""
+    lost Model said); ``runs`` (the runs, with their names and overrides); ``models``;
+    ``wall_s``."""
 
     def __init__(self) -> None:
+        self.runs: List[Experiment] = []
         self.results: Dict[str, Data] = {}
         self.failures: Dict[str, str] = {}
         self.lost: List[str] = []
@@ -101,6 +108,7 @@ def run_batch(experiments: ExperimentLike, session: Optional[Session] = None,
     if pool.size == 0:
         raise Error(f"no Model matching {models!r} in the session at {session.address}")
     batch = Batch()
+    batch.runs = runs
     batch.models = pool.names()
     lock = threading.Lock()
     pool.set_on_lost(lambda why: batch.lost.append(why))

@@ -134,7 +134,19 @@ void BindExperiment(py::module_& m) {
       .def_readonly("scene", &experiment::Experiment::scene)
       .def_readonly("record", &experiment::Experiment::record)
       .def_readonly("every_n_steps", &experiment::Experiment::every_n_steps)
-      .def_readonly("duration_s", &experiment::Experiment::duration_s);
+      .def_readonly("duration_s", &experiment::Experiment::duration_s)
+      .def_property_readonly(
+          "overrides",
+          [](const experiment::Experiment& e) {
+            py::dict out;
+            for (const auto& o : e.overrides) out[py::str(o.id)] = o.values;
+            return out;
+          },
+          "The parameters written before the run: {id: values}, in order (a sweep's too).")
+      .def("__repr__", [](const experiment::Experiment& e) {
+        return "<caliper experiment " + e.name + ": " + e.scene + ", " +
+               std::to_string(e.duration_s) + " s>";
+      });
   m.def("_load_experiments", &experiment::LoadFile, py::arg("path"));
   m.def("_run_on", &RunOn, py::arg("model"), py::arg("experiment"));
 }
