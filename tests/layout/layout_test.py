@@ -22,6 +22,8 @@ Rules (a target or object belongs to the folder whose CMakeLists.txt defines its
      header, so a public header that leaks one fails here); libs/sgal, libs/actuators and libs/daq
      read no CORBA, no Qt and no engine header; of the libraries only libs/rtc and libs/client (and
      what links libs/client: libs/calibration's evaluator) read generated IDL headers
+The Python package's extension (python/) is a client like the components: rule 1 holds for it
+too (it reads no component's header and links no component's target).
 Targets under tests/, bench/ and fuzz/ may use anything: they are not components.
 
 Exit status: 0 all rules hold, 1 a rule is broken (each violation printed), 77 skipped (the build
@@ -64,6 +66,8 @@ EXEMPT_TOPS = ("tests", "bench", "fuzz")
 def owner_of(folder):
     """'components/ctl' for components/ctl/..., 'libs/sgal' for libs/sgal/..., else None."""
     parts = folder.split("/")
+    if parts[0] == "python":
+        return "python"
     if len(parts) >= 2 and parts[0] in ("components", "libs"):
         return parts[0] + "/" + parts[1]
     return None
@@ -73,6 +77,8 @@ def kind_of(folder):
     top = folder.split("/")[0]
     if top in ("components", "libs"):
         return top
+    if top == "python":
+        return "components"  # a client: a leaf like the components
     if top in EXEMPT_TOPS:
         return "exempt"
     return "other"
