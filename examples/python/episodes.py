@@ -32,6 +32,18 @@ SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 MASS = "ecce_arm.forearm.mass"
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """--help: this docstring as written, and the options' defaults."""
+
+    def _get_help_string(self, action):
+        default = action.default
+        if default in (None, False, argparse.SUPPRESS):
+            return action.help
+        if isinstance(default, (list, tuple)):
+            default = " ".join(map(str, default))
+        return f"{action.help} (default: {default})"
+
+
 # -- the session: a private one by default, or a running one ----------------------------------
 def add_session_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("session (default: a private one started for this run)")
@@ -47,7 +59,10 @@ def open_session(args: argparse.Namespace, models: int):
     """A caliper.Session: the running one asked for, else a private LocalSession of `models`
     Models with the shipped arm loaded (stopped when the block ends)."""
     if args.nameservice or args.latest:
-        session = caliper.connect(args.nameservice)
+        try:
+            session = caliper.connect(args.nameservice)
+        except caliper.ConnectionError as e:
+            raise SystemExit(f"error: {e}") from None
         print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
         yield session
         return
@@ -106,9 +121,7 @@ def episode(env: caliper.TendonEnv, seed: int, policy, args: argparse.Namespace)
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
     parser.add_argument("--episodes", type=int, default=3,
                         help="random episodes, and as many PD ones (seeds 0, 1, ...)")
     parser.add_argument("--actions", type=int, default=500,
@@ -210,12 +223,13 @@ def plot(traces: dict, vector_trace, args: argparse.Namespace, period_s: float, 
         for label, style in (("random", ":"), ("PD", "-")):
             mass, angles = traces[(label, seed)]
             t = np.arange(len(angles)) * period_s
-            ax.plot(t, angles, style, color=f"C{seed}", label=f"{label}, seed {seed} ({mass:.2f} kg)")
+            ax.plot(t, angles, style, color=f"C{seed}",
+                    label=f"{label}, seed {seed} ({mass:.2f} kg)")
     ax.axhline(args.target_rad, color="k", linestyle="--", linewidth=1, label="target")
     ax.set_title("TendonEnv: random actions (dotted) and PD (solid)")
     ax.set_xlabel("time in the episode [s]")
     ax.set_ylabel("elbow angle [rad]")
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=8, loc="center right")
     if vector_trace is not None:
         masses, angles = vector_trace
         ax = axes[0, 1]

@@ -35,6 +35,18 @@ ANGLE = "ecce_arm.elbow.position"
 TENSION = "ecce_arm.elbow_flexor.tendon.tension"
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """--help: this docstring as written, and the options' defaults."""
+
+    def _get_help_string(self, action):
+        default = action.default
+        if default in (None, False, argparse.SUPPRESS):
+            return action.help
+        if isinstance(default, (list, tuple)):
+            default = " ".join(map(str, default))
+        return f"{action.help} (default: {default})"
+
+
 # -- the session: a private one by default, or a running one ----------------------------------
 def add_session_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("session (default: a private one started for this run)")
@@ -50,7 +62,10 @@ def open_session(args: argparse.Namespace, models: int):
     """A caliper.Session: the running one asked for, else a private LocalSession of `models`
     Models with the shipped arm loaded (stopped when the block ends)."""
     if args.nameservice or args.latest:
-        session = caliper.connect(args.nameservice)
+        try:
+            session = caliper.connect(args.nameservice)
+        except caliper.ConnectionError as e:
+            raise SystemExit(f"error: {e}") from None
         print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
         yield session
         return
@@ -81,9 +96,7 @@ def experiments(args: argparse.Namespace) -> dict:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
     parser.add_argument("--masses-kg", type=float, nargs="+",
                         default=[0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
                         help="forearm masses to run [kg] (the shipped arm's is 1 kg)")

@@ -8,9 +8,11 @@ with the arithmetic of the C++ controller (components/pd_controller/pd_controlle
     flexor   = clamp(bias + u, 0, max)                [V]
     extensor = clamp(bias - u, 0, max)                [V]
 
-and then steps the Model `--steps-per-tick` physics steps (10 x 1 ms by default). Nothing else
-moves the Model, so a run is a function of its options. It prints the elbow angle every 0.5 s of
-simulated time and the final error, and plots angle, motor commands and tendon tensions.
+and then steps the Model `--steps-per-tick` physics steps (10 x 1 ms by default; the C++
+controller's lock-step mode, controller.lockstep). The target here is 0.8 rad (the demo asks its
+controller for 1.0 rad: `--target-rad 1.0`). Nothing else moves the Model, so a run is a
+function of its options. It prints the elbow angle every 0.5 s of simulated time and the final
+error, and plots angle, motor commands and tendon tensions.
 
 Run it right after building (it starts a private session with one Model of the shipped arm):
 
@@ -36,6 +38,18 @@ ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
 SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """--help: this docstring as written, and the options' defaults."""
+
+    def _get_help_string(self, action):
+        default = action.default
+        if default in (None, False, argparse.SUPPRESS):
+            return action.help
+        if isinstance(default, (list, tuple)):
+            default = " ".join(map(str, default))
+        return f"{action.help} (default: {default})"
+
+
 # -- the session: a private one by default, or a running one ----------------------------------
 def add_session_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("session (default: a private one started for this run)")
@@ -51,7 +65,10 @@ def open_session(args: argparse.Namespace, models: int):
     """A caliper.Session: the running one asked for, else a private LocalSession of `models`
     Models with the shipped arm loaded (stopped when the block ends)."""
     if args.nameservice or args.latest:
-        session = caliper.connect(args.nameservice)
+        try:
+            session = caliper.connect(args.nameservice)
+        except caliper.ConnectionError as e:
+            raise SystemExit(f"error: {e}") from None
         print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
         yield session
         return
@@ -78,9 +95,7 @@ def prepare(model: "caliper.Model") -> None:
 
 # -- the controller -------------------------------------------------------------------------------
 def main() -> int:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
     parser.add_argument("--target-rad", type=float, default=0.8, help="elbow target [rad]")
     parser.add_argument("--kp", type=float, default=20.0, help="proportional gain [V/rad]")
     parser.add_argument("--kd", type=float, default=1.0, help="derivative gain [V s/rad]")

@@ -16,7 +16,7 @@ for bit (caliper.verify).
 
     launch/caliper python examples/python/read_recording.py
     launch/caliper python examples/python/read_recording.py --verify
-    launch/caliper python examples/python/read_recording.py run.sqlite --channel ecce_arm.hand.position
+    launch/caliper python examples/python/read_recording.py FILE --channel ecce_arm.hand.position
 """
 
 import argparse
@@ -37,6 +37,18 @@ CHANNELS = ["ecce_arm.elbow.position", "ecce_arm.elbow_flexor.tendon.tension",
             "ecce_arm.elbow_extensor.tendon.tension", "ecce_arm.hand.position"]
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """--help: this docstring as written, and the options' defaults."""
+
+    def _get_help_string(self, action):
+        default = action.default
+        if default in (None, False, argparse.SUPPRESS):
+            return action.help
+        if isinstance(default, (list, tuple)):
+            default = " ".join(map(str, default))
+        return f"{action.help} (default: {default})"
+
+
 # -- the session: a private one by default, or a running one ----------------------------------
 def add_session_arguments(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("session (default: a private one started for this run)")
@@ -52,7 +64,10 @@ def open_session(args: argparse.Namespace, models: int):
     """A caliper.Session: the running one asked for, else a private LocalSession of `models`
     Models with the shipped arm loaded (stopped when the block ends)."""
     if args.nameservice or args.latest:
-        session = caliper.connect(args.nameservice)
+        try:
+            session = caliper.connect(args.nameservice)
+        except caliper.ConnectionError as e:
+            raise SystemExit(f"error: {e}") from None
         print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
         yield session
         return
@@ -84,7 +99,7 @@ def record(args: argparse.Namespace) -> str:
         arm = session.model(args.model)
         prepare(arm)
         # a name of its own: a recording never overwrites a file
-        name = time.strftime("read_recording-%Y%m%d-%H%M%S.caliper")
+        name = time.strftime(f"read_recording-%Y%m%d-%H%M%S-{os.getpid()}.caliper")
         status = arm.start_recording(name, channels=args.channels, every=args.every)
         print(f"{arm.name} records into {status.path} (on its host)")
         third = max(1, round(args.duration_s / 3 / arm.time_step_s))
@@ -113,9 +128,7 @@ def record(args: argparse.Namespace) -> str:
 
 # -- reading it -----------------------------------------------------------------------------------
 def main() -> int:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
     parser.add_argument("recording", nargs="?",
                         help="a recording to read (default: make one, see above)")
     parser.add_argument("--channel", default=CHANNELS[0], help="the channel to plot")

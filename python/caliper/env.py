@@ -211,8 +211,9 @@ class VectorEnv:
     """N environments, each on its own Model, stepped in parallel (their calls release the
     GIL, and each Model computes on its own process, here or on other hosts). Observations,
     rewards and flags come stacked along a first axis of size N. An environment whose episode
-    ends is reset in the same call (gymnasium's classic autoreset): its last observation is in
-    ``info["final_observation"][i]``, marked by ``info["_final_observation"][i]``.
+    ends is reset in the same call (gymnasium's classic autoreset): the observation and info are
+    the new episode's, its last observation and info are in ``info["final_observation"][i]`` and
+    ``info["final_info"][i]``, marked by ``info["_final_observation"][i]``.
 
     ``VectorEnv.across(session, models="*", **kwargs)`` makes one TendonEnv(**kwargs) per Model
     matching the glob."""
@@ -262,8 +263,9 @@ class VectorEnv:
         def one(env: TendonEnv, action: np.ndarray):
             obs, reward, terminated, truncated, info = env.step(action)
             if terminated or truncated:
-                info = dict(info, final_observation=obs)
-                obs, _ = env.reset()
+                final_obs, final_info = obs, info
+                obs, info = env.reset()
+                info = dict(info, final_observation=final_obs, final_info=final_info)
             return obs, reward, terminated, truncated, info
 
         results = self._map(one, self.envs, list(actions))
@@ -275,9 +277,9 @@ class VectorEnv:
         out: Dict[str, Any] = {"elapsed_steps": np.array([i["elapsed_steps"] for i in infos]),
                                "parameters": [i["parameters"] for i in infos]}
         if any("final_observation" in i for i in infos):
-            out["final_observation"] = np.array([i.get("final_observation") for i in infos],
-                                                dtype=object)
-            out["_final_observation"] = np.array(["final_observation" in i for i in infos])
+            for key in ("final_observation", "final_info"):
+                out[key] = np.array([i.get(key) for i in infos], dtype=object)
+                out["_" + key] = np.array([key in i for i in infos])
         return out
 
     def close(self) -> None:

@@ -14,9 +14,12 @@ __all__ = ["Recording", "Event", "LogRecord", "SceneVersion"]
 
 
 class Event(NamedTuple):
-    """Something that changed the simulation, taking effect after `step` steps: kind "command"
-    (target: the actuator; values: the command), "parameter" (target: the id; values), "pull"
-    (target: the body; values: point [m], target [m], stiffness [N/m]), "release", "edit"."""
+    """Something that happened in the recording, taking effect after `step` steps: kind
+    "command" (target: the actuator; values: the command in its unit, V for a DC motor),
+    "parameter" (target: the id; values in its unit), "pull" (target: the body; values: the point
+    in the body's frame [m], the target in the world [m], the stiffness [N/m]), "release", "edit"
+    (target: what the edit did), "keyframe" (a full-state keyframe was written) and "end"
+    (target: why the recording ended, e.g. "stopped")."""
     step: int
     kind: str
     target: str

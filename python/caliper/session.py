@@ -3,12 +3,15 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import tempfile
 import time
+import weakref
 from typing import List, NamedTuple, Optional, Sequence
 
 from . import _caliper
@@ -59,6 +62,28 @@ def binary(name: str) -> str:
                             "(build Caliper with `launch/caliper build`)")
 
 
+def _die_with_parent() -> None:
+    """In a child before exec: SIGTERM when the Python process that started it ends, however it
+    ends (prctl PR_SET_PDEATHSIG), so that no session outlives its program."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
+def _stop(processes: List[subprocess.Popen], directory: str, keep: bool) -> None:
+    for p in reversed(processes):
+        if p.poll() is None:
+            p.terminate()
+    for p in reversed(processes):
+        try:
+            p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+    processes.clear()
+    if not keep:
+        shutil.rmtree(directory, ignore_errors=True)
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -76,7 +101,9 @@ class LocalSession:
 
     The Models write recordings and saved scenes below :attr:`files_dir`; the processes' output
     goes to files in :attr:`directory` (kept when `keep` is true). `options` are further
-    ``KEY=VALUE`` settings of the Models (``caliper-model --help`` lists them).
+    ``KEY=VALUE`` settings of the Models (``caliper-model --help`` lists them). The processes end
+    with the program at the latest, also when it is killed (they get SIGTERM when the thread that
+    started them ends: start a LocalSession from a thread that lives as long as you use it).
     """
 
     def __init__(self, models: int = 1, scene: Optional[str] = None, timeout_s: float = 5.0,
@@ -87,6 +114,9 @@ class LocalSession:
         self._keep = keep
         self._processes: List[subprocess.Popen] = []
         self.session: Optional[Session] = None
+        # stopped at the latest when the program ends (or this object goes), and the processes
+        # get SIGTERM from the kernel if the program dies without a word
+        self._finalizer = weakref.finalize(self, _stop, self._processes, self.directory, keep)
         try:
             self._start(models, scene, timeout_s, list(options), start_timeout_s)
         except BaseException:
@@ -96,7 +126,8 @@ class LocalSession:
     def _spawn(self, argv: List[str], log: str) -> subprocess.Popen:
         with open(os.path.join(self.directory, log), "ab") as out:
             p = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT,
-                                 stdin=subprocess.DEVNULL, cwd=self.directory)
+                                 stdin=subprocess.DEVNULL, cwd=self.directory,
+                                 preexec_fn=_die_with_parent)
         self._processes.append(p)
         return p
 
@@ -163,19 +194,8 @@ class LocalSession:
 
     def close(self) -> None:
         """Stops the Models and the naming service (TERM, then KILL after 10 s) and removes
-        the directory unless `keep`."""
-        for p in reversed(self._processes):
-            if p.poll() is None:
-                p.terminate()
-        for p in reversed(self._processes):
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
-        self._processes.clear()
-        if not self._keep:
-            shutil.rmtree(self.directory, ignore_errors=True)
+        the directory unless `keep`. Also done when the program ends."""
+        self._finalizer()
 
     def __enter__(self) -> Session:
         assert self.session is not None

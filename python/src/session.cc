@@ -27,13 +27,15 @@ SessionHandle Connect(const std::string& nameservice, double timeout_s) {
   auto session = std::make_shared<client::Session>(
       client::SessionOptions{nameservice, timeout_s, "caliper-python"});
   SessionHandle handle{session, timeout_s};
+  // kept before it answers: a Session that failed would destroy the process's ORB, which the
+  // sessions already open share
+  Open().push_back(session);
   {
     py::gil_scoped_release release;
     session->orb();  // the process's ORB first: per-thread deadlines need it
     CallScope scope(timeout_s);
     CosNaming::NamingContext_var root = session->Root();  // ConnectionError when it is away
   }
-  Open().push_back(session);
   return handle;
 }
 

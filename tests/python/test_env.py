@@ -10,8 +10,8 @@ import pytest
 
 import caliper
 
-ROOT = os.environ.get("CALIPER_SOURCE_DIR") or os.path.dirname(
-    os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.abspath(os.environ.get("CALIPER_SOURCE_DIR") or os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 
 ACTUATORS = ["elbow_flexor", "elbow_extensor"]

@@ -4,8 +4,9 @@ trajectories, sampled every step by lossless feeds, are equal bit for bit.
 
 The run lasts 5 s of simulated time: with the default gains the motors saturate (flexor 6 V,
 extensor 0 V) until the elbow passes about 0.55 rad (2.7 s), and the extensor leaves 0 V only
-after 4.3 s; a shorter run would compare two saturated schedules and miss a wrong gain, bias or
-target (checked: kp 20.0001 in Python then differs from the component)."""
+after 4.3 s; a shorter run would compare two saturated schedules and miss a wrong gain or bias
+(checked: kp 20.0001, kd 1.0001 or bias 1.0001 in Python then differ from the component; at
+1.5 s kp 20.0001 went unnoticed)."""
 
 import os
 import signal
@@ -18,8 +19,8 @@ import pytest
 
 import caliper
 
-ROOT = os.environ.get("CALIPER_SOURCE_DIR") or os.path.dirname(
-    os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.abspath(os.environ.get("CALIPER_SOURCE_DIR") or os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 ELBOW = "ecce_arm.elbow.position"
 

@@ -126,6 +126,8 @@ void Feeds::SetConsumerWake(std::function<void(uint64_t)> wake) {
 
 void Feeds::OnStep(uint64_t step, double time) { recorder_.OnStep(step, time); }
 
+void Feeds::Flush() { recorder_.Flush(); }
+
 void Feeds::NotifyRoom() {
   {
     std::lock_guard<std::mutex> room(room_mutex_);

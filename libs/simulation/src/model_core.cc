@@ -347,8 +347,10 @@ void ModelCore::Pause() {
   {
     const auto lock = Lock();
     Require(true);
-    if (!EndExperimentLocked("pause") && state_ == RunState::kRunning)
+    if (!EndExperimentLocked("pause") && state_ == RunState::kRunning) {
       state_ = RunState::kPaused;  // a step request ends paused
+      feeds_.Flush();              // the samples up to the pause go out now
+    }
   }
   feeds_.NotifyRoom();  // a step waiting for a lossless consumer ends
 }
@@ -430,6 +432,9 @@ uint64_t ModelCore::StepNow(uint64_t n) {
     }
   }
   const uint64_t ran = step_done_;
+  // the samples of every step run go out now, not with the next batch (lock-step clients read
+  // what they asked for)
+  if (ran > 0) feeds_.Flush();
   if (restarts_ == generation && state_ != RunState::kFaulted) {
     state_ = RunState::kPaused;
     // writes that came during the request and found no step after them take effect now, as

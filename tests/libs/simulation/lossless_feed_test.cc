@@ -119,6 +119,19 @@ TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   EXPECT_GT(status.waited_s, 0.0);  // the taker was slower than the steps: the Model waited
 }
 
+TEST(LosslessFeed, AStepRequestSendsEverySampleItTookIncludingAPartialBatch) {
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
+  SlowTaker taker(core, id, 0ms);
+  EXPECT_EQ(core.StepNow(1234), 1234u);  // 123 whole batches and 4 samples
+  ASSERT_TRUE(WaitForSamples(taker, 1234)) << taker.samples() << " samples: the last 4 stayed";
+  EXPECT_EQ(core.StepNow(6), 6u);  // a step request that fills no batch
+  ASSERT_TRUE(WaitForSamples(taker, 1240)) << taker.samples() << " samples";
+  EXPECT_EQ(taker.breaks(), "");
+  EXPECT_EQ(core.SubscriptionStatus(id).batches, 125u);
+}
+
 TEST(LosslessFeed, WithoutLosslessTheSameRunDropsAndCountsTheSamples) {
   ModelCore core;
   core.Load(Model("pendulum_tendon.dae"));
