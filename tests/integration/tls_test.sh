@@ -97,6 +97,34 @@ done_rows=$(tail -n +2 "$WORK/batch/summary.csv" 2>/dev/null | cut -d, -f2 | gre
 if [ $rc -eq 0 ] && [ "$done_rows" -eq 6 ]; then pass "alice's batch of 6 experiments passed over TLS"
 else cat "$WORK/batch.out"; fail "the batch exited $rc with $done_rows of 6 runs done"; fi
 
+# ---------------------------------------------------------------- the Python package over TLS
+# alice's Python: Models of both hosts, a scene sent by content to hostb, steps, the same batch
+PY_DIR=$(cd "$BIN/.." && pwd)/python
+if [ -f "$PY_DIR/caliper/__init__.py" ]; then
+  in_ns a env CALIPER_HOST=hosta CALIPER_PKI="$WORK/pki-a" CALIPER_TLS_IDENTITY=users/alice \
+    PYTHONPATH="$PY_DIR" CALIPER_BIN_DIR="$BIN" PYTHONDONTWRITEBYTECODE=1 \
+    /usr/bin/python3 - "$NS" "$SRC" >"$WORK/python.out" 2>&1 <<'PYTHON'
+import sys
+import caliper
+session = caliper.connect(sys.argv[1])
+models = session.models()
+remote = [m for m in models if m.endswith("@hostb")]
+assert len(remote) == 2 and "model0@hosta" in models, models
+arm = session.model(remote[0])
+assert not arm.local
+arm.load(sys.argv[2] + "/models/ecce_arm.dae")  # another host: by content
+arm.set_commands({"elbow_flexor": 6.0})
+assert arm.step(200) == 200 and float(arm.get("ecce_arm.elbow.position")) > 0.001
+batch = caliper.run_batch(sys.argv[2] + "/tests/data/cluster/arm_sweep.json", session,
+                          progress=False)
+assert len(batch.results) == 6 and not batch.failures, batch.failures
+print("python over TLS:", " ".join(models), "|", len(batch.results), "runs")
+PYTHON
+  rc=$?
+  if [ $rc -eq 0 ]; then pass "$(grep 'python over TLS' "$WORK/python.out")"
+  else cat "$WORK/python.out"; fail "alice's Python over TLS exited $rc"; fi
+fi
+
 # ---------------------------------------------------------------- every network port is TLS
 # s_client CLIENT-OPTIONS... against ADDR:PORT from hostc; -ign_eof keeps it reading after the
 # handshake until the server closes: a TLS 1.3 server refuses a client certificate (or its
