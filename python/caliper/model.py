@@ -177,8 +177,10 @@ def _record(self: Model, ids: Union[str, Sequence[str]], steps: Optional[int] = 
             duration_s: Optional[float] = None, every: int = 1) -> Data:
     """Steps the Model `steps` times (or for `duration_s` of simulated time) and returns every
     `every`-th sample of the channels `ids`, losslessly (the Model waits for this client), as
-    :class:`Data`: time first, then each channel in its shape and unit. The Model must not be
-    running (lock-step). Ctrl-C stops it between pieces of 20,000 steps."""
+    :class:`Data`: time first, then each channel in its shape and unit. Samples are taken after
+    the first step and then every `every` steps (steps 1, 1 + every, ...), as every DAQ
+    subscription does. The Model must not be running (lock-step). Ctrl-C stops it between
+    pieces of 20,000 steps. RunFailed (with ``.steps``) when the physics faults on the way."""
     n = _steps_for(self, steps, duration_s)
     with Feed(self, ids, every) as feed:
         return feed.step(n)

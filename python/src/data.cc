@@ -60,23 +60,28 @@ class Feed {
       const CORBA::ULong ran = model_->Run(
           [&] { return model_->ref.model->step(static_cast<CORBA::ULong>(piece)); }, kLongCallS);
       done += ran;
-      if (ran < piece) break;  // faulted: the caller sees the status
+      if (ran < piece) break;  // faulted, paused or stopped meanwhile, or a replay's end
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     }
-    return Take(10.0);
+    py::tuple block = Take(10.0, true);
+    RaiseIfFaulted(*model_, steps, done);
+    return block;
   }
 
-  // What has arrived, after waiting up to `wait_s` for the samples the Model has taken.
-  py::tuple Take(double wait_s) {
+  // What has arrived, after waiting up to `wait_s` for the samples the Model has taken; with
+  // `complete`, Failure when some have not arrived by then.
+  py::tuple Take(double wait_s, bool complete = false) {
+    uint64_t taken = 0;
     {
       py::gil_scoped_release release;
       CallScope scope(model_->s.timeout_s);
       const auto until = std::chrono::steady_clock::now() +
                          std::chrono::microseconds(static_cast<int64_t>(wait_s * 1e6));
       while (std::chrono::steady_clock::now() < until) {
-        const D::SubscriptionStatus status = client::Call(model_->ref, [&] { return feed_->Status(); });
+        const D::SubscriptionStatus status = feed_->Status();
+        taken = status.samples;
         std::lock_guard<std::mutex> lock(feed_->mutex());
-        if (received_ >= status.samples) break;
+        if (received_ >= taken) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
     }
@@ -84,6 +89,10 @@ class Feed {
     if (gaps_ > 0)
       throw client::Failure(model_->ref.name + ": " + std::to_string(gaps_) +
                             " batches of the lossless feed were lost");
+    if (complete && received_ < taken)
+      throw client::Failure(model_->ref.name + ": " + std::to_string(taken - received_) + " of " +
+                            std::to_string(taken) + " samples did not arrive within " +
+                            std::to_string(wait_s) + " s");
     return Block(times_, data_, width_);
   }
 
@@ -186,7 +195,7 @@ void BindData(py::module_& m) {
            py::arg("ids"), py::arg("every") = 1)
       .def_property_readonly("channels", &Feed::channels)
       .def("step", &Feed::Step, py::arg("steps"))
-      .def("take", &Feed::Take, py::arg("wait_s") = 0.0)
+      .def("take", &Feed::Take, py::arg("wait_s") = 0.0, py::arg("complete") = false)
       .def("close", &Feed::Close);
   BindRecordingFile(m);
 }

@@ -59,17 +59,7 @@ uint32_t Step(ModelObject& m, int64_t n) {
     throw py::value_error("n must be 1 to 4294967295 steps, not " + std::to_string(n));
   const CORBA::ULong asked = static_cast<CORBA::ULong>(n);
   const CORBA::ULong done = m.Run([&] { return m.ref.model->step(asked); }, kLongCallS);
-  if (done < asked) {
-    M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
-    if (s->state == M::FAULTED) {
-      py::object error = py::module_::import("caliper.errors").attr("RunFailed")(
-          m.ref.name + ": the simulation faulted after " + std::to_string(done) + " of " +
-          std::to_string(asked) + " steps: " + s->last_error.in());
-      error.attr("steps") = done;
-      PyErr_SetObject(error.get_type().ptr(), error.ptr());
-      throw py::error_already_set();
-    }
-  }
+  RaiseIfFaulted(m, asked, done);
   return done;
 }
 
@@ -182,8 +172,12 @@ py::list ActuatorStates(ModelObject& m) {
 }
 
 template <class Op>
-void SetPositive(ModelObject& m, const char* what, double value, bool zero_ok, Op op) {
-  if (!std::isfinite(value) || value < 0 || (!zero_ok && value == 0))
+void SetPositive(ModelObject& m, const char* what, const py::object& given, bool zero_ok, Op op) {
+  const std::vector<double> v = FiniteValues(given, what);
+  if (v.size() != 1)
+    throw py::value_error(std::string(what) + " must be one number, not " + std::to_string(v.size()));
+  const double value = v[0];
+  if (value < 0 || (!zero_ok && value == 0))
     throw py::value_error(std::string(what) + " must be " + (zero_ok ? ">= 0" : "> 0") +
                           " and finite, not " + std::to_string(value));
   m.Run([&] { op(m.ref.model.in(), value); });
@@ -220,7 +214,8 @@ RunFailed (with `.steps`) when the physics faulted on the way. Releases the GIL.
       .def("stop", [](ModelObject& m) { m.Run([&] { m.ref.model->stop(); }); },
            "Stops it and goes back to the scene's initial state.")
       .def("reset", [](ModelObject& m) { m.Run([&] { m.ref.model->reset(); }); },
-           "Back to the scene's initial state (time 0), paused; clears a fault.")
+           "Back to the scene's initial state (time 0); a running Model runs on from there, a "
+           "paused or stopped one stays so; a faulted one is stopped (the fault cleared).")
       .def("status",
            [](ModelObject& m) {
              M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
@@ -233,7 +228,7 @@ RunFailed (with `.steps`) when the physics faulted on the way. Releases the GIL.
             M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
             return s->time_step;
           },
-          [](ModelObject& m, double v) {
+          [](ModelObject& m, const py::object& v) {
             SetPositive(m, "time_step_s", v, false,
                         [](M::Model_ptr p, double x) { p->set_time_step(x); });
           },
@@ -244,7 +239,7 @@ RunFailed (with `.steps`) when the physics faulted on the way. Releases the GIL.
             M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
             return s->real_time_factor;
           },
-          [](ModelObject& m, double v) {
+          [](ModelObject& m, const py::object& v) {
             SetPositive(m, "real_time_factor", v, true,
                         [](M::Model_ptr p, double x) { p->set_real_time_factor(x); });
           },
@@ -285,6 +280,18 @@ std::shared_ptr<ModelObject> OpenModel(SessionHandle& s, const std::string& name
   m->ref = client::ConnectModel(*s.session, lookup);
   m->ref.name = name;
   return m;
+}
+
+void RaiseIfFaulted(ModelObject& m, uint64_t asked, uint64_t done) {
+  if (done >= asked) return;
+  M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
+  if (s->state != M::FAULTED) return;  // a pause, a stop or a replay's end
+  py::object error = py::module_::import("caliper.errors").attr("RunFailed")(
+      m.ref.name + ": the simulation faulted after " + std::to_string(done) + " of " +
+      std::to_string(asked) + " steps: " + s->last_error.in());
+  error.attr("steps") = done;
+  PyErr_SetObject(error.get_type().ptr(), error.ptr());
+  throw py::error_already_set();
 }
 
 std::vector<std::pair<uint32_t, uint32_t>> ModelObject::Shapes(

@@ -30,6 +30,10 @@ struct ModelObject {
   std::vector<std::pair<uint32_t, uint32_t>> Shapes(const std::vector<std::string>& ids);
 };
 
+/// After a step request that ran `done` of `asked` steps: raises caliper.RunFailed (with
+/// .steps) when the Model faulted on the way.
+void RaiseIfFaulted(ModelObject& m, uint64_t asked, uint64_t done);
+
 /// Session.model(name): the Model bound as `name` (model1@hostb is hostb/model1).
 std::shared_ptr<ModelObject> OpenModel(SessionHandle& s, const std::string& name);
 

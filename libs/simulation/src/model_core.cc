@@ -411,6 +411,8 @@ uint64_t ModelCore::StepNow(uint64_t n) {
   auto slice_end = rate_wall_ + kSlice;
   std::string ended;
   while (step_done_ < n) {
+    // a replay's step request ends at the recording's end, as a replay running there pauses
+    if (replay_ && loaded_->physics->steps() >= replay_->last_step()) break;
     // a lossless consumer is let catch up; a stop, pause or shutdown meanwhile ends the request
     if (AwaitConsumersLocked(lock) &&
         (restarts_ != generation || !end_request_.empty() || cancel_)) {

@@ -314,6 +314,12 @@ TEST_F(ModelRecording, WithoutChannelsTheRecordingStillEndsWhereItStopped) {
   EXPECT_EQ(replay.replay_status().step, 550u);
   EXPECT_EQ(replay.status().state, RunState::kPaused);
   EXPECT_EQ(Read(replay, kHand), hand);
+  // a step request ends at the recording's end too, with the steps it ran
+  replay.Seek(0.5);
+  EXPECT_EQ(replay.StepNow(200), 50u);
+  EXPECT_EQ(replay.replay_status().step, 550u);
+  EXPECT_EQ(replay.StepNow(10), 0u);
+  EXPECT_EQ(Read(replay, kHand), hand);
 }
 
 TEST_F(ModelRecording, TheLogGoesIntoTheRecording) {
