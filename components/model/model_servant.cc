@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "caliper/actuators/actuator.h"
@@ -121,6 +122,17 @@ void ModelServant::reset() { Guard([&] { core_.Reset(); }); }
 CORBA::ULong ModelServant::step(CORBA::ULong n) {
   return Guard([&] { return static_cast<CORBA::ULong>(core_.StepNow(n)); });
 }
+M::CycleResult* ModelServant::control_cycle(const M::CommandSeq& commands, CORBA::ULong n,
+                                            const S::StringSeq& ids) {
+  D::ValueSeq_var check = get(ids);  // ids it cannot read are refused before anything changes
+  set_commands(commands);
+  auto result = std::make_unique<M::CycleResult>();
+  result->steps = step(n);
+  D::ValueSeq_var values = get(ids);
+  result->values = values.in();
+  return result.release();
+}
+
 void ModelServant::set_time_step(CORBA::Double s) {
   Guard([&] { core_.SetTimeStep(s); });
 }

@@ -27,6 +27,9 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   void stop() override;
   void reset() override;
   CORBA::ULong step(CORBA::ULong n) override;
+  Caliper::Simulation::CycleResult* control_cycle(const Caliper::Simulation::CommandSeq& commands,
+                                                  CORBA::ULong n,
+                                                  const Caliper::Scene::StringSeq& ids) override;
   void set_time_step(CORBA::Double seconds) override;
   void set_real_time_factor(CORBA::Double factor) override;
   Caliper::Simulation::SimulationStatus* status() override;

@@ -25,6 +25,7 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
+from . import _caliper
 from .model import Model
 from .session import Session
 from .spaces import GYMNASIUM, Box
@@ -123,6 +124,7 @@ class TendonEnv(_EnvBase):  # type: ignore[misc,valid-type]
         width = sum(int(np.prod(np.shape(v), dtype=np.int64)) for v in
                     self.model.get(self.observation_ids))
         self.observation_space = Box(-np.inf, np.inf, shape=(width,), dtype=np.float64)
+        self._lockstep = _caliper._Lockstep([self.model], self.actuators, self.observation_ids)
         self.np_random = np.random.default_rng()
         self.elapsed_steps = 0
         self.parameters: Dict[str, float] = {}
@@ -150,16 +152,22 @@ class TendonEnv(_EnvBase):  # type: ignore[misc,valid-type]
     def step(self, action) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
         """Applies `action` (clipped to the action space), runs `frames_per_action` steps and
         returns (observation, reward, terminated, truncated, info)."""
+        a = self._check_action(action)
+        obs = self._lockstep.step(self.to_commands(a)[None, :], self.frames_per_action)[0]
+        return self._outcome(obs, a)
+
+    def _check_action(self, action) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"action must have shape {self.action_space.shape}, not {a.shape}")
         if not np.all(np.isfinite(a)):
             raise ValueError("action must be finite")
-        a = np.clip(a, self.action_space.low, self.action_space.high)
-        self.model.set_commands(dict(zip(self.actuators, self.to_commands(a).tolist())))
-        self.model.step(self.frames_per_action)
+        return np.clip(a, self.action_space.low, self.action_space.high)
+
+    def _outcome(self, obs: np.ndarray, a: np.ndarray
+                 ) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
+        """What step returns once the Model ran the action (set, stepped, observed)."""
         self.elapsed_steps += 1
-        obs = self._observe()
         reward = float(self.reward_fn(obs, a, self)) if self.reward_fn else 0.0
         terminated = bool(self.terminated_fn(obs, self)) if self.terminated_fn else False
         truncated = self.elapsed_steps >= self.max_episode_steps
@@ -208,8 +216,9 @@ class TendonEnv(_EnvBase):  # type: ignore[misc,valid-type]
 
 
 class VectorEnv:
-    """N environments, each on its own Model, stepped in parallel (their calls release the
-    GIL, and each Model computes on its own process, here or on other hosts). Observations,
+    """N environments with the same actuators, observations and control period, each on its
+    own Model, stepped in parallel (one lock-step cycle per Model on threads of the extension,
+    without the GIL; each Model computes in its own process, here or on other hosts). Observations,
     rewards and flags come stacked along a first axis of size N. An environment whose episode
     ends is reset in the same call (gymnasium's classic autoreset): the observation and info are
     the new episode's, its last observation and info are in ``info["final_observation"][i]`` and
@@ -224,6 +233,15 @@ class VectorEnv:
         self.envs = list(envs)
         self.num_envs = len(self.envs)
         first = self.envs[0]
+        for e in self.envs[1:]:
+            if (e.actuators, e.observation_ids, e.frames_per_action) != \
+                    (first.actuators, first.observation_ids, first.frames_per_action):
+                raise ValueError("the environments of a VectorEnv must have the same actuators, "
+                                 "observations and frames_per_action")
+        if len({e.model.path for e in self.envs}) != self.num_envs:
+            raise ValueError("each environment of a VectorEnv needs a Model of its own")
+        self._lockstep = _caliper._Lockstep([e.model for e in self.envs], first.actuators,
+                                            first.observation_ids)
         self.single_observation_space = first.observation_space
         self.single_action_space = first.action_space
         self.observation_space = Box(-np.inf, np.inf,
@@ -260,15 +278,17 @@ class VectorEnv:
             raise ValueError(f"actions must have shape {self.action_space.shape}, not "
                              f"{actions.shape}")
 
-        def one(env: TendonEnv, action: np.ndarray):
-            obs, reward, terminated, truncated, info = env.step(action)
+        clipped = [e._check_action(a) for e, a in zip(self.envs, actions)]
+        commands = np.stack([e.to_commands(a) for e, a in zip(self.envs, clipped)])
+        observed = self._lockstep.step(commands, self.envs[0].frames_per_action)
+        results = []
+        for env, obs, a in zip(self.envs, observed, clipped):
+            obs, reward, terminated, truncated, info = env._outcome(obs, a)
             if terminated or truncated:
                 final_obs, final_info = obs, info
                 obs, info = env.reset()
                 info = dict(info, final_observation=final_obs, final_info=final_info)
-            return obs, reward, terminated, truncated, info
-
-        results = self._map(one, self.envs, list(actions))
+            results.append((obs, reward, terminated, truncated, info))
         infos = self._stack_infos([r[4] for r in results])
         return (np.stack([r[0] for r in results]), np.array([r[1] for r in results]),
                 np.array([r[2] for r in results]), np.array([r[3] for r in results]), infos)

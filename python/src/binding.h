@@ -46,6 +46,7 @@ void BindSession(py::module_& m);
 void BindModel(py::module_& m);
 void BindData(py::module_& m);
 void BindWork(py::module_& m);
+void BindLockstep(py::module_& m);
 
 /// A sequence of finite floats from `value` (a number or an array-like), TypeError/ValueError
 /// naming `argument` when it is not one.

@@ -136,6 +136,30 @@ py::array_t<double> GetValues(ModelObject& m, const py::object& ids) {
   return out;
 }
 
+// control_cycle(): the Model's one-call lock-step cycle; every value of `ids` after the steps
+py::array_t<double> ControlCycle(ModelObject& m, const py::object& commands, int64_t n,
+                                 const py::object& ids) {
+  if (n < 1 || n > 0xffffffffLL)
+    throw py::value_error("steps must be 1 to 4294967295, not " + std::to_string(n));
+  const M::CommandSeq seq = Commands(commands);
+  const S::StringSeq id_seq = ToSeq(IdList(ids, "ids"));
+  std::vector<double> flat;
+  const CORBA::ULong ran = m.Run(
+      [&] {
+        M::CycleResult_var r =
+            m.ref.model->control_cycle(seq, static_cast<CORBA::ULong>(n), id_seq);
+        for (CORBA::ULong i = 0; i < r->values.length(); ++i)
+          flat.insert(flat.end(), r->values[i].data.get_buffer(),
+                      r->values[i].data.get_buffer() + r->values[i].data.length());
+        return r->steps;
+      },
+      kLongCallS);
+  RaiseIfFaulted(m, static_cast<uint64_t>(n), ran);
+  py::array_t<double> out(static_cast<py::ssize_t>(flat.size()));
+  std::copy(flat.begin(), flat.end(), out.mutable_data());
+  return out;
+}
+
 void Set(ModelObject& m, const std::string& id, const py::object& value) {
   const std::vector<double> v = FiniteValues(value, "value");
   const auto shape = m.Shapes({id})[0];
@@ -261,6 +285,10 @@ void BindDaq(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
 for a position) or of a list of ids (a list of such arrays).)doc")
       .def("get_values", &GetValues, py::arg("ids"),
            "Every value of `ids`, one channel after the other, as one flat float64 array.")
+      .def("control_cycle", &ControlCycle, py::arg("commands"), py::arg("steps"), py::arg("ids"),
+           R"doc(One lock-step control cycle in one round trip: sets `commands` (a dict
+{actuator: value}), runs `steps` steps and returns every value of `ids` after them, flat (as
+get_values). Refused commands or ids change nothing. RunFailed when the physics faults.)doc")
       .def("set", &Set, py::arg("id"), py::arg("value"),
            R"doc(Writes a parameter by DAQ id (e.g. ecce_arm.forearm.mass, in its unit): a number
 or an array with the channel's element count. NaN, infinities and wrong sizes raise ValueError

@@ -9,4 +9,5 @@ PYBIND11_MODULE(_caliper, m) {
   BindModel(m);
   BindData(m);
   BindWork(m);
+  BindLockstep(m);
 }

@@ -468,6 +468,23 @@ TEST_F(HostileModelTest, MotorsAndParametersRefuseUnknownNamesNonFiniteValuesAnd
   EXPECT_ANSWERED(D::ValueSeq_var(ref_->get(Ids(100000, first))));
   EXPECT_ANSWERED(D::ValueSeq_var(ref_->get(S::StringSeq())));
 
+  // a control cycle refuses what set_commands and get refuse; a refused command steps nothing
+  const auto steps = [&] { return M::SimulationStatus_var(ref_->status())->steps; };
+  const CORBA::ULongLong before = steps();
+  EXPECT_REFUSED(M::CycleResult_var(ref_->control_cycle(commands, 10, Ids(1, first))), "");
+  commands.length(kMillion);
+  EXPECT_REFUSED(M::CycleResult_var(ref_->control_cycle(commands, 10, Ids(1, first))), "");
+  EXPECT_EQ(steps(), before);
+  commands.length(1);
+  commands[0].actuator = motor.c_str();
+  commands[0].value = 0;
+  EXPECT_REFUSED(M::CycleResult_var(ref_->control_cycle(commands, 10, Ids(kMillion, first))), "");
+  EXPECT_REFUSED(M::CycleResult_var(ref_->control_cycle(commands, 10, Ids(1, "nosuch"))), "");
+  EXPECT_EQ(steps(), before);
+  M::CycleResult_var cycle = ref_->control_cycle(commands, 10, Ids(2, first));
+  EXPECT_EQ(cycle->steps, 10u);
+  EXPECT_EQ(cycle->values.length(), 2u);
+
   // writing: every writable channel with non-finite values, a wrong count, a lying shape and
   // 10 MB of values
   int writable = 0;

@@ -370,3 +370,27 @@ def test_fault_property_names_the_fault(new_session):
     model.reset()
     assert model.fault is None
     assert model.step(100) == 100
+
+
+def test_control_cycle_is_set_commands_step_and_get_in_one_call(arm):
+    """The Model's control_cycle gives bit for bit what the three calls give, and refuses a bad
+    command or id without stepping."""
+    ids = [ELBOW, HAND]
+    actions = [{"elbow_flexor": 6.0 - 0.5 * k, "elbow_extensor": 0.3 * k} for k in range(12)]
+    one_call = [arm.control_cycle(a, 7, ids) for a in actions]
+    arm.reset()
+    three_calls = []
+    for a in actions:
+        arm.set_commands(a)
+        arm.step(7)
+        three_calls.append(arm.get_values(ids))
+    assert all(np.array_equal(x, y) for x, y in zip(one_call, three_calls))
+    assert one_call[-1].shape == (4,)
+    steps = arm.status().steps
+    with pytest.raises(caliper.UnknownId):
+        arm.control_cycle({"no_such_motor": 1.0}, 7, ids)
+    with pytest.raises(caliper.UnknownId):
+        arm.control_cycle({"elbow_flexor": 1.0}, 7, ["no.such.id"])
+    with pytest.raises(ValueError, match="commands"):
+        arm.control_cycle({"elbow_flexor": float("nan")}, 7, ids)
+    assert arm.status().steps == steps
