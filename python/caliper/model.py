@@ -215,6 +215,14 @@ def _feed(self: Model, ids: Union[str, Sequence[str]], every: int = 1) -> Feed:
     return Feed(self, ids, every)
 
 
+def _parameters(self: Model, pattern: str = "*") -> Dict[str, Tuple[np.ndarray, str]]:
+    """The model parameters (static channels: masses, stiffnesses, motor constants, ...) whose
+    id matches the glob, as {id: (value, unit)}, each value in its channel's shape and unit."""
+    channels = [c for c in self.channels(pattern) if c.static]
+    values = self.get([c.id for c in channels]) if channels else []
+    return {c.id: (v, c.unit) for c, v in zip(channels, values)}
+
+
 def _fault(self: Model) -> Optional[str]:
     """Why the simulation faulted (the Model's report), or None when it runs normally."""
     s = self.status()
@@ -223,6 +231,7 @@ def _fault(self: Model) -> Optional[str]:
 
 Model.record = _record
 Model.feed = _feed
+Model.parameters = _parameters
 Model.fault = property(_fault)
 Model.stream = _stream
 Model.run_experiment = _run_experiment

@@ -394,3 +394,11 @@ def test_control_cycle_is_set_commands_step_and_get_in_one_call(arm):
     with pytest.raises(ValueError, match="commands"):
         arm.control_cycle({"elbow_flexor": float("nan")}, 7, ids)
     assert arm.status().steps == steps
+
+
+def test_parameters_give_values_with_units(arm):
+    params = arm.parameters("ecce_arm.forearm.*")
+    value, unit = params["ecce_arm.forearm.mass"]
+    assert unit == "kg" and value.shape == () and float(value) > 0
+    assert all(c.static for c in arm.channels("ecce_arm.forearm.*") if c.id in params)
+    assert "ecce_arm.forearm.position" not in params  # a state, not a parameter
