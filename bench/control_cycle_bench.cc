@@ -29,7 +29,8 @@ int Main(int argc, char** argv) {
   const long cycles = std::stol(argv[3]), rounds = std::stol(argv[4]);
   ::Caliper::Scene::StringSeq ids;
   ids.length(static_cast<CORBA::ULong>(argc - 7));
-  for (int i = 7; i < argc; ++i) ids[static_cast<CORBA::ULong>(i - 7)] = static_cast<const char*>(argv[i]);  // copied
+  for (int i = 7; i < argc; ++i)
+    ids[static_cast<CORBA::ULong>(i - 7)] = static_cast<const char*>(argv[i]);  // copied
   M::CommandSeq commands;
   commands.length(2);
   commands[0].actuator = static_cast<const char*>(argv[5]);
@@ -46,8 +47,10 @@ int Main(int argc, char** argv) {
         m.model->step(1);
       }
     });
-    const double us = std::chrono::duration<double, std::micro>(
-                          std::chrono::steady_clock::now() - start).count() / cycles;
+    const double us =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+            .count() /
+        cycles;
     best = std::min(best, us);
   }
   std::printf("cycle_us %.3f\n", best);

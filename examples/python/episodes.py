@@ -18,7 +18,6 @@ in parallel with the PD policy, and plots angle against time.
 """
 
 import argparse
-import contextlib
 import os
 import sys
 import time
@@ -32,64 +31,10 @@ SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 MASS = "ecce_arm.forearm.mass"
 
 
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """--help: this docstring as written, and the options' defaults."""
-
-    def _get_help_string(self, action):
-        default = action.default
-        if default in (None, False, argparse.SUPPRESS):
-            return action.help
-        if isinstance(default, (list, tuple)):
-            default = " ".join(map(str, default))
-        return f"{action.help} (default: {default})"
-
-
-# -- the session: a private one by default, or a running one ----------------------------------
-def add_session_arguments(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("session (default: a private one started for this run)")
-    which = group.add_mutually_exclusive_group()
-    which.add_argument("--nameservice", metavar="corbaname::HOST:PORT",
-                       help="use the Models of the running session with this naming service")
-    which.add_argument("--latest", action="store_true",
-                       help="use the newest session started on this host (caliper.connect())")
-
-
-@contextlib.contextmanager
-def open_session(args: argparse.Namespace, models: int):
-    """A caliper.Session: the running one asked for, else a private LocalSession of `models`
-    Models with the shipped arm loaded (stopped when the block ends)."""
-    if args.nameservice or args.latest:
-        try:
-            session = caliper.connect(args.nameservice)
-        except caliper.ConnectionError as e:
-            raise SystemExit(f"error: {e}") from None
-        print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
-        yield session
-        return
-    started = time.monotonic()
-    local = caliper.LocalSession(models=models, scene=SCENE)
-    try:
-        print(f"session: private, {models} Model(s) of {os.path.relpath(SCENE, ROOT)} at "
-              f"{local.address} (started in {time.monotonic() - started:.2f} s)")
-        yield local.session
-    finally:
-        local.close()
-
-
-def prepare(model: "caliper.Model") -> None:
-    """The arm loaded and paused (the environment steps it)."""
-    status = model.status()
-    if status.state == "EMPTY" or os.path.basename(status.scene) != os.path.basename(SCENE):
-        print(f"{model.name}: loading {SCENE}")
-        model.load(SCENE)
-    if model.status().state == "RUNNING":
-        model.pause()
-
-
 # -- the task and the policies ------------------------------------------------------------------
 def make_env(session: "caliper.Session", name: str, args: argparse.Namespace) -> caliper.TendonEnv:
     model = session.model(name)
-    prepare(model)
+    caliper.cli.prepare(model, SCENE)
     target = args.target_rad
     return caliper.TendonEnv(
         model, session=session,
@@ -121,7 +66,7 @@ def episode(env: caliper.TendonEnv, seed: int, policy, args: argparse.Namespace)
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=caliper.cli.HelpFormatter)
     parser.add_argument("--episodes", type=int, default=3,
                         help="random episodes, and as many PD ones (seeds 0, 1, ...)")
     parser.add_argument("--actions", type=int, default=500,
@@ -131,12 +76,12 @@ def main() -> int:
     parser.add_argument("--mass-kg", type=float, nargs=2, default=[0.5, 2.0],
                         metavar=("LOW", "HIGH"), help="range of the forearm's mass [kg]")
     parser.add_argument("--out", default="results", metavar="DIR", help="folder of the figure")
-    add_session_arguments(parser)
+    caliper.cli.add_session_arguments(parser)
     args = parser.parse_args()
     if args.episodes < 1 or args.actions < 1 or args.max_v <= 0:
         parser.error("--episodes, --actions and --max-v must be positive")
 
-    with open_session(args, models=2) as session:
+    with caliper.cli.open_session(args, models=2, scene=SCENE) as session:
         names = session.models()[:2]
         env = make_env(session, names[0], args)
         print(env)

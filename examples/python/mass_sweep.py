@@ -18,11 +18,9 @@ the elbow angle against time for each mass: a heavier forearm rises more slowly 
 """
 
 import argparse
-import contextlib
 import csv
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -33,50 +31,6 @@ SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 MASS = "ecce_arm.forearm.mass"
 ANGLE = "ecce_arm.elbow.position"
 TENSION = "ecce_arm.elbow_flexor.tendon.tension"
-
-
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """--help: this docstring as written, and the options' defaults."""
-
-    def _get_help_string(self, action):
-        default = action.default
-        if default in (None, False, argparse.SUPPRESS):
-            return action.help
-        if isinstance(default, (list, tuple)):
-            default = " ".join(map(str, default))
-        return f"{action.help} (default: {default})"
-
-
-# -- the session: a private one by default, or a running one ----------------------------------
-def add_session_arguments(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("session (default: a private one started for this run)")
-    which = group.add_mutually_exclusive_group()
-    which.add_argument("--nameservice", metavar="corbaname::HOST:PORT",
-                       help="use the Models of the running session with this naming service")
-    which.add_argument("--latest", action="store_true",
-                       help="use the newest session started on this host (caliper.connect())")
-
-
-@contextlib.contextmanager
-def open_session(args: argparse.Namespace, models: int):
-    """A caliper.Session: the running one asked for, else a private LocalSession of `models`
-    Models with the shipped arm loaded (stopped when the block ends)."""
-    if args.nameservice or args.latest:
-        try:
-            session = caliper.connect(args.nameservice)
-        except caliper.ConnectionError as e:
-            raise SystemExit(f"error: {e}") from None
-        print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
-        yield session
-        return
-    started = time.monotonic()
-    local = caliper.LocalSession(models=models, scene=SCENE)
-    try:
-        print(f"session: private, {models} Model(s) of {os.path.relpath(SCENE, ROOT)} at "
-              f"{local.address} (started in {time.monotonic() - started:.2f} s)")
-        yield local.session
-    finally:
-        local.close()
 
 
 # -- the sweep ------------------------------------------------------------------------------------
@@ -96,7 +50,7 @@ def experiments(args: argparse.Namespace) -> dict:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=caliper.cli.HelpFormatter)
     parser.add_argument("--masses-kg", type=float, nargs="+",
                         default=[0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
                         help="forearm masses to run [kg] (the shipped arm's is 1 kg)")
@@ -112,7 +66,7 @@ def main() -> int:
                         help="with a running session: the Models to use (a glob, e.g. '*@hostb')")
     parser.add_argument("--out", default="results", metavar="DIR",
                         help="folder of the figure and the table")
-    add_session_arguments(parser)
+    caliper.cli.add_session_arguments(parser)
     args = parser.parse_args()
     if any(not m > 0 for m in args.masses_kg):
         parser.error("masses must be > 0 kg")
@@ -122,7 +76,7 @@ def main() -> int:
         parser.error("--duration-s and --models must be positive")
     args.masses_kg = sorted(args.masses_kg)
 
-    with open_session(args, models=args.models) as session:
+    with caliper.cli.open_session(args, models=args.models, scene=SCENE) as session:
         print(f"{len(args.masses_kg)} runs of {args.duration_s:g} s: flexor {args.flex_v:g} V "
               f"for {args.duration_s / 2:g} s, then extensor {args.extend_v:g} V")
         batch = caliper.run_batch(experiments(args), session=session, models=args.glob,

@@ -25,7 +25,6 @@ controllers will command the same motors.
 """
 
 import argparse
-import contextlib
 import os
 import sys
 import time
@@ -38,64 +37,9 @@ ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
 SCENE = os.path.join(ROOT, "models", "ecce_arm.dae")
 
 
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """--help: this docstring as written, and the options' defaults."""
-
-    def _get_help_string(self, action):
-        default = action.default
-        if default in (None, False, argparse.SUPPRESS):
-            return action.help
-        if isinstance(default, (list, tuple)):
-            default = " ".join(map(str, default))
-        return f"{action.help} (default: {default})"
-
-
-# -- the session: a private one by default, or a running one ----------------------------------
-def add_session_arguments(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("session (default: a private one started for this run)")
-    which = group.add_mutually_exclusive_group()
-    which.add_argument("--nameservice", metavar="corbaname::HOST:PORT",
-                       help="use the Models of the running session with this naming service")
-    which.add_argument("--latest", action="store_true",
-                       help="use the newest session started on this host (caliper.connect())")
-
-
-@contextlib.contextmanager
-def open_session(args: argparse.Namespace, models: int):
-    """A caliper.Session: the running one asked for, else a private LocalSession of `models`
-    Models with the shipped arm loaded (stopped when the block ends)."""
-    if args.nameservice or args.latest:
-        try:
-            session = caliper.connect(args.nameservice)
-        except caliper.ConnectionError as e:
-            raise SystemExit(f"error: {e}") from None
-        print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
-        yield session
-        return
-    started = time.monotonic()
-    local = caliper.LocalSession(models=models, scene=SCENE)
-    try:
-        print(f"session: private, {models} Model(s) of {os.path.relpath(SCENE, ROOT)} at "
-              f"{local.address} (started in {time.monotonic() - started:.2f} s)")
-        yield local.session
-    finally:
-        local.close()
-
-
-def prepare(model: "caliper.Model") -> None:
-    """Lock-step from the scene's start: the arm loaded, paused, at time 0."""
-    status = model.status()
-    if status.state == "EMPTY" or os.path.basename(status.scene) != os.path.basename(SCENE):
-        print(f"{model.name}: loading {SCENE}")
-        model.load(SCENE)
-    if model.status().state == "RUNNING":
-        model.pause()
-    model.reset()
-
-
 # -- the controller -------------------------------------------------------------------------------
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=caliper.cli.HelpFormatter)
     parser.add_argument("--target-rad", type=float, default=0.8, help="elbow target [rad]")
     parser.add_argument("--kp", type=float, default=20.0, help="proportional gain [V/rad]")
     parser.add_argument("--kd", type=float, default=1.0, help="derivative gain [V s/rad]")
@@ -113,15 +57,15 @@ def main() -> int:
     parser.add_argument("--plot", metavar="PNG",
                         help="the figure's file (default: DIR/pd_elbow.png)")
     parser.add_argument("--no-plot", action="store_true", help="write no figure")
-    add_session_arguments(parser)
+    caliper.cli.add_session_arguments(parser)
     args = parser.parse_args()
     if args.steps_per_tick < 1 or args.duration_s <= 0 or args.max_v < 0:
         parser.error("--steps-per-tick, --duration-s and --max-v must be positive")
 
     flexor, extensor = "elbow_flexor", "elbow_extensor"
-    with open_session(args, models=1) as session:
+    with caliper.cli.open_session(args, models=1, scene=SCENE) as session:
         arm = session.model(args.model)
-        prepare(arm)
+        caliper.cli.prepare(arm, SCENE)
         # the joint's channels, found as the C++ controller finds them
         position = arm.channels("*.elbow.position")[0].id      # ecce_arm.elbow.position
         velocity = position[:-len("position")] + "velocity"

@@ -21,7 +21,6 @@ for bit (caliper.verify).
 
 import argparse
 import collections
-import contextlib
 import os
 import shutil
 import sys
@@ -37,67 +36,12 @@ CHANNELS = ["ecce_arm.elbow.position", "ecce_arm.elbow_flexor.tendon.tension",
             "ecce_arm.elbow_extensor.tendon.tension", "ecce_arm.hand.position"]
 
 
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """--help: this docstring as written, and the options' defaults."""
-
-    def _get_help_string(self, action):
-        default = action.default
-        if default in (None, False, argparse.SUPPRESS):
-            return action.help
-        if isinstance(default, (list, tuple)):
-            default = " ".join(map(str, default))
-        return f"{action.help} (default: {default})"
-
-
-# -- the session: a private one by default, or a running one ----------------------------------
-def add_session_arguments(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("session (default: a private one started for this run)")
-    which = group.add_mutually_exclusive_group()
-    which.add_argument("--nameservice", metavar="corbaname::HOST:PORT",
-                       help="use the Models of the running session with this naming service")
-    which.add_argument("--latest", action="store_true",
-                       help="use the newest session started on this host (caliper.connect())")
-
-
-@contextlib.contextmanager
-def open_session(args: argparse.Namespace, models: int):
-    """A caliper.Session: the running one asked for, else a private LocalSession of `models`
-    Models with the shipped arm loaded (stopped when the block ends)."""
-    if args.nameservice or args.latest:
-        try:
-            session = caliper.connect(args.nameservice)
-        except caliper.ConnectionError as e:
-            raise SystemExit(f"error: {e}") from None
-        print(f"session: {session.address} (running; Models: {', '.join(session.models())})")
-        yield session
-        return
-    started = time.monotonic()
-    local = caliper.LocalSession(models=models, scene=SCENE)
-    try:
-        print(f"session: private, {models} Model(s) of {os.path.relpath(SCENE, ROOT)} at "
-              f"{local.address} (started in {time.monotonic() - started:.2f} s)")
-        yield local.session
-    finally:
-        local.close()
-
-
-def prepare(model: "caliper.Model") -> None:
-    """From the scene's start: the arm loaded, paused, at time 0."""
-    status = model.status()
-    if status.state == "EMPTY" or os.path.basename(status.scene) != os.path.basename(SCENE):
-        print(f"{model.name}: loading {SCENE}")
-        model.load(SCENE)
-    if model.status().state == "RUNNING":
-        model.pause()
-    model.reset()
-
-
 # -- making a recording ---------------------------------------------------------------------------
 def record(args: argparse.Namespace) -> str:
     """Records --duration-s of the arm on a Model and returns the copy in --out."""
-    with open_session(args, models=1) as session:
+    with caliper.cli.open_session(args, models=1, scene=SCENE) as session:
         arm = session.model(args.model)
-        prepare(arm)
+        caliper.cli.prepare(arm, SCENE)
         # a name of its own: a recording never overwrites a file
         name = time.strftime(f"read_recording-%Y%m%d-%H%M%S-{os.getpid()}.caliper")
         status = arm.start_recording(name, channels=args.channels, every=args.every)
@@ -128,7 +72,7 @@ def record(args: argparse.Namespace) -> str:
 
 # -- reading it -----------------------------------------------------------------------------------
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=HelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=caliper.cli.HelpFormatter)
     parser.add_argument("recording", nargs="?",
                         help="a recording to read (default: make one, see above)")
     parser.add_argument("--channel", default=CHANNELS[0], help="the channel to plot")
@@ -143,7 +87,7 @@ def main() -> int:
                         help="re-simulate the recording and compare it bit for bit")
     parser.add_argument("--out", default="results", metavar="DIR",
                         help="folder of the recording's copy, the CSV and the figure")
-    add_session_arguments(parser)
+    caliper.cli.add_session_arguments(parser)
     args = parser.parse_args()
     if args.duration_s <= 0 or args.every < 1:
         parser.error("--duration-s and --every must be positive")

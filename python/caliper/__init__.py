@@ -12,7 +12,7 @@ and train controllers in a Gymnasium-style environment.
 See docs/python.md for the whole tour and ``help()`` on every class.
 """
 
-from . import errors
+from . import cli, errors
 from .errors import (ConnectionError, EditRefused, Error, FormatError, InvalidParameter,
                      LimitExceeded, LoadFailed, NotAvailable, RecordingError, RunFailed,
                      SetupError, UnknownId)
@@ -29,9 +29,9 @@ __version__ = "0.1.0"
 
 __all__ = [
     "connect", "Session", "LocalSession", "Component", "Model", "Status", "Channel", "Actuator",
-    "ActuatorState", "EditStatus", "RecordStatus", "ReplayStatus", "Data", "Feed", "Recording", "Event",
-    "LogRecord", "SceneVersion", "verify", "load_experiments", "run_batch", "Batch",
-    "Calibration", "Evaluation", "TendonEnv", "VectorEnv", "Box", "binary", "errors", "Error", "ConnectionError", "UnknownId",
-    "InvalidParameter", "NotAvailable", "LoadFailed", "LimitExceeded", "RunFailed",
-    "EditRefused", "SetupError", "FormatError", "RecordingError",
+    "ActuatorState", "EditStatus", "RecordStatus", "ReplayStatus", "Data", "Feed", "Recording",
+    "Event", "LogRecord", "SceneVersion", "verify", "load_experiments", "run_batch", "Batch",
+    "Calibration", "Evaluation", "TendonEnv", "VectorEnv", "Box", "binary", "cli", "errors",
+    "Error", "ConnectionError", "UnknownId", "InvalidParameter", "NotAvailable", "LoadFailed",
+    "LimitExceeded", "RunFailed", "EditRefused", "SetupError", "FormatError", "RecordingError",
 ]

@@ -8,7 +8,6 @@ extension's; see ``help(caliper.Model)``.
 from __future__ import annotations
 
 import math
-import os
 from typing import Dict, Iterator, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np

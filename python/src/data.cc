@@ -121,8 +121,9 @@ py::object Header(const recording::Reader& r) {
   py::list channels;
   for (const auto& c : h.channels)
     channels.append(py::module_::import("caliper.model")
-                        .attr("Channel")(c.id, c.unit, py::tuple(py::cast(ChannelShape(c.rows, c.cols))),
-                                         false, false, ""));
+                        .attr("Channel")(c.id, c.unit,
+                                         py::tuple(py::cast(ChannelShape(c.rows, c.cols))), false,
+                                         false, ""));
   py::dict out;
   out["model_name"] = h.model_name;
   out["scene_file_name"] = h.scene_file_name;

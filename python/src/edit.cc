@@ -83,110 +83,118 @@ py::object SetObstacle(ModelObject& m, const std::string& name, const std::strin
 }  // namespace
 
 void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
-  c.def("move_path_point",
-        [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
-          const S::PathPoint p = Point(point, "point");
-          return Edit([&](M::Model_ptr r) {
-            return r->move_path_point(tendon.c_str(), index, p);
-          })(m);
-        },
-        py::arg("tendon"), py::arg("index"), py::arg("point"),
-        "Moves a tendon's path point `index` to `point`: (body, (x, y, z)) in the body's frame "
-        "[m], or an obstacle's name.")
-      .def("insert_path_point",
-           [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
-             const S::PathPoint p = Point(point, "point");
-             return Edit([&](M::Model_ptr r) {
-               return r->insert_path_point(tendon.c_str(), index, p);
-             })(m);
-           },
-           py::arg("tendon"), py::arg("index"), py::arg("point"),
-           "Inserts a path point before `index` (as move_path_point's `point`).")
-      .def("remove_path_point",
-           [](ModelObject& m, const std::string& tendon, uint32_t index) {
-             return Edit([&](M::Model_ptr r) {
-               return r->remove_path_point(tendon.c_str(), index);
-             })(m);
-           },
-           py::arg("tendon"), py::arg("index"), "Removes a tendon's path point.")
-      .def("add_tendon",
-           [](ModelObject& m, const std::string& tendon, const py::object& start,
-              const py::object& end, double radius_m, const std::string& actuator,
-              const std::string& kind) {
-             const S::PathPoint a = Point(start, "start"), b = Point(end, "end");
-             if (!(radius_m > 0) || radius_m > 1) throw py::value_error("radius_m must be in (0, 1] m");
-             return Edit([&](M::Model_ptr r) {
-               return r->add_tendon(tendon.c_str(), a, b, radius_m, actuator.c_str(), kind.c_str());
-             })(m);
-           },
-           py::arg("tendon"), py::arg("start"), py::arg("end"), py::arg("radius_m") = 0.001,
-           py::arg("actuator") = "", py::arg("kind") = "",
-           "Adds a tendon from `start` to `end` (points as in move_path_point), with an actuator "
-           "of `kind` at its defaults when `actuator` is named (see actuator_kinds()).")
-      .def("remove_tendon",
-           [](ModelObject& m, const std::string& tendon) {
-             return Edit([&](M::Model_ptr r) { return r->remove_tendon(tendon.c_str()); })(m);
-           },
-           py::arg("tendon"), "Removes a tendon and its actuator.")
+  c.def(
+       "move_path_point",
+       [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
+         const S::PathPoint p = Point(point, "point");
+         return Edit([&](M::Model_ptr r) { return r->move_path_point(tendon.c_str(), index, p); })(
+             m);
+       },
+       py::arg("tendon"), py::arg("index"), py::arg("point"),
+       "Moves a tendon's path point `index` to `point`: (body, (x, y, z)) in the body's frame "
+       "[m], or an obstacle's name.")
+      .def(
+          "insert_path_point",
+          [](ModelObject& m, const std::string& tendon, uint32_t index, const py::object& point) {
+            const S::PathPoint p = Point(point, "point");
+            return Edit(
+                [&](M::Model_ptr r) { return r->insert_path_point(tendon.c_str(), index, p); })(m);
+          },
+          py::arg("tendon"), py::arg("index"), py::arg("point"),
+          "Inserts a path point before `index` (as move_path_point's `point`).")
+      .def(
+          "remove_path_point",
+          [](ModelObject& m, const std::string& tendon, uint32_t index) {
+            return Edit(
+                [&](M::Model_ptr r) { return r->remove_path_point(tendon.c_str(), index); })(m);
+          },
+          py::arg("tendon"), py::arg("index"), "Removes a tendon's path point.")
+      .def(
+          "add_tendon",
+          [](ModelObject& m, const std::string& tendon, const py::object& start,
+             const py::object& end, double radius_m, const std::string& actuator,
+             const std::string& kind) {
+            const S::PathPoint a = Point(start, "start"), b = Point(end, "end");
+            if (!(radius_m > 0) || radius_m > 1)
+              throw py::value_error("radius_m must be in (0, 1] m");
+            return Edit([&](M::Model_ptr r) {
+              return r->add_tendon(tendon.c_str(), a, b, radius_m, actuator.c_str(), kind.c_str());
+            })(m);
+          },
+          py::arg("tendon"), py::arg("start"), py::arg("end"), py::arg("radius_m") = 0.001,
+          py::arg("actuator") = "", py::arg("kind") = "",
+          "Adds a tendon from `start` to `end` (points as in move_path_point), with an actuator "
+          "of `kind` at its defaults when `actuator` is named (see actuator_kinds()).")
+      .def(
+          "remove_tendon",
+          [](ModelObject& m, const std::string& tendon) {
+            return Edit([&](M::Model_ptr r) { return r->remove_tendon(tendon.c_str()); })(m);
+          },
+          py::arg("tendon"), "Removes a tendon and its actuator.")
       .def("set_obstacle", &SetObstacle, py::arg("name"), py::arg("body"), py::arg("kind"),
            py::arg("position_m"), py::arg("quaternion") = std::vector<double>{1, 0, 0, 0},
            py::arg("radius_m") = 0.02, py::arg("length_m") = 0.1,
            "Adds or changes a wrapping obstacle (kind sphere or cylinder) fixed in `body`.")
-      .def("remove_obstacle",
-           [](ModelObject& m, const std::string& name) {
-             return Edit([&](M::Model_ptr r) { return r->remove_obstacle(name.c_str()); })(m);
-           },
-           py::arg("name"), "Removes a wrapping obstacle.")
-      .def("set_mass",
-           [](ModelObject& m, const std::string& body, double mass_kg) {
-             if (!std::isfinite(mass_kg) || mass_kg <= 0)
-               throw py::value_error("mass_kg must be > 0 and finite");
-             return Edit([&](M::Model_ptr r) { return r->set_mass(body.c_str(), mass_kg); })(m);
-           },
-           py::arg("body"), py::arg("mass_kg"), "Sets a body's mass [kg].")
-      .def("set_shape_dims",
-           [](ModelObject& m, const std::string& body, uint32_t index, const py::object& dims) {
-             const std::vector<double> d = FiniteValues(dims, "dims_m");
-             S::DoubleSeq seq;
-             seq.length(static_cast<CORBA::ULong>(d.size()));
-             for (size_t i = 0; i < d.size(); ++i) seq[static_cast<CORBA::ULong>(i)] = d[i];
-             return Edit([&](M::Model_ptr r) {
-               return r->set_shape_dims(body.c_str(), index, seq);
-             })(m);
-           },
-           py::arg("body"), py::arg("index"), py::arg("dims_m"),
-           "Sets the dimensions [m] of a body's collision shape `index`.")
+      .def(
+          "remove_obstacle",
+          [](ModelObject& m, const std::string& name) {
+            return Edit([&](M::Model_ptr r) { return r->remove_obstacle(name.c_str()); })(m);
+          },
+          py::arg("name"), "Removes a wrapping obstacle.")
+      .def(
+          "set_mass",
+          [](ModelObject& m, const std::string& body, double mass_kg) {
+            if (!std::isfinite(mass_kg) || mass_kg <= 0)
+              throw py::value_error("mass_kg must be > 0 and finite");
+            return Edit([&](M::Model_ptr r) { return r->set_mass(body.c_str(), mass_kg); })(m);
+          },
+          py::arg("body"), py::arg("mass_kg"), "Sets a body's mass [kg].")
+      .def(
+          "set_shape_dims",
+          [](ModelObject& m, const std::string& body, uint32_t index, const py::object& dims) {
+            const std::vector<double> d = FiniteValues(dims, "dims_m");
+            S::DoubleSeq seq;
+            seq.length(static_cast<CORBA::ULong>(d.size()));
+            for (size_t i = 0; i < d.size(); ++i) seq[static_cast<CORBA::ULong>(i)] = d[i];
+            return Edit(
+                [&](M::Model_ptr r) { return r->set_shape_dims(body.c_str(), index, seq); })(m);
+          },
+          py::arg("body"), py::arg("index"), py::arg("dims_m"),
+          "Sets the dimensions [m] of a body's collision shape `index`.")
       .def("undo", Edit([](M::Model_ptr r) { return r->undo(); }), "Reverts the last edit.")
       .def("redo", Edit([](M::Model_ptr r) { return r->redo(); }), "Applies it again.")
       .def("edit_status", Edit([](M::Model_ptr r) { return r->edit_status(); }),
            "The revision and what undo() and redo() would do.")
-      .def("actuator_kinds",
-           [](ModelObject& m) {
-             M::ActuatorKindSeq_var k = m.Run([&] { return m.ref.model->actuator_kinds(); });
-             py::dict out;
-             for (CORBA::ULong i = 0; i < k->length(); ++i) {
-               py::dict parameters;
-               for (CORBA::ULong p = 0; p < k[i].parameters.length(); ++p)
-                 parameters[py::str(k[i].parameters[p].in())] =
-                     py::make_tuple(k[i].defaults[p], std::string(k[i].units[p].in()));
-               out[py::str(k[i].kind.in())] = parameters;
-             }
-             return out;
-           },
-           "The actuator kinds add_tendon knows: {kind: {parameter: (default, unit)}}.")
-      .def("pull",
-           [](ModelObject& m, const std::string& body, const py::object& point,
-              const py::object& target, double stiffness_n_per_m) {
-             const M::Vector3 p = ToVector3(point, "point_m"), t = ToVector3(target, "target_m");
-             if (!std::isfinite(stiffness_n_per_m) || stiffness_n_per_m <= 0)
-               throw py::value_error("stiffness_n_per_m must be > 0 and finite");
-             m.Run([&] { m.ref.model->pull(body.c_str(), p, t, stiffness_n_per_m); });
-           },
-           py::arg("body"), py::arg("point_m"), py::arg("target_m"),
-           py::arg("stiffness_n_per_m") = 100.0,
-           "Pulls `body` at `point_m` (its frame) toward `target_m` (world) with a spring.")
-      .def("release_pull", [](ModelObject& m) { m.Run([&] { m.ref.model->release_pull(); }); },
-           "Lets go of a pull.");
+      .def(
+          "actuator_kinds",
+          [](ModelObject& m) {
+            M::ActuatorKindSeq_var k = m.Run([&] { return m.ref.model->actuator_kinds(); });
+            py::dict out;
+            for (CORBA::ULong i = 0; i < k->length(); ++i) {
+              py::dict parameters;
+              for (CORBA::ULong p = 0; p < k[i].parameters.length(); ++p)
+                parameters[py::str(k[i].parameters[p].in())] =
+                    py::make_tuple(k[i].defaults[p], std::string(k[i].units[p].in()));
+              out[py::str(k[i].kind.in())] = parameters;
+            }
+            return out;
+          },
+          "The actuator kinds add_tendon knows: {kind: {parameter: (default, unit)}}.")
+      .def(
+          "pull",
+          [](ModelObject& m, const std::string& body, const py::object& point,
+             const py::object& target, double stiffness_n_per_m) {
+            const M::Vector3 p = ToVector3(point, "point_m"), t = ToVector3(target, "target_m");
+            if (!std::isfinite(stiffness_n_per_m) || stiffness_n_per_m <= 0)
+              throw py::value_error("stiffness_n_per_m must be > 0 and finite");
+            m.Run([&] { m.ref.model->pull(body.c_str(), p, t, stiffness_n_per_m); });
+          },
+          py::arg("body"), py::arg("point_m"), py::arg("target_m"),
+          py::arg("stiffness_n_per_m") = 100.0,
+          "Pulls `body` at `point_m` (its frame) toward `target_m` (world) with a spring.")
+      .def(
+          "release_pull", [](ModelObject& m) { m.Run([&] { m.ref.model->release_pull(); }); },
+          "Lets go of a pull.");
 }
 
 }  // namespace caliper::python

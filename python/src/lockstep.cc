@@ -48,8 +48,9 @@ class Lockstep {
   }
 
   // commands: Models x actuators [their unit]; returns Models x observed values
-  py::array_t<double> Step(const py::array_t<double, py::array::c_style | py::array::forcecast>& commands,
-                           uint32_t frames) {
+  py::array_t<double> Step(
+      const py::array_t<double, py::array::c_style | py::array::forcecast>& commands,
+      uint32_t frames) {
     const size_t n = lanes_.size(), a = lanes_[0].commands.length();
     if (commands.ndim() != 2 || static_cast<size_t>(commands.shape(0)) != n ||
         static_cast<size_t>(commands.shape(1)) != a)
@@ -103,9 +104,8 @@ class Lockstep {
       M::CycleResult_var cycle;
       {
         CallScope scope(kLongCallS);
-        cycle = client::Call(m.ref, [&] {
-          return m.ref.model->control_cycle(lane.commands, frames_, lane.ids);
-        });
+        cycle = client::Call(
+            m.ref, [&] { return m.ref.model->control_cycle(lane.commands, frames_, lane.ids); });
       }
       const CORBA::ULong ran = cycle->steps;
       if (ran < frames_) {

@@ -22,9 +22,9 @@ S::StringSeq ToSeq(const std::vector<std::string>& ids) {
 py::object Types() { return py::module_::import("caliper.model"); }
 
 py::object StatusObject(const M::SimulationStatus& s) {
-  return Types().attr("Status")(rtc::Name(s.state), std::string(s.scene.in()), s.sim_time,
-                                s.steps, s.time_step, s.real_time_factor,
-                                s.achieved_real_time_factor, std::string(s.last_error.in()));
+  return Types().attr("Status")(rtc::Name(s.state), std::string(s.scene.in()), s.sim_time, s.steps,
+                                s.time_step, s.real_time_factor, s.achieved_real_time_factor,
+                                std::string(s.last_error.in()));
 }
 
 std::string AbsolutePath(const py::object& path) {
@@ -179,10 +179,9 @@ py::list Actuators(ModelObject& m) {
   M::ActuatorInfoSeq_var list = m.Run([&] { return m.ref.model->actuators(); });
   py::list out;
   for (CORBA::ULong i = 0; i < list->length(); ++i)
-    out.append(Types().attr("Actuator")(std::string(list[i].name.in()),
-                                        std::string(list[i].kind.in()),
-                                        std::string(list[i].tendon.in()),
-                                        std::string(list[i].command_unit.in())));
+    out.append(Types().attr("Actuator")(
+        std::string(list[i].name.in()), std::string(list[i].kind.in()),
+        std::string(list[i].tendon.in()), std::string(list[i].command_unit.in())));
   return out;
 }
 
@@ -199,7 +198,8 @@ template <class Op>
 void SetPositive(ModelObject& m, const char* what, const py::object& given, bool zero_ok, Op op) {
   const std::vector<double> v = FiniteValues(given, what);
   if (v.size() != 1)
-    throw py::value_error(std::string(what) + " must be one number, not " + std::to_string(v.size()));
+    throw py::value_error(std::string(what) + " must be one number, not " +
+                          std::to_string(v.size()));
   const double value = v[0];
   if (value < 0 || (!zero_ok && value == 0))
     throw py::value_error(std::string(what) + " must be " + (zero_ok ? ">= 0" : "> 0") +
@@ -213,39 +213,46 @@ void BindControl(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
 this host's files and may read it, else by content (always with send=True; a URDF is converted
 to COLLADA here). Returns the import's warnings. LoadFailed names the file, the element and the
 problem; the Model keeps its scene.)doc")
-      .def("load_bytes",
-           [](ModelObject& m, const std::string& file_name, const py::bytes& data) {
-             const std::string bytes = data;
-             m.Run([&] { m.ref.model->load_scene_data(file_name.c_str(), client::ToOctets(bytes)); },
-                   kLongCallS);
-             std::lock_guard<std::mutex> lock(m.shapes_mutex);
-             m.shapes.clear();
-           },
-           py::arg("file_name"), py::arg("data"),
-           "Loads a scene from its bytes; `file_name` (NAME.dae or NAME.zae) tells the format.")
-      .def("export_scene",
-           [](ModelObject& m) {
-             M::Octets_var o = m.Run([&] { return m.ref.model->export_scene(); }, kLongCallS);
-             return py::bytes(reinterpret_cast<const char*>(o->get_buffer()), o->length());
-           },
-           "The scene as it is now (edits and tuned parameters included), as COLLADA bytes.")
+      .def(
+          "load_bytes",
+          [](ModelObject& m, const std::string& file_name, const py::bytes& data) {
+            const std::string bytes = data;
+            m.Run([&] { m.ref.model->load_scene_data(file_name.c_str(), client::ToOctets(bytes)); },
+                  kLongCallS);
+            std::lock_guard<std::mutex> lock(m.shapes_mutex);
+            m.shapes.clear();
+          },
+          py::arg("file_name"), py::arg("data"),
+          "Loads a scene from its bytes; `file_name` (NAME.dae or NAME.zae) tells the format.")
+      .def(
+          "export_scene",
+          [](ModelObject& m) {
+            M::Octets_var o = m.Run([&] { return m.ref.model->export_scene(); }, kLongCallS);
+            return py::bytes(reinterpret_cast<const char*>(o->get_buffer()), o->length());
+          },
+          "The scene as it is now (edits and tuned parameters included), as COLLADA bytes.")
       .def("step", &Step, py::arg("n") = 1,
            R"doc(Runs `n` steps now (the Model must not be running) and returns the steps run.
 RunFailed (with `.steps`) when the physics faulted on the way. Releases the GIL.)doc")
-      .def("start", [](ModelObject& m) { m.Run([&] { m.ref.model->start(); }); },
-           "Runs the simulation at its real-time factor until pause() or stop().")
-      .def("pause", [](ModelObject& m) { m.Run([&] { m.ref.model->pause(); }); }, "Pauses it.")
-      .def("stop", [](ModelObject& m) { m.Run([&] { m.ref.model->stop(); }); },
-           "Stops it and goes back to the scene's initial state.")
-      .def("reset", [](ModelObject& m) { m.Run([&] { m.ref.model->reset(); }); },
-           "Back to the scene's initial state (time 0); a running Model runs on from there, a "
-           "paused or stopped one stays so; a faulted one is stopped (the fault cleared).")
-      .def("status",
-           [](ModelObject& m) {
-             M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
-             return StatusObject(s.in());
-           },
-           "The simulation's state, time [s], steps, time step [s] and real-time factors.")
+      .def(
+          "start", [](ModelObject& m) { m.Run([&] { m.ref.model->start(); }); },
+          "Runs the simulation at its real-time factor until pause() or stop().")
+      .def(
+          "pause", [](ModelObject& m) { m.Run([&] { m.ref.model->pause(); }); }, "Pauses it.")
+      .def(
+          "stop", [](ModelObject& m) { m.Run([&] { m.ref.model->stop(); }); },
+          "Stops it and goes back to the scene's initial state.")
+      .def(
+          "reset", [](ModelObject& m) { m.Run([&] { m.ref.model->reset(); }); },
+          "Back to the scene's initial state (time 0); a running Model runs on from there, a "
+          "paused or stopped one stays so; a faulted one is stopped (the fault cleared).")
+      .def(
+          "status",
+          [](ModelObject& m) {
+            M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
+            return StatusObject(s.in());
+          },
+          "The simulation's state, time [s], steps, time step [s] and real-time factors.")
       .def_property(
           "time_step_s",
           [](ModelObject& m) {
@@ -314,9 +321,10 @@ void RaiseIfFaulted(ModelObject& m, uint64_t asked, uint64_t done) {
   if (done >= asked) return;
   M::SimulationStatus_var s = m.Run([&] { return m.ref.model->status(); });
   if (s->state != M::FAULTED) return;  // a pause, a stop or a replay's end
-  py::object error = py::module_::import("caliper.errors").attr("RunFailed")(
-      m.ref.name + ": the simulation faulted after " + std::to_string(done) + " of " +
-      std::to_string(asked) + " steps: " + s->last_error.in());
+  py::object error =
+      py::module_::import("caliper.errors")
+          .attr("RunFailed")(m.ref.name + ": the simulation faulted after " + std::to_string(done) +
+                             " of " + std::to_string(asked) + " steps: " + s->last_error.in());
   error.attr("steps") = done;
   PyErr_SetObject(error.get_type().ptr(), error.ptr());
   throw py::error_already_set();
@@ -365,12 +373,15 @@ A Model of a session (Session.model): a Bullet world with its tendons, actuators
 Every call waits for the Model's answer with the GIL released; the Model's refusals raise
 caliper.errors classes with its message.
 )doc");
-  c.def_property_readonly("name", [](ModelObject& o) { return o.ref.name; },
-                          "The name it was asked for (model0, model1@hostb).")
-      .def_property_readonly("path", [](ModelObject& o) { return o.ref.path; },
-                             "Its naming path, HOST.host_cxt/INSTANCE.rtc.")
-      .def_property_readonly("local", [](ModelObject& o) { return o.ref.local; },
-                             "Whether it runs on this host (shares its files).")
+  c.def_property_readonly(
+       "name", [](ModelObject& o) { return o.ref.name; },
+       "The name it was asked for (model0, model1@hostb).")
+      .def_property_readonly(
+          "path", [](ModelObject& o) { return o.ref.path; },
+          "Its naming path, HOST.host_cxt/INSTANCE.rtc.")
+      .def_property_readonly(
+          "local", [](ModelObject& o) { return o.ref.local; },
+          "Whether it runs on this host (shares its files).")
       .def("__repr__", [](ModelObject& o) { return "<caliper.Model " + o.ref.path + ">"; });
   BindControl(c);
   BindDaq(c);

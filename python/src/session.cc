@@ -58,8 +58,7 @@ py::list Components(SessionHandle& s) {
   py::list out;
   py::object component = py::module_::import("caliper.session").attr("Component");
   for (auto& e : entries)
-    out.append(component(e.instance + "@" + e.host, e.host, e.instance, e.path,
-                         KindOf(e.object)));
+    out.append(component(e.instance + "@" + e.host, e.host, e.instance, e.path, KindOf(e.object)));
   return out;
 }
 
@@ -139,9 +138,8 @@ ConnectionError when it cannot be reached.)doc")
            py::arg("renderer") = "",
            R"doc(A PNG of the Scene Renderer's view (`renderer` by name, or the session's first),
 `width` x `height` pixels, as bytes. NotAvailable when no renderer runs.)doc")
-      .def("__repr__", [](SessionHandle& s) {
-        return "<caliper.Session " + s.session->address() + ">";
-      });
+      .def("__repr__",
+           [](SessionHandle& s) { return "<caliper.Session " + s.session->address() + ">"; });
 }
 
 }  // namespace caliper::python

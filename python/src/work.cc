@@ -18,12 +18,12 @@ py::tuple RecordingTuple(const experiment::Recording& r) {
   py::list channels;
   py::object channel = py::module_::import("caliper.model").attr("Channel");
   for (const auto& c : r.channels)
-    channels.append(channel(c.id, c.unit, py::tuple(py::cast(ChannelShape(c.rows, c.cols))), false,
-                            false, ""));
+    channels.append(
+        channel(c.id, c.unit, py::tuple(py::cast(ChannelShape(c.rows, c.cols))), false, false, ""));
   py::array_t<double> t(static_cast<py::ssize_t>(r.times.size()));
   std::copy(r.times.begin(), r.times.end(), t.mutable_data());
-  py::array_t<double> d({static_cast<py::ssize_t>(r.times.size()),
-                         static_cast<py::ssize_t>(r.values_per_sample)});
+  py::array_t<double> d(
+      {static_cast<py::ssize_t>(r.times.size()), static_cast<py::ssize_t>(r.values_per_sample)});
   std::copy(r.data.begin(), r.data.end(), d.mutable_data());
   return py::make_tuple(channels, t, d);
 }
@@ -192,7 +192,8 @@ void BindWork(py::module_& m) {
            })
       .def("experiments", [](Calibration& c) { return c.spec.experiments; })
       .def("evaluate", &Evaluate, py::arg("values"), py::arg("keep_recordings") = false)
-      .def_property_readonly("evaluations", [](Calibration& c) { return c.evaluator.evaluations(); })
+      .def_property_readonly("evaluations",
+                             [](Calibration& c) { return c.evaluator.evaluations(); })
       .def_property_readonly("faults", [](Calibration& c) { return c.evaluator.faults(); });
 }
 
