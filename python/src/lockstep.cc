@@ -3,6 +3,8 @@
 // environments (caliper.env). The cycles run on
 // threads of this module with the GIL released, one per Model after the first, which the
 // calling thread runs itself; Python is touched only before and after.
+#include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <thread>
 
@@ -73,8 +75,11 @@ class Lockstep {
       }
       wake_.notify_all();
       Cycle(lanes_[0]);
+      // the other lanes end within a few hundred microseconds of this one: look before sleeping
+      // (a wake-up across virtual CPUs costs more than the wait)
+      SpinUntil([&] { return pending_.load() == 0; }, kSpin);
       std::unique_lock<std::mutex> lock(mutex_);
-      done_.wait(lock, [&] { return pending_ == 0; });
+      done_.wait(lock, [&] { return pending_.load() == 0; });
     }
     for (auto& lane : lanes_)
       if (lane.error) std::rethrow_exception(std::exchange(lane.error, nullptr));
@@ -129,9 +134,11 @@ class Lockstep {
   void Work(size_t index) {
     uint64_t seen = 0;
     while (true) {
+      // the next cycle usually comes after the caller's Python work on this one: look first
+      SpinUntil([&] { return quit_.load() || generation_.load() != seen; }, kSpin);
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        wake_.wait(lock, [&] { return quit_ || generation_ != seen; });
+        wake_.wait(lock, [&] { return quit_.load() || generation_.load() != seen; });
         if (quit_) return;
         seen = generation_;
       }
@@ -141,14 +148,22 @@ class Lockstep {
     }
   }
 
+  // Checks `ready` for up to `spin`, yielding the CPU between looks.
+  template <class Ready>
+  static void SpinUntil(Ready ready, std::chrono::microseconds spin) {
+    const auto until = std::chrono::steady_clock::now() + spin;
+    while (!ready() && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+  }
+  static constexpr std::chrono::microseconds kSpin{300};
+
   std::vector<Lane> lanes_;
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  uint64_t generation_ = 0;
-  size_t pending_ = 0;
+  std::atomic<uint64_t> generation_{0};
+  std::atomic<size_t> pending_{0};
   CORBA::ULong frames_ = 1;
-  bool quit_ = false;
+  std::atomic<bool> quit_{false};
 };
 
 }  // namespace
