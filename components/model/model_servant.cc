@@ -124,12 +124,14 @@ CORBA::ULong ModelServant::step(CORBA::ULong n) {
 }
 M::CycleResult* ModelServant::control_cycle(const M::CommandSeq& commands, CORBA::ULong n,
                                             const S::StringSeq& ids) {
-  D::ValueSeq_var check = get(ids);  // ids it cannot read are refused before anything changes
-  set_commands(commands);
+  std::vector<std::pair<std::string, double>> list;
+  for (CORBA::ULong i = 0; i < commands.length(); ++i)
+    list.emplace_back(commands[i].actuator.in(), commands[i].value);
+  const ModelCore::Cycle cycle = Guard([&] { return core_.ControlCycle(list, n, FromIdl(ids)); });
   auto result = std::make_unique<M::CycleResult>();
-  result->steps = step(n);
-  D::ValueSeq_var values = get(ids);
-  result->values = values.in();
+  result->steps = static_cast<CORBA::ULong>(cycle.steps);
+  result->values.length(static_cast<CORBA::ULong>(cycle.values.size()));
+  for (CORBA::ULong i = 0; i < cycle.values.size(); ++i) result->values[i] = ToIdl(cycle.values[i]);
   return result.release();
 }
 

@@ -306,4 +306,5 @@ class VectorEnv:
         """Closes every environment and the worker threads."""
         for e in self.envs:
             e.close()
+        self._lockstep = None  # its threads end with it
         self._executor.shutdown()

@@ -96,8 +96,9 @@ def run_batch(experiments: ExperimentLike, session: Optional[Session] = None,
     """Runs every experiment across every Model of the session whose name matches `models` (a
     glob: ``*``, ``*@hostb``), one run per Model at a time, as fast as possible. A run whose
     Model is lost (killed, unreachable, no answer in `run_timeout_s`) goes to another Model, at
-    most `attempts` times, the rule of ``caliper-ctl batch``; Models that join meanwhile take
-    runs too. `progress` prints a line per run to stderr (True), or is called with (done, total).
+    most `attempts` times, the rule of ``caliper-ctl batch``; while every Model is lost it looks
+    for new ones for up to `wait_for_model_s`. `progress` prints a line per run to stderr (True),
+    or is called with (done, total).
     Each run loads its scene afresh, so a run gives the same bits on any Model."""
     runs = experiments_of(experiments)
     names = [r.name for r in runs]

@@ -130,10 +130,12 @@ Model = _caliper.Model
 
 
 class Feed:
-    """A lossless subscription to channels of a Model (``Model.feed``): the Model's stepping
-    waits for this client, so no sample is lost. :meth:`step` steps the Model itself and returns
-    the samples of those steps; :meth:`take` returns what arrived while something else (a
-    controller, ``start()``) ran it. Close it (or use ``with``) to end the subscription."""
+    """A lossless subscription to channels of a Model (``Model.feed``): when the Model steps
+    in lock-step or as fast as possible, its stepping waits for this client, so no sample is
+    lost; running at a real-time factor above 0 it does not wait, and a client that lags loses
+    batches (then :meth:`take` raises, saying so). :meth:`step` steps the Model itself and
+    returns the samples of those steps; :meth:`take` returns what arrived while something else
+    (a controller, ``start()``) ran it. Close it (or use ``with``) to end the subscription."""
 
     def __init__(self, model: Model, ids: Union[str, Sequence[str]], every: int = 1):
         self._feed = _caliper._Feed(model, ids, every)
@@ -145,8 +147,8 @@ class Feed:
         return Data(self.channels, *self._feed.step(steps))
 
     def take(self, wait_s: float = 1.0) -> Data:
-        """The samples that arrived since the last take, after waiting up to `wait_s` [s] for
-        those the Model has already taken."""
+        """The samples that arrived since the last take; a Model at rest is waited for up to
+        `wait_s` [s] until every sample it took has arrived (within one push poll, 20 ms)."""
         return Data(self.channels, *self._feed.take(wait_s))
 
     def close(self) -> None:

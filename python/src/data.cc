@@ -33,11 +33,15 @@ class Feed {
       : model_(std::move(model)), ids_(IdList(ids, "ids")) {
     if (ids_.empty()) throw py::value_error("ids must name at least one channel");
     if (every < 1) throw py::value_error("every must be >= 1 step");
+    every_ = every;
     ModelObject& m = *model_;
     D::ChannelInfoSeq_var all = m.Run([&] { return m.ref.model->list("*"); });
     for (const auto& id : ids_)
       for (CORBA::ULong i = 0; i < all->length(); ++i)
-        if (id == all[i].id.in()) channels_.append(ChannelObject(all[i]));
+        if (id == all[i].id.in()) {
+          channels_.append(ChannelObject(all[i]));
+          width_hint_ += static_cast<uint64_t>(all[i].rows) * all[i].cols;
+        }
     py::gil_scoped_release release;
     CallScope scope(m.s.timeout_s);
     feed_ = std::make_unique<client::DataFeed>(
@@ -50,10 +54,23 @@ class Feed {
           received_ += b.count;
         });
   }
-  ~Feed() { Close(); }
+  ~Feed() {
+    try {
+      Close();
+    } catch (const std::exception&) {
+      // the Model or this process's ORB is going: nothing left to end
+    }
+  }
 
   // Steps the Model `steps` (in pieces, so that Ctrl-C is seen) and takes every sample.
   py::tuple Step(uint64_t steps) {
+    const uint64_t values = (steps + every_ - 1) / every_ * width_hint_;
+    if (values > kMaxValues)
+      throw client::LimitExceededError(
+          model_->ref.name + ": " + std::to_string(steps) + " steps of these channels are " +
+              std::to_string(values) + " values, more than one call keeps in memory (" +
+              std::to_string(kMaxValues) + "); take them in blocks (Model.stream)",
+          kMaxValues);
     uint64_t done = 0;
     while (done < steps) {
       const uint64_t piece = std::min<uint64_t>(steps - done, 20000);
@@ -68,32 +85,47 @@ class Feed {
     return block;
   }
 
-  // What has arrived, after waiting up to `wait_s` for the samples the Model has taken; with
-  // `complete`, Failure when some have not arrived by then.
+  // What has arrived. At rest, after waiting up to `wait_s` [s] for the samples the Model has
+  // taken (its last, partial batch comes within a push poll); a running Model is not waited for
+  // (its batch in progress fills as it runs). With `complete`, Failure when some are missing.
   py::tuple Take(double wait_s, bool complete = false) {
-    uint64_t taken = 0;
+    if (!(wait_s >= 0 && wait_s <= 3600)) throw py::value_error("wait_s must be 0 to 3600 s");
+    uint64_t taken = 0, received = 0, gaps = 0;
+    std::vector<double> times, data;
+    size_t width = 0;
     {
       py::gil_scoped_release release;
       CallScope scope(model_->s.timeout_s);
+      M::SimulationStatus_var state = client::StatusOf(model_->ref);
+      const bool running = state->state == M::RUNNING;
       const auto until = std::chrono::steady_clock::now() +
                          std::chrono::microseconds(static_cast<int64_t>(wait_s * 1e6));
-      while (std::chrono::steady_clock::now() < until) {
-        const D::SubscriptionStatus status = feed_->Status();
-        taken = status.samples;
-        std::lock_guard<std::mutex> lock(feed_->mutex());
-        if (received_ >= taken) break;
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      while (true) {
+        taken = feed_->Status().samples;
+        {
+          std::lock_guard<std::mutex> lock(feed_->mutex());
+          if (running || received_ >= taken) break;
+        }
+        if (std::chrono::steady_clock::now() >= until) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
+      // out of the callback's reach before any Python object is made
+      std::lock_guard<std::mutex> lock(feed_->mutex());
+      times.swap(times_);
+      data.swap(data_);
+      width = width_;
+      received = received_;
+      gaps = gaps_;
     }
-    std::lock_guard<std::mutex> lock(feed_->mutex());
-    if (gaps_ > 0)
-      throw client::Failure(model_->ref.name + ": " + std::to_string(gaps_) +
-                            " batches of the lossless feed were lost");
-    if (complete && received_ < taken)
-      throw client::Failure(model_->ref.name + ": " + std::to_string(taken - received_) + " of " +
+    if (gaps > 0)
+      throw client::Failure(model_->ref.name + ": " + std::to_string(gaps) +
+                            " batches of the lossless feed were lost (the Model drops batches "
+                            "while it runs at a real-time factor above 0 and this client lags)");
+    if (complete && received < taken)
+      throw client::Failure(model_->ref.name + ": " + std::to_string(taken - received) + " of " +
                             std::to_string(taken) + " samples did not arrive within " +
                             std::to_string(wait_s) + " s");
-    return Block(times_, data_, width_);
+    return Block(times, data, width);
   }
 
   void Close() {
@@ -113,6 +145,10 @@ class Feed {
   // written by the callback under feed_->mutex()
   std::vector<double> times_, data_;
   size_t width_ = 0;
+  uint32_t every_ = 1;
+  uint64_t width_hint_ = 0;  // values per sample, from the channels' shapes
+  // the most values Step gathers in one call (8 GB of float64)
+  static constexpr uint64_t kMaxValues = 1000000000;
   uint64_t received_ = 0, next_batch_ = 1, gaps_ = 0;
 };
 

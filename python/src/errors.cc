@@ -2,6 +2,7 @@
 // part uses.
 #include <omniORB4/CORBA.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "binding.h"
@@ -16,7 +17,9 @@ namespace caliper::python {
 CallScope::CallScope(double timeout_s) {
   thread_local rtc::OmniThread known;  // once per thread, for its lifetime
   (void)known;
-  omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(timeout_s * 1000));
+  // 0 would fall back to the ORB's global deadline (the first session's): "none" is the longest
+  omniORB::setClientThreadCallTimeout(
+      timeout_s > 0 ? static_cast<CORBA::ULong>(std::min(timeout_s * 1000, 4e9)) : 0xFFFFFFFFu);
 }
 
 CallScope::~CallScope() { omniORB::setClientThreadCallTimeout(0); }

@@ -3,6 +3,7 @@
 // environments (caliper.env). The cycles run on
 // threads of this module with the GIL released, one per Model after the first, which the
 // calling thread runs itself; Python is touched only before and after.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -36,6 +37,10 @@ class Lockstep {
         lane.ids[static_cast<CORBA::ULong>(i)] = observed[i].c_str();
       lanes_.push_back(std::move(lane));
     }
+    // looking before sleeping pays only while every lane has a core to itself
+    spin_ = lanes_.size() <= std::max(1u, std::thread::hardware_concurrency())
+                ? kSpin
+                : std::chrono::microseconds(0);
     for (size_t i = 1; i < lanes_.size(); ++i) workers_.emplace_back([this, i] { Work(i); });
   }
 
@@ -77,7 +82,7 @@ class Lockstep {
       Cycle(lanes_[0]);
       // the other lanes end within a few hundred microseconds of this one: look before sleeping
       // (a wake-up across virtual CPUs costs more than the wait)
-      SpinUntil([&] { return pending_.load() == 0; }, kSpin);
+      SpinUntil([&] { return pending_.load() == 0; }, spin_);
       std::unique_lock<std::mutex> lock(mutex_);
       done_.wait(lock, [&] { return pending_.load() == 0; });
     }
@@ -135,7 +140,7 @@ class Lockstep {
     uint64_t seen = 0;
     while (true) {
       // the next cycle usually comes after the caller's Python work on this one: look first
-      SpinUntil([&] { return quit_.load() || generation_.load() != seen; }, kSpin);
+      SpinUntil([&] { return quit_.load() || generation_.load() != seen; }, spin_);
       {
         std::unique_lock<std::mutex> lock(mutex_);
         wake_.wait(lock, [&] { return quit_.load() || generation_.load() != seen; });
@@ -164,6 +169,7 @@ class Lockstep {
   std::atomic<size_t> pending_{0};
   CORBA::ULong frames_ = 1;
   std::atomic<bool> quit_{false};
+  std::chrono::microseconds spin_{0};
 };
 
 }  // namespace

@@ -12,6 +12,10 @@ namespace S = ::Caliper::Scene;
 
 namespace {
 
+// the most values a client sends for one parameter (the Model's largest, a mesh's vertices,
+// has far fewer)
+constexpr size_t kMaxParameterValues = 100000;
+
 S::StringSeq ToSeq(const std::vector<std::string>& ids) {
   S::StringSeq out;
   out.length(static_cast<CORBA::ULong>(ids.size()));
@@ -49,8 +53,6 @@ py::list Load(ModelObject& m, const py::object& path, bool send) {
         }
       },
       kLongCallS);
-  std::lock_guard<std::mutex> lock(m.shapes_mutex);
-  m.shapes.clear();
   return py::cast(sent.warnings);
 }
 
@@ -100,11 +102,7 @@ void SetCommands(ModelObject& m, const py::object& commands) {
 py::list Channels(ModelObject& m, const std::string& pattern) {
   D::ChannelInfoSeq_var list = m.Run([&] { return m.ref.model->list(pattern.c_str()); });
   py::list out;
-  std::lock_guard<std::mutex> lock(m.shapes_mutex);
-  for (CORBA::ULong i = 0; i < list->length(); ++i) {
-    out.append(ChannelObject(list[i]));
-    m.shapes[list[i].id.in()] = {list[i].rows, list[i].cols};
-  }
+  for (CORBA::ULong i = 0; i < list->length(); ++i) out.append(ChannelObject(list[i]));
   return out;
 }
 
@@ -162,14 +160,22 @@ py::array_t<double> ControlCycle(ModelObject& m, const py::object& commands, int
 
 void Set(ModelObject& m, const std::string& id, const py::object& value) {
   const std::vector<double> v = FiniteValues(value, "value");
-  const auto shape = m.Shapes({id})[0];
-  if (v.size() != static_cast<size_t>(shape.first) * shape.second)
-    throw py::value_error("value must have " + std::to_string(shape.first * shape.second) +
-                          " elements for " + id + " (" + std::to_string(shape.first) + " x " +
-                          std::to_string(shape.second) + "), not " + std::to_string(v.size()));
+  if (v.size() > kMaxParameterValues)
+    throw py::value_error("value has " + std::to_string(v.size()) + " elements; no parameter of " +
+                          id + " or any other has more than " +
+                          std::to_string(kMaxParameterValues));
+  // the channel's shape as the Model has it now (UnknownId naming the id), so that a wrong
+  // count is refused here, naming the argument; the Model checks again when it writes
+  const S::StringSeq one = ToSeq({id});
+  D::ValueSeq_var now = m.Run([&] { return m.ref.model->get(one); });
+  const uint32_t rows = now[0].rows, cols = now[0].cols;
+  if (v.size() != static_cast<size_t>(rows) * cols)
+    throw py::value_error("value must have " + std::to_string(rows * cols) + " elements for " + id +
+                          " (" + std::to_string(rows) + " x " + std::to_string(cols) + "), not " +
+                          std::to_string(v.size()));
   D::Value value_idl;
-  value_idl.rows = shape.first;
-  value_idl.cols = shape.second;
+  value_idl.rows = rows;
+  value_idl.cols = cols;
   value_idl.data.length(static_cast<CORBA::ULong>(v.size()));
   for (size_t i = 0; i < v.size(); ++i) value_idl.data[static_cast<CORBA::ULong>(i)] = v[i];
   m.Run([&] { m.ref.model->set(id.c_str(), value_idl); });
@@ -219,8 +225,6 @@ problem; the Model keeps its scene.)doc")
             const std::string bytes = data;
             m.Run([&] { m.ref.model->load_scene_data(file_name.c_str(), client::ToOctets(bytes)); },
                   kLongCallS);
-            std::lock_guard<std::mutex> lock(m.shapes_mutex);
-            m.shapes.clear();
           },
           py::arg("file_name"), py::arg("data"),
           "Loads a scene from its bytes; `file_name` (NAME.dae or NAME.zae) tells the format.")
@@ -298,8 +302,9 @@ for a position) or of a list of ids (a list of such arrays).)doc")
 get_values). Refused commands or ids change nothing. RunFailed when the physics faults.)doc")
       .def("set", &Set, py::arg("id"), py::arg("value"),
            R"doc(Writes a parameter by DAQ id (e.g. ecce_arm.forearm.mass, in its unit): a number
-or an array with the channel's element count. NaN, infinities and wrong sizes raise ValueError
-before anything is sent; the Model's own bounds raise InvalidParameter.)doc");
+or an array with the channel's element count. NaN, infinities and sizes no parameter has raise
+ValueError naming the argument before anything is sent (the shape is asked first); the Model's
+own bounds raise InvalidParameter.)doc");
 }
 
 }  // namespace
@@ -328,29 +333,6 @@ void RaiseIfFaulted(ModelObject& m, uint64_t asked, uint64_t done) {
   error.attr("steps") = done;
   PyErr_SetObject(error.get_type().ptr(), error.ptr());
   throw py::error_already_set();
-}
-
-std::vector<std::pair<uint32_t, uint32_t>> ModelObject::Shapes(
-    const std::vector<std::string>& ids) {
-  std::vector<std::pair<uint32_t, uint32_t>> out;
-  {
-    std::lock_guard<std::mutex> lock(shapes_mutex);
-    for (const auto& id : ids) {
-      const auto it = shapes.find(id);
-      if (it == shapes.end()) break;
-      out.push_back(it->second);
-    }
-    if (out.size() == ids.size()) return out;
-  }
-  const S::StringSeq seq = ToSeq(ids);
-  D::ValueSeq_var values = Run([&] { return ref.model->get(seq); });  // UnknownId names the id
-  out.clear();
-  std::lock_guard<std::mutex> lock(shapes_mutex);
-  for (CORBA::ULong i = 0; i < values->length(); ++i) {
-    shapes[ids[i]] = {values[i].rows, values[i].cols};
-    out.emplace_back(values[i].rows, values[i].cols);
-  }
-  return out;
 }
 
 py::object ChannelObject(const D::ChannelInfo& c) {

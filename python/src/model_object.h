@@ -14,9 +14,6 @@ namespace caliper::python {
 struct ModelObject {
   SessionHandle s;
   client::ModelRef ref;
-  /// Channel shapes by id (rows, cols), learnt from the Model's channel list; cleared on load.
-  std::mutex shapes_mutex;
-  std::map<std::string, std::pair<uint32_t, uint32_t>> shapes;
 
   /// Runs `f` on the Model with the GIL released and a call deadline of `timeout_s` (the
   /// session's when < 0), the Model's exceptions turned into the library's (client::Call).
@@ -26,8 +23,6 @@ struct ModelObject {
     CallScope scope(timeout_s < 0 ? s.timeout_s : timeout_s);
     return client::Call(ref, std::forward<F>(f));
   }
-  /// The shapes of `ids` (one channel list call for those not known yet); GIL held.
-  std::vector<std::pair<uint32_t, uint32_t>> Shapes(const std::vector<std::string>& ids);
 };
 
 /// After a step request that ran `done` of `asked` steps: raises caliper.RunFailed (with

@@ -83,7 +83,10 @@ py::bytes Screenshot(SessionHandle& s, uint32_t width, uint32_t height,
     std::string name = renderer;
     if (name.empty())
       for (auto& e : s.session->List())
-        if (KindOf(e.object) == "Renderer") name = e.host + "/" + e.instance;
+        if (KindOf(e.object) == "Renderer") {
+          name = e.host + "/" + e.instance;
+          break;
+        }
     if (name.empty())
       throw client::NotAvailableError(
           "no Scene Renderer runs in the session at " + s.session->address() +

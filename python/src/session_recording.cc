@@ -69,8 +69,6 @@ size. Read the file with caliper.Recording.)doc")
           [](ModelObject& m, const std::string& path) {
             M::ReplayStatus_var r =
                 m.Run([&] { return m.ref.model->open_replay(path.c_str()); }, kLongCallS);
-            std::lock_guard<std::mutex> lock(m.shapes_mutex);
-            m.shapes.clear();
             return ReplayStatusObject(r.in());
           },
           py::arg("path"),

@@ -50,10 +50,10 @@ class Scenes {
 };
 
 py::tuple RunOn(ModelObject& m, const experiment::Experiment& e) {
-  static Scenes scenes;
   experiment::Recording r;
   {
     py::gil_scoped_release release;
+    Scenes scenes;  // read afresh: the file as it is now
     const std::string& bytes = scenes.Of(e.scene);
     CallScope scope(kLongCallS);
     M::Recording_var idl =

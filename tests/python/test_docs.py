@@ -34,6 +34,7 @@ def test_the_page_runs_as_written(capsys):
     assert "value must be finite; element 0 is NaN" in out
     assert "(250, 3)" in out
     assert "undo set the mass of forearm to 1.5 kg" in out
-    assert "[Event(step=" in out and "kind='command', target='elbow_flexor'" in out
+    assert "[Event(step=100, kind='command', target='elbow_flexor'" in out
+    assert "[0.  0.1 0.2]" in out  # the keyframes' times [s] from the reset
     finals = [float(v) for v in re.findall(r"'ecce_arm.forearm.mass': \[[0-9.]+\]\} (\S+)", out)]
     assert len(finals) == 3 and finals[0] > finals[1] > finals[2]  # heavier hangs lower

@@ -1,11 +1,7 @@
 """Experiments from Python: Model.run_experiment, caliper.run_batch over 2 Models (a mass sweep,
 a Model killed mid-batch, bad files, a missing scene) and caliper.Calibration on measurements
-made here with known parameters.
-
-The shared sessions are class-scoped, and the tests that start sessions of their own run outside
-those classes: a failed connection attempt destroys the process's ORB (see
-test_a_failed_connect_leaves_the_open_sessions_usable), which would otherwise turn one bug into
-failures of every later test."""
+made here with known parameters. A failed connection attempt leaves the sessions already open
+working (test_a_failed_connect_leaves_the_open_sessions_usable)."""
 
 import json
 import os
@@ -40,9 +36,7 @@ MASSES = [0.6, 0.9, 1.2, 1.5]
 
 @pytest.fixture(scope="class")
 def session():
-    """A private session with 2 Models per class. Class-scoped so that it is never open while
-    a test below starts a session of its own (see
-    test_a_failed_connect_leaves_the_open_sessions_usable)."""
+    """A private session with 2 Models per class of tests."""
     with caliper.LocalSession(models=2, scene=SCENE) as s:
         yield s
 

@@ -126,7 +126,15 @@ void Feeds::SetConsumerWake(std::function<void(uint64_t)> wake) {
 
 void Feeds::OnStep(uint64_t step, double time) { recorder_.OnStep(step, time); }
 
-void Feeds::Flush() { recorder_.Flush(); }
+bool Feeds::Flush(uint64_t subscription) {
+  try {
+    const uint64_t before = recorder_.Stats(subscription).batches;
+    recorder_.Flush(subscription);
+    return recorder_.Stats(subscription).batches != before;
+  } catch (const daq::UnknownId&) {
+    return false;
+  }
+}
 
 void Feeds::NotifyRoom() {
   {

@@ -347,10 +347,8 @@ void ModelCore::Pause() {
   {
     const auto lock = Lock();
     Require(true);
-    if (!EndExperimentLocked("pause") && state_ == RunState::kRunning) {
+    if (!EndExperimentLocked("pause") && state_ == RunState::kRunning)
       state_ = RunState::kPaused;  // a step request ends paused
-      feeds_.Flush();              // the samples up to the pause go out now
-    }
   }
   feeds_.NotifyRoom();  // a step waiting for a lossless consumer ends
 }
@@ -390,13 +388,34 @@ void ModelCore::Reset() {
   rate_sim_ = run_sim_start_;
 }
 
-uint64_t ModelCore::StepNow(uint64_t n) {
-  auto lock = Lock();
+void ModelCore::RequireCanStepLocked() const {
   Require(true);
   RequireIdle();
   if (state_ == RunState::kRunning) throw NotAvailable("the simulation is running; pause it to step");
   if (state_ == RunState::kFaulted)
     throw NotAvailable("the simulation stopped on a fault (" + last_error_ + "); reset it first");
+}
+
+uint64_t ModelCore::StepNow(uint64_t n) {
+  auto lock = Lock();
+  RequireCanStepLocked();
+  return StepRequestLocked(lock, n);
+}
+
+ModelCore::Cycle ModelCore::ControlCycle(
+    const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
+    const std::vector<std::string>& ids) {
+  auto lock = Lock();
+  RequireCanStepLocked();
+  SampleLocked(ids);  // ids it cannot read are refused before anything changes
+  if (!commands.empty()) SetCommandsLocked(commands);
+  Cycle out;
+  out.steps = StepRequestLocked(lock, n);
+  out.values = SampleLocked(ids);
+  return out;
+}
+
+uint64_t ModelCore::StepRequestLocked(std::unique_lock<std::mutex>& lock, uint64_t n) {
   if (n == 0) return 0;
   step_request_ = n;
   step_done_ = 0;
@@ -434,9 +453,6 @@ uint64_t ModelCore::StepNow(uint64_t n) {
     }
   }
   const uint64_t ran = step_done_;
-  // the samples of every step run go out now, not with the next batch (lock-step clients read
-  // what they asked for)
-  if (ran > 0) feeds_.Flush();
   if (restarts_ == generation && state_ != RunState::kFaulted) {
     state_ = RunState::kPaused;
     // writes that came during the request and found no step after them take effect now, as
@@ -626,6 +642,10 @@ std::vector<ModelCore::ActuatorInfo> ModelCore::Actuators() const {
 
 void ModelCore::SetCommands(const std::vector<std::pair<std::string, double>>& commands) {
   const auto lock = Lock();
+  SetCommandsLocked(commands);
+}
+
+void ModelCore::SetCommandsLocked(const std::vector<std::pair<std::string, double>>& commands) {
   Require(true);
   RequireNoExperiment();
   RequireNotReplaying("motor commands");
@@ -690,11 +710,15 @@ std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) co
 }
 
 std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
+  const auto lock = Lock();
+  return SampleLocked(ids);
+}
+
+std::vector<daq::Reading> ModelCore::SampleLocked(const std::vector<std::string>& ids) const {
   if (ids.size() > limits_.ids_per_call)
     throw LimitExceeded(std::to_string(ids.size()) + " ids in one call; at most " +
                         std::to_string(limits_.ids_per_call) + " (split the request)",
                         limits_.ids_per_call);
-  const auto lock = Lock();
   Require(true);
   try {
     return registry_.Sample(ids);
@@ -771,6 +795,16 @@ bool ModelCore::AwaitConsumersLocked(std::unique_lock<std::mutex>& lock) {
 
 std::vector<daq::Batch> ModelCore::TakeBatches(uint64_t subscription, bool* gone,
                                                uint64_t* dropped_samples) {
+  bool ended = false;
+  std::vector<daq::Batch> batches = feeds_.TakeBatches(subscription, &ended, dropped_samples);
+  if (gone != nullptr) *gone = ended;
+  if (!batches.empty() || ended) return batches;
+  {
+    // never waits: a step holding the lock is not resting anyway
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || state_ == RunState::kRunning || step_request_ != 0) return batches;
+    if (!feeds_.Flush(subscription)) return batches;
+  }
   return feeds_.TakeBatches(subscription, gone, dropped_samples);
 }
 

@@ -119,7 +119,7 @@ TEST(LosslessFeed, AStepRequestWaitsForASlowTakerAndLosesNoSample) {
   EXPECT_GT(status.waited_s, 0.0);  // the taker was slower than the steps: the Model waited
 }
 
-TEST(LosslessFeed, AStepRequestSendsEverySampleItTookIncludingAPartialBatch) {
+TEST(LosslessFeed, EveryStepOfARequestReachesATakerOnceTheModelRests) {
   ModelCore core;
   core.Load(Model("pendulum_tendon.dae"));
   const uint64_t id = core.Subscribe({kPosition}, 1, 10, 2000ms);
@@ -130,6 +130,30 @@ TEST(LosslessFeed, AStepRequestSendsEverySampleItTookIncludingAPartialBatch) {
   ASSERT_TRUE(WaitForSamples(taker, 1240)) << taker.samples() << " samples";
   EXPECT_EQ(taker.breaks(), "");
   EXPECT_EQ(core.SubscriptionStatus(id).batches, 125u);
+}
+
+TEST(LosslessFeed, LockStepRequestsOfOneStepKeepWholeBatchesAndLoseNothing) {
+  // a lock-step client (step(1) after step(1)) while a lossy subscriber looks every 20 ms: the
+  // samples wait in whole batches, and only a Model at rest hands out its partial one
+  ModelCore core;
+  core.Load(Model("pendulum_tendon.dae"));
+  const uint64_t id = core.Subscribe({kPosition}, 1, 50);
+  // 250 requests: 5 whole batches, within the queue's 6 (256 MiB / 8 B / 100,000 values / 50)
+  for (int i = 0; i < 250; ++i) EXPECT_EQ(core.StepNow(1), 1u);
+  FeedStatus status = core.SubscriptionStatus(id);
+  EXPECT_EQ(status.batches, 5u) << "one batch per 50 steps, not one per request";
+  EXPECT_EQ(status.dropped_samples, 0u);
+  uint64_t taken = 0;
+  for (const daq::Batch& b : core.TakeBatches(id)) taken += b.step_count;
+  EXPECT_EQ(taken, 250u);
+  EXPECT_EQ(core.StepNow(7), 7u);
+  // at rest: the partial batch of 7 goes out to the taker that finds nothing else
+  const auto rest = core.TakeBatches(id);
+  ASSERT_EQ(rest.size(), 1u);
+  EXPECT_EQ(rest[0].step_count, 7u);
+  EXPECT_TRUE(core.TakeBatches(id).empty());
+  status = core.SubscriptionStatus(id);
+  EXPECT_EQ(status.dropped_samples, 0u);
 }
 
 TEST(LosslessFeed, WithoutLosslessTheSameRunDropsAndCountsTheSamples) {

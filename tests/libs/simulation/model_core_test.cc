@@ -3,12 +3,12 @@
 // step ending as a fault at the start of the failing step, and the bounds of what one call or
 // one queue may take.
 #include "caliper/simulation/model_core.h"
-#include "caliper/simulation/fault_injection.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <future>
@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "caliper/simulation/fault_injection.h"
 
 namespace caliper::simulation {
 namespace {
@@ -121,6 +122,34 @@ TEST(ModelCore, StopEndsAStepRequestAndRewinds) {
 
 // Stop, reset and load rewind the commands too (as MuJoCo's reset zeroes its controls); pause
 // keeps them. "Not driven" is checked against a Model that never had a command.
+TEST(ModelCore, AControlCycleIsTheThreeCallsUnderOneLockAndARefusalChangesNothing) {
+  const char* const kPosition = "pendulum_tendon.pendulum.position";
+  ModelCore three, one;
+  three.Load(Model("pendulum_tendon.dae"));
+  one.Load(Model("pendulum_tendon.dae"));
+  const std::string motor = one.Actuators().at(0).name;
+  for (double volts : {6.0, 2.0, 4.5}) {
+    three.SetCommands({{motor, volts}});
+    ASSERT_EQ(three.StepNow(20), 20u);
+    const ModelCore::Cycle cycle = one.ControlCycle({{motor, volts}}, 20, {kPosition});
+    EXPECT_EQ(cycle.steps, 20u);
+    ASSERT_EQ(cycle.values.size(), 1u);
+    EXPECT_EQ(cycle.values[0].values, three.Sample({kPosition}).at(0).values);
+  }
+  const uint64_t steps = one.status().steps;
+  EXPECT_THROW(one.ControlCycle({{motor, 1.0}}, 20, {"no.such.id"}), UnknownId);
+  EXPECT_THROW(one.ControlCycle({{motor, 1.0}, {"no_such_motor", 1.0}}, 20, {kPosition}),
+               UnknownId);
+  EXPECT_THROW(one.ControlCycle({{motor, std::nan("")}}, 20, {kPosition}), InvalidValue);
+  EXPECT_EQ(one.status().steps, steps) << "a refused cycle stepped";
+  EXPECT_EQ(one.ActuatorStates().at(0).command, 4.5) << "a refused cycle changed a command";
+  one.Start();
+  EXPECT_THROW(one.ControlCycle({{motor, 1.0}}, 20, {kPosition}), NotAvailable);
+  one.Pause();
+  EXPECT_EQ(one.ActuatorStates().at(0).command, 4.5)
+      << "a cycle refused while running changed a command";
+}
+
 TEST(ModelCore, StopResetAndLoadZeroEveryCommandAndPauseKeepsThem) {
   const char* const kPosition = "pendulum_tendon.pendulum.position";
   ModelCore idle;

@@ -52,9 +52,8 @@ class Feeds {
   void SetConsumerWake(std::function<void(uint64_t subscription)> wake);
   /// Samples the subscriptions due after step `step` at simulated time `time` [s].
   void OnStep(uint64_t step, double time);
-  /// Queues every subscription's partial batch, so that a client that asked for steps gets
-  /// the samples of all of them when the request ends (a step request, a pause).
-  void Flush();
+  /// Queues the subscription's partial batch; false when it had none (or is unknown).
+  bool Flush(uint64_t subscription);
 
   /// Waits, with `lock` (the owner's, held) released, until every lossless subscription's queue
   /// has room for the batches of one step; ends (Unsubscribe with the reason) one whose consumer

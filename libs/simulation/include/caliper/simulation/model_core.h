@@ -135,6 +135,16 @@ class ModelCore {
   /// start, load, reset or a time-step change meanwhile gets NotAvailable saying what runs.
   /// NotAvailable while running or faulted.
   uint64_t StepNow(uint64_t n);
+  /// One lock-step control cycle under one lock: checks the ids (LimitExceeded, UnknownId) and
+  /// the commands (SetCommands' errors) and StepNow's preconditions before anything changes,
+  /// applies the commands (none: allowed in a replay too), runs StepNow's request of `n` steps
+  /// and reads `ids` after them, before another client can step or write.
+  struct Cycle {
+    uint64_t steps = 0;
+    std::vector<daq::Reading> values;
+  };
+  Cycle ControlCycle(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
+                     const std::vector<std::string>& ids);
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
   Status status() const;
@@ -271,9 +281,12 @@ class ModelCore {
   /// Called, with the core's lock held, when the stepping begins to wait for the consumer of a
   /// lossless subscription (its sender should push now): must only post and return.
   void SetConsumerWake(std::function<void(uint64_t subscription)> wake);
-  /// Thread-safe without the model's lock: for the subscribers' sender threads. `gone` tells
+  /// For the subscribers' sender threads (it never waits for the model's lock). `gone` tells
   /// whether the subscription no longer exists (the Model ended it, or its client did).
-  /// `dropped_samples` gets how many samples its full queue dropped so far.
+  /// `dropped_samples` gets how many samples its full queue dropped so far. When nothing is
+  /// queued and the Model rests (not running, no step request: paused, stopped, between the
+  /// requests of a lock-step client), the partial batch goes out: a sender polling every P ms
+  /// delivers every sample within P ms of the last step, in whole batches while steps go on.
   std::vector<daq::Batch> TakeBatches(uint64_t subscription, bool* gone = nullptr,
                                       uint64_t* dropped_samples = nullptr);
   bool WaitForBatches(uint64_t subscription, std::chrono::milliseconds timeout);
@@ -327,6 +340,11 @@ class ModelCore {
   /// Applies the queued commands, in the order they came.
   void ApplyPendingLocked();
   void StepLocked();
+  // StepNow's preconditions, and its request once they hold; the lock is held on return
+  void RequireCanStepLocked() const;
+  uint64_t StepRequestLocked(std::unique_lock<std::mutex>& lock, uint64_t n);
+  void SetCommandsLocked(const std::vector<std::pair<std::string, double>>& commands);
+  std::vector<daq::Reading> SampleLocked(const std::vector<std::string>& ids) const;
   void PublishLocked();
   void RewindLocked();
   /// The achieved real-time factor over the wall time since the last measurement, once at least
