@@ -4,7 +4,6 @@ meanwhile, other calls answer), and a million calls do not grow the process."""
 import threading
 import time
 
-import pytest
 
 ELBOW = "ecce_arm.elbow.position"
 
