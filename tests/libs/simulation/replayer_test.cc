@@ -4,6 +4,7 @@
 // the seek's step, and the files a replay refuses, with their messages.
 #include "caliper/simulation/replayer.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -21,6 +22,10 @@
 
 namespace caliper::simulation {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StrEq;
+using ::testing::ThrowsMessage;
 
 std::string Model(const std::string& file) {
   const char* src = std::getenv("CALIPER_SOURCE_DIR");
@@ -98,6 +103,19 @@ struct ReplayerTest : ::testing::Test {
       EXPECT_EQ(bytes, "<COLLADA/>");
       return Import(file);
     };
+  }
+
+  /// A file of one keyframe (the recording's end state) at step 0 and `events`, as a damaged or
+  /// hand-made recording may be; its path.
+  std::string WriteOneKeyframe(const std::string& suffix,
+                               const std::vector<recording::Event>& events) {
+    recording::Writer writer(path + suffix, header, {0, 0, "pendulum.dae", "<COLLADA/>"},
+                             std::chrono::milliseconds(500), 0);
+    recording::Keyframe k;
+    k.state = end;
+    writer.AddKeyframe(k);
+    for (const auto& e : events) writer.AddEvent(e);
+    return path + suffix;
   }
 
   /// Restores `replayer` at `step` into a new engine (in `physics`, its registry `registry`).
@@ -212,38 +230,21 @@ TEST_F(ReplayerTest, FindsTheStepNearestATimeClampedToTheRecording) {
 
 TEST_F(ReplayerTest, RefusesKeyframesTooFarApart) {
   Record();
-  {
-    // a last event far beyond the last keyframe (15)
-    recording::Writer writer(path + ".far", header, {0, 0, "pendulum.dae", "<COLLADA/>"},
-                             std::chrono::milliseconds(500), 0);
-    recording::Keyframe k;
-    k.state = end;
-    writer.AddKeyframe(k);
-    writer.AddEvent({0, "keyframe", "", {}});
-    writer.AddEvent({1500, "end", "stopped", {}});
-  }
-  try {
-    Replayer replayer(path + ".far");
-    FAIL() << "opened";
-  } catch (const recording::RecordingError& e) {
-    EXPECT_EQ(std::string(e.what()), path +
-                                         ".far: its keyframes lie up to 1500 steps apart; a "
-                                         "replay takes at most 1000");
-  }
+  // a last event far beyond the only keyframe
+  const std::string far =
+      WriteOneKeyframe(".far", {{0, "keyframe", "", {}}, {1500, "end", "stopped", {}}});
+  EXPECT_THAT([&] { Replayer replayer(far); },
+              ThrowsMessage<recording::RecordingError>(
+                  StrEq(far + ": its keyframes lie up to 1500 steps apart; a replay takes at "
+                              "most 1000")));
 }
 
 TEST_F(ReplayerTest, RefusesARecordingOfAnotherEngine) {
   header.engine = "another-engine 9";
   Record();
-  try {
-    Replayer replayer(path);
-    FAIL() << "opened";
-  } catch (const recording::RecordingError& e) {
-    EXPECT_NE(std::string(e.what()).find(path + " was recorded with another-engine 9; this build "
-                                                "runs "),
-              std::string::npos)
-        << e.what();
-  }
+  EXPECT_THAT([&] { Replayer replayer(path); },
+              ThrowsMessage<recording::RecordingError>(
+                  HasSubstr(path + " was recorded with another-engine 9; this build runs ")));
 }
 
 TEST_F(ReplayerTest, RefusesAKeyframeThatDoesNotFitTheScene) {
@@ -252,37 +253,22 @@ TEST_F(ReplayerTest, RefusesAKeyframeThatDoesNotFitTheScene) {
   const Replayer::Start start = replayer.StartAt(0, Importer("two_link_antagonistic.dae"));
   physics = physics_bullet::MakeScene(*start.scene);
   daq::Registry other;
-  try {
-    replayer.Restore(start, *physics, other);
-    FAIL() << "restored";
-  } catch (const recording::RecordingError& e) {
-    EXPECT_NE(std::string(e.what()).find(path + ": the keyframe at step 0 does not fit its scene"),
-              std::string::npos)
-        << e.what();
-  }
+  EXPECT_THAT([&] { replayer.Restore(start, *physics, other); },
+              ThrowsMessage<recording::RecordingError>(
+                  HasSubstr(path + ": the keyframe at step 0 does not fit its scene")));
 }
 
 TEST_F(ReplayerTest, RefusesAKeyframeWithoutItsMarkAsDamaged) {
   Record();
-  {
-    recording::Writer writer(path + ".damaged", header, {0, 0, "pendulum.dae", "<COLLADA/>"},
-                             std::chrono::milliseconds(500), 0);
-    recording::Keyframe k;
-    k.state = end;
-    writer.AddKeyframe(k);  // and no "keyframe" event
-  }
-  Replayer replayer(path + ".damaged");
+  const std::string damaged = WriteOneKeyframe(".damaged", {});  // and no "keyframe" event
+  Replayer replayer(damaged);
   const Replayer::Start start = replayer.StartAt(0, Importer());
   physics = physics_bullet::MakeScene(*start.scene);
   daq::Registry empty;
-  try {
-    replayer.Restore(start, *physics, empty);
-    FAIL() << "restored";
-  } catch (const recording::RecordingError& e) {
-    EXPECT_EQ(std::string(e.what()), path +
-                                         ".damaged: the keyframe at step 0 has no mark among "
-                                         "the events (a damaged file)");
-  }
+  EXPECT_THAT([&] { replayer.Restore(start, *physics, empty); },
+              ThrowsMessage<recording::RecordingError>(
+                  StrEq(damaged + ": the keyframe at step 0 has no mark among the events (a "
+                                  "damaged file)")));
 }
 
 }  // namespace
