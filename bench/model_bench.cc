@@ -19,6 +19,7 @@
 
 #include "caliper/collada/exporter.h"
 #include "caliper/model.hh"
+#include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/naming.h"
 #include "echo.hh"
 #include "support/process.h"
@@ -41,10 +42,24 @@ class EchoServant : public virtual POA_CaliperBench::EchoServer {
   }
 };
 
-int RunEchoServer(const std::string& ior_file) {
-  int argc = 3;
-  const char* args[] = {"echo", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  CORBA::ORB_var orb = CORBA::ORB_init(argc, const_cast<char**>(args));
+// The ORB options of a process listening on `endpoint` (a local unix socket in a directory only
+// this user can enter, as every Caliper process by default, or loopback TCP).
+std::vector<std::string> OrbOptions(const std::string& endpoint) {
+  std::vector<std::string> options = {"bench", "-ORBendPoint", endpoint};
+  if (endpoint.rfind("giop:unix:", 0) == 0)
+    for (const auto& o : rtc::LocalSocketOrbOptions()) options.push_back(o);
+  return options;
+}
+
+CORBA::ORB_ptr InitOrb(const std::vector<std::string>& options) {
+  std::vector<const char*> args;
+  for (const auto& o : options) args.push_back(o.c_str());
+  int argc = static_cast<int>(args.size());
+  return CORBA::ORB_init(argc, const_cast<char**>(args.data()));
+}
+
+int RunEchoServer(const std::string& ior_file, const std::string& endpoint) {
+  CORBA::ORB_var orb = InitOrb(OrbOptions(endpoint));
   CORBA::Object_var obj = orb->resolve_initial_references("RootPOA");
   PortableServer::POA_var poa = PortableServer::POA::_narrow(obj);
   auto* servant = new EchoServant;
@@ -115,7 +130,7 @@ class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 3 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2]);
+  if (argc == 4 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2], argv[3]);
   testing::TempDir dir;
   // a private naming service and a Model with the shipped arm
   testing::NamingService naming(dir.path());
@@ -128,12 +143,14 @@ int main(int argc, char** argv) {
                           "log.spool_dir=" + dir.path() + "/spool", "-o", "log.level=warn", "-o",
                           "model.write_dir=" + dir.path()},
                          dir.path() + "/model.out");
-  const std::string ior_file = dir.path() + "/echo.ior";
-  testing::Process echo({argv[0], "--echo-server", ior_file}, dir.path() + "/echo.out");
+  // the same bare servant on a unix socket (as the Model listens) and on loopback TCP
+  const std::string ior_file = dir.path() + "/echo.ior", tcp_ior_file = dir.path() + "/echo-tcp.ior";
+  testing::Process echo({argv[0], "--echo-server", ior_file, rtc::kLocalEndpoint},
+                        dir.path() + "/echo.out");
+  testing::Process echo_tcp({argv[0], "--echo-server", tcp_ior_file, "giop:tcp:127.0.0.1:"},
+                            dir.path() + "/echo-tcp.out");
 
-  int orb_argc = 3;
-  const char* orb_args[] = {"bench", "-ORBendPoint", "giop:tcp:127.0.0.1:"};
-  CORBA::ORB_var orb = CORBA::ORB_init(orb_argc, const_cast<char**>(orb_args));
+  CORBA::ORB_var orb = InitOrb(OrbOptions(rtc::kLocalEndpoint));
   M::Model_var arm;
   testing::WaitFor(
       [&] {
@@ -146,13 +163,16 @@ int main(int argc, char** argv) {
         }
       },
       std::chrono::seconds(20));
-  testing::WaitFor([&] { return !testing::ReadFile(ior_file).empty(); }, std::chrono::seconds(10));
+  for (const std::string& file : {ior_file, tcp_ior_file})
+    testing::WaitFor([&] { return !testing::ReadFile(file).empty(); }, std::chrono::seconds(10));
   if (CORBA::is_nil(arm)) {
     std::fprintf(stderr, "the Model did not come up: %s\n", model.Output().c_str());
     return 1;
   }
   CORBA::Object_var echo_obj = orb->string_to_object(testing::ReadFile(ior_file).c_str());
   CaliperBench::EchoServer_var server = CaliperBench::EchoServer::_narrow(echo_obj);
+  CORBA::Object_var tcp_obj = orb->string_to_object(testing::ReadFile(tcp_ior_file).c_str());
+  CaliperBench::EchoServer_var server_tcp = CaliperBench::EchoServer::_narrow(tcp_obj);
 
   // 1. control cycle
   M::ActuatorInfoSeq_var actuators = arm->actuators();
@@ -180,6 +200,15 @@ int main(int argc, char** argv) {
   std::printf("# control cycle %.1f us on caliper-model (running in real time), %.1f us on a bare "
               "omniORB servant with the same payloads\n", cycle, raw);
   Ratio("control_cycle_vs_raw_omniorb", cycle / raw, 1.3);
+  // what a session reachable only by its user costs: the same two calls on a unix socket in a
+  // private directory against loopback TCP (which every user of the host could reach)
+  const double raw_tcp = Median(calls, [&] {
+    server_tcp->take_commands(commands);
+    S::DoubleSeq_var v = server_tcp->values_for(ids);
+  });
+  std::printf("# two small calls (set 10 commands, get 20 values): %.1f us on a unix socket, "
+              "%.1f us on loopback TCP\n", raw, raw_tcp);
+  Ratio("local_unix_vs_tcp_calls", raw / raw_tcp, 1.0);
   arm->pause();
 
   // 2. observer bytes per update as more of 40 bodies move
@@ -235,6 +264,7 @@ int main(int argc, char** argv) {
   Ratio("slow_observer_slowdown", free_rate / slowed_rate, 1.05);
   model.Signal(SIGTERM);
   echo.Signal(SIGTERM);
+  echo_tcp.Signal(SIGTERM);
   model.Wait(std::chrono::seconds(5));
   orb->destroy();
   return 0;

@@ -1,5 +1,5 @@
 # Sourced by scripts that need Models on this machine alone (benchmarks, the calibration example,
-# tests): a private naming service on a free loopback port and N Models, all stopped by
+# tests): a private naming service on a unix socket only this user reaches and N Models, all stopped by
 # local_models_stop. Needs BIN (the build's bin/); exports CALIPER_NAMESERVICE.
 LOCAL_MODELS_PIDS=()
 
@@ -8,6 +8,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/naming.sh"
 
 local_models_start() {  # WORKDIR COUNT
   local dir=$1 count=$2 i
+  session_socket_dir "$dir"
   start_nameserver "$dir"
   LOCAL_MODELS_PIDS+=("$NS_PID")
   export CALIPER_NAMESERVICE=$NS_ADDR

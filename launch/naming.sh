@@ -52,6 +52,19 @@ tls_exec() {  # COMMAND ARGS...
   exec "$@"
 }
 
+# A directory for a session's unix sockets, only this user can enter: SESSION_DIR/sock, or a
+# private one under /tmp when that path would be too long for a socket (107 bytes at most). Sets
+# and exports CALIPER_SOCKET_DIR.
+session_socket_dir() {  # SESSION_DIR
+  local dir=$1/sock
+  if [ ${#dir} -gt 80 ]; then
+    dir=$(mktemp -d "${TMPDIR:-/tmp}/caliper-sock.XXXXXX") || die "cannot make a socket directory"
+    ln -sfn "$dir" "$1/sock"
+  fi
+  mkdir -p -m 700 "$dir" && chmod 700 "$dir"
+  export CALIPER_SOCKET_DIR=$dir
+}
+
 naming_answers() {  # ADDRESS
   case "$1" in
     *:ssliop:*) (tls_exec timeout 5 nameclt -ORBInitRef "NameService=$1" list) >/dev/null 2>&1 ;;
@@ -59,20 +72,42 @@ naming_answers() {  # ADDRESS
   esac
 }
 
-# Starts omniNames in DIR; sets NS_PORT, NS_PID, NS_ADDR. tls: on giop:ssl only (plain TCP
-# refused), with this host's identity; the address is then corbaname:ssliop:ADDRESS:PORT.
+# Starts omniNames in DIR; sets NS_PID, NS_ADDR (and NS_PORT on TCP). local (the default): on
+# the unix socket SOCKDIR/naming.sock (SOCKDIR = $CALIPER_SOCKET_DIR, which must be a directory
+# only this user can enter), address corbaname:omniunix:SOCKDIR/naming.sock: no other user of the
+# host reaches it (libs/rtc local_sockets.h). tls: on giop:ssl only (plain TCP refused), with this
+# host's identity; the address is then corbaname:ssliop:ADDRESS:PORT. plain: giop:tcp (network
+# mode with --insecure).
 # Messages up to 4 MiB (omniORB refuses larger ones): a reference with its TLS profile takes
 # under a kilobyte, a binding's name a few dozen bytes; the components' messages go elsewhere.
-start_nameserver() {  # DIR [LISTEN_ADDRESS [tls|plain]]
-  local dir=$1 addr=${2:-127.0.0.1} mode=${3:-plain} try
+start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
+  local dir=$1 addr=${2:-127.0.0.1} mode=${3:-local} try
   local -a run=(exec) proto=tcp scheme="corbaname::"
+  mkdir -p "$dir"
+  if [ "$mode" = local ]; then
+    local sock=${CALIPER_SOCKET_DIR:?no socket directory: call session_socket_dir first}/naming.sock
+    rm -f "$sock"
+    mkdir -p "$dir/omninames"
+    (exec omniNames -start -always -nohostname -datadir "$dir/omninames" \
+      -ORBendPoint "giop:unix:$sock" -ORBunixTransportPermission 0600 \
+      -ORBgiopMaxMsgSize 4194304 >"$dir/omninames.log" 2>&1) &
+    NS_PID=$!
+    NS_PORT=
+    NS_ADDR="corbaname:omniunix:$sock"
+    for _ in $(seq 1 50); do
+      naming_answers "$NS_ADDR" && return 0
+      kill -0 "$NS_PID" 2>/dev/null || break
+      sleep 0.1
+    done
+    kill "$NS_PID" 2>/dev/null || true
+    die "omniNames did not start on $sock, see $dir/omninames.log"
+  fi
   if [ "$mode" = tls ]; then
     tls_identity
     run=(tls_exec env "ORBserverTransportRule=* ssl" "ORBclientTransportRule=* ssl")
     proto=ssl
     scheme="corbaname:ssliop:"
   fi
-  mkdir -p "$dir"
   for try in 1 2 3; do
     NS_PORT=$(free_port)
     mkdir -p "$dir/omninames-$NS_PORT"

@@ -7,7 +7,7 @@
 
 # network mode: TLS unless --insecure (CALIPER_INSECURE=1), which says loudly what it gives up
 network_security() {  # sets NS_MODE (tls|plain) for start_nameserver
-  if [ -z "${CALIPER_LISTEN:-}" ]; then NS_MODE=plain; return 0; fi
+  if [ -z "${CALIPER_LISTEN:-}" ]; then NS_MODE=local; return 0; fi
   case "${CALIPER_INSECURE:-}" in
     1|true|yes)
       NS_MODE=plain
@@ -56,15 +56,23 @@ stop_session() {
   kill -TERM "$NS_PID" 2>/dev/null || true
   wait 2>/dev/null || true
   rm -f "$LATEST"
+  # sockets of processes that did not unlink theirs (omniNames, a killed component)
+  find "$CALIPER_SOCKET_DIR" -maxdepth 1 -type s -delete 2>/dev/null
+  # a socket directory made under /tmp because the session's path was too long
+  if [ -L "$SESSION_DIR/sock" ]; then rm -rf "$(readlink "$SESSION_DIR/sock")"; fi
   [ ${#left[@]} -eq 0 ] || say "had to kill: ${left[*]}"
   say "session log: $(ls "$SESSION_DIR"/caliper-*.log 2>/dev/null | head -1)"
 }
 
 new_session() {
-  mkdir -p "$STATE_DIR"
+  private_state_dir
   SESSION_ID=s$$
   SESSION_DIR=$SESSIONS_DIR/$(date +%Y%m%d-%H%M%S)-$SESSION_ID
-  mkdir -p "$SESSION_DIR"
+  # the session's files, its log and its sockets are its user's alone
+  mkdir -p -m 700 "$SESSIONS_DIR"
+  mkdir -p -m 700 "$SESSION_DIR"
+  # a local session listens on unix sockets in here: no other user of the host reaches it
+  session_socket_dir "$SESSION_DIR"
   # the components' default write directory for paths from clients (model.write_dir,
   # renderer.write_dir): a directory of its own, so that clients cannot overwrite the session
   # log, the naming service's data, the spool or the *.out files; the Main Window's tools

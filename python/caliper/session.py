@@ -7,7 +7,6 @@ import ctypes
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import tempfile
 import time
@@ -84,14 +83,9 @@ def _stop(processes: List[subprocess.Popen], directory: str, keep: bool) -> None
         shutil.rmtree(directory, ignore_errors=True)
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 class LocalSession:
-    """A private session on this machine: a naming service on a free loopback port and `models`
+    """A private session on this machine, reachable only by this user (unix sockets in a private
+    directory): a naming service and `models`
     Models (model0, model1, ...), each loading `scene` when given; everything stops when the
     ``with`` block ends (or at :meth:`close`)::
 
@@ -127,19 +121,24 @@ class LocalSession:
         with open(os.path.join(self.directory, log), "ab") as out:
             p = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT,
                                  stdin=subprocess.DEVNULL, cwd=self.directory,
-                                 preexec_fn=_die_with_parent)
+                                 env=getattr(self, "_env", None), preexec_fn=_die_with_parent)
         self._processes.append(p)
         return p
 
     def _start(self, models: int, scene: Optional[str], timeout_s: float, options: List[str],
                start_timeout_s: float) -> None:
-        port = _free_port()
-        self.address = f"corbaname::127.0.0.1:{port}"
+        # unix sockets in a directory only this user can enter (mkdtemp makes it 0700): no other
+        # user of the machine reaches the session
+        sockets = os.path.join(self.directory, "sock")
+        os.mkdir(sockets, 0o700)
+        self._env = dict(os.environ, CALIPER_SOCKET_DIR=sockets)
+        naming = os.path.join(sockets, "naming.sock")
+        self.address = f"corbaname:omniunix:{naming}"
         data = os.path.join(self.directory, "omninames")
         os.mkdir(data)
-        self._spawn([shutil.which("omniNames") or "/usr/bin/omniNames", "-start", str(port),
-                     "-always", "-nohostname", "-datadir", data, "-ORBendPoint",
-                     f"giop:tcp:127.0.0.1:{port}"], "omninames.log")
+        self._spawn([shutil.which("omniNames") or "/usr/bin/omniNames", "-start", "-always",
+                     "-nohostname", "-datadir", data, "-ORBendPoint", f"giop:unix:{naming}",
+                     "-ORBunixTransportPermission", "0600"], "omninames.log")
         deadline = time.monotonic() + start_timeout_s
         while True:
             try:

@@ -83,21 +83,21 @@ for to in "198.51.100.3:${port:-none}" 198.51.100.1:2809; do
     pass "plain GIOP to $to refused ($(grep -o 'COMM_FAILURE\|TRANSIENT' <<<"$out" | head -1))"
   else fail "plain GIOP to $to not refused: $out"; fi
 done
-# a component without --listen (in TLS mode for its naming service, but listening on loopback
-# only): bound in the naming service but unreachable
+# a component without --listen (in TLS mode for its naming service, but listening locally only,
+# on a unix socket): bound in the naming service but unreachable
 in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$PKI" "$BIN/caliper-model" --nameservice "$NS" --instance loopback \
   -o "log.spool_dir=$WORK/spool" >"$WORK/loopback.out" 2>&1 &
+lpid=$!
 for _ in $(seq 1 100); do grep -q "is up as" "$WORK/loopback.out" && break; sleep 0.1; done
-lpid=$(in_ns c ss -ltnpH | grep -v 198.51.100 | sed -n 's/.*pid=\([0-9]*\).*/\1/p' | head -1)
-if [ -n "$lpid" ] && ! in_ns c ss -ltnpH | grep "pid=$lpid," | grep -vq '127.0.0.1:'; then
-  pass "a loopback-mode Model listens only on 127.0.0.1 ($(in_ns c ss -ltnpH | grep -c "pid=$lpid,") sockets)"
+if in_ns c ss -lxpH | grep -q "pid=$lpid," && ! in_ns c ss -ltnpH | grep -q "pid=$lpid,"; then
+  pass "a local-mode Model listens on no TCP port, only on a unix socket ($(in_ns c ss -lxpH | grep "pid=$lpid," | awk '{print $5}' | head -1))"
 else
-  fail "the loopback-mode Model listens elsewhere: $(in_ns c ss -ltnp)"
+  fail "the local-mode Model listens elsewhere: $(in_ns c ss -ltnpH; in_ns c ss -lxpH)"
 fi
 if ctl --timeout 2 status --model hostc/loopback0 >/dev/null 2>&1; then
-  fail "a loopback-mode Model on hostc answered hosta"
-else pass "a loopback-mode Model on hostc is not reachable from hosta"; fi
-kill "$(in_ns c ss -ltnpH | grep "pid=$lpid," | sed -n 's/.*pid=\([0-9]*\).*/\1/p' | head -1)" 2>/dev/null
+  fail "a local-mode Model on hostc answered hosta"
+else pass "a local-mode Model on hostc is not reachable from hosta"; fi
+kill "$lpid" 2>/dev/null
 
 # ---------------------------------------------------------------- the experiments
 cat >"$WORK/runs.json" <<JSON

@@ -1,5 +1,6 @@
 #include "caliper/client/session.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -14,6 +15,9 @@ std::string LatestSession() {
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
   const std::string file = std::string(runtime != nullptr && *runtime != '\0' ? runtime : "/tmp") +
                            "/caliper-" + std::to_string(getuid()) + "/latest-session";
+  // only a file of this user counts: another could leave one pointing at a session of theirs
+  struct stat st {};
+  if (stat(file.c_str(), &st) != 0 || st.st_uid != getuid()) return "";
   std::ifstream in(file);
   std::string address, pid;
   if (!std::getline(in, address) || !std::getline(in, pid) || address.empty()) return "";

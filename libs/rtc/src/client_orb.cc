@@ -1,5 +1,6 @@
 #include "caliper/rtc/client_orb.h"
 
+#include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/naming.h"
 #include "caliper/rtc/transport_security.h"
 
@@ -44,7 +45,7 @@ CORBA::ORB_ptr ClientOrb(const char* program, double call_timeout_s,
   std::vector<std::string> options;
   if (!secured) {
     SecurityRequest request;
-    request.endpoint = "giop:tcp:127.0.0.1:";
+    request.endpoint = kLocalEndpoint;  // callbacks (feeds, observers) reach only this user
     if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
       request.endpoint = ListenEndpoint(listen);
     request.naming_address = NamingAddress(naming_address);

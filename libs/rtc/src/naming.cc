@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "caliper/core/system.h"
+#include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/transport_security.h"
 
 namespace caliper::rtc {
@@ -35,6 +36,11 @@ CosNaming::NamingContext_ptr ResolveRoot(CORBA::ORB_ptr orb, const std::string& 
     return root._retn();
   } catch (const CORBA::Exception& e) {
     std::string why = Describe(e);
+    if (IsLocalSocketAddress(address)) {
+      // another user's session (or one that has ended): said for the naming service itself
+      const std::string note = LocalSocketNote(LocalSocketPath(address), "the naming service");
+      if (!note.empty()) why = why.substr(0, why.find(": ")) + ": " + note;
+    }
     if (why.find(": ", 0) == std::string::npos) {
       // no note from the transport: ask the service for a TLS handshake ourselves
       const std::string probe = ProbeNamingService(address);

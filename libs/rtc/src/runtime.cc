@@ -34,8 +34,9 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
        "('' = $CALIPER_NAMESERVICE or corbaname::127.0.0.1:2809)"},
       {"naming.instance", Type::kString, type_name, "instance base name (bound as NAME0, NAME1, ...)"},
       {"naming.update.interval", Type::kDouble, "10", "re-registration period [s]", 0.05, 3600},
-      {"corba.endpoint", Type::kString, "giop:tcp:127.0.0.1:",
-       "omniORB endpoint to listen on (loopback only by default; --listen ADDR or $CALIPER_LISTEN "
+      {"corba.endpoint", Type::kString, "giop:unix:",
+       "omniORB endpoint to listen on (by default a unix socket in a directory only this user "
+       "can enter, $CALIPER_SOCKET_DIR or /tmp/caliper-UID; --listen ADDR or $CALIPER_LISTEN "
        "make it giop:ssl:ADDR:, reachable from other hosts over TLS, giop:tcp:ADDR: with "
        "--insecure)"},
       {"corba.insecure", Type::kBool, "false",

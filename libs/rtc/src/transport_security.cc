@@ -10,6 +10,7 @@
 #include <sys/time.h>
 #include <unistd.h>
 
+#include <omniORB4/cdrStream.h>
 #include <omniORB4/omniInterceptors.h>
 #include <omniORB4/sslContext.h>  // also forces the link of libomnisslTP4 (OMNI_FORCE_LINK)
 #include <openssl/err.h>
@@ -29,6 +30,7 @@
 #include <vector>
 
 #include "caliper/core/system.h"
+#include "caliper/rtc/local_sockets.h"
 
 namespace caliper::rtc {
 
@@ -57,6 +59,10 @@ thread_local Clock::time_point t_peer_when;
 // when it decoded several (a listing), since a failed call does not say which object it was for
 constexpr size_t kMaxTlsOnlyHosts = 8;
 thread_local std::vector<HandshakeNote> t_tls_only;
+// the unix sockets of the local references this thread decoded lately (another user's session
+// refuses us at connect(), and the failed call does not say which socket it was)
+constexpr size_t kMaxLocalSockets = 8;
+thread_local std::vector<HandshakeNote> t_local_sockets;
 
 std::string Trim(std::string s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
@@ -219,19 +225,42 @@ void LogWithoutSslNotice(const char* message) {
   std::fputs(message, stderr);
 }
 
-// without TLS: notes the references whose only address is a TLS one
+// `text` as the newest of `notes`, at most `max` kept
+void Remember(std::vector<HandshakeNote>* notes, const std::string& text, size_t max) {
+  auto seen = std::find_if(notes->begin(), notes->end(),
+                           [&](const HandshakeNote& n) { return n.text == text; });
+  if (seen != notes->end()) notes->erase(seen);
+  if (notes->size() == max) notes->erase(notes->begin());
+  notes->push_back({text, Clock::now()});
+}
+
+// the socket file of omniORB's unix transport component: an encapsulation of the host name and
+// the file name, read with omniORB's own stream
+std::string UnixSocketOf(const IOP::TaggedComponent& component) {
+  try {
+    cdrEncapsulationStream stream(component.component_data.get_buffer(),
+                                  component.component_data.length(), 1);
+    CORBA::String_var host = stream.unmarshalRawString();
+    CORBA::String_var file = stream.unmarshalRawString();
+    return file.in();
+  } catch (...) {
+    return "";
+  }
+}
+
+// notes the references whose only address is a TLS one (without TLS), and those on a unix socket
 CORBA::Boolean DecodeIor(omni::omniInterceptors::decodeIOR_T::info_T& info) {
   if (!info.has_iiop_body || info.iiop.address.port != 0) return true;
-  for (CORBA::ULong i = 0; i < info.iiop.components.length(); ++i)
-    if (info.iiop.components[i].tag == IOP::TAG_SSL_SEC_TRANS) {
-      const std::string host = info.iiop.address.host.in();
-      auto seen = std::find_if(t_tls_only.begin(), t_tls_only.end(),
-                               [&](const HandshakeNote& n) { return n.text == host; });
-      if (seen != t_tls_only.end()) t_tls_only.erase(seen);
-      if (t_tls_only.size() == kMaxTlsOnlyHosts) t_tls_only.erase(t_tls_only.begin());
-      t_tls_only.push_back({host, Clock::now()});
-      break;
+  for (CORBA::ULong i = 0; i < info.iiop.components.length(); ++i) {
+    const IOP::TaggedComponent& component = info.iiop.components[i];
+    if (component.tag == IOP::TAG_OMNIORB_UNIX_TRANS) {
+      if (const std::string file = UnixSocketOf(component); !file.empty())
+        Remember(&t_local_sockets, file, kMaxLocalSockets);
+    } else if (component.tag == IOP::TAG_SSL_SEC_TRANS &&
+               ProcessSecurity().transport != Transport::kTls) {
+      Remember(&t_tls_only, info.iiop.address.host.in(), kMaxTlsOnlyHosts);
     }
+  }
   return true;
 }
 
@@ -451,8 +480,14 @@ std::vector<std::string> SecurityOrbOptions(const TransportSecurity& security) {
     // the SSL transport is linked into every program: without TLS it says at each start that it
     // is disabled, which is as meant
     omniORB::setLogFunction(LogWithoutSslNotice);
+    // a local process: its sockets in a directory only its user can enter
+    if (security.endpoint.rfind("giop:unix:", 0) == 0) return LocalSocketOrbOptions();
     return {};
   }
+  std::vector<std::string> options = {"-ORBclientTransportRule", "* ssl",
+                                      "-ORBserverTransportRule", "* ssl"};
+  if (security.endpoint.rfind("giop:unix:", 0) == 0)
+    for (auto& o : LocalSocketOrbOptions()) options.push_back(o);
   {
     std::lock_guard<std::mutex> lock(g_mutex);
     g_security = security;
@@ -466,7 +501,7 @@ std::vector<std::string> SecurityOrbOptions(const TransportSecurity& security) {
   sslContext::info_callback = InfoCallback;
   // TLS only, in and out, whatever the endpoints: a plain one passed as -ORBendPoint, set in
   // $ORBendPoint or in omniORB's configuration file listens, but refuses every connection
-  return {"-ORBclientTransportRule", "* ssl", "-ORBserverTransportRule", "* ssl"};
+  return options;
 }
 
 void InstallProcessSecurity(const TransportSecurity& security) {
@@ -485,8 +520,7 @@ void InstallProcessSecurity(const TransportSecurity& security) {
 
 void InstallTransportDiagnostics() {
   static std::once_flag once;
-  if (ProcessSecurity().transport != Transport::kTls)
-    std::call_once(once, [] { omniORB::getInterceptors()->decodeIOR.add(DecodeIor); });
+  std::call_once(once, [] { omniORB::getInterceptors()->decodeIOR.add(DecodeIor); });
 }
 
 const TransportSecurity& ProcessSecurity() {
@@ -528,9 +562,27 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
     }
   }
   const std::string minor = sys->NP_minorString() != nullptr ? sys->NP_minorString() : "";
+  if (minor == "TRANSIENT_ConnectFailed") {
+    // a local object: another user's session, or one that has ended. The failed call does not
+    // say which of the references read lately it was for: the newest unreachable one is named,
+    // and how many others are unreachable too
+    std::string note;
+    size_t others = 0;
+    for (auto n = t_local_sockets.rbegin(); n != t_local_sockets.rend(); ++n)
+      if (Clock::now() - n->when < std::chrono::seconds(60))
+        if (std::string why = LocalSocketNote(n->text, "the object"); !why.empty())
+          note.empty() ? note = why : (++others, note);
+    if (!note.empty()) {
+      t_local_sockets.clear();
+      if (others > 0)
+        note = "(one of " + std::to_string(others + 1) + " local references read last, none " +
+               "reachable) " + note;
+      return note;
+    }
+  }
   const std::string mode = ProcessSecurity().transport == Transport::kInsecure
                                ? "--insecure / CALIPER_INSECURE"
-                               : "loopback mode";
+                               : "local mode";
   std::string hosts;  // of the TLS-only references decoded in the last minute, oldest first
   size_t count = 0;
   for (const HandshakeNote& n : t_tls_only)
@@ -556,6 +608,8 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
 }
 
 std::string ProbeNamingService(const std::string& address) {
+  if (IsLocalSocketAddress(address))
+    return LocalSocketNote(LocalSocketPath(address), "the naming service");
   std::string host, port;
   if (!AddressHostPort(address, &host, &port)) return "";
   return ProbeTls(host, port, "the naming service at " + host + ":" + port);

@@ -31,7 +31,8 @@ class OmniThread {
   bool dummy_;
 };
 
-/// The process's ORB: initialised on the first call (endpoint giop:tcp:127.0.0.1, or in network
+/// The process's ORB: initialised on the first call (endpoint giop:unix: in a directory only this
+/// user can enter, local_sockets.h; or in network
 /// mode giop:ssl:$CALIPER_LISTEN: over TLS, giop:tcp:$CALIPER_LISTEN: with CALIPER_INSECURE=1;
 /// network mode also when the naming service, `naming_address` or else $CALIPER_NAMESERVICE, is
 /// not on loopback: see transport_security.h; per-thread call timeouts enabled; messages up to

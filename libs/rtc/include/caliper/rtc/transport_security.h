@@ -1,6 +1,7 @@
 #pragma once
-// How a process talks to the others: on loopback in plain GIOP (a session on one host, nothing to
-// configure), or on a network over TLS with client certificates (omniORB's SSL transport,
+// How a process talks to the others: locally in plain GIOP over unix-domain sockets that only its
+// user can reach (a session on one host, nothing to configure: local_sockets.h), or on a network
+// over TLS with client certificates (omniORB's SSL transport,
 // libomnisslTP4), or on a network in plain GIOP when asked explicitly (--insecure).
 //
 // Network mode: the process listens on an address other than loopback (--listen ADDR,
@@ -34,7 +35,7 @@ class SecurityError : public std::runtime_error {
 };
 
 enum class Transport {
-  kLoopback,  ///< plain GIOP on loopback: one host
+  kLoopback,  ///< local: plain GIOP on unix sockets (or loopback TCP when asked): one host
   kTls,       ///< network mode over TLS with client certificates
   kInsecure,  ///< network mode in plain GIOP (--insecure): anyone who reaches a port is trusted
 };

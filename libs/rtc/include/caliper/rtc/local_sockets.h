@@ -1,0 +1,46 @@
+#pragma once
+// A local session (no --listen) is reachable only by the user who started it: its processes
+// listen on unix-domain sockets (omniORB's giop:unix: endpoints), not on TCP, in a directory that
+// only that user can enter (mode 0700). Another user's connect() is refused by the kernel
+// (EACCES), before omniORB reads a byte; root is not kept out (nothing on the machine keeps root
+// out). The naming service of such a session listens on DIR/naming.sock and is addressed as
+// corbaname:omniunix:DIR/naming.sock.
+//
+// The directory: $CALIPER_SOCKET_DIR (launch/caliper sets the session's DIR/sock), else the
+// launcher's state directory, ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID.
+
+#include <string>
+#include <vector>
+
+namespace caliper::rtc {
+
+/// The endpoint a local process listens on.
+inline constexpr const char* kLocalEndpoint = "giop:unix:";
+
+/// Where this process's unix-domain sockets go: made (mode 0700) when missing, and checked: a
+/// directory (not a link) of this user that no other user can enter, with room for a socket name
+/// (unix socket paths hold at most 107 bytes). Throws SecurityError saying what is wrong and what
+/// to do (CALIPER_SOCKET_DIR). The default directory is closed (0700) when it is ours; one of
+/// another user (squatted) is not used: a private /tmp/caliper-UID-XXXXXX is made instead, and
+/// said on stderr.
+std::string LocalSocketDir();
+
+/// The omniORB options that put a giop:unix: endpoint's socket in LocalSocketDir(), readable
+/// and writable by this user only.
+std::vector<std::string> LocalSocketOrbOptions();
+
+/// True for a corbaname:/corbaloc: address of a unix-domain socket (corbaname:omniunix:PATH).
+bool IsLocalSocketAddress(const std::string& address);
+
+/// The socket file of such an address ('' for another kind).
+std::string LocalSocketPath(const std::string& address);
+
+/// The address of the naming service listening on the unix socket PATH.
+std::string LocalNamingAddress(const std::string& socket_path);
+
+/// Why this process cannot connect to the unix socket `path`: a directory on the way that this
+/// user cannot enter (its owner and mode: another user's session), a socket it may not write, or
+/// no socket at all (the session ended). '' when nothing stands in the way.
+std::string LocalSocketNote(const std::string& path, const std::string& what);
+
+}  // namespace caliper::rtc

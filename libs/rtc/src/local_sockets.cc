@@ -1,0 +1,157 @@
+#include "caliper/rtc/local_sockets.h"
+
+#include <pwd.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <mutex>
+
+#include "caliper/rtc/transport_security.h"
+
+namespace caliper::rtc {
+
+namespace {
+
+// a socket name omniORB makes (PID-TIME, 21 bytes) or ours (naming.sock), a slash and the NUL
+constexpr size_t kMaxDirBytes = 107 - 24;
+
+std::string UserOf(uid_t uid) {
+  if (const passwd* pw = getpwuid(uid); pw != nullptr) return pw->pw_name;
+  return "uid " + std::to_string(uid);
+}
+
+std::string Octal(mode_t mode) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%04o", static_cast<unsigned>(mode & 07777));
+  return text;
+}
+
+// '' when `dir` is a directory of this user that nobody else can enter, else what is wrong
+std::string Unsafe(const std::string& dir) {
+  struct stat st {};
+  if (lstat(dir.c_str(), &st) != 0) return std::string("cannot read it (") + std::strerror(errno) + ")";
+  if (S_ISLNK(st.st_mode)) return "it is a symbolic link";
+  if (!S_ISDIR(st.st_mode)) return "it is not a directory";
+  if (st.st_uid != geteuid()) return "it belongs to " + UserOf(st.st_uid);
+  if ((st.st_mode & 077) != 0) return "other users may enter it (mode " + Octal(st.st_mode) + ")";
+  return "";
+}
+
+std::string Checked(const std::string& dir, const std::string& source) {
+  if (dir.size() > kMaxDirBytes)
+    throw SecurityError("the directory for this session's unix sockets, " + dir + " (" + source +
+                        "), is " + std::to_string(dir.size()) + " bytes long: a socket path " +
+                        "holds at most 107; set CALIPER_SOCKET_DIR to a shorter directory");
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
+    throw SecurityError("cannot make the directory for unix sockets " + dir + " (" + source +
+                        "): " + std::strerror(errno) + "; set CALIPER_SOCKET_DIR to another");
+  if (const std::string why = Unsafe(dir); !why.empty())
+    throw SecurityError("the directory for unix sockets " + dir + " (" + source + ") is refused: " +
+                        why + "; a local session needs a directory only its user can enter " +
+                        "(chmod 700, or set CALIPER_SOCKET_DIR to another)");
+  return dir;
+}
+
+std::string Resolve() {
+  if (const char* env = std::getenv("CALIPER_SOCKET_DIR"); env != nullptr && *env != '\0')
+    return Checked(env, "$CALIPER_SOCKET_DIR");
+  // the launcher's state directory (latest-session lives there too): in systemd's per-user
+  // runtime directory when there is one of ours, else in /tmp
+  std::string base = "/tmp";
+  if (const char* run = std::getenv("XDG_RUNTIME_DIR"); run != nullptr && *run != '\0') {
+    struct stat st {};
+    if (stat(run, &st) == 0 && st.st_uid == geteuid()) base = run;
+  }
+  const std::string dir = base + "/caliper-" + std::to_string(geteuid());
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
+    throw SecurityError("cannot make the directory for unix sockets " + dir + ": " +
+                        std::strerror(errno) + "; set CALIPER_SOCKET_DIR to another");
+  struct stat st {};
+  // ours but opened up (an older launcher made it 0755): closed again
+  if (lstat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode) && st.st_uid == geteuid() &&
+      (st.st_mode & 077) != 0)
+    chmod(dir.c_str(), 0700);
+  const std::string why = Unsafe(dir);
+  if (why.empty()) return Checked(dir, "the default");
+  // someone else made it first: never use it, make a private one
+  std::string pattern = dir + "-XXXXXX";
+  if (mkdtemp(pattern.data()) == nullptr)
+    throw SecurityError("cannot make a private directory for unix sockets " + pattern + ": " +
+                        std::strerror(errno));
+  std::cerr << "caliper: " << dir << " is not used for unix sockets (" << why << "); using "
+            << pattern << " instead\n";
+  return Checked(pattern, "made because " + dir + " is refused");
+}
+
+}  // namespace
+
+std::string LocalSocketDir() {
+  static std::mutex mutex;
+  static std::string dir;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (dir.empty()) dir = Resolve();
+  return dir;
+}
+
+std::vector<std::string> LocalSocketOrbOptions() {
+  return {"-ORBunixTransportDirectory", LocalSocketDir(), "-ORBunixTransportPermission", "0600"};
+}
+
+std::string LocalSocketPath(const std::string& address) {
+  for (const char* prefix : {"corbaname:omniunix:", "corbaloc:omniunix:"}) {
+    const size_t n = std::strlen(prefix);
+    if (address.compare(0, n, prefix) != 0) continue;
+    std::string path = address.substr(n);
+    // corbaloc:omniunix:PATH:/KEY and corbaname:omniunix:PATH#NAME
+    if (const size_t key = path.find(":/"); key != std::string::npos) path.resize(key);
+    if (const size_t name = path.find('#'); name != std::string::npos) path.resize(name);
+    return path;
+  }
+  return "";
+}
+
+bool IsLocalSocketAddress(const std::string& address) { return !LocalSocketPath(address).empty(); }
+
+std::string LocalNamingAddress(const std::string& socket_path) {
+  return "corbaname:omniunix:" + socket_path;
+}
+
+std::string LocalSocketNote(const std::string& path, const std::string& what) {
+  if (path.empty() || path.front() != '/') return "";
+  const std::string me = UserOf(geteuid());
+  // every directory on the way must let us search it
+  for (size_t slash = path.find('/', 1); slash != std::string::npos;
+       slash = path.find('/', slash + 1)) {
+    const std::string dir = path.substr(0, slash);
+    if (access(dir.c_str(), X_OK) == 0) continue;
+    const int error = errno;
+    struct stat st {};
+    if (error == EACCES && stat(dir.c_str(), &st) == 0)
+      return what + " listens on the unix socket " + path + ", in " + dir + ", a directory of " +
+             UserOf(st.st_uid) + " (mode " + Octal(st.st_mode) + ") that " + me +
+             " cannot enter: a local Caliper session is reachable only by the user who started "
+             "it; run your own (launch/caliper session), or ask for a network session with "
+             "certificates (docs/cluster.md)";
+    if (error == ENOENT)
+      return "there is no " + dir + " for " + what + "'s socket " + path +
+             ": the session has ended, or the address is from another machine";
+    return "cannot enter " + dir + " on the way to " + what + "'s socket " + path + " (" +
+           std::strerror(error) + ")";
+  }
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0)
+    return "there is no socket " + path + " for " + what + ": the process has ended";
+  if (!S_ISSOCK(st.st_mode)) return path + " is not a socket";
+  if (access(path.c_str(), W_OK) != 0)
+    return what + " listens on the unix socket " + path + " of " + UserOf(st.st_uid) + " (mode " +
+           Octal(st.st_mode) + "), which " + me + " may not use: a local Caliper session is " +
+           "reachable only by the user who started it";
+  return "";
+}
+
+}  // namespace caliper::rtc
