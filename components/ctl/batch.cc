@@ -7,14 +7,19 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <thread>
+
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
 
 #include "batch_plan.h"
 #include "cluster_verbs.h"
@@ -49,6 +54,7 @@ struct BatchOptions {
   int max_attempts = 5;
   double wait_models_s = 10;      // how long to wait for a first Model
   unsigned long spawn = 0;        // Models to ask the managers for (0: use those bound)
+  std::string status;             // a JSON file with the progress, rewritten every second
 };
 
 // One Model of the pool the batch uses, and its worker thread.
@@ -96,9 +102,14 @@ class BatchRun {
   // a Model found: its slot and worker
   void Join(size_t index);
   void Work(Slot* slot);
+  // the batch ends (done, or SIGINT / SIGTERM pending)
+  bool Stopping() const { return stop_ || core::InterruptPending(); }
   void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
   void Watch();
   void Progress(bool last);
+  // the progress as JSON in --status (replaced whole, so a reader never sees half of it)
+  void WriteStatus(const std::string& state, size_t busy, size_t models, double rate,
+                   double eta_s);
   int Dispatch();
   // Stops the workers (a worker stuck in a call to a lost Model is left: the process then
   // ends with _exit) and the Models asked of the managers.
@@ -122,7 +133,8 @@ class BatchRun {
   client::ModelPool pool_;             // last: its finder uses the members above
   Clock::time_point begin_ = Clock::now();
   Clock::time_point last_progress_;
-  double total_sim_s_ = 0;
+  Clock::time_point last_status_;
+  bool interrupted_ = false;  // by SIGINT or SIGTERM: unfinished runs are marked interrupted
 };
 
 void BatchRun::LoadScenes() {
@@ -170,7 +182,7 @@ void BatchRun::Work(Slot* slot) {
   rtc::OmniThread omni;
   // the run call may take long; a dead peer is found by the watcher's status polls
   omniORB::setClientThreadCallTimeout(static_cast<CORBA::ULong>(options_.run_timeout_s * 1000));
-  while (!stop_ && !plan_.finished()) {
+  while (!Stopping() && !plan_.finished()) {
     if (pool_.down(slot->index)) {
       // back when it answers and no longer runs what it was given up on
       if (!pool_.Probe(slot->index)) std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -217,11 +229,20 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   } catch (const D::InvalidParameter& e) {
     plan_.Fail(ticket, e.reason.in());
   } catch (const M::NotAvailable& e) {
-    // busy with a run given up on earlier, or shutting down: set aside until it is idle
-    plan_.Retry(ticket, slot->name + ": " + e.reason.in());
-    pool_.SetDown(slot->index, e.reason.in());
+    // busy with a run given up on earlier, or shutting down: set aside until it is idle. A
+    // Model going away never ran the run: that costs the run no attempt (on scancel Slurm stops
+    // the Models before this client hears of it; the runs are then interrupted, not failed)
+    const std::string reason = e.reason.in();
+    if (Stopping() || reason.find("shutting down") != std::string::npos) plan_.Abandon(ticket);
+    else plan_.Retry(ticket, slot->name + ": " + reason);
+    pool_.SetDown(slot->index, reason);
   } catch (const CORBA::SystemException& e) {
-    plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
+    // a Model that died during the run costs it an attempt (a run that kills every Model ends
+    // failed); one that was gone before the call (connect refused) does not
+    const char* minor = e.NP_minorString();
+    const bool gone_before = minor != nullptr && std::string(minor) == "TRANSIENT_ConnectFailed";
+    if (Stopping() || gone_before) plan_.Abandon(ticket);
+    else plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
     pool_.SetDown(slot->index, rtc::Describe(e));
   } catch (const CORBA::Exception& e) {
     plan_.Fail(ticket, slot->name + ": " + rtc::Describe(e));
@@ -292,10 +313,38 @@ void BatchRun::Watch() {
   }
 }
 
+void BatchRun::WriteStatus(const std::string& state, size_t busy, size_t models, double rate,
+                           double eta_s) {
+  if (options_.status.empty()) return;
+  last_status_ = Clock::now();
+  boost::property_tree::ptree tree;
+  tree.put("state", state);
+  tree.put("file", options_.file);
+  tree.put("out", options_.out);
+  tree.put("runs_total", plan_.size());
+  tree.put("runs_done", plan_.done());
+  tree.put("runs_failed", plan_.failed());
+  tree.put("models", models);
+  tree.put("models_busy", busy);
+  tree.put("sim_s_per_s", Fixed(rate, 3));
+  tree.put("eta_s", eta_s >= 0 ? Fixed(eta_s, 1) : std::string());
+  tree.put("wall_s", Fixed(Since(begin_), 3));
+  tree.put("updated_unix_s", std::time(nullptr));
+  try {
+    core::WriteFileReplacing(options_.status, [&](std::ostream& out) {
+      boost::property_tree::write_json(out, tree);
+    });
+  } catch (const std::exception& e) {
+    std::cerr << "warning: --status " << options_.status << ": " << e.what() << "\n";
+  }
+}
+
 void BatchRun::Progress(bool last) {
   const bool tty = isatty(STDERR_FILENO) != 0;
-  if (!last && !tty && Since(last_progress_) < 5) return;
-  last_progress_ = Clock::now();
+  const bool status_due = !options_.status.empty() && Since(last_status_) >= 1;
+  if (!last && !status_due && !tty && Since(last_progress_) < 5) return;
+  const bool print = last || tty || Since(last_progress_) >= 5;
+  if (print) last_progress_ = Clock::now();
   const size_t total = plan_.size(), done = plan_.done(), failed = plan_.failed();
   // simulated seconds: steps of finished runs times their step, plus runs in flight
   double sim_done = 0, sim_left = 0;
@@ -326,9 +375,12 @@ void BatchRun::Progress(bool last) {
        << (done + failed) << "/" << total << " runs";
   if (failed) line << " (" << failed << " failed)";
   line << ", " << busy << "/" << models << " Models busy, " << Fixed(rate, 2) << " sim-s/s";
-  if (rate > 0 && sim_left > 0) line << ", ETA " << Fixed(std::max(0.0, sim_left) / rate, 0) << " s";
+  const double eta = rate > 0 && sim_left > 0 ? std::max(0.0, sim_left) / rate : -1;
+  if (eta >= 0) line << ", ETA " << Fixed(eta, 0) << " s";
   else if (last) line << ", " << Fixed(wall, 1) << " s";
-  std::cerr << (tty ? "\r\033[K" : "") << line.str() << (tty && !last ? "" : "\n") << std::flush;
+  if (status_due || last) WriteStatus(last ? "finishing" : "running", busy, models, rate, eta);
+  if (print)
+    std::cerr << (tty ? "\r\033[K" : "") << line.str() << (tty && !last ? "" : "\n") << std::flush;
 }
 
 void BatchRun::WriteSummary(double wall_s) {
@@ -341,10 +393,18 @@ void BatchRun::WriteSummary(double wall_s) {
       const Outcome& o = outcomes[i];
       std::string retries;
       for (const auto& r : o.retries) retries += (retries.empty() ? "" : "; ") + r.reason;
-      out << CsvField(runs_[i].name) << "," << ToString(o.state) << "," << CsvField(o.model) << ","
+      // stopped (Ctrl-C, SIGTERM from Slurm's scancel or time limit): said as such
+      const bool cut = interrupted_ && (o.state == Outcome::State::kPending ||
+                                        o.state == Outcome::State::kRunning);
+      const std::string status = cut ? "interrupted" : ToString(o.state);
+      const std::string reason =
+          cut ? (o.state == Outcome::State::kRunning ? "stopped while it ran" : "never started") +
+                    std::string(": the batch was interrupted (SIGINT or SIGTERM)")
+              : o.reason;
+      out << CsvField(runs_[i].name) << "," << status << "," << CsvField(o.model) << ","
           << o.attempts << "," << runs_[i].duration_s << "," << o.steps << "," << o.samples << ","
           << o.wall_s << "," << o.load_wall_s << "," << o.step_wall_s << "," << CsvField(retries)
-          << "," << CsvField(o.reason) << "\n";
+          << "," << CsvField(reason) << "\n";
     }
   });
   size_t retries = 0;
@@ -450,7 +510,7 @@ int BatchRun::Dispatch() {
   while (!plan_.finished()) {
     plan_.WaitForChange(std::chrono::milliseconds(100));
     if (core::InterruptPending()) {
-      interrupted = true;
+      interrupted = interrupted_ = true;
       break;
     }
     if (Since(last_watch) < 0.5) continue;
@@ -477,7 +537,40 @@ int BatchRun::Dispatch() {
   Progress(true);
   WriteSummary(wall);
   for (const auto& e : write_errors_) std::cerr << "error: " << e << "\n";
-  return interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
+  const int rc = interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
+  double sim_done = 0;
+  const auto outcomes = plan_.outcomes();
+  for (size_t i = 0; i < outcomes.size(); ++i)
+    if (outcomes[i].state == Outcome::State::kDone) sim_done += runs_[i].duration_s;
+  WriteStatus(interrupted ? "interrupted" : rc == 0 ? "done" : "failed", 0, 0,
+              wall > 0 ? sim_done / wall : 0, 0);
+  return rc;
+}
+
+// The runs named in `only` (NAME,NAME,... or @FILE with one name per line), in the file's order;
+// a name the file does not make is an error.
+std::vector<experiment::Experiment> SelectRuns(std::vector<experiment::Experiment> runs,
+                                               const std::string& only) {
+  std::vector<std::string> names;
+  if (!only.empty() && only.front() == '@') {
+    std::ifstream in(only.substr(1));
+    if (!in) throw Failure("--only: cannot read " + only.substr(1));
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) names.push_back(line);
+  } else {
+    std::stringstream in(only);
+    for (std::string name; std::getline(in, name, ',');)
+      if (!name.empty()) names.push_back(name);
+  }
+  std::set<std::string> wanted(names.begin(), names.end()), known;
+  std::vector<experiment::Experiment> kept;
+  for (auto& r : runs) {
+    known.insert(r.name);
+    if (wanted.count(r.name)) kept.push_back(std::move(r));
+  }
+  for (const auto& n : wanted)
+    if (!known.count(n)) throw UsageError("--only: the file makes no run named '" + n + "'");
+  return kept;
 }
 
 int Batch(Client& client, std::vector<std::string>& args) {
@@ -505,6 +598,10 @@ int Batch(Client& client, std::vector<std::string>& args) {
     throw UsageError("--spawn takes a whole number of Models from 1 to 10000");
   options.spawn = static_cast<unsigned long>(spawn);
   options.max_attempts = static_cast<int>(attempts);
+  TakeOption(args, "--status", &options.status);
+  std::string only;
+  const bool select = TakeOption(args, "--only", &only);
+  const bool list = TakeFlag(args, "--list");
   RejectOptions(args);
   if (args.size() != 1) throw UsageError("expected one experiment FILE");
   options.file = args[0];
@@ -513,6 +610,11 @@ int Batch(Client& client, std::vector<std::string>& args) {
     runs = experiment::LoadFile(options.file);
   } catch (const experiment::FormatError& e) {
     throw Failure(e.what());
+  }
+  if (select) runs = SelectRuns(std::move(runs), only);
+  if (list) {
+    for (const auto& r : runs) std::cout << r.name << "\n";
+    return 0;
   }
   if (options.out.empty()) {
     const std::time_t now = std::time(nullptr);
@@ -529,7 +631,8 @@ int Batch(Client& client, std::vector<std::string>& args) {
 void AddBatchVerb(std::map<std::string, Verb>* verbs) {
   Verb verb{
       "batch FILE [--out DIR] [--models GLOB] [--spawn N] [--stall-timeout S]\n"
-      "          [--max-attempts N] [--run-timeout S] [--wait-models S]",
+      "          [--max-attempts N] [--run-timeout S] [--wait-models S] [--status FILE]\n"
+      "          [--only NAMES|@FILE] [--list]",
       "run a file of experiments on every Model in the naming service, as fast as possible",
       Batch, "cluster",
       "  FILE is JSON: a scene, parameter overrides (\"set\"), a command schedule (\"commands\"\n"
@@ -546,12 +649,19 @@ void AddBatchVerb(std::map<std::string, Verb>* verbs) {
       "  --max-attempts   tries per run before it is reported failed (5)\n"
       "  --run-timeout    the longest one run may take [s] (3600)\n"
       "  --wait-models    how long to wait for a first Model [s] (10)\n"
+      "  --status FILE    the progress as JSON, rewritten every second: state (running,\n"
+      "                   finishing, done, failed, interrupted), runs_total, runs_done,\n"
+      "                   runs_failed, models, models_busy, sim_s_per_s, eta_s, wall_s\n"
+      "                   (launch/caliper slurm status reads it)\n"
+      "  --only NAMES     run only these runs: NAME,NAME,... or @FILE (one name per line)\n"
+      "  --list           print the names of the runs (after --only) and exit\n"
       "  --out DIR        DIR/runs/NAME.csv (time [s] and the ids with units, in the shortest\n"
       "                   text that reads back exactly) and\n"
       "                   DIR/summary.csv (status, Model, attempts, times, every retry with its\n"
       "                   reason); default FILE-DATE-TIME. Progress goes to stderr.\n"
       "  A physics fault fails its run with the Model's report (not retried). Exit 0 when every\n"
-      "  run is done, 1 when any failed, 130 on Ctrl-C (the summary is written first).\n",
+      "  run is done, 1 when any failed, 130 on Ctrl-C or SIGTERM (the summary is written first,\n"
+      "  the runs that did not finish marked interrupted).\n",
       true};
   (*verbs)["batch"] = verb;
 }

@@ -100,6 +100,18 @@ void BatchPlan::Retry(const Ticket& ticket, const std::string& reason) {
   changed_.notify_all();
 }
 
+void BatchPlan::Abandon(const Ticket& ticket) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!Live(ticket)) return;
+  Outcome& o = outcomes_[ticket.run];
+  Release(ticket);
+  if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
+  if (o.attempts > 0) --o.attempts;
+  o.state = Outcome::State::kPending;
+  waiting_.push_front(ticket.run);
+  changed_.notify_all();
+}
+
 bool BatchPlan::finished() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return ended_ == outcomes_.size();

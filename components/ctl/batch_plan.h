@@ -57,6 +57,10 @@ class BatchPlan {
   /// The attempt is lost (the Model died, the link went down, no answer): the run waits again,
   /// unless it ended meanwhile or ran out of attempts. Once per ticket; later calls do nothing.
   void Retry(const Ticket& ticket, const std::string& reason);
+  /// The batch is being stopped (SIGINT, SIGTERM: the Models go down with it): the attempt does
+  /// not count, and the run waits again without a retry, so that the summary says it was
+  /// interrupted rather than failed.
+  void Abandon(const Ticket& ticket);
 
   bool finished() const;
   /// Returns when a run ends or `wait` has passed.

@@ -87,8 +87,8 @@ done
 # on a unix socket): bound in the naming service but unreachable
 in_ns c env CALIPER_HOST=hostc CALIPER_PKI="$PKI" "$BIN/caliper-model" --nameservice "$NS" --instance loopback \
   -o "log.spool_dir=$WORK/spool" >"$WORK/loopback.out" 2>&1 &
-lpid=$!
 for _ in $(seq 1 100); do grep -q "is up as" "$WORK/loopback.out" && break; sleep 0.1; done
+lpid=$(pgrep -f -- '--instance loopback' | head -1)
 if in_ns c ss -lxpH | grep -q "pid=$lpid," && ! in_ns c ss -ltnpH | grep -q "pid=$lpid,"; then
   pass "a local-mode Model listens on no TCP port, only on a unix socket ($(in_ns c ss -lxpH | grep "pid=$lpid," | awk '{print $5}' | head -1))"
 else
@@ -215,5 +215,5 @@ done
 
 if [ $FAILS -eq 0 ]; then echo "cluster_test: all checks passed"; exit 0; fi
 echo "cluster_test: $FAILS checks failed; the batch's stderr and the managers' output:"
-tail -5 "$WORK/cluster.err" "$WORK"/manager-*.out
+tail -n 5 "$WORK/cluster.err" "$WORK"/manager-*.out
 exit 1

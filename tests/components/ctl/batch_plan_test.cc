@@ -103,6 +103,32 @@ TEST(BatchPlan, CompleteKeepsTheResultWithAttemptsAndRetries) {
   EXPECT_TRUE(plan.finished());
 }
 
+TEST(BatchPlan, AbandonedAttemptsNeitherCountNorFail) {
+  // scancel: the Models die with the client; a run lost then waits again, with no retry and no
+  // attempt used, however often it happens, and a stale ticket changes nothing
+  BatchPlan plan(2, 2);
+  for (int i = 0; i < 5; ++i) {
+    const auto t = plan.Next("model1@a", kNoWait);
+    ASSERT_TRUE(t);
+    EXPECT_EQ(t->run, 0u) << "the abandoned run is first in line again";
+    plan.Abandon(*t);
+    plan.Abandon(*t);  // once per ticket
+  }
+  const Outcome o = plan.outcomes()[0];
+  EXPECT_EQ(o.state, State::kPending);
+  EXPECT_EQ(o.attempts, 0);
+  EXPECT_TRUE(o.retries.empty());
+  EXPECT_EQ(plan.failed(), 0u);
+  EXPECT_FALSE(plan.finished());
+  // a run that ended meanwhile stays ended
+  const auto a = plan.Next("model1@a", kNoWait);
+  ASSERT_TRUE(a);
+  EXPECT_TRUE(plan.Complete(*a, Result("model1@a", 10)));
+  plan.Abandon(*a);
+  EXPECT_EQ(plan.outcomes()[0].state, State::kDone);
+  EXPECT_EQ(plan.outcomes()[0].attempts, 1);
+}
+
 TEST(BatchPlan, FirstResultWinsAndDuplicatesReturnFalse) {
   BatchPlan plan(2, 2);
   const auto t = plan.Next("model1@a", kNoWait);
