@@ -19,7 +19,9 @@ local_models_start() {  # WORKDIR COUNT
 }
 
 local_models_add() {  # WORKDIR: one more Model; LOCAL_MODEL_PID is its pid
-  "$BIN/caliper-model" -o "log.spool_dir=$1/spool" -o log.level=warn >>"$1/models.out" 2>&1 &
+  # it dies with the script that started it (setpriv --pdeathsig), also when that is killed
+  setpriv --pdeathsig TERM "$BIN/caliper-model" -o "log.spool_dir=$1/spool" -o log.level=warn \
+    >>"$1/models.out" 2>&1 &
   LOCAL_MODEL_PID=$!
   LOCAL_MODELS_PIDS+=($!)
 }

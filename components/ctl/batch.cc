@@ -103,7 +103,12 @@ class BatchRun {
   void Join(size_t index);
   void Work(Slot* slot);
   // the batch ends (done, or SIGINT / SIGTERM pending)
-  bool Stopping() const { return stop_ || core::InterruptPending(); }
+  bool Stopping() { return stop_ || Interrupted(); }
+  // SIGINT or SIGTERM arrived (taking a pending one consumes it: latched here for every thread)
+  bool Interrupted() {
+    if (!interrupt_ && core::InterruptPending()) interrupt_ = true;
+    return interrupt_;
+  }
   void Attempt(Slot* slot, const BatchPlan::Ticket& ticket);
   void Watch();
   void Progress(bool last);
@@ -135,6 +140,7 @@ class BatchRun {
   Clock::time_point last_progress_;
   Clock::time_point last_status_;
   bool interrupted_ = false;  // by SIGINT or SIGTERM: unfinished runs are marked interrupted
+  std::atomic<bool> interrupt_{false};
 };
 
 void BatchRun::LoadScenes() {
@@ -509,7 +515,7 @@ int BatchRun::Dispatch() {
   bool interrupted = false;
   while (!plan_.finished()) {
     plan_.WaitForChange(std::chrono::milliseconds(100));
-    if (core::InterruptPending()) {
+    if (Interrupted()) {
       interrupted = interrupted_ = true;
       break;
     }

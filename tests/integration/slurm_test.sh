@@ -11,7 +11,8 @@
 #     summary marks the others interrupted;
 #  3. the same sweep as a job array of 4 tasks with one task cancelled on purpose: the merge job
 #     reports what is missing, `launch/caliper slurm rerun` runs only that, and the merged runs/
-#     equal the single-host results byte for byte.
+#     equal the single-host results byte for byte;
+#  4. a calibration over both nodes in plain GIOP (--insecure, which warns).
 # Needs root (namespaces, daemons); without it, or without Slurm, skipped (exit 77) with the reason.
 set -uo pipefail
 TAG=sl$$
@@ -50,6 +51,17 @@ cat >"$SHARED/sweep.json" <<JSON
  "sweep": {"ecce_arm.forearm.mass": [0.30, 0.31, 0.32, 0.33, 0.34, 0.35, 0.36, 0.37, 0.38, 0.39,
                                       0.40, 0.41, 0.42, 0.43, 0.44, 0.45, 0.46, 0.47, 0.48, 0.49]}}
 JSON
+cat >"$SHARED/runs.json" <<JSON
+{"scene": "$SRC/models/ecce_arm.dae", "duration_s": 1, "every_n_steps": 10,
+ "record": ["ecce_arm.elbow.position"],
+ "commands": [[0, "elbow_flexor", 6], [0.5, "elbow_flexor", 1], [0.5, "elbow_extensor", 5]]}
+JSON
+sed 's/"commands"/"set": {"ecce_arm.forearm.mass": 1.3}, "commands"/' "$SHARED/runs.json" >"$SHARED/truth.json"
+cat >"$SHARED/cal.json" <<JSON
+{"experiments": "runs.json", "measured": {"runs": "truth/runs/truth.csv"},
+ "parameters": [{"id": "ecce_arm.forearm.mass", "lower": 0.5, "upper": 2, "scale": "log"}],
+ "optimiser": {"generations": 3, "population": 5, "sigma0": 0.2}, "seed": 3}
+JSON
 # the single-host reference: a local session of two Models on hosta
 in_ns a env BIN="$BIN" SRC="$SRC" WORK="$WORK" bash -c '
   source "$SRC/launch/local_models.sh"
@@ -57,6 +69,8 @@ in_ns a env BIN="$BIN" SRC="$SRC" WORK="$WORK" bash -c '
   local_models_start "$WORK/ref-session" 2
   "$BIN/caliper-ctl" batch "$WORK/shared/sweep.json" --out "$WORK/reference" >"$WORK/reference.out" 2>&1
   rc=$?
+  # a "measured" recording for the calibration job: the arm with a heavier forearm
+  "$BIN/caliper-ctl" batch "$WORK/shared/truth.json" --out "$WORK/shared/truth" >/dev/null 2>&1 || rc=1
   local_models_stop
   exit $rc' || { cat "$WORK/reference.out"; echo "FAIL: the single-host batch"; exit 1; }
 echo "reference: $(grep ' runs done' "$WORK/reference.out" | tail -1)"
@@ -72,7 +86,8 @@ caliper_processes() {  # every Caliper process (and naming service) in the host 
   local n p
   for n in a b c; do
     for p in $(ip netns pids "$TAG-$n" 2>/dev/null); do
-      ps -o comm= -p "$p" 2>/dev/null | grep -E '^(caliper-|omniNames)' | sed "s/^/host$n: /"
+      ps -o comm=,pid=,ppid=,etimes=,args= -p "$p" 2>/dev/null | grep -E '^(caliper-|omniNames)' |
+        cut -c1-200 | sed "s/^/host$n: /"
     done
   done
 }
@@ -187,6 +202,23 @@ cmp -s <(cut -d, -f1,2,5,6,7 "$WORK/reference/summary.csv") <(cut -d, -f1,2,5,6,
   fail "merged summary differs: $(diff <(cut -d, -f1,2,5,6,7 "$WORK/reference/summary.csv") <(cut -d, -f1,2,5,6,7 "$OUT3/summary.csv") | head -5)"
 left=$(caliper_processes)
 [ -z "$left" ] && pass "no Caliper process left after the array" || fail "left: $left"
+
+# ---------------------------------------------------------------- 4. a calibration, --insecure
+OUT4=$SHARED/calibration
+job4=$(caliper slurm calibrate "$SHARED/cal.json" --out "$OUT4" --nodes 2 --models-per-node 1 \
+  --insecure --no-requeue 2>"$WORK/submit4.err" | tail -1)
+[[ "$job4" =~ ^[0-9]+$ ]] || { cat "$WORK/submit4.err"; fail "slurm calibrate did not submit"; }
+slurm_wait_job "${job4:-0}" 180 || fail "calibration job $job4 still queued"
+state=$(slurm_a scontrol show job "$job4" 2>/dev/null | grep -oE 'JobState=\S+' | xargs)
+if grep -q COMPLETED <<<"$state" && [ -s "$OUT4/parameters.csv" ] && grep -q '"state": "done"' "$OUT4/status.json"; then
+  pass "calibration job $job4 over 2 nodes (plain GIOP, --insecure): $(grep -i 'best cost\|final cost\|cost' "$OUT4/calibrate.out" | tail -1 | cut -c1-120)"
+else
+  fail "calibration job $job4: $state; $(tail -n 5 "$OUT4"/slurm-*.out "$OUT4/progress.log" 2>&1)"
+fi
+grep -q WARNING "$OUT4"/slurm-*.out "$OUT4"/session/*.out 2>/dev/null && pass "--insecure warns in the job's output" ||
+  fail "no INSECURE warning from the calibration job"
+left=$(caliper_processes)
+[ -z "$left" ] && pass "no Caliper process left after the calibration" || fail "left: $left"
 
 [ "$FAILS" -eq 0 ] || { echo "$FAILS check(s) failed; slurm logs:"; slurm_logs | tail -n 60; exit 1; }
 echo "all checks passed"
