@@ -6,7 +6,7 @@
 # their lines of `launch/caliper help`, between deps and ctl
 dev_usage() {
   cat <<'USAGE'
-  bench [physics|collada|model|gui|cluster|calibration|python|all]
+  bench [physics|collada|model|gui|cluster|calibration|python|slurm|all]
                           build and run the benchmarks (all by default; physics: the engine
                           against raw Bullet and MuJoCo, collada: COLLADA and URDF load
                           times, model: the control cycle and DAQ, gui: plotter drawing, log
@@ -14,7 +14,10 @@ dev_usage() {
                           cluster: batch throughput with 1 and 2 Models, per-run overhead,
                           calibration: evaluations/s with 1 and 2 Models, python: the
                           package's control cycle against C++, record rate, vector
-                          environment with 2 Models against 1); one line
+                          environment with 2 Models against 1, slurm (root): a sweep
+                          through a real Slurm cluster of namespaces against directly started
+                          managers, 1,000 runs with a node killed; model also: a call on a
+                          unix socket against loopback TCP); one line
                           per figure: RATIO <name> <value> (target <target>)
   faults [--freeze S]     the fault suite on a GUI session with a controller (Xvfb when there is no
                           display): renderer and plotter stopped for S s (default 30), renderer,
@@ -54,8 +57,8 @@ cmd_bench() {
   [ $# -gt 0 ] && shift
   cmd_build
   case "$which" in
-    physics|collada|model|gui|cluster|calibration|python|all) ;;
-    *) die "bench physics|collada|model|gui|cluster|calibration|python|all" ;;
+    physics|collada|model|gui|cluster|calibration|python|slurm|all) ;;
+    *) die "bench physics|collada|model|gui|cluster|calibration|python|slurm|all" ;;
   esac
   if [ "$which" = physics ] || [ "$which" = all ]; then
     say "physics benchmarks (a minute or two)"
@@ -74,6 +77,15 @@ cmd_bench() {
   if [ "$which" = cluster ] || [ "$which" = all ]; then
     say "cluster benchmarks (about a minute)"
     CALIPER_BIN_DIR=$BIN bash "$ROOT/bench/cluster_bench.sh"
+  fi
+  if [ "$which" = slurm ] || [ "$which" = all ]; then
+    if [ "$(id -u)" = 0 ]; then
+      cmd_deps slurm
+      say "slurm benchmarks (two minutes: a Slurm cluster of network namespaces, 200-run sweeps)"
+      CALIPER_BIN_DIR=$BIN bash "$ROOT/bench/slurm_bench.sh"
+    else
+      say "slurm benchmarks skipped: they make a Slurm cluster of network namespaces, which needs root"
+    fi
   fi
   if [ "$which" = calibration ] || [ "$which" = all ]; then
     say "calibration benchmarks (a minute; --example adds the example's wall time, minutes)"

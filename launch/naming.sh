@@ -85,14 +85,25 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
   local -a run=(exec) proto=tcp scheme="corbaname::"
   mkdir -p "$dir"
   if [ "$mode" = local ]; then
-    local sock=${CALIPER_SOCKET_DIR:?no socket directory: call session_socket_dir first}/naming.sock
+    # the sockets in DIR/sock unless the caller chose (session_socket_dir)
+    [ -n "${CALIPER_SOCKET_DIR:-}" ] || session_socket_dir "$dir"
+    local sock=$CALIPER_SOCKET_DIR/naming.sock
     rm -f "$sock"
     mkdir -p "$dir/omninames"
+    # other ORBs (Tcl Combat) have no unix transport: loopback TCP too when asked
+    local -a tcp=()
+    NS_PORT=
+    NS_TCP_ADDR=
+    if [ "${CALIPER_LOOPBACK_TCP:-}" = 1 ]; then
+      NS_PORT=$(free_port)
+      tcp=(-ORBendPoint "giop:tcp:127.0.0.1:$NS_PORT")
+      NS_TCP_ADDR="corbaname::127.0.0.1:$NS_PORT"
+      say "WARNING: --loopback-tcp: the session also listens on 127.0.0.1 ($NS_TCP_ADDR, for other ORBs): every user of this host can reach it"
+    fi
     (exec omniNames -start -always -nohostname -datadir "$dir/omninames" \
-      -ORBendPoint "giop:unix:$sock" -ORBunixTransportPermission 0600 \
+      -ORBendPoint "giop:unix:$sock" "${tcp[@]}" -ORBunixTransportPermission 0600 \
       -ORBgiopMaxMsgSize 4194304 >"$dir/omninames.log" 2>&1) &
     NS_PID=$!
-    NS_PORT=
     NS_ADDR="corbaname:omniunix:$sock"
     for _ in $(seq 1 50); do
       naming_answers "$NS_ADDR" && return 0

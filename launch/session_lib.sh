@@ -89,6 +89,7 @@ new_session() {
     -o "logger.session=$SESSION_ID" -o exec.auto_activate=true
   wait_bound logger0
   say "session $SESSION_ID: naming service $NS_ADDR, files in $SESSION_DIR"
+  [ -z "${NS_TCP_ADDR:-}" ] || say "for other ORBs (Tcl): naming service $NS_TCP_ADDR (loopback TCP)"
 }
 
 ctl() { "$BIN/caliper-ctl" --nameservice "$NS_ADDR" "$@"; }

@@ -319,7 +319,7 @@ PushTarget::Outcome ObserverTarget::Push(std::string* why) {
     return Outcome::kSent;
   } catch (const CORBA::Exception& e) {
     *why = rtc::Describe(e);
-    if (PeerGone(e)) return Outcome::kGone;
+    if (PeerGone(e, observer_.in())) return Outcome::kGone;
     // the backlog goes, the observer stays: what did not arrive is sent again unless something
     // newer replaced it, and the next transforms carry every body
     filter_ = sgal::ChangeFilter();
@@ -395,7 +395,7 @@ PushTarget::Outcome SubscriptionTarget::Push(std::string* why) {
       if (lossless_)
         *why = "a push failed: " + *why + "; a lossless subscription ends at its first failed push";
       last_failure_ = *why;
-      return PeerGone(e) || lossless_ ? Outcome::kGone : Outcome::kFailed;
+      return PeerGone(e, consumer_.in()) || lossless_ ? Outcome::kGone : Outcome::kFailed;
     }
   }
   last_failure_.clear();

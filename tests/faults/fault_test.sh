@@ -49,7 +49,7 @@ freeze() {  # NAME WHAT (observer|subscription)
   during=$(step_rate "$FREEZE")
   kill -CONT "${PID[$name]}"
   local port
-  port=$(port_of "${PID[$name]}")
+  port=$(socket_of "${PID[$name]}")
   note "$name stopped for $FREEZE s: the Model stepped $before steps/s before, $during while it was stopped"
   if [ "$(echo "$during >= 0.95 * $before && $before > 0" | bc -l)" = 1 ]; then
     pass "the Model kept stepping while the $name was stopped ($during vs $before steps/s)"
@@ -58,7 +58,7 @@ freeze() {  # NAME WHAT (observer|subscription)
   fi
   # the Model logged that the push failed, and then that it answers again
   served_again() {
-    tail -n +"$((lines + 1))" "$(session_log)" | grep -q "$what [0-9]* (client 127.0.0.1:$port) answers again"
+    tail -n +"$((lines + 1))" "$(session_log)" | grep -F "(client unix:$port) answers again" | grep -q "$what [0-9]"
   }
   if t=$(wait_until "$BACK" served_again); then
     pass "the $name is served again ${t} s after SIGCONT ($what kept)"

@@ -5,8 +5,10 @@
 # can kill, stop and restart them one at a time as a supervisor would. Needs an X display (an own
 # Xvfb is started when there is none) and the programs of a build (CALIPER_BIN_DIR).
 #
-# Every process listens on 127.0.0.1 only (the components' default endpoint, omniNames with
-# -ORBendPoint giop:tcp:127.0.0.1:PORT): nothing is reachable from another host.
+# Every process listens on a unix socket only (the components' default endpoint, omniNames on
+# sock/naming.sock in a directory only this user can enter): nothing is reachable from another
+# host or user. A process is told by its socket, as the Model and the logger name their clients
+# (client unix:SOCKET).
 
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?set CALIPER_SOURCE_DIR to the source tree}
@@ -50,6 +52,7 @@ need_display() {
 # the naming service on NS_PORT (a free one the first time) with a fresh database in DIR
 start_naming() {  # DIR
   if [ -z "${NS_PORT:-}" ]; then
+    # the same socket every time (CALIPER_SOCKET_DIR stays), a fresh database
     start_nameserver "$1"
   else
     mkdir -p "$1"
@@ -89,9 +92,9 @@ start() {  # NAME
   PID[$name]=$!
 }
 
-# the port a process listens on (its ORB's endpoint), "" while it has none
-port_of() {  # PID
-  ss -tlnpH 2>/dev/null | awk -v p="pid=$1," 'index($0, p) { n = split($4, a, ":"); print a[n]; exit }'
+# the unix socket a process listens on (its ORB's endpoint), "" while it has none
+socket_of() {  # PID
+  ss -lxpH 2>/dev/null | awk -v p="pid=$1," 'index($0, p) { print $5; exit }'
 }
 
 # the session log
@@ -119,27 +122,33 @@ bound_as() {  # INSTANCE PID
 }
 
 # the Model registered a subscription, an observer, or the logger a listener, of the process PID
-subscribed() { local p; p=$(port_of "$1"); [ -n "$p" ] && log_has "added (client 127.0.0.1:$p)"; }
+subscribed() { local p; p=$(socket_of "$1"); [ -n "$p" ] && log_has "added (client unix:$p)"; }
 # as above, but a line after the first N lines of the session log
 subscribed_after() {  # PID LINES
   local p f
-  p=$(port_of "$1"); f=$(session_log)
-  [ -n "$p" ] && [ -n "$f" ] && tail -n +"$(($2 + 1))" "$f" | grep -qF "added (client 127.0.0.1:$p)"
+  p=$(socket_of "$1"); f=$(session_log)
+  [ -n "$p" ] && [ -n "$f" ] && tail -n +"$(($2 + 1))" "$f" | grep -qF "added (client unix:$p)"
 }
 log_lines() { local f; f=$(session_log); [ -n "$f" ] && wc -l <"$f" || echo 0; }
 
 # the process is up: its ORB listens, or (a client only, the main window) it holds a connection
 up() {  # PID
-  [ -n "$(port_of "$1")" ] ||
-    ss -tnpH state established 2>/dev/null | awk -v p="pid=$1," 'index($0, p) {f = 1} END {exit !f}'
+  [ -n "$(socket_of "$1")" ] ||
+    ss -xpH state established 2>/dev/null | awk -v p="pid=$1," 'index($0, p) {f = 1} END {exit !f}'
 }
 
 # the process holds a connection to the Model (the main window polls its status)
 connected_to_model() {  # PID
-  local mp
-  mp=$(port_of "${PID[model]}")
-  [ -n "$mp" ] && ss -tnpH state established 2>/dev/null |
-    awk -v p="pid=$1," -v peer="127.0.0.1:$mp" 'index($0, p) && $4 == peer {f = 1} END {exit !f}'
+  local ms
+  ms=$(socket_of "${PID[model]}")
+  # the Model's ends of its connections (its socket's path, their inodes), and a connection of
+  # PID whose peer is one of them (ss -x with one state: netid, queues, local path, local inode,
+  # peer path, peer inode)
+  [ -n "$ms" ] && ss -xpH state established 2>/dev/null |
+    awk -v p="pid=$1," -v m="pid=${PID[model]}," -v path="$ms" '
+      index($0, m) && $4 == path {model[$5] = 1}
+      index($0, p) {peer[$7] = 1}
+      END {for (i in peer) if (i in model) exit 0; exit 1}'
 }
 
 model_steps() { ctl status 2>/dev/null | awk '$1 == "steps" {print $2}'; }

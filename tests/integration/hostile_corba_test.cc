@@ -904,7 +904,11 @@ TEST(HostileMessageSize, ARequestOverTheLimitIsASystemExceptionAndTheServerGoesO
   std::fill(big.get_buffer(), big.get_buffer() + big.length(), 'x');
   const Outcome o = Try([&] { ref->load_scene_data("big.dae", big); });
   EXPECT_EQ(o.kind, Outcome::kSystem) << o;
-  EXPECT_TRUE(Contains(o.name, "MARSHAL") || Contains(o.name, "COMM_FAILURE")) << o;
+  // over loopback TCP MARSHAL or COMM_FAILURE; over a unix socket (the default) the server's
+  // closing the connection mid-request is a TRANSIENT
+  EXPECT_TRUE(Contains(o.name, "MARSHAL") || Contains(o.name, "COMM_FAILURE") ||
+              Contains(o.name, "TRANSIENT"))
+      << o;
   // a million ids (about 30 MB) too
   D::ChannelInfoSeq_var channels = ref->list("*");
   const Outcome ids = Try([&] { D::ValueSeq_var(ref->get(Ids(kMillion, channels[0].id.in()))); });

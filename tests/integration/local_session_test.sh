@@ -163,7 +163,11 @@ steps=$(as $ALICE "$BIN/caliper-ctl" status 2>&1 | awk '/^steps/ {print $2}')
 
 # ---------------------------------------------------------------- the session ends cleanly
 kill -TERM -- "-$SESSION_PID" 2>/dev/null
-for _ in $(seq 1 100); do kill -0 "$SESSION_PID" 2>/dev/null || break; sleep 0.1; done
+# runuser ends at once; the launcher's shutdown goes on a little
+for _ in $(seq 1 100); do
+  kill -0 "$SESSION_PID" 2>/dev/null || pgrep -u $ALICE -f 'launch/caliper session' >/dev/null || break
+  sleep 0.1
+done
 SESSION_PID=
 left=$(find "$SDIR/sock" -type s | wc -l)
 [ "$left" -eq 0 ] && pass "the session's sockets are gone after it stopped" || fail "$left sockets left in $SDIR/sock"

@@ -83,9 +83,11 @@ class TclController : public ::testing::Test {
 
     naming_ = std::make_unique<NamingService>(dir_.path());
     model_ = std::make_unique<Process>(
+        // Combat has no unix transport: the Model listens on loopback TCP too, as asked
         std::vector<std::string>{Bin("caliper-model"), "--nameservice", naming_->address(), "-o",
                                  "log.service=none", "-o",
-                                 "log.spool_dir=" + dir_.path() + "/spool"},
+                                 "log.spool_dir=" + dir_.path() + "/spool", "-o",
+                                 "corba.loopback_tcp=true"},
         dir_.path() + "/model.out");
     ASSERT_TRUE(WaitFor([&] { return Contains(model_->Output(), " is up as "); }, seconds(20)))
         << model_->Output();

@@ -1,8 +1,15 @@
 #include "caliper/rtc/local_sockets.h"
 
 #include <pwd.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
+
+#include <omniORB4/IIOP.h>
+#include <omniORB4/cdrStream.h>
+#include <omniORB4/omniIOR.h>
+#include <omniORB4/omniObjRef.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -57,7 +64,7 @@ std::string Checked(const std::string& dir, const std::string& source) {
   return dir;
 }
 
-std::string Resolve() {
+std::string ResolveDir() {
   if (const char* env = std::getenv("CALIPER_SOCKET_DIR"); env != nullptr && *env != '\0')
     return Checked(env, "$CALIPER_SOCKET_DIR");
   // the launcher's state directory (latest-session lives there too): in systemd's per-user
@@ -94,9 +101,11 @@ std::string LocalSocketDir() {
   static std::mutex mutex;
   static std::string dir;
   std::lock_guard<std::mutex> lock(mutex);
-  if (dir.empty()) dir = Resolve();
+  if (dir.empty()) dir = ResolveDir();
   return dir;
 }
+
+std::string ResolveLocalSocketDir() { return ResolveDir(); }
 
 std::vector<std::string> LocalSocketOrbOptions() {
   return {"-ORBunixTransportDirectory", LocalSocketDir(), "-ORBunixTransportPermission", "0600"};
@@ -119,6 +128,54 @@ bool IsLocalSocketAddress(const std::string& address) { return !LocalSocketPath(
 
 std::string LocalNamingAddress(const std::string& socket_path) {
   return "corbaname:omniunix:" + socket_path;
+}
+
+std::string UnixSocketOfComponent(const IOP::TaggedComponent& component) {
+  if (component.tag != IOP::TAG_OMNIORB_UNIX_TRANS) return "";
+  // an encapsulation of the host name and the file name, read with omniORB's own stream
+  try {
+    cdrEncapsulationStream stream(component.component_data.get_buffer(),
+                                  component.component_data.length(), 1);
+    CORBA::String_var host = stream.unmarshalRawString();
+    CORBA::String_var file = stream.unmarshalRawString();
+    return file.in();
+  } catch (...) {
+    return "";
+  }
+}
+
+std::string UnixSocketOf(CORBA::Object_ptr ref) {
+  if (CORBA::is_nil(ref)) return "";
+  std::string socket;
+  omniIOR* ior = ref->_PR_getobj()->_getIOR();
+  const IOP::TaggedProfileList& profiles = ior->iopProfiles();
+  for (CORBA::ULong i = 0; i < profiles.length() && socket.empty(); ++i) {
+    if (profiles[i].tag != IOP::TAG_INTERNET_IOP) continue;
+    try {
+      IIOP::ProfileBody body;
+      IIOP::unmarshalProfile(profiles[i], body);
+      for (CORBA::ULong c = 0; c < body.components.length() && socket.empty(); ++c)
+        socket = UnixSocketOfComponent(body.components[c]);
+    } catch (const CORBA::SystemException&) {
+      // a malformed profile: try the next one
+    }
+  }
+  ior->release();
+  return socket;
+}
+
+bool LocalSocketListening(const std::string& path) {
+  sockaddr_un address{};
+  if (path.empty() || path.size() >= sizeof address.sun_path) return false;
+  address.sun_family = AF_UNIX;
+  std::memcpy(address.sun_path, path.c_str(), path.size());
+  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) return true;  // cannot tell: not gone
+  const int rc = connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address);
+  const int error = errno;
+  close(fd);
+  // EAGAIN: its backlog is full (a stopped process): there, but busy
+  return rc == 0 || (error != ECONNREFUSED && error != ENOENT);
 }
 
 std::string LocalSocketNote(const std::string& path, const std::string& what) {

@@ -1,5 +1,6 @@
 #include "caliper/rtc/peers.h"
 
+#include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/naming.h"
 
 #include <omniORB4/IIOP.h>
@@ -11,6 +12,8 @@ namespace caliper::rtc {
 
 std::string ClientOf(CORBA::Object_ptr ref) {
   if (CORBA::is_nil(ref)) return "(nil)";
+  // a local client: its unix socket names its process (its IIOP address is a placeholder)
+  if (const std::string socket = UnixSocketOf(ref); !socket.empty()) return "unix:" + socket;
   std::string client;
   omniIOR* ior = ref->_PR_getobj()->_getIOR();
   const IOP::TaggedProfileList& profiles = ior->iopProfiles();
@@ -32,6 +35,14 @@ bool PeerGone(const CORBA::Exception& e) {
   if (CORBA::OBJECT_NOT_EXIST::_downcast(&e)) return true;
   const auto* transient = CORBA::TRANSIENT::_downcast(&e);
   return transient != nullptr && transient->minor() == omni::TRANSIENT_ConnectFailed;
+}
+
+bool PeerGone(const CORBA::Exception& e, CORBA::Object_ptr ref) {
+  if (!PeerGone(e)) return false;
+  if (CORBA::OBJECT_NOT_EXIST::_downcast(&e)) return true;
+  // a local object: gone when nothing listens on its socket any more
+  const std::string socket = UnixSocketOf(ref);
+  return socket.empty() || !LocalSocketListening(socket);
 }
 
 std::string Unreachable(CORBA::Object_ptr ref, const char* what, const char* repository_id,

@@ -39,6 +39,10 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
        "can enter, $CALIPER_SOCKET_DIR or /tmp/caliper-UID; --listen ADDR or $CALIPER_LISTEN "
        "make it giop:ssl:ADDR:, reachable from other hosts over TLS, giop:tcp:ADDR: with "
        "--insecure)"},
+      {"corba.loopback_tcp", Type::kBool, "false",
+       "a local process also listens on loopback TCP (giop:tcp:127.0.0.1:), for clients of other "
+       "ORBs (Tcl Combat) that have no unix transport; every user of this host can then reach "
+       "it (also $CALIPER_LOOPBACK_TCP=1, launch/caliper session --loopback-tcp); warns"},
       {"corba.insecure", Type::kBool, "false",
        "network mode without TLS: plain GIOP, no authentication (also --insecure, "
        "$CALIPER_INSECURE=1); warns loudly"},
@@ -270,6 +274,9 @@ std::optional<int> ReadCommandLine(int argc, char** argv, const ComponentType& t
     if (const char* listen = std::getenv("CALIPER_LISTEN"); listen != nullptr && *listen != '\0')
       overrides.push_back("corba.endpoint=" + ListenEndpoint(listen));
     if (InsecureFromEnvironment()) overrides.push_back("corba.insecure=true");
+    if (const char* tcp = std::getenv("CALIPER_LOOPBACK_TCP");
+        tcp != nullptr && (std::string(tcp) == "1" || std::string(tcp) == "true"))
+      overrides.push_back("corba.loopback_tcp=true");
     core::ArgumentSpec spec;
     spec.valued = {"-f", "-o", "--nameservice", "--listen", "--instance"};
     spec.flags = {"--insecure"};
@@ -360,6 +367,12 @@ std::optional<TransportSecurity> SetUpTransport(const std::string& program,
     return std::nullopt;
   }
   ReportTransport(program, security, log);
+  if (config.GetBool("corba.loopback_tcp") && security.transport == Transport::kLoopback) {
+    log.warn("also listening on loopback TCP (corba.loopback_tcp): every user of this host can "
+             "reach this process");
+    std::cerr << program << ": warning: also on loopback TCP (corba.loopback_tcp, for other "
+              << "ORBs): every user of this host can reach this process\n";
+  }
   InstallProcessSecurity(security);
   return security;
 }
@@ -372,6 +385,9 @@ void AddOrbOptions(const core::Config& config, const TransportSecurity& security
   // not hold; without it a connect is bounded by the call's own deadline
   const int timeout_ms = static_cast<int>(config.GetDouble("corba.call_timeout") * 1000);
   for (const auto& option : SecurityOrbOptions(security)) orb_args->push_back(option);
+  // other ORBs (Tcl Combat) have no unix transport: loopback TCP beside the socket, when asked
+  if (config.GetBool("corba.loopback_tcp") && security.transport == Transport::kLoopback)
+    orb_args->insert(orb_args->end(), {"-ORBendPoint", "giop:tcp:127.0.0.1:"});
   orb_args->insert(orb_args->end(),
                    {"-ORBendPoint", security.endpoint, "-ORBclientCallTimeOutPeriod",
                     std::to_string(timeout_ms), "-ORBgiopMaxMsgSize",

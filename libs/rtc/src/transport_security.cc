@@ -10,7 +10,6 @@
 #include <sys/time.h>
 #include <unistd.h>
 
-#include <omniORB4/cdrStream.h>
 #include <omniORB4/omniInterceptors.h>
 #include <omniORB4/sslContext.h>  // also forces the link of libomnisslTP4 (OMNI_FORCE_LINK)
 #include <openssl/err.h>
@@ -234,27 +233,13 @@ void Remember(std::vector<HandshakeNote>* notes, const std::string& text, size_t
   notes->push_back({text, Clock::now()});
 }
 
-// the socket file of omniORB's unix transport component: an encapsulation of the host name and
-// the file name, read with omniORB's own stream
-std::string UnixSocketOf(const IOP::TaggedComponent& component) {
-  try {
-    cdrEncapsulationStream stream(component.component_data.get_buffer(),
-                                  component.component_data.length(), 1);
-    CORBA::String_var host = stream.unmarshalRawString();
-    CORBA::String_var file = stream.unmarshalRawString();
-    return file.in();
-  } catch (...) {
-    return "";
-  }
-}
-
 // notes the references whose only address is a TLS one (without TLS), and those on a unix socket
 CORBA::Boolean DecodeIor(omni::omniInterceptors::decodeIOR_T::info_T& info) {
   if (!info.has_iiop_body || info.iiop.address.port != 0) return true;
   for (CORBA::ULong i = 0; i < info.iiop.components.length(); ++i) {
     const IOP::TaggedComponent& component = info.iiop.components[i];
     if (component.tag == IOP::TAG_OMNIORB_UNIX_TRANS) {
-      if (const std::string file = UnixSocketOf(component); !file.empty())
+      if (const std::string file = UnixSocketOfComponent(component); !file.empty())
         Remember(&t_local_sockets, file, kMaxLocalSockets);
     } else if (component.tag == IOP::TAG_SSL_SEC_TRANS &&
                ProcessSecurity().transport != Transport::kTls) {
@@ -568,10 +553,15 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
     // and how many others are unreachable too
     std::string note;
     size_t others = 0;
-    for (auto n = t_local_sockets.rbegin(); n != t_local_sockets.rend(); ++n)
-      if (Clock::now() - n->when < std::chrono::seconds(60))
-        if (std::string why = LocalSocketNote(n->text, "the object"); !why.empty())
-          note.empty() ? note = why : (++others, note);
+    for (auto n = t_local_sockets.rbegin(); n != t_local_sockets.rend(); ++n) {
+      if (Clock::now() - n->when >= std::chrono::seconds(60)) continue;
+      std::string why = LocalSocketNote(n->text, "the object");
+      // the newest reference is most likely the one called: reachable, there is nothing to say
+      // (older ones may be of processes long gone)
+      if (n == t_local_sockets.rbegin() && why.empty()) break;
+      if (why.empty()) continue;
+      note.empty() ? note = why : (++others, note);
+    }
     if (!note.empty()) {
       t_local_sockets.clear();
       if (others > 0)

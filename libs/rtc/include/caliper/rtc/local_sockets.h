@@ -9,6 +9,8 @@
 // The directory: $CALIPER_SOCKET_DIR (launch/caliper sets the session's DIR/sock), else the
 // launcher's state directory, ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID.
 
+#include <omniORB4/CORBA.h>
+
 #include <string>
 #include <vector>
 
@@ -25,6 +27,9 @@ inline constexpr const char* kLocalEndpoint = "giop:unix:";
 /// said on stderr.
 std::string LocalSocketDir();
 
+/// The same, decided afresh from the environment (LocalSocketDir keeps the first answer).
+std::string ResolveLocalSocketDir();
+
 /// The omniORB options that put a giop:unix: endpoint's socket in LocalSocketDir(), readable
 /// and writable by this user only.
 std::vector<std::string> LocalSocketOrbOptions();
@@ -37,6 +42,19 @@ std::string LocalSocketPath(const std::string& address);
 
 /// The address of the naming service listening on the unix socket PATH.
 std::string LocalNamingAddress(const std::string& socket_path);
+
+/// The socket file in omniORB's unix transport component of a reference ('' when it has none).
+std::string UnixSocketOfComponent(const IOP::TaggedComponent& component);
+
+/// The unix socket of `ref` (its first IIOP profile's unix transport component), '' for a
+/// reference without one (a network object).
+std::string UnixSocketOf(CORBA::Object_ptr ref);
+
+/// True when something listens on the unix socket `path`: a connect() there is not refused
+/// (ECONNREFUSED: a file left by a process that is gone) and the file exists. omniORB tries a
+/// local object's other addresses after a call timed out (its IIOP profile's placeholder, port
+/// 0, which always fails to connect): a failed connect alone does not tell that it is gone.
+bool LocalSocketListening(const std::string& path);
 
 /// Why this process cannot connect to the unix socket `path`: a directory on the way that this
 /// user cannot enter (its owner and mode: another user's session), a socket it may not write, or
