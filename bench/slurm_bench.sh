@@ -9,7 +9,8 @@
 #   a 1,000-run sweep of 0.2 s runs through Slurm on 2 nodes with hostc killed mid-run: its wall
 #     time and runs per second, and that every run is done
 # Needs root (namespaces) and Slurm (launch/caliper deps slurm). Run through
-# `launch/caliper bench slurm`.
+# `launch/caliper bench slurm`. BENCH_PAIRS="1" runs one pair; BENCH_VERBOSE=1 prints each job's
+# timeline (naming service, managers up, client exit, teardown).
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 export CALIPER_BIN_DIR=${CALIPER_BIN_DIR:-$ROOT/build/bin} CALIPER_SOURCE_DIR=$ROOT
@@ -72,9 +73,9 @@ direct() {  # OUT
     pids+=($!)
   done
   local ctl=(in_ns b env CALIPER_HOST=hostb CALIPER_PKI="$PKI" "$BIN/caliper-ctl" --nameservice "$ns")
-  for _ in $(seq 1 300); do
+  for _ in $(seq 1 1200); do
     [ "$("${ctl[@]}" managers 2>/dev/null | grep -v unreachable | grep -c 'manager0.rtc')" -ge 2 ] && break
-    sleep 0.2
+    sleep 0.05
   done
   "${ctl[@]}" batch "$SHARED/sweep200.json" --spawn 4 --out "$out" >"$out/batch.out" 2>"$out/progress.log"
   for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill -TERM "${pids[$i]}" 2>/dev/null; done
@@ -102,13 +103,15 @@ through_slurm() {  # OUT SWEEP [KILL_AFTER_RUNS]: prints the job's wall time [s]
 }
 
 ratios=()
-for i in 1 2 3; do
+for i in ${BENCH_PAIRS:-1 2 3}; do
   d=$(direct "$WORK/direct$i")
   s=$(through_slurm "$SHARED/slurm$i" "$SHARED/sweep200.json")
   done_runs=$(awk -F, 'NR > 1 && $2 == "done"' "$SHARED/slurm$i/summary.csv" 2>/dev/null | wc -l)
   r=$(awk -v s="$s" -v d="$d" 'BEGIN {printf "%.3f", s / d}')
-  echo "# pair $i: 200 runs of 1 s on 2 nodes x 2 Models: direct $d s, through Slurm $s s ($done_runs done): $r"
+  bw() { grep -o '[0-9.]* s of wall time' "$1/batch.out" | grep -o '^[0-9.]*'; }
+  echo "# pair $i: 200 runs of 1 s on 2 nodes x 2 Models: direct $d s (batch $(bw "$WORK/direct$i") s), through Slurm $s s (batch $(bw "$SHARED/slurm$i") s; $done_runs done): $r"
   ratios+=("$r")
+  [ -z "${BENCH_VERBOSE:-}" ] || { grep caliper-job "$SHARED/slurm$i"/slurm-*.out; grep -E 'runs on|runs done' "$SHARED/slurm$i/progress.log" "$SHARED/slurm$i/batch.out"; }
 done
 median=$(printf '%s\n' "${ratios[@]}" | sort -n | sed -n 2p)
 ok=$(awk -v m="$median" 'BEGIN {print (m <= 1.10) ? "" : "  <- off target"}')
