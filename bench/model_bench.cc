@@ -193,19 +193,20 @@ int main(int argc, char** argv) {
     arm->set_commands(commands);
     Caliper::Daq::ValueSeq_var v = arm->get(ids);
   });
-  const double raw = Median(calls, [&] {
-    server->take_commands(commands);
-    S::DoubleSeq_var v = server->values_for(ids);
-  });
+  // the same two calls on the bare servant, on a unix socket or on loopback TCP
+  auto bare = [&](CaliperBench::EchoServer_ptr echo) {
+    return Median(calls, [&] {
+      echo->take_commands(commands);
+      S::DoubleSeq_var v = echo->values_for(ids);
+    });
+  };
+  const double raw = bare(server);
   std::printf("# control cycle %.1f us on caliper-model (running in real time), %.1f us on a bare "
               "omniORB servant with the same payloads\n", cycle, raw);
   Ratio("control_cycle_vs_raw_omniorb", cycle / raw, 1.3);
   // what a session reachable only by its user costs: the same two calls on a unix socket in a
   // private directory against loopback TCP (which every user of the host could reach)
-  const double raw_tcp = Median(calls, [&] {
-    server_tcp->take_commands(commands);
-    S::DoubleSeq_var v = server_tcp->values_for(ids);
-  });
+  const double raw_tcp = bare(server_tcp);
   std::printf("# two small calls (set 10 commands, get 20 values): %.1f us on a unix socket, "
               "%.1f us on loopback TCP\n", raw, raw_tcp);
   // on this 2-core VM the unix socket is the slower one (each call wakes a thread on the other

@@ -72,6 +72,17 @@ naming_answers() {  # ADDRESS
   esac
 }
 
+# the omniNames of NS_PID answers at NS_ADDR within 5 s; else it is stopped and 1 returned
+naming_started() {
+  for _ in $(seq 1 50); do
+    naming_answers "$NS_ADDR" && return 0
+    kill -0 "$NS_PID" 2>/dev/null || break
+    sleep 0.1
+  done
+  kill "$NS_PID" 2>/dev/null || true
+  return 1
+}
+
 # Starts omniNames in DIR; sets NS_PID, NS_ADDR (and NS_PORT on TCP). local (the default): on
 # the unix socket SOCKDIR/naming.sock (SOCKDIR = $CALIPER_SOCKET_DIR, which must be a directory
 # only this user can enter), address corbaname:omniunix:SOCKDIR/naming.sock: no other user of the
@@ -105,12 +116,7 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
       -ORBgiopMaxMsgSize 4194304 >"$dir/omninames.log" 2>&1) &
     NS_PID=$!
     NS_ADDR="corbaname:omniunix:$sock"
-    for _ in $(seq 1 50); do
-      naming_answers "$NS_ADDR" && return 0
-      kill -0 "$NS_PID" 2>/dev/null || break
-      sleep 0.1
-    done
-    kill "$NS_PID" 2>/dev/null || true
+    naming_started && return 0
     die "omniNames did not start on $sock, see $dir/omninames.log"
   fi
   if [ "$mode" = tls ]; then
@@ -127,12 +133,7 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
       -ORBgiopMaxMsgSize 4194304 >"$dir/omninames.log" 2>&1) &
     NS_PID=$!
     NS_ADDR="$scheme$addr:$NS_PORT"
-    for _ in $(seq 1 50); do
-      naming_answers "$NS_ADDR" && return 0
-      kill -0 "$NS_PID" 2>/dev/null || break
-      sleep 0.1
-    done
-    kill "$NS_PID" 2>/dev/null || true
+    naming_started && return 0
     say "omniNames did not start on port $NS_PORT (try $try), see $dir/omninames.log"
   done
   die "could not start the naming service"

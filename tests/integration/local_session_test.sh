@@ -162,15 +162,13 @@ steps=$(as $ALICE "$BIN/caliper-ctl" status 2>&1 | awk '/^steps/ {print $2}')
 [ "$steps" = 150 ] && pass "alice's Model is untouched (150 steps)" || fail "alice's Model has $steps steps"
 
 # ---------------------------------------------------------------- the session ends cleanly
-kill -TERM -- "-$SESSION_PID" 2>/dev/null
-# runuser ends at once; the launcher's shutdown goes on a little
-for _ in $(seq 1 100); do
-  kill -0 "$SESSION_PID" 2>/dev/null || pgrep -u $ALICE -f 'launch/caliper session' >/dev/null || break
-  sleep 0.1
-done
+# TERM to the launcher itself, as Ctrl-C or kill would (runuser, TERMed, KILLs its child)
+kill -TERM "$(pgrep -u $ALICE -f 'launch/caliper session' | head -1)" 2>/dev/null
+for _ in $(seq 1 100); do kill -0 "$SESSION_PID" 2>/dev/null || break; sleep 0.1; done
 SESSION_PID=
 left=$(find "$SDIR/sock" -type s | wc -l)
-[ "$left" -eq 0 ] && pass "the session's sockets are gone after it stopped" || fail "$left sockets left in $SDIR/sock"
+[ "$left" -eq 0 ] && pass "the session's sockets are gone after it stopped" ||
+  fail "$left sockets left in $SDIR/sock: $(ls -l "$SDIR/sock"; pgrep -u $ALICE -a; tail -n 4 "$WORK/session.out")"
 
 [ "$FAILS" -eq 0 ] || { echo "$FAILS check(s) failed"; exit 1; }
 echo "all checks passed"

@@ -144,23 +144,33 @@ std::string UnixSocketOfComponent(const IOP::TaggedComponent& component) {
   }
 }
 
-std::string UnixSocketOf(CORBA::Object_ptr ref) {
-  if (CORBA::is_nil(ref)) return "";
-  std::string socket;
+bool VisitIiopProfiles(CORBA::Object_ptr ref,
+                       const std::function<bool(const IIOP::ProfileBody&)>& visit) {
+  if (CORBA::is_nil(ref)) return false;
+  bool done = false;
   omniIOR* ior = ref->_PR_getobj()->_getIOR();
   const IOP::TaggedProfileList& profiles = ior->iopProfiles();
-  for (CORBA::ULong i = 0; i < profiles.length() && socket.empty(); ++i) {
+  for (CORBA::ULong i = 0; i < profiles.length() && !done; ++i) {
     if (profiles[i].tag != IOP::TAG_INTERNET_IOP) continue;
     try {
       IIOP::ProfileBody body;
       IIOP::unmarshalProfile(profiles[i], body);
-      for (CORBA::ULong c = 0; c < body.components.length() && socket.empty(); ++c)
-        socket = UnixSocketOfComponent(body.components[c]);
+      done = visit(body);
     } catch (const CORBA::SystemException&) {
       // a malformed profile: try the next one
     }
   }
   ior->release();
+  return done;
+}
+
+std::string UnixSocketOf(CORBA::Object_ptr ref) {
+  std::string socket;
+  VisitIiopProfiles(ref, [&](const IIOP::ProfileBody& body) {
+    for (CORBA::ULong c = 0; c < body.components.length() && socket.empty(); ++c)
+      socket = UnixSocketOfComponent(body.components[c]);
+    return !socket.empty();
+  });
   return socket;
 }
 

@@ -15,19 +15,10 @@ std::string ClientOf(CORBA::Object_ptr ref) {
   // a local client: its unix socket names its process (its IIOP address is a placeholder)
   if (const std::string socket = UnixSocketOf(ref); !socket.empty()) return "unix:" + socket;
   std::string client;
-  omniIOR* ior = ref->_PR_getobj()->_getIOR();
-  const IOP::TaggedProfileList& profiles = ior->iopProfiles();
-  for (CORBA::ULong i = 0; i < profiles.length() && client.empty(); ++i) {
-    if (profiles[i].tag != IOP::TAG_INTERNET_IOP) continue;
-    try {
-      IIOP::ProfileBody body;
-      IIOP::unmarshalProfile(profiles[i], body);
-      client = std::string(body.address.host.in()) + ":" + std::to_string(body.address.port);
-    } catch (const CORBA::SystemException&) {
-      // a malformed profile: try the next one
-    }
-  }
-  ior->release();
+  VisitIiopProfiles(ref, [&](const IIOP::ProfileBody& body) {
+    client = std::string(body.address.host.in()) + ":" + std::to_string(body.address.port);
+    return true;
+  });
   return client.empty() ? "(no IIOP address)" : client;
 }
 

@@ -10,6 +10,9 @@
 // launcher's state directory, ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID.
 
 #include <omniORB4/CORBA.h>
+#include <omniORB4/IIOP.h>
+
+#include <functional>
 
 #include <string>
 #include <vector>
@@ -45,6 +48,11 @@ std::string LocalNamingAddress(const std::string& socket_path);
 
 /// The socket file in omniORB's unix transport component of a reference ('' when it has none).
 std::string UnixSocketOfComponent(const IOP::TaggedComponent& component);
+
+/// Calls `visit` with each IIOP profile of `ref` that reads (a malformed one is passed over)
+/// until it returns true; false when none did.
+bool VisitIiopProfiles(CORBA::Object_ptr ref,
+                       const std::function<bool(const IIOP::ProfileBody&)>& visit);
 
 /// The unix socket of `ref` (its first IIOP profile's unix transport component), '' for a
 /// reference without one (a network object).
