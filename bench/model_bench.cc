@@ -132,6 +132,8 @@ class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2], argv[3]);
   testing::TempDir dir;
+  // every process's socket in the bench's own directory (gone with it)
+  setenv("CALIPER_SOCKET_DIR", (dir.path() + "/sock").c_str(), 1);
   // a private naming service and a Model with the shipped arm
   testing::NamingService naming(dir.path());
   const char* source = std::getenv("CALIPER_SOURCE_DIR");

@@ -53,7 +53,7 @@ tls_exec() {  # COMMAND ARGS...
 }
 
 # A directory for a session's unix sockets, only this user can enter: SESSION_DIR/sock, or a
-# private one under /tmp when that path would be too long for a socket (107 bytes at most). Sets
+# private one under /tmp when that path would be too long for a socket (107 bytes in all, so 87 for the directory). Sets
 # and exports CALIPER_SOCKET_DIR.
 session_socket_dir() {  # SESSION_DIR
   local dir=$1/sock

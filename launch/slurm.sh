@@ -23,8 +23,8 @@ Usage: launch/caliper slurm VERB ...
   status JOB|DIR
       the job's state (squeue) and its progress: runs done, failed, sim-s/s, ETA
   rerun DIR [--array K] [SBATCH OPTIONS...]
-      submit again only the runs of DIR that have no result (failed, cancelled or lost array
-      tasks), as an array (default one task per 10 missing runs, at most 8) and a merge
+      submit again only the runs of DIR that have no result (cancelled, interrupted or in lost
+      array tasks; a failed run, a physics fault, stays failed), as an array (default one task per 10 missing runs, at most 8) and a merge
   merge DIR
       put an array's results together now (the merge job does this by itself)
 
@@ -106,7 +106,7 @@ cmd_slurm() {
 }
 
 slurm_job() {  # batch|calibrate FILE --out DIR ...
-  local mode=$1 file="" dir="" nodes=2 array=0 extra="" id
+  local mode=$1 file="" dir="" nodes=2 array=0 id
   MODELS_PER_NODE=2
   shift
   local -a sbatch_args=()
@@ -182,7 +182,7 @@ slurm_status() {
     fi
   fi
   /usr/bin/python3 - "$dir" <<'PY'
-import glob, json, os, sys, time
+import csv, glob, json, os, sys, time
 d = sys.argv[1]
 files = [os.path.join(d, "status.json")] + sorted(glob.glob(os.path.join(d, "tasks", "*", "status.json")))
 rows = []
@@ -218,9 +218,9 @@ if running and eta:
 print(f"{d}: {', '.join(parts)} ({'/'.join(states)}; updated {age:.0f} s ago)")
 summary = os.path.join(d, "summary.csv")
 if os.path.exists(summary) and not running:
-    with open(summary) as fh:
-        lines = fh.read().splitlines()[1:]
-    left = [l.split(",")[0] for l in lines if l.split(",")[1:2] != ["done"]]
+    with open(summary, newline="") as fh:
+        lines = [r for r in csv.reader(fh) if r][1:]
+    left = [r[0] for r in lines if r[1:2] != ["done"]]
     print(f"summary: {summary}: {len(lines) - len(left)} of {len(lines)} done" +
           (f"; not done: {', '.join(left[:10])}{' ...' if len(left) > 10 else ''}"
            f" (launch/caliper slurm rerun {d})" if left else ""))
@@ -249,8 +249,8 @@ slurm_rerun() {
   mkdir -p "$dir/array"
   [ -s "$dir/array/names.txt" ] || slurm_run_names "$file" >"$dir/array/names.txt"
   # bring the summary up to date with what every task left, then take what is not done
-  /usr/bin/python3 "$ROOT/launch/slurm/merge.py" "$dir" >/dev/null || true  # 1: some missing
-  awk -F, 'NR > 1 && $2 != "done" {print $1}' "$dir/summary.csv" >"$dir/array/missing.txt"
+  # (merge.py writes array/missing.txt; exit 1 when some are missing)
+  /usr/bin/python3 "$ROOT/launch/slurm/merge.py" "$dir" >/dev/null || true
   local n
   n=$(grep -c . "$dir/array/missing.txt" || true)
   [ "$n" -gt 0 ] || { say "every run of $dir is done: nothing to rerun"; return 0; }

@@ -26,12 +26,14 @@
 #include "caliper/client/experiments.h"
 #include "caliper/client/model_pool.h"
 #include "caliper/client/scene_transfer.h"
+#include "caliper/core/config.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
 #include "caliper/experiment/experiment.h"
 #include "caliper/model.hh"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/rtc/naming.h"
+#include "caliper/rtc/peers.h"
 #include "csv_recording.h"
 
 namespace caliper::ctl {
@@ -141,6 +143,7 @@ class BatchRun {
   Clock::time_point last_status_;
   bool interrupted_ = false;  // by SIGINT or SIGTERM: unfinished runs are marked interrupted
   std::atomic<bool> interrupt_{false};
+  bool status_warned_ = false;  // a --status file that cannot be written is said once
 };
 
 void BatchRun::LoadScenes() {
@@ -205,7 +208,7 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
   {
     std::lock_guard<std::mutex> lock(slot->mutex);
     if (stop_) {
-      plan_.Retry(ticket, slot->name + ": the batch was stopped");
+      plan_.Abandon(ticket);  // never sent: it costs the run nothing
       return;
     }
     slot->in_call = true;  // with the ticket: the end of Run sees both or neither
@@ -239,15 +242,20 @@ void BatchRun::Attempt(Slot* slot, const BatchPlan::Ticket& ticket) {
     // Model going away never ran the run: that costs the run no attempt (on scancel Slurm stops
     // the Models before this client hears of it; the runs are then interrupted, not failed)
     const std::string reason = e.reason.in();
-    if (Stopping() || reason.find("shutting down") != std::string::npos) plan_.Abandon(ticket);
+    const bool leaving = reason.find("shutting down") != std::string::npos;
+    if (Stopping() || leaving) plan_.Abandon(ticket, Stopping());
     else plan_.Retry(ticket, slot->name + ": " + reason);
     pool_.SetDown(slot->index, reason);
+    // its status still answers while it shuts down, which would bring it back at once
+    if (leaving) std::this_thread::sleep_for(std::chrono::milliseconds(500));
   } catch (const CORBA::SystemException& e) {
     // a Model that died during the run costs it an attempt (a run that kills every Model ends
-    // failed); one that was gone before the call (connect refused) does not
-    const char* minor = e.NP_minorString();
-    const bool gone_before = minor != nullptr && std::string(minor) == "TRANSIENT_ConnectFailed";
-    if (Stopping() || gone_before) plan_.Abandon(ticket);
+    // failed); one that was gone before the call does not. Gone, not slow: nothing listens at
+    // its address (omniORB also reports a failed connect for a live local Model after a call to
+    // it timed out: that run is retried and counted)
+    const bool gone_before = CORBA::TRANSIENT::_downcast(&e) != nullptr &&
+                             rtc::PeerGone(e, model.in());
+    if (Stopping() || gone_before) plan_.Abandon(ticket, Stopping());
     else plan_.Retry(ticket, slot->name + ": " + rtc::Describe(e));
     pool_.SetDown(slot->index, rtc::Describe(e));
   } catch (const CORBA::Exception& e) {
@@ -341,7 +349,9 @@ void BatchRun::WriteStatus(const std::string& state, size_t busy, size_t models,
       boost::property_tree::write_json(out, tree);
     });
   } catch (const std::exception& e) {
-    std::cerr << "warning: --status " << options_.status << ": " << e.what() << "\n";
+    if (!status_warned_) std::cerr << "warning: --status " << options_.status << ": " << e.what()
+                                   << " (said once)\n";
+    status_warned_ = true;
   }
 }
 
@@ -403,8 +413,9 @@ void BatchRun::WriteSummary(double wall_s) {
       const bool cut = interrupted_ && (o.state == Outcome::State::kPending ||
                                         o.state == Outcome::State::kRunning);
       const std::string status = cut ? "interrupted" : ToString(o.state);
+      const bool ran = o.state == Outcome::State::kRunning || o.stopped;
       const std::string reason =
-          cut ? (o.state == Outcome::State::kRunning ? "stopped while it ran" : "never started") +
+          cut ? (ran ? "stopped while it ran" : "never started") +
                     std::string(": the batch was interrupted (SIGINT or SIGTERM)")
               : o.reason;
       out << CsvField(runs_[i].name) << "," << status << "," << CsvField(o.model) << ","
@@ -446,6 +457,7 @@ int BatchRun::Run() {
   } catch (const std::exception& e) {
     // the workers and the spawned Models must end before the error goes up
     std::cerr << "caliper-ctl batch: " << e.what() << "\n";
+    WriteStatus("failed", 0, 0, 0, -1);
   }
   return Finish(rc);
 }
@@ -549,7 +561,7 @@ int BatchRun::Dispatch() {
   for (size_t i = 0; i < outcomes.size(); ++i)
     if (outcomes[i].state == Outcome::State::kDone) sim_done += runs_[i].duration_s;
   WriteStatus(interrupted ? "interrupted" : rc == 0 ? "done" : "failed", 0, 0,
-              wall > 0 ? sim_done / wall : 0, 0);
+              wall > 0 ? sim_done / wall : 0, -1);
   return rc;
 }
 
@@ -562,12 +574,13 @@ std::vector<experiment::Experiment> SelectRuns(std::vector<experiment::Experimen
     std::ifstream in(only.substr(1));
     if (!in) throw Failure("--only: cannot read " + only.substr(1));
     for (std::string line; std::getline(in, line);)
-      if (!line.empty()) names.push_back(line);
+      if (const std::string name = core::Trim(line); !name.empty()) names.push_back(name);
   } else {
     std::stringstream in(only);
     for (std::string name; std::getline(in, name, ',');)
-      if (!name.empty()) names.push_back(name);
+      if (!core::Trim(name).empty()) names.push_back(core::Trim(name));
   }
+  if (names.empty()) throw UsageError("--only: no run named in '" + only + "'");
   std::set<std::string> wanted(names.begin(), names.end()), known;
   std::vector<experiment::Experiment> kept;
   for (auto& r : runs) {
@@ -575,7 +588,8 @@ std::vector<experiment::Experiment> SelectRuns(std::vector<experiment::Experimen
     if (wanted.count(r.name)) kept.push_back(std::move(r));
   }
   for (const auto& n : wanted)
-    if (!known.count(n)) throw UsageError("--only: the file makes no run named '" + n + "'");
+    if (!known.count(n))
+      throw UsageError("--only: the experiment file makes no run named '" + n + "'");
   return kept;
 }
 

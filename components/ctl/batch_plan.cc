@@ -100,13 +100,14 @@ void BatchPlan::Retry(const Ticket& ticket, const std::string& reason) {
   changed_.notify_all();
 }
 
-void BatchPlan::Abandon(const Ticket& ticket) {
+void BatchPlan::Abandon(const Ticket& ticket, bool stopping) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!Live(ticket)) return;
   Outcome& o = outcomes_[ticket.run];
   Release(ticket);
   if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
   if (o.attempts > 0) --o.attempts;
+  o.stopped = o.stopped || stopping;
   o.state = Outcome::State::kPending;
   waiting_.push_front(ticket.run);
   changed_.notify_all();

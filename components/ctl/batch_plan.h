@@ -32,6 +32,7 @@ struct Outcome {
   double step_wall_s = 0;       // the Model's stepping and sampling [s]
   uint64_t steps = 0;
   size_t samples = 0;
+  bool stopped = false;         // an attempt was under way when the batch was stopped
 };
 
 const char* ToString(Outcome::State state);
@@ -60,7 +61,9 @@ class BatchPlan {
   /// The batch is being stopped (SIGINT, SIGTERM: the Models go down with it): the attempt does
   /// not count, and the run waits again without a retry, so that the summary says it was
   /// interrupted rather than failed.
-  void Abandon(const Ticket& ticket);
+  /// `stopping`: the batch is being stopped (the run is then said to have been stopped while it
+  /// ran, if it does not end otherwise).
+  void Abandon(const Ticket& ticket, bool stopping = false);
 
   bool finished() const;
   /// Returns when a run ends or `wait` has passed.

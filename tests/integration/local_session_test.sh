@@ -153,7 +153,7 @@ done
 for n in model0 logger0 manager0; do
   out=$(as $MALLORY timeout 20 "$BIN/caliper-ctl" --nameservice "$MNS" --timeout 5 state "$n" 2>&1)
   if grep -q "$why" <<<"$out" && grep -q "$ALICE" <<<"$out"; then
-    pass "alice's $n refuses mallory: $(grep -o 'the object listens on the unix socket [^,]*' <<<"$out")"
+    pass "alice's $n refuses mallory: $(grep -o "the object's unix socket [^,]*" <<<"$out")"
   else fail "mallory's state $n: $out"; fi
 done
 out=$(as $MALLORY timeout 20 "$BIN/caliper-ctl" --nameservice "$MNS" --timeout 5 status --model model0 2>&1)

@@ -1,10 +1,11 @@
 #include "caliper/client/session.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
+#include <sstream>
 
 #include "caliper/core/system.h"
 #include "caliper/rtc/client_orb.h"
@@ -15,10 +16,18 @@ std::string LatestSession() {
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
   const std::string file = std::string(runtime != nullptr && *runtime != '\0' ? runtime : "/tmp") +
                            "/caliper-" + std::to_string(getuid()) + "/latest-session";
-  // only a file of this user counts: another could leave one pointing at a session of theirs
+  // only a file of this user counts (another could leave one pointing at a session of theirs),
+  // not a link, and what is read is the file checked
+  const int fd = open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return "";
   struct stat st {};
-  if (stat(file.c_str(), &st) != 0 || st.st_uid != getuid()) return "";
-  std::ifstream in(file);
+  char text[4096];
+  ssize_t n = -1;
+  if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == getuid())
+    n = read(fd, text, sizeof text);
+  close(fd);
+  if (n <= 0) return "";
+  std::istringstream in(std::string(text, static_cast<size_t>(n)));
   std::string address, pid;
   if (!std::getline(in, address) || !std::getline(in, pid) || address.empty()) return "";
   char* end = nullptr;

@@ -1,5 +1,6 @@
 #include "caliper/rtc/local_sockets.h"
 
+#include <fcntl.h>
 #include <pwd.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -24,11 +25,17 @@ namespace caliper::rtc {
 
 namespace {
 
-// a socket name omniORB makes (PID-TIME, 21 bytes) or ours (naming.sock), a slash and the NUL
-constexpr size_t kMaxDirBytes = 107 - 24;
+// sun_path holds 107 bytes and a NUL; a slash and omniORB's name (%09u-%09u, 19 bytes) or ours
+// (naming.sock) follow the directory
+constexpr size_t kMaxDirBytes = 107 - 1 - 19;
 
+// the name of a user (getpwuid_r: notes are made on any thread)
 std::string UserOf(uid_t uid) {
-  if (const passwd* pw = getpwuid(uid); pw != nullptr) return pw->pw_name;
+  passwd pw{};
+  passwd* found = nullptr;
+  char buffer[4096];
+  if (getpwuid_r(uid, &pw, buffer, sizeof buffer, &found) == 0 && found != nullptr)
+    return found->pw_name;
   return "uid " + std::to_string(uid);
 }
 
@@ -41,7 +48,10 @@ std::string Octal(mode_t mode) {
 // '' when `dir` is a directory of this user that nobody else can enter, else what is wrong
 std::string Unsafe(const std::string& dir) {
   struct stat st {};
-  if (lstat(dir.c_str(), &st) != 0) return std::string("cannot read it (") + std::strerror(errno) + ")";
+  if (lstat(dir.c_str(), &st) != 0) {
+    const int error = errno;
+    return std::string("cannot read it (") + std::strerror(error) + ")";
+  }
   if (S_ISLNK(st.st_mode)) return "it is a symbolic link";
   if (!S_ISDIR(st.st_mode)) return "it is not a directory";
   if (st.st_uid != geteuid()) return "it belongs to " + UserOf(st.st_uid);
@@ -52,11 +62,19 @@ std::string Unsafe(const std::string& dir) {
 std::string Checked(const std::string& dir, const std::string& source) {
   if (dir.size() > kMaxDirBytes)
     throw SecurityError("the directory for this session's unix sockets, " + dir + " (" + source +
-                        "), is " + std::to_string(dir.size()) + " bytes long: a socket path " +
-                        "holds at most 107; set CALIPER_SOCKET_DIR to a shorter directory");
-  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
+                        "), is " + std::to_string(dir.size()) + " bytes long: at most " +
+                        std::to_string(kMaxDirBytes) + " leave room for a socket's name (a " +
+                        "socket path holds 107); set CALIPER_SOCKET_DIR to a shorter directory");
+  // the paths go into references that other processes read (absolute), and omniORB expands %u
+  // in it; ':', ',' and '#' would end the path in a corbaname:omniunix: address
+  if (dir.front() != '/' || dir.find_first_of("%:,#") != std::string::npos)
+    throw SecurityError("the directory for unix sockets " + dir + " (" + source + ") is refused: " +
+                        "give an absolute path without %, :, , or #");
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    const int error = errno;
     throw SecurityError("cannot make the directory for unix sockets " + dir + " (" + source +
-                        "): " + std::strerror(errno) + "; set CALIPER_SOCKET_DIR to another");
+                        "): " + std::strerror(error) + "; set CALIPER_SOCKET_DIR to another");
+  }
   if (const std::string why = Unsafe(dir); !why.empty())
     throw SecurityError("the directory for unix sockets " + dir + " (" + source + ") is refused: " +
                         why + "; a local session needs a directory only its user can enter " +
@@ -75,9 +93,11 @@ std::string ResolveDir() {
     if (stat(run, &st) == 0 && st.st_uid == geteuid()) base = run;
   }
   const std::string dir = base + "/caliper-" + std::to_string(geteuid());
-  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    const int error = errno;
     throw SecurityError("cannot make the directory for unix sockets " + dir + ": " +
-                        std::strerror(errno) + "; set CALIPER_SOCKET_DIR to another");
+                        std::strerror(error) + "; set CALIPER_SOCKET_DIR to another");
+  }
   struct stat st {};
   // ours but opened up (an older launcher made it 0755): closed again
   if (lstat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode) && st.st_uid == geteuid() &&
@@ -87,9 +107,11 @@ std::string ResolveDir() {
   if (why.empty()) return Checked(dir, "the default");
   // someone else made it first: never use it, make a private one
   std::string pattern = dir + "-XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr)
+  if (mkdtemp(pattern.data()) == nullptr) {
+    const int error = errno;
     throw SecurityError("cannot make a private directory for unix sockets " + pattern + ": " +
-                        std::strerror(errno));
+                        std::strerror(error));
+  }
   std::cerr << "caliper: " << dir << " is not used for unix sockets (" << why << "); using "
             << pattern << " instead\n";
   return Checked(pattern, "made because " + dir + " is refused");
@@ -176,7 +198,7 @@ std::string UnixSocketOf(CORBA::Object_ptr ref) {
 
 bool LocalSocketListening(const std::string& path) {
   sockaddr_un address{};
-  if (path.empty() || path.size() >= sizeof address.sun_path) return false;
+  if (path.empty() || path.size() >= sizeof address.sun_path) return true;  // cannot tell
   address.sun_family = AF_UNIX;
   std::memcpy(address.sun_path, path.c_str(), path.size());
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -190,17 +212,16 @@ bool LocalSocketListening(const std::string& path) {
 
 std::string LocalSocketNote(const std::string& path, const std::string& what) {
   if (path.empty() || path.front() != '/') return "";
-  const std::string me = UserOf(geteuid());
   // every directory on the way must let us search it
   for (size_t slash = path.find('/', 1); slash != std::string::npos;
        slash = path.find('/', slash + 1)) {
     const std::string dir = path.substr(0, slash);
-    if (access(dir.c_str(), X_OK) == 0) continue;
+    if (faccessat(AT_FDCWD, dir.c_str(), X_OK, AT_EACCESS) == 0) continue;
     const int error = errno;
     struct stat st {};
     if (error == EACCES && stat(dir.c_str(), &st) == 0)
-      return what + " listens on the unix socket " + path + ", in " + dir + ", a directory of " +
-             UserOf(st.st_uid) + " (mode " + Octal(st.st_mode) + ") that " + me +
+      return what + "'s unix socket " + path + " is in " + dir + ", a directory of " +
+             UserOf(st.st_uid) + " (mode " + Octal(st.st_mode) + ") that " + UserOf(geteuid()) +
              " cannot enter: a local Caliper session is reachable only by the user who started "
              "it; run your own (launch/caliper session), or ask for a network session with "
              "certificates (docs/cluster.md)";
@@ -214,10 +235,13 @@ std::string LocalSocketNote(const std::string& path, const std::string& what) {
   if (stat(path.c_str(), &st) != 0)
     return "there is no socket " + path + " for " + what + ": the process has ended";
   if (!S_ISSOCK(st.st_mode)) return path + " is not a socket";
-  if (access(path.c_str(), W_OK) != 0)
-    return what + " listens on the unix socket " + path + " of " + UserOf(st.st_uid) + " (mode " +
-           Octal(st.st_mode) + "), which " + me + " may not use: a local Caliper session is " +
-           "reachable only by the user who started it";
+  if (faccessat(AT_FDCWD, path.c_str(), W_OK, AT_EACCESS) != 0)
+    return what + "'s unix socket " + path + " belongs to " + UserOf(st.st_uid) + " (mode " +
+           Octal(st.st_mode) + "), which " + UserOf(geteuid()) + " may not use: a local Caliper " +
+           "session is reachable only by the user who started it";
+  // a file left by a process that was killed
+  if (!LocalSocketListening(path))
+    return "nothing listens on " + what + "'s unix socket " + path + ": the process has ended";
   return "";
 }
 

@@ -16,6 +16,7 @@
 #include "caliper/logging/batching_appender.h"
 #include "caliper/rtc/client_orb.h"
 #include "caliper/logging/log.h"
+#include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/log_service_sink.h"
 #include "caliper/rtc/naming.h"
 #include "caliper/rtc/rtobject_servant.h"
@@ -36,7 +37,8 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
       {"naming.update.interval", Type::kDouble, "10", "re-registration period [s]", 0.05, 3600},
       {"corba.endpoint", Type::kString, "giop:unix:",
        "omniORB endpoint to listen on (by default a unix socket in a directory only this user "
-       "can enter, $CALIPER_SOCKET_DIR or /tmp/caliper-UID; --listen ADDR or $CALIPER_LISTEN "
+       "can enter, $CALIPER_SOCKET_DIR or ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID; --listen ADDR "
+       "or $CALIPER_LISTEN "
        "make it giop:ssl:ADDR:, reachable from other hosts over TLS, giop:tcp:ADDR: with "
        "--insecure)"},
       {"corba.loopback_tcp", Type::kBool, "false",
@@ -360,6 +362,8 @@ std::optional<TransportSecurity> SetUpTransport(const std::string& program,
   TransportSecurity security;
   try {
     security = ChooseTransport(config, naming_address, orb_args);
+    // the socket directory, checked now (a refused one is said and the component stops here)
+    if (security.endpoint.rfind("giop:unix:", 0) == 0) LocalSocketDir();
   } catch (const std::exception& e) {
     log.error("%s", e.what());
     std::cerr << program << ": error: " << e.what() << "\n";

@@ -241,8 +241,7 @@ CORBA::Boolean DecodeIor(omni::omniInterceptors::decodeIOR_T::info_T& info) {
     if (component.tag == IOP::TAG_OMNIORB_UNIX_TRANS) {
       if (const std::string file = UnixSocketOfComponent(component); !file.empty())
         Remember(&t_local_sockets, file, kMaxLocalSockets);
-    } else if (component.tag == IOP::TAG_SSL_SEC_TRANS &&
-               ProcessSecurity().transport != Transport::kTls) {
+    } else if (component.tag == IOP::TAG_SSL_SEC_TRANS) {
       Remember(&t_tls_only, info.iiop.address.host.in(), kMaxTlsOnlyHosts);
     }
   }
@@ -504,8 +503,11 @@ void InstallProcessSecurity(const TransportSecurity& security) {
 }
 
 void InstallTransportDiagnostics() {
+  // without TLS only: a TLS process reaches no unix socket and no TLS-only reference is news to
+  // it, and it would look at paths in references that remote clients give it
   static std::once_flag once;
-  std::call_once(once, [] { omniORB::getInterceptors()->decodeIOR.add(DecodeIor); });
+  if (ProcessSecurity().transport != Transport::kTls)
+    std::call_once(once, [] { omniORB::getInterceptors()->decodeIOR.add(DecodeIor); });
 }
 
 const TransportSecurity& ProcessSecurity() {
@@ -554,7 +556,7 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
     std::string note;
     size_t others = 0;
     for (auto n = t_local_sockets.rbegin(); n != t_local_sockets.rend(); ++n) {
-      if (Clock::now() - n->when >= std::chrono::seconds(60)) continue;
+      if (Clock::now() - n->when >= std::chrono::seconds(60)) break;  // older ones follow
       std::string why = LocalSocketNote(n->text, "the object");
       // the newest reference is most likely the one called: reachable, there is nothing to say
       // (older ones may be of processes long gone)
@@ -565,8 +567,8 @@ std::string TransportFailureNote(const CORBA::Exception& e) {
     if (!note.empty()) {
       t_local_sockets.clear();
       if (others > 0)
-        note = "(one of " + std::to_string(others + 1) + " local references read last, none " +
-               "reachable) " + note;
+        note = std::to_string(others + 1) + " local references read lately are unreachable; " +
+               "the newest: " + note;
       return note;
     }
   }

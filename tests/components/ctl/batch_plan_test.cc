@@ -112,7 +112,21 @@ TEST(BatchPlan, AbandonedAttemptsNeitherCountNorFail) {
     ASSERT_TRUE(t);
     EXPECT_EQ(t->run, 0u) << "the abandoned run is first in line again";
     plan.Abandon(*t);
-    plan.Abandon(*t);  // once per ticket
+    plan.Abandon(*t);  // once per ticket: not queued twice, not refunded twice
+  }
+  {
+    // run 0 once in the queue, then run 1
+    const auto a = plan.Next("model1@a", kNoWait);
+    const auto b = plan.Next("model1@a", kNoWait);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->run, 0u);
+    EXPECT_EQ(b->run, 1u);
+    EXPECT_FALSE(plan.Next("model1@a", kNoWait)) << "no run queued twice";
+    EXPECT_EQ(plan.outcomes()[0].attempts, 1);
+    plan.Abandon(*b);
+    plan.Abandon(*a, true);  // in front again
+    EXPECT_TRUE(plan.outcomes()[0].stopped) << "abandoned while the batch stopped";
+    EXPECT_FALSE(plan.outcomes()[1].stopped);
   }
   const Outcome o = plan.outcomes()[0];
   EXPECT_EQ(o.state, State::kPending);

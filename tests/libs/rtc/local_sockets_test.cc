@@ -78,9 +78,20 @@ TEST_F(LocalSocketsTest, RefusesADirectoryOthersMayEnterALinkAndATooLongPath) {
   setenv("CALIPER_SOCKET_DIR", link.c_str(), 1);
   EXPECT_NE(Error().find("symbolic link"), std::string::npos) << Error();
 
-  const std::string deep = dir_ + "/" + std::string(90, 'd');
-  setenv("CALIPER_SOCKET_DIR", deep.c_str(), 1);
-  EXPECT_NE(Error().find("at most 107"), std::string::npos) << Error();
+  // 87 bytes fit (a 19-byte name, a slash and the NUL make 108), 88 do not
+  const std::string base = dir_ + "/";
+  const std::string fits = base + std::string(87 - base.size(), 'f');
+  const std::string over = base + std::string(88 - base.size(), 'o');
+  setenv("CALIPER_SOCKET_DIR", fits.c_str(), 1);
+  EXPECT_EQ(Error(), "") << fits.size();
+  setenv("CALIPER_SOCKET_DIR", over.c_str(), 1);
+  EXPECT_NE(Error().find("88 bytes long: at most 87"), std::string::npos) << Error();
+
+  for (const std::string& bad : {std::string("relative/sock"), dir_ + "/a%u", dir_ + "/a:b",
+                                dir_ + "/a#b", dir_ + "/a,b"}) {
+    setenv("CALIPER_SOCKET_DIR", bad.c_str(), 1);
+    EXPECT_NE(Error().find("absolute path without"), std::string::npos) << bad << ": " << Error();
+  }
 }
 
 TEST_F(LocalSocketsTest, RefusesADirectoryOfAnotherUser) {
@@ -116,7 +127,11 @@ TEST_F(LocalSocketsTest, TellsAListeningSocketFromOneLeftBehind) {
   EXPECT_TRUE(LocalSocketListening(live));
   EXPECT_FALSE(LocalSocketListening(dead)) << "a file nothing listens on: refused";
   EXPECT_FALSE(LocalSocketListening(dir_ + "/none.sock"));
+  EXPECT_TRUE(LocalSocketListening("/" + std::string(120, 'x'))) << "cannot tell: not gone";
   EXPECT_EQ(LocalSocketNote(live, "the Model"), "") << "reachable: nothing to say";
+  EXPECT_NE(LocalSocketNote(dead, "the Model").find("nothing listens on the Model's unix socket"),
+            std::string::npos)
+      << LocalSocketNote(dead, "the Model");
   EXPECT_NE(LocalSocketNote(dir_ + "/none.sock", "the Model").find("has ended"),
             std::string::npos);
   EXPECT_NE(LocalSocketNote("/nonexistent-dir/x.sock", "the Model").find("session has ended"),
@@ -136,7 +151,8 @@ TEST_F(LocalSocketsTest, SaysWhoseDirectoryKeepsAnotherUserOut) {
   if (child == 0) {
     if (setgid(65534) != 0 || setuid(65534) != 0) _exit(3);
     const std::string note = LocalSocketNote(path, "the naming service");
-    _exit(note.find("a directory of root (mode 0700)") != std::string::npos &&
+    _exit(note.find("the naming service's unix socket " + path + " is in " + sock_dir +
+                    ", a directory of root (mode 0700)") != std::string::npos &&
                   note.find("reachable only by the user who started it") != std::string::npos
               ? 0
               : 1);

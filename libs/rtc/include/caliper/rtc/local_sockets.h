@@ -24,7 +24,8 @@ inline constexpr const char* kLocalEndpoint = "giop:unix:";
 
 /// Where this process's unix-domain sockets go: made (mode 0700) when missing, and checked: a
 /// directory (not a link) of this user that no other user can enter, with room for a socket name
-/// (unix socket paths hold at most 107 bytes). Throws SecurityError saying what is wrong and what
+/// (at most 87 bytes: a socket path holds 107, and a name follows), an absolute path without %, :,
+/// , or #. Throws SecurityError saying what is wrong and what
 /// to do (CALIPER_SOCKET_DIR). The default directory is closed (0700) when it is ours; one of
 /// another user (squatted) is not used: a private /tmp/caliper-UID-XXXXXX is made instead, and
 /// said on stderr.
@@ -59,14 +60,16 @@ bool VisitIiopProfiles(CORBA::Object_ptr ref,
 std::string UnixSocketOf(CORBA::Object_ptr ref);
 
 /// True when something listens on the unix socket `path`: a connect() there is not refused
-/// (ECONNREFUSED: a file left by a process that is gone) and the file exists. omniORB tries a
+/// (ECONNREFUSED: a file left by a process that is gone) and the file exists; true when it cannot
+/// tell (a path too long to try, no socket to try with). omniORB tries a
 /// local object's other addresses after a call timed out (its IIOP profile's placeholder, port
 /// 0, which always fails to connect): a failed connect alone does not tell that it is gone.
 bool LocalSocketListening(const std::string& path);
 
 /// Why this process cannot connect to the unix socket `path`: a directory on the way that this
-/// user cannot enter (its owner and mode: another user's session), a socket it may not write, or
-/// no socket at all (the session ended). '' when nothing stands in the way.
+/// user cannot enter (its owner and mode: another user's session), a socket it may not write, no
+/// socket at all (the session ended) or one nothing listens on (its process was killed). '' when
+/// nothing stands in the way.
 std::string LocalSocketNote(const std::string& path, const std::string& what);
 
 }  // namespace caliper::rtc
