@@ -274,9 +274,30 @@ int Inspect(Client&, std::vector<std::string>& args) {
   return 0;
 }
 
+// The naming service this program uses, once it answers: the address on stdout (for $(...) and
+// `export`), where it came from on stderr.
+int Address(Client& client, std::vector<std::string>& args) {
+  const bool as_export = TakeFlag(args, "--export");
+  if (!args.empty()) throw UsageError("address takes no arguments but --export");
+  CosNaming::NamingContext_var root = client.Root();  // ConnectionError when nothing answers
+  std::cerr << "caliper-ctl: the naming service of " << client.address_source() << "\n";
+  if (as_export)
+    std::cout << "export CALIPER_NAMESERVICE='" << client.address() << "'\n";
+  else
+    std::cout << client.address() << "\n";
+  return 0;
+}
+
 std::map<std::string, Verb> Verbs() {
   std::map<std::string, Verb> verbs;
   verbs["ls"] = {"ls", "list the components in the naming service with their states", List};
+  verbs["address"] = {"address [--export]",
+                      "print the session's naming service address (and, on stderr, whose it is)",
+                      Address};
+  verbs["address"].details =
+      "  The address every verb would use, once its naming service answers (exit 1 when not).\n"
+      "  --export prints `export CALIPER_NAMESERVICE='...'` for your shell:\n"
+      "    eval \"$(launch/caliper ctl address --export)\"\n";
   verbs["state"] = {"state NAME", "print a component's lifecycle state (and why, in ERROR)", State};
   for (const std::string v : {"activate", "deactivate", "reset", "exit"}) {
     verbs[v] = {v + " NAME",
@@ -313,9 +334,11 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
   std::cout << "Usage: caliper-ctl [--nameservice corbaname::HOST:PORT] [--timeout S] VERB ...\n\n"
             << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
             << "$CALIPER_NAMESERVICE, else the newest session launch/caliper started that still\n"
-            << "runs, else corbaname::127.0.0.1:2809. NAME is an instance name (model0),\n"
-            << "host/model0, or host.host_cxt/model0.rtc. `inspect` reads a file and needs no\n"
-            << "session.\n";
+            << "runs, else the one of `launch/caliper nameserver start`, else\n"
+            << "corbaname::127.0.0.1:2809; a $CALIPER_NAMESERVICE where nothing listens any more\n"
+            << "gives way to a running session, with a note on stderr (`address` says which).\n"
+            << "NAME is an instance name (model0), host/model0, or host.host_cxt/model0.rtc.\n"
+            << "`inspect` reads a file and needs no session.\n";
   const std::pair<const char*, const char*> groups[] = {
       {"components", "Components"},
       {"model", "Model (model0, or --model NAME on each verb)"},

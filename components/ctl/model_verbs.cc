@@ -912,9 +912,9 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "export the scene with its current parameters as COLLADA", Save,
       "  Whatever was loaded (COLLADA or URDF), FILE is COLLADA with Caliper's technique.\n"
       "  FILE is written by the Model's process (sent as an absolute path) when it lies below\n"
-      "  the Model's write directory (model.write_dir, the session's directory); otherwise (a\n"
-      "  Model on another host, --send, files elsewhere) the export comes back by content and\n"
-      "  is written here.\n");
+      "  the Model's write directory (model.write_dir: the session's files/ folder when\n"
+      "  `launch/caliper session` or `demo` started the Model); otherwise (a Model on another\n"
+      "  host, --send, files elsewhere) the export comes back by content and is written here.\n");
 }
 
 }  // namespace caliper::ctl

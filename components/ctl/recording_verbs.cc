@@ -14,6 +14,7 @@
 #include "caliper/collada/importer.h"
 #include "caliper/core/numbers.h"
 #include "caliper/core/system.h"
+#include "caliper/client/scene_transfer.h"
 #include "caliper/model.hh"
 #include "caliper/recording/recording.h"
 #include "model_client.h"
@@ -34,10 +35,15 @@ ModelRef ConnectWithLongCalls(Client& client, std::vector<std::string>& args) {
   return m;
 }
 
-// A path for the Model: absolute from here for a Model on this host, else as given (relative
-// paths then start from the Model's write directory).
-std::string PathForModel(const ModelRef& m, const std::string& path) {
-  return m.local ? Absolute(path) : path;
+// Recordings are .caliper files: FILE without an extension gets it; another extension is kept,
+// with a warning (the Main Window's dialogs and the docs look for .caliper).
+std::string RecordingFileName(const std::string& file) {
+  const std::filesystem::path p(file);
+  if (!p.has_extension()) return file + ".caliper";
+  if (p.extension() != ".caliper")
+    std::cerr << "warning: " << file
+              << ": recordings are .caliper files (the Main Window's dialogs look for them)\n";
+  return file;
 }
 
 // Where the Model reads or writes, for the message when it refuses a path.
@@ -46,18 +52,6 @@ std::string WhereModelWrites(const ModelRef& m) {
     M::FileAccess_var files = m.model->file_access();
     return std::strlen(files->write_dir) > 0 ? std::string(files->write_dir.in())
                                              : std::string("(none: model.write_dir is not set)");
-  } catch (const CORBA::Exception&) {
-    return "(unknown)";
-  }
-}
-
-std::string WhereModelReads(const ModelRef& m) {
-  try {
-    M::FileAccess_var files = m.model->file_access();
-    std::string dirs;
-    for (CORBA::ULong i = 0; i < files->read_dirs.length(); ++i)
-      dirs += (i > 0 ? ", " : "") + std::string(files->read_dirs[i].in());
-    return dirs.empty() ? "(none)" : dirs;
   } catch (const CORBA::Exception&) {
     return "(unknown)";
   }
@@ -111,7 +105,8 @@ int RecordingStart(const ModelRef& m, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected: recording start FILE [options]");
   o.channels.length(static_cast<CORBA::ULong>(channels.size()));
   for (CORBA::ULong i = 0; i < channels.size(); ++i) o.channels[i] = channels[i].c_str();
-  const std::string path = PathForModel(m, args[0]);
+  // relative names start from the Model's write directory (the session's files/)
+  const std::string path = RecordingFileName(args[0]);
   M::RecordStatus_var s;
   try {
     s = Call(m, [&] { return m.model->start_recording(path.c_str(), o); });
@@ -287,6 +282,7 @@ int Replay(Client& client, std::vector<std::string>& args) {
   ModelRef m = ConnectWithLongCalls(client, args);
   // the Model's refusals of commands during a replay name `replay --fork`
   if (TakeFlag(args, "--fork")) args.insert(args.begin(), "fork");
+  const bool send = TakeFlag(args, "--send");
   RejectOptions(args);
   if (args.empty()) throw UsageError("expected: replay FILE | seek SECONDS | fork | status");
   const std::string what = args[0];
@@ -307,16 +303,17 @@ int Replay(Client& client, std::vector<std::string>& args) {
     s = Call(m, [&] { return m.model->replay_status(); });
   } else {
     if (args.size() != 1) throw UsageError("expected one FILE");
-    const std::string path = PathForModel(m, what);
+    const std::string path = Absolute(what);
+    client::OpenedReplay opened;
     try {
-      s = Call(m, [&] { return m.model->open_replay(path.c_str()); });
-    } catch (const Failure& e) {
-      const std::string why = e.what();
-      if (why.find("open_replay:") != std::string::npos)
-        throw Failure(why + "\n  the Model reads recordings only below " + WhereModelReads(m));
-      throw;
+      opened = Call(m, [&] { return client::OpenReplay(m.model, path, m.local, send); });
+    } catch (const std::runtime_error& e) {
+      if (dynamic_cast<const Failure*>(&e) != nullptr) throw;
+      throw Failure(e.what());  // the file, read here
     }
-    std::cout << m.name << ": replaying " << s->path.in()
+    s = new M::ReplayStatus(opened.status);
+    std::cout << m.name << ": replaying " << (opened.by_content ? path : std::string(s->path.in()))
+              << (opened.by_content ? " (sent by content)" : "")
               << " (paused; start, pause, step and rtf play it)\n";
   }
   PrintReplayStatus(s.in());
@@ -365,9 +362,10 @@ void AddRecordingVerbs(std::map<std::string, Verb>* verbs) {
       "  keyframe every N steps (--keyframe-every, 100), every command, parameter write,\n"
       "  pull and edit with its step, the Model's log and the channels ID (--channel, as\n"
       "  often as needed) every N steps (--every, 1). It commits at least every 0.5 s, so\n"
-      "  a killed Model loses at most that. FILE must not exist and must lie below the\n"
-      "  Model's write directory (model.write_dir; `launch/caliper session` sets it to the\n"
-      "  session's files/); a Model on this host gets it as an absolute path from here.\n"
+      "  a killed Model loses at most that. FILE (NAME.caliper; .caliper is added to a name\n"
+      "  without an extension) must not exist; a relative FILE starts from the Model's write\n"
+      "  directory (model.write_dir: the session's files/ when the launcher started it), an\n"
+      "  absolute one must lie below it.\n"
       "  --max-mb M ends the recording, as a full disk does, beyond M megabytes (10^6\n"
       "  bytes); the simulation goes on and `recording status` says why it ended.\n"
       "  A load, stop or reset of the simulation ends a recording too.\n"
@@ -376,15 +374,18 @@ void AddRecordingVerbs(std::map<std::string, Verb>* verbs) {
           on};
   (*verbs)["recording"] = rec;
   Verb replay{
-      "replay FILE | replay seek SECONDS | replay fork | replay status   [--model NAME]\n"
+      "replay FILE [--send] | replay seek SECONDS | replay fork | replay status   [--model NAME]\n"
       "          | replay --info FILE | replay --verify FILE | replay --csv FILE OUT.csv",
       "play a recording in a Model, seek, fork; a recording's summary, verification, CSV",
       [](Client& c, std::vector<std::string>& a) { return FileErrors(Replay, c, a); }, "model",
-      "  replay FILE: the Model loads the recording (FILE below its read directories or its\n"
-      "  write directory) at its start, paused. Play it with the usual verbs: start (at the\n"
-      "  real-time factor), pause, step N, rtf F (speed; 0 as fast as possible); it pauses at\n"
-      "  its end; stop and reset go back to its start. Observers and `record` (the DAQ) see it\n"
-      "  as a running Model. Commands, parameter writes and edits are refused until fork.\n"
+      "  replay FILE: the Model loads the recording at its start, paused: by path when FILE\n"
+      "  lies below its read directories or its write directory on this host, else (another\n"
+      "  host, files elsewhere, --send) by content, as a copy it keeps while it replays it,\n"
+      "  so a recording of an earlier session replays in today's. Play it with the usual\n"
+      "  verbs: start (at the real-time factor), pause, step N, rtf F (speed; 0 as fast as\n"
+      "  possible); it pauses at its end; stop and reset go back to its start. Observers and\n"
+      "  `record` (the DAQ) see it as a running Model. Commands, parameter writes and edits\n"
+      "  are refused until fork.\n"
       "  seek SECONDS: to the moment nearest SECONDS of simulated time, from a keyframe.\n"
       "  fork (or --fork): the Model simulates on from where the replay stands; commands,\n"
       "  parameter writes and edits are allowed again.\n"

@@ -65,7 +65,17 @@ int Screenshot(Client& client, std::vector<std::string>& args) {
   ParseSize(size, &width, &height);
   const std::string path = Absolute(args[0]);
 
-  const rtc::ComponentEntry entry = client.Find(name);
+  rtc::ComponentEntry entry;
+  try {
+    entry = client.Find(name);
+  } catch (const client::ConnectionError&) {
+    throw;
+  } catch (const Failure& e) {
+    // a headless session has no renderer: say how to get one
+    throw Failure(std::string(e.what()) +
+                  "\n  (a headless session has no Scene Renderer; `launch/caliper open renderer` "
+                  "starts one on a display, e.g. Xvfb)");
+  }
   V::Renderer_var renderer;
   try {
     renderer = V::Renderer::_narrow(entry.object);
@@ -108,8 +118,10 @@ void AddRendererVerbs(std::map<std::string, Verb>* verbs) {
       "a PNG of a Scene Renderer's current view (1024x768 unless --size)", Screenshot, "renderer",
       "  The renderer is renderer0, or --renderer NAME. It writes FILE itself (sent as an\n"
       "  absolute path) when it runs on this host and FILE lies below its write directory\n"
-      "  (renderer.write_dir, the session's directory); otherwise (another host, --fetch,\n"
-      "  files elsewhere) the PNG comes back by content and is written here.\n"};
+      "  (renderer.write_dir: the session's files/ folder when the launcher started it);\n"
+      "  otherwise (another host, --fetch, files elsewhere) the PNG comes back by content and\n"
+      "  is written here. A headless session (`session --headless`, `demo --headless`) has no\n"
+      "  Scene Renderer: start one with `launch/caliper open renderer` (it needs a display).\n"};
 }
 
 }  // namespace caliper::ctl

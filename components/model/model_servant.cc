@@ -662,6 +662,20 @@ M::ReplayStatus* ModelServant::open_replay(const char* path) {
   });
 }
 
+M::ReplayStatus* ModelServant::open_replay_data(const char* file_name, const M::Octets& data) {
+  return Guard([&] {
+    try {
+      return ToIdl(core_.OpenReplayData(
+          file_name,
+          std::string(reinterpret_cast<const char*>(data.get_buffer()), data.length())));
+    } catch (const recording::RecordingError& e) {
+      throw M::LoadFailed(rtc::BoundedReason(e.what()).c_str());
+    } catch (const collada::ImportError& e) {
+      throw M::LoadFailed(rtc::BoundedReason(e.what()).c_str());
+    }
+  });
+}
+
 M::ReplayStatus* ModelServant::seek(CORBA::Double time) {
   return Guard([&] {
     try {

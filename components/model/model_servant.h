@@ -97,6 +97,8 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   Caliper::Simulation::RecordStatus* stop_recording() override;
   Caliper::Simulation::RecordStatus* recording_status() override;
   Caliper::Simulation::ReplayStatus* open_replay(const char* path) override;
+  Caliper::Simulation::ReplayStatus* open_replay_data(
+      const char* file_name, const Caliper::Simulation::Octets& data) override;
   Caliper::Simulation::ReplayStatus* seek(CORBA::Double time) override;
   Caliper::Simulation::ReplayStatus* replay_status() override;
   void fork() override;

@@ -1,7 +1,9 @@
 // caliper.Model's session recordings (the Model writes one SQLite file on its host) and replay:
 // open, seek, fork.
 #include <cmath>
+#include <filesystem>
 
+#include "caliper/client/scene_transfer.h"
 #include "model_object.h"
 
 namespace caliper::python {
@@ -66,14 +68,17 @@ size. Read the file with caliper.Recording.)doc")
           "Whether it records, where, how much, and why it stopped early if it did.")
       .def(
           "open_replay",
-          [](ModelObject& m, const std::string& path) {
-            M::ReplayStatus_var r =
-                m.Run([&] { return m.ref.model->open_replay(path.c_str()); }, kLongCallS);
-            return ReplayStatusObject(r.in());
+          [](ModelObject& m, const std::string& path, bool send) {
+            const std::string absolute = std::filesystem::absolute(path).string();
+            const client::OpenedReplay opened = m.Run(
+                [&] { return client::OpenReplay(m.ref.model, absolute, m.ref.local, send); },
+                kLongCallS);
+            return ReplayStatusObject(opened.status);
           },
-          py::arg("path"),
-          "The Model replays a recording (a file it may read), paused at its start; start(), "
-          "step() and seek() play it, fork() simulates on.")
+          py::arg("path"), py::arg("send") = false,
+          "The Model replays a recording, paused at its start; start(), step() and seek() play "
+          "it, fork() simulates on. A file the Model cannot read itself (on another host, outside "
+          "its directories, or send=True) goes by content.")
       .def(
           "seek",
           [](ModelObject& m, double time_s) {

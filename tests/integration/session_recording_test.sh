@@ -26,14 +26,18 @@ field() { awk -v k="$1" 'index($0, k) == 1 {print $NF; exit}'; }  # LABEL: the l
 ctl load "$SRC/models/ecce_arm.dae" >/dev/null || fail "load"
 
 # ------------------------------------------------------------------ a refused path, a recording
-if ctl recording start "$WORK/outside.sqlite" >"$WORK/out" 2>&1; then fail "recorded outside the write dir"
+if ctl recording start "$WORK/outside.caliper" >"$WORK/out" 2>&1; then fail "recorded outside the write dir"
 elif grep -q "only below its write directory $F" "$WORK/out"; then pass "refused outside: $(head -1 "$WORK/out" | cut -c1-100)"
 else cat "$WORK/out"; fail "no reason for the refused path"; fi
 
 CH1=ecce_arm.elbow.position
 CH2=ecce_arm.elbow_flexor.tension
-ctl recording start "$F/run.sqlite" --channel $CH1 --channel $CH2 >"$WORK/out" 2>&1 ||
+# a name without a directory starts from the write directory and gets the one extension .caliper
+ctl recording start run --channel $CH1 --channel $CH2 >"$WORK/out" 2>&1 ||
   { cat "$WORK/out"; fail "recording start"; }
+grep -q "^model0: recording to $F/run.caliper$" "$WORK/out" &&
+  pass "recording start run: into the write directory as run.caliper" ||
+  { cat "$WORK/out"; fail "recording start run: not $F/run.caliper"; }
 grep -q "^recording  *yes" "$WORK/out" && pass "recording started" || fail "not recording"
 ctl motor elbow_flexor 3 >/dev/null && ctl step 300 >/dev/null || fail "command, step"
 ctl set ecce_arm.elbow_extensor.stiffness 4000 >/dev/null && ctl step 300 >/dev/null ||
@@ -45,18 +49,18 @@ steps=$(field "steps recorded" <"$WORK/stop")
 seconds=$(field "simulated time recorded" <"$WORK/stop")
 bytes=$(awk '/^size/ {print $3}' "$WORK/stop")
 per_min=$(field "bytes per simulated minute" <"$WORK/stop")
-[ "$steps" = 10000 ] && [ "$seconds" = 10 ] && [ "$bytes" = "$(stat -c %s "$F/run.sqlite")" ] &&
+[ "$steps" = 10000 ] && [ "$seconds" = 10 ] && [ "$bytes" = "$(stat -c %s "$F/run.caliper")" ] &&
   pass "stop: $steps steps, $seconds s, $bytes bytes, $per_min bytes per simulated minute" ||
   { cat "$WORK/stop"; fail "stop's numbers"; }
 
 # ------------------------------------------------------------------ the file alone
-ctl replay --verify "$F/run.sqlite" >"$WORK/verify" 2>"$WORK/verify.err"
+ctl replay --verify "$F/run.caliper" >"$WORK/verify" 2>"$WORK/verify.err"
 rc=$?
 if [ $rc = 0 ] && grep -q "^identical: 10000 steps, [0-9]* keyframes, 10000 samples compared bit for bit" "$WORK/verify"; then
   pass "verify: $(cat "$WORK/verify"); $(tail -1 "$WORK/verify.err")"
 else cat "$WORK/verify" "$WORK/verify.err"; fail "verify (exit $rc)"; fi
 
-ctl replay --info "$F/run.sqlite" >"$WORK/info" 2>&1 || { cat "$WORK/info"; fail "--info"; }
+ctl replay --info "$F/run.caliper" >"$WORK/info" 2>&1 || { cat "$WORK/info"; fail "--info"; }
 grep -q "^model  *ecce_arm$" "$WORK/info" && grep -q "^duration \[s\]  *10$" "$WORK/info" &&
   grep -q "^steps  *10000 (0 to 10000)" "$WORK/info" && grep -q "^keyframes  *10[0-9] (every 100" "$WORK/info" &&
   grep -q "^  $CH1 \[rad\]$" "$WORK/info" && grep -q "^  $CH2 \[N\]$" "$WORK/info" &&
@@ -65,13 +69,13 @@ grep -q "^model  *ecce_arm$" "$WORK/info" && grep -q "^duration \[s\]  *10$" "$W
   pass "--info: $(grep -E '^(events|bytes per)' "$WORK/info" | tr -s ' ' | paste -sd';')" ||
   { cat "$WORK/info"; fail "--info's content"; }
 
-ctl replay --csv "$F/run.sqlite" "$WORK/run.csv" >/dev/null 2>&1 || fail "--csv"
+ctl replay --csv "$F/run.caliper" "$WORK/run.csv" >/dev/null 2>&1 || fail "--csv"
 [ "$(head -1 "$WORK/run.csv")" = "time [s],$CH1 [rad],$CH2 [N]" ] &&
   [ "$(wc -l <"$WORK/run.csv")" = 10001 ] && pass "--csv: $(head -1 "$WORK/run.csv"), 10000 rows" ||
   { head -2 "$WORK/run.csv"; fail "--csv columns"; }
 
 # ------------------------------------------------------------------ replay in the Model
-ctl replay "$F/run.sqlite" >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "replay FILE"; }
+ctl replay "$F/run.caliper" >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "replay FILE"; }
 grep -q "^time / end \[s\]  *0 / 10$" "$WORK/open" && pass "replay opened at 0 of 10 s" ||
   { cat "$WORK/open"; fail "replay status after open"; }
 if ctl motor elbow_flexor 1 >"$WORK/out" 2>&1; then fail "a command during a replay was accepted"
@@ -113,21 +117,31 @@ want=$(awk -F, 'NR == 502 {printf "%.7g", $3}' "$WORK/run.csv")  # step 501 (hea
 [ -n "$got" ] && [ "$got" = "$want" ] && pass "after the seek, t = 0.501 s: $CH2 = $got N as recorded" ||
   fail "after the seek: $CH2 = '$got', recorded '$want'"
 
+# a copy outside the Model's directories (yesterday's session, another disk) goes by content
+cp "$F/run.caliper" "$WORK/yesterday.caliper"
+ctl replay "$WORK/yesterday.caliper" >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "replay by content"; }
+grep -q "replaying $WORK/yesterday.caliper (sent by content)" "$WORK/open" &&
+  grep -q "^time / end \[s\]  *0 / 10$" "$WORK/open" &&
+  pass "a recording outside the Model's directories replays by content: $(head -1 "$WORK/open" | cut -c1-110)" ||
+  { cat "$WORK/open"; fail "replay of a file outside the Model's directories"; }
+ctl replay "$F/run.caliper" >/dev/null 2>&1 && ctl replay seek 0.5 >/dev/null && ctl step 1 >/dev/null ||
+  fail "back to the replay by path"
+
 ctl replay fork >/dev/null 2>&1 || fail "fork"
 ctl motor elbow_flexor 1 >/dev/null 2>&1 && ctl step 10 >/dev/null 2>&1 &&
   pass "fork at 0.501 s: a command is accepted, steps go on" || fail "command after fork"
 [ "$(ctl replay status | awk '/^replaying/ {print $2}')" = no ] || fail "still replaying after fork"
 
 # ------------------------------------------------------------------ a replaced scene is refused
-python3 - "$F/run.sqlite" "$F/changed.sqlite" "$SRC/models/pendulum_tendon.dae" <<'EOF'
+python3 - "$F/run.caliper" "$F/changed.caliper" "$SRC/models/pendulum_tendon.dae" <<'EOF'
 import shutil, sqlite3, sys
 shutil.copy(sys.argv[1], sys.argv[2])
 db = sqlite3.connect(sys.argv[2])
 db.execute("UPDATE scenes SET data = ?", (open(sys.argv[3], "rb").read(),))
 db.commit()
 EOF
-if ctl replay "$F/changed.sqlite" >"$WORK/out" 2>&1; then fail "a recording of another scene replayed"
-elif grep -q "changed.sqlite" "$WORK/out"; then pass "replaced scene refused: $(head -1 "$WORK/out" | cut -c1-140)"
+if ctl replay "$F/changed.caliper" >"$WORK/out" 2>&1; then fail "a recording of another scene replayed"
+elif grep -q "changed.caliper" "$WORK/out"; then pass "replaced scene refused: $(head -1 "$WORK/out" | cut -c1-140)"
 else cat "$WORK/out"; fail "the refusal does not name the file"; fi
 
 # ------------------------------------------------------------------ the session's log
@@ -138,7 +152,7 @@ else cat "$WORK/out"; fail "the refusal does not name the file"; fi
 LOCAL_MODELS_PIDS+=($!)
 for _ in $(seq 1 100); do ctl state logger0 >/dev/null 2>&1 && break; sleep 0.1; done
 sleep 2.5  # the Model's next look for the Logging component
-ctl recording start "$F/with_log.sqlite" >/dev/null 2>&1 || fail "recording start (log)"
+ctl recording start "$F/with_log.caliper" >/dev/null 2>&1 || fail "recording start (log)"
 local_models_add "$WORK"
 logged_model=$LOCAL_MODEL_PID
 for _ in $(seq 1 100); do ctl state model1 >/dev/null 2>&1 && break; sleep 0.1; done
@@ -149,7 +163,7 @@ kill -TERM "$logged_model" 2>/dev/null; wait "$logged_model" 2>/dev/null
 components=$(python3 -c "
 import sqlite3, sys
 db = sqlite3.connect('file:' + sys.argv[1] + '?mode=ro', uri=True)
-print(' '.join(sorted({c for (c,) in db.execute('SELECT component FROM log')})))" "$F/with_log.sqlite")
+print(' '.join(sorted({c for (c,) in db.execute('SELECT component FROM log')})))" "$F/with_log.caliper")
 if echo " $components " | grep -q " model1 "; then
   pass "the recording holds the session log: records of $components"
 else fail "the recording's log has records of '$components', none of model1"; fi
@@ -178,14 +192,14 @@ fills_up() {  # LABEL FILE PATTERN [recording start options]
   else fail "$label: error '$why', steps $s1 -> $s2"; fi
   ctl stop >/dev/null
 }
-fills_up "--max-mb 1" "$F/full.sqlite" "limit" --max-mb 1
+fills_up "--max-mb 1" "$F/full.caliper" "limit" --max-mb 1
 
 # a disk that is really full: a 1 MB tmpfs inside the write directory (mounting needs root, which
 # CI has)
 if [ "$(id -u)" = 0 ] && mkdir -p "$F/tiny" && mount -t tmpfs -o size=1m tmpfs "$F/tiny" 2>/dev/null; then
   trap 'umount "$F/tiny" 2>/dev/null; local_models_stop; rm -rf "$WORK"' EXIT
-  fills_up "a full disk" "$F/tiny/full.sqlite" "disk full"
-  ctl replay --info "$F/tiny/full.sqlite" >"$WORK/full" 2>&1 &&
+  fills_up "a full disk" "$F/tiny/full.caliper" "disk full"
+  ctl replay --info "$F/tiny/full.caliper" >"$WORK/full" 2>&1 &&
     pass "the full disk's file opens: $(grep -m1 duration "$WORK/full")" ||
     { cat "$WORK/full"; fail "the full disk's file does not open"; }
   umount "$F/tiny" || fail "umount"
@@ -198,13 +212,13 @@ local_models_add "$WORK"
 victim=$LOCAL_MODEL_PID
 for _ in $(seq 1 100); do ctl state model1 >/dev/null 2>&1 && break; sleep 0.1; done
 ctl load "$SRC/models/ecce_arm.dae" --model model1 >/dev/null || fail "load model1"
-ctl recording start "$F/killed.sqlite" --channel $CH1 --model model1 >/dev/null || fail "start model1"
+ctl recording start "$F/killed.caliper" --channel $CH1 --model model1 >/dev/null || fail "start model1"
 ctl start --model model1 >/dev/null || fail "start model1"
 sleep 2
 at_kill=$(ctl status --model model1 | awk '/^simulated time/ {print $4}')
 kill -KILL "$victim"
 wait "$victim" 2>/dev/null
-ctl replay --info "$F/killed.sqlite" >"$WORK/killed" 2>&1 || { cat "$WORK/killed"; fail "the killed Model's file"; }
+ctl replay --info "$F/killed.caliper" >"$WORK/killed" 2>&1 || { cat "$WORK/killed"; fail "the killed Model's file"; }
 last=$(field "duration" <"$WORK/killed")
 if awk -v a="$at_kill" -v l="$last" 'BEGIN {exit !(l > 0 && a - l <= 0.75 && l <= a + 0.1)}'; then
   pass "kill -9 at t = $at_kill s: the file opens and ends at $last s (lost $(awk -v a="$at_kill" -v l="$last" 'BEGIN {print a - l}') s)"

@@ -1,7 +1,11 @@
 #include "caliper/client/scene_transfer.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 #include "caliper/collada/importer.h"
@@ -12,14 +16,23 @@ namespace caliper::client {
 
 namespace M = ::Caliper::Simulation;
 
+namespace {
+
+// what a file sent by content may weigh: one message, less 1 MiB for the rest of the call
+void CheckFitsOneMessage(const std::string& path, size_t bytes, const std::string& what) {
+  const size_t limit = static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20);
+  if (bytes > limit)
+    throw std::runtime_error(path + " is " + std::to_string(bytes >> 20) + " MiB: " + what +
+                             " travel in one CORBA message of at most " +
+                             std::to_string(limit >> 20) + " MiB");
+}
+
+}  // namespace
+
 std::string ReadScene(const std::string& path, std::vector<std::string>* warnings) {
   // ImportError and ExportError (std::runtime_error) name the file
   const std::string bytes = model_file::ContentToSend(path, warnings).bytes;
-  const size_t limit = static_cast<size_t>(rtc::kMaxMessageBytes) - (1u << 20);
-  if (bytes.size() > limit)
-    throw std::runtime_error(path + " is " + std::to_string(bytes.size() >> 20) +
-                             " MiB: scenes travel in one CORBA message of at most " +
-                             std::to_string(limit >> 20) + " MiB");
+  CheckFitsOneMessage(path, bytes.size(), "scenes");
   return bytes;
 }
 
@@ -80,6 +93,36 @@ SentScene LoadScene(M::Model_ptr model, const std::string& path, bool by_content
   sent.file_name = SceneFileName(path);
   model->load_scene_data(sent.file_name.c_str(), ToOctets(bytes));
   return sent;
+}
+
+OpenedReplay OpenReplay(M::Model_ptr model, const std::string& path, bool local,
+                        bool force_content) {
+  OpenedReplay opened;
+  bool by_path = local && !force_content;
+  if (by_path) {
+    // the Model reads recordings below its read directories and its write directory
+    M::FileAccess_var files = model->file_access();
+    std::vector<std::string> dirs;
+    for (CORBA::ULong i = 0; i < files->read_dirs.length(); ++i)
+      dirs.push_back(files->read_dirs[i].in());
+    if (*files->write_dir.in() != '\0') dirs.push_back(files->write_dir.in());
+    by_path = core::ConfinedPaths(dirs, "", "", true).Allows(path, core::ConfinedPaths::Access::kRead);
+  }
+  if (by_path) {
+    M::ReplayStatus_var s = model->open_replay(path.c_str());
+    opened.status = s.in();
+    return opened;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read it: " + std::strerror(errno));
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error(path + ": cannot read it: " + std::strerror(errno));
+  CheckFitsOneMessage(path, bytes.size(), "recordings sent by content");
+  opened.by_content = true;
+  M::ReplayStatus_var s = model->open_replay_data(
+      std::filesystem::path(path).filename().string().c_str(), ToOctets(bytes));
+  opened.status = s.in();
+  return opened;
 }
 
 }  // namespace caliper::client

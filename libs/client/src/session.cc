@@ -1,47 +1,130 @@
 #include "caliper/client/session.h"
 
 #include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <iostream>
+#include <mutex>
+#include <regex>
 #include <sstream>
+#include <vector>
 
 #include "caliper/core/system.h"
 #include "caliper/rtc/client_orb.h"
+#include "caliper/rtc/local_sockets.h"
 
 namespace caliper::client {
 
-std::string LatestSession() {
+namespace {
+
+// ${XDG_RUNTIME_DIR:-/tmp}/caliper-UID/NAME: where the launcher says what runs
+std::string StateFile(const std::string& name) {
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
-  const std::string file = std::string(runtime != nullptr && *runtime != '\0' ? runtime : "/tmp") +
-                           "/caliper-" + std::to_string(getuid()) + "/latest-session";
-  // only a file of this user counts (another could leave one pointing at a session of theirs),
-  // not a link, and what is read is the file checked
+  return std::string(runtime != nullptr && *runtime != '\0' ? runtime : "/tmp") + "/caliper-" +
+         std::to_string(getuid()) + "/" + name;
+}
+
+// The lines of a launcher's state file (ADDRESS, PID[, DIRECTORY]) when the file is this user's
+// (another could leave one pointing at a session of theirs), not a link, and PID still runs;
+// what is read is the file checked. Empty when not.
+std::vector<std::string> LiveStateFile(const std::string& file) {
   const int fd = open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0) return "";
+  if (fd < 0) return {};
   struct stat st {};
   char text[4096];
   ssize_t n = -1;
   if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == getuid())
     n = read(fd, text, sizeof text);
   close(fd);
-  if (n <= 0) return "";
+  if (n <= 0) return {};
   std::istringstream in(std::string(text, static_cast<size_t>(n)));
-  std::string address, pid;
-  if (!std::getline(in, address) || !std::getline(in, pid) || address.empty()) return "";
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  if (lines.size() < 2 || lines[0].empty()) return {};
   char* end = nullptr;
-  const long id = std::strtol(pid.c_str(), &end, 10);
-  if (end == pid.c_str() || *end != '\0' || id <= 0 || !core::ProcessAlive(id)) return "";
-  return address;
+  const long id = std::strtol(lines[1].c_str(), &end, 10);
+  if (end == lines[1].c_str() || *end != '\0' || id <= 0 || !core::ProcessAlive(id)) return {};
+  return lines;
+}
+
+// Whether something listens where `address` (corbaname:omniunix:PATH or corbaname::HOST:PORT,
+// also :iiop:/:ssliop:) points: a unix socket with a listener, a TCP port that accepts within
+// 1 s. Only to tell a stale $CALIPER_NAMESERVICE; an address of another form counts as alive.
+bool NamingListens(const std::string& address) {
+  if (rtc::IsLocalSocketAddress(address))
+    return rtc::LocalSocketListening(rtc::LocalSocketPath(address));
+  static const std::regex kTcp(
+      R"(^corbaname:(?:(?:iiop|ssliop)?:)(?:\d\.\d@)?(\[[^\]]+\]|[^:/#,\[]+)(?::(\d+))?(?:[/#].*)?$)");
+  std::smatch m;
+  if (!std::regex_match(address, m, kTcp)) return true;
+  std::string host = m[1].str();
+  if (host.front() == '[') host = host.substr(1, host.size() - 2);
+  const std::string port = m[2].matched ? m[2].str() : "2809";
+  addrinfo hints{};
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* list = nullptr;
+  if (getaddrinfo(host.c_str(), port.c_str(), &hints, &list) != 0) return false;
+  bool open_port = false;
+  for (addrinfo* a = list; a != nullptr && !open_port; a = a->ai_next) {
+    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (fd < 0) continue;
+    if (connect(fd, a->ai_addr, a->ai_addrlen) == 0) {
+      open_port = true;
+    } else if (errno == EINPROGRESS) {
+      pollfd p{fd, POLLOUT, 0};
+      int error = 0;
+      socklen_t length = sizeof error;
+      open_port = poll(&p, 1, 1000) == 1 &&
+                  getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &length) == 0 && error == 0;
+    }
+    close(fd);
+  }
+  freeaddrinfo(list);
+  return open_port;
+}
+
+}  // namespace
+
+std::string LatestSession() {
+  const std::vector<std::string> lines = LiveStateFile(StateFile("latest-session"));
+  return lines.empty() ? "" : lines[0];
+}
+
+NamingChoice ChooseNamingAddress(const std::string& option) {
+  if (!option.empty()) return {option, "--nameservice"};
+  const std::vector<std::string> latest = LiveStateFile(StateFile("latest-session"));
+  const std::vector<std::string> own = LiveStateFile(StateFile("nameserver"));
+  NamingChoice found;
+  if (!latest.empty())
+    found = {latest[0], "the newest running session" +
+                            (latest.size() > 2 ? " (" + latest[2] + ")" : std::string())};
+  else if (!own.empty())
+    found = {own[0], "the naming service of `launch/caliper nameserver start`"};
+  const char* env = std::getenv("CALIPER_NAMESERVICE");
+  if (env != nullptr && *env != '\0') {
+    // a variable left from a session that has ended gives way to one that runs
+    if (found.address.empty() || found.address == env || NamingListens(env))
+      return {env, "$CALIPER_NAMESERVICE"};
+    found.note = std::string("$CALIPER_NAMESERVICE (") + env + ") does not answer; using " +
+                 found.source + ", " + found.address;
+    return found;
+  }
+  if (!found.address.empty()) return found;
+  return {rtc::NamingAddress(""), "the default (no running session of yours was found)"};
 }
 
 std::string ResolveNamingAddress(const std::string& option) {
-  if (!option.empty()) return option;
-  const char* env = std::getenv("CALIPER_NAMESERVICE");
-  if (env != nullptr && *env != '\0') return env;
-  const std::string latest = LatestSession();
-  return latest.empty() ? rtc::NamingAddress("") : latest;
+  const NamingChoice choice = ChooseNamingAddress(option);
+  static std::once_flag said;
+  if (!choice.note.empty())
+    std::call_once(said, [&] { std::cerr << "caliper: " << choice.note << "\n"; });
+  return choice.address;
 }
 
 Session::~Session() {
@@ -57,8 +140,8 @@ CosNaming::NamingContext_ptr Session::Root() {
   try {
     return rtc::ResolveRoot(orb_, address_);
   } catch (const rtc::Unreachable& e) {
-    throw ConnectionError(std::string(e.what()) +
-                              "\n  (is a session running? start one with `launch/caliper demo`, "
+    throw ConnectionError(std::string(e.what()) + "\n  (the address is " + source_ +
+                              "; is a session running? start one with `launch/caliper session`, "
                               "or pass --nameservice corbaname::HOST:PORT)",
                           address_);
   }
@@ -121,6 +204,7 @@ const std::string& Session::address() {
 void Session::Connect() {
   if (!CORBA::is_nil(orb_)) return;
   address_ = ResolveNamingAddress(options_.nameservice);
+  source_ = ChooseNamingAddress(options_.nameservice).source;
   // TLS when on a network
   orb_ = rtc::ClientOrb(options_.program.c_str(), options_.timeout_s, address_);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <locale>
 #include <sstream>
 
@@ -45,6 +46,24 @@ const char* TypeName(ConfigKey::Type t) {
     case ConfigKey::Type::kBool: return "true|false";
   }
   return "?";
+}
+
+// " in [MIN, MAX]" for a bounded number, " one of a|b|c" for a string with choices, else "".
+std::string Domain(const ConfigKey& k) {
+  const bool numeric = k.type == ConfigKey::Type::kInt || k.type == ConfigKey::Type::kDouble;
+  const bool low = k.min > -1e300, high = k.max < 1e300;
+  if (numeric && (low || high)) {
+    std::ostringstream range;
+    range << std::setprecision(15) << " in [" << (low ? k.min : -HUGE_VAL) << ", "
+          << (high ? k.max : HUGE_VAL) << "]";
+    return range.str();
+  }
+  if (k.type == ConfigKey::Type::kString && !k.choices.empty()) {
+    std::string list;
+    for (const auto& c : k.choices) list += (list.empty() ? "" : "|") + c;
+    return " one of " + list;
+  }
+  return "";
 }
 
 }  // namespace
@@ -185,7 +204,7 @@ std::string Config::Help() const {
   for (const auto& k : schema_) width = std::max(width, k.name.size());
   for (const auto& k : schema_) {
     out << "  " << k.name << std::string(width - k.name.size() + 2, ' ') << k.help << " ("
-        << TypeName(k.type) << ", default '" << k.default_value << "')\n";
+        << TypeName(k.type) << Domain(k) << ", default '" << k.default_value << "')\n";
   }
   return out.str();
 }

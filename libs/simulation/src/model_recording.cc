@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <set>
 #include <limits>
 #include <cmath>
@@ -279,6 +280,26 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(), replay_->duration(),
                                replay_->header().model_name.c_str());
   return ReplayStatusLocked();
+}
+
+ModelCore::ReplayStatus ModelCore::OpenReplayData(const std::string& file_name,
+                                                  const std::string& bytes) {
+  const std::string name = std::filesystem::path(file_name).filename().string();
+  if (name.empty() || name == "." || name == "..")
+    throw recording::RecordingError("a recording sent by content needs a file name, got '" +
+                                    file_name + "'");
+  auto copy = std::make_unique<core::ScratchDirectory>("caliper-replay");
+  const std::string path = copy->path() + "/" + name;
+  {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (!out.flush())
+      throw recording::RecordingError(name + " (sent by content): cannot write its copy " + path);
+  }
+  const ReplayStatus status = OpenReplay(path);
+  const auto lock = Lock();
+  if (replay_ && replay_->path() == path) replay_copy_ = std::move(copy);
+  return status;
 }
 
 ModelCore::ReplayStatus ModelCore::Seek(double time_s) {

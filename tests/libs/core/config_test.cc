@@ -284,12 +284,13 @@ TEST(ConfigTest, ItemsListsEveryKeyInSchemaOrder) {
 TEST(ConfigTest, HelpListsEveryKeyWithTypeDefaultAndHelp) {
   Config config(Schema());
   const std::string help = config.Help();
-  EXPECT_NE(help.find("  exec.rate    tick rate [Hz] (number, default '100')\n"), std::string::npos)
+  EXPECT_NE(help.find("  exec.rate    tick rate [Hz] (number in [0.1, 1000], default '100')\n"), std::string::npos)
       << help;
-  EXPECT_NE(help.find("  exec.kind    execution context kind (string, default 'periodic')\n"),
+  EXPECT_NE(help.find("  exec.kind    execution context kind (string one of "
+                      "periodic|external, default 'periodic')\n"),
             std::string::npos)
       << help;
-  EXPECT_NE(help.find("  queue.depth  queue length [records] (integer, default '8')\n"),
+  EXPECT_NE(help.find("  queue.depth  queue length [records] (integer in [1, 64], default '8')\n"),
             std::string::npos)
       << help;
   EXPECT_NE(help.find("  gui.enabled  show the window (true|false, default 'false')\n"),

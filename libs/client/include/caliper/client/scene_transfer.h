@@ -52,4 +52,18 @@ struct SentScene {
 SentScene LoadScene(::Caliper::Simulation::Model_ptr model, const std::string& path,
                     bool by_content);
 
+/// How a recording was opened for replay.
+struct OpenedReplay {
+  bool by_content = false;
+  ::Caliper::Simulation::ReplayStatus status;
+};
+
+/// The Model replays the recording at the absolute `path`: by path when it is on this host
+/// (`local`) and below the Model's read or write directories, else by content (a copy the Model
+/// keeps while it replays), also when `force_content` (--send). std::runtime_error when the file
+/// cannot be read here or exceeds one message; the Model's exceptions (LoadFailed, ...) and
+/// CORBA's pass.
+OpenedReplay OpenReplay(::Caliper::Simulation::Model_ptr model, const std::string& path,
+                        bool local, bool force_content);
+
 }  // namespace caliper::client

@@ -25,8 +25,20 @@ namespace caliper::client {
 /// the session's directory); "" when there is none or its naming service has ended.
 std::string LatestSession();
 
+/// Which naming service a client uses and why.
+struct NamingChoice {
+  std::string address;
+  std::string source;  ///< "--nameservice", "$CALIPER_NAMESERVICE", "the newest running session (DIR)", ...
+  std::string note;    ///< why $CALIPER_NAMESERVICE was passed over ("" when it was not)
+};
+
 /// Where a session's naming service is: `option` when given, else $CALIPER_NAMESERVICE, else
-/// the latest session (LatestSession), else corbaname::127.0.0.1:2809.
+/// the latest session (LatestSession), else the one of `launch/caliper nameserver start`, else
+/// corbaname::127.0.0.1:2809. A $CALIPER_NAMESERVICE where nothing listens (left from a session
+/// that has ended) gives way to the latest session or that naming service, with a note saying so.
+NamingChoice ChooseNamingAddress(const std::string& option);
+
+/// ChooseNamingAddress's address; its note, when there is one, goes to stderr (once a process).
 std::string ResolveNamingAddress(const std::string& option);
 
 struct SessionOptions {
@@ -65,6 +77,11 @@ class Session {
   PortableServer::POA_ptr RootPoa();
   /// The naming service's address this session uses.
   const std::string& address();
+  /// Where that address came from (NamingChoice::source).
+  const std::string& address_source() {
+    address();
+    return source_;
+  }
   const SessionOptions& options() const { return options_; }
 
  private:
@@ -73,6 +90,7 @@ class Session {
   SessionOptions options_;
   CORBA::ORB_var orb_;
   std::string address_;
+  std::string source_;
 };
 
 }  // namespace caliper::client

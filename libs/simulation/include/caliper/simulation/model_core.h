@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "caliper/core/scratch_directory.h"
 #include "caliper/recording/recording.h"
 #include "caliper/simulation/core_types.h"
 #include "caliper/simulation/edit_history.h"
@@ -221,6 +222,10 @@ class ModelCore {
   /// bit); it pauses at its end. Commands, parameter writes and edits are refused until Fork().
   /// Throws LoadError or recording::RecordingError naming the file and why.
   ReplayStatus OpenReplay(const std::string& path);
+  /// OpenReplay of a recording sent by content: a private copy named after `file_name` (its last
+  /// component) is kept while it is the replay. Throws as OpenReplay, and
+  /// recording::RecordingError when the copy cannot be written.
+  ReplayStatus OpenReplayData(const std::string& file_name, const std::string& bytes);
   /// Goes to the step nearest `time_s` (clamped to the recording): its keyframe, then at most
   /// keyframe_every - 1 steps.
   ReplayStatus Seek(double time_s);
@@ -332,6 +337,7 @@ class ModelCore {
   void RestoreReplayLocked(uint64_t step);
   ReplayStatus ReplayStatusLocked() const;
   std::unique_ptr<SessionRecorder> recorder_session_;
+  std::unique_ptr<core::ScratchDirectory> replay_copy_;  // a replay sent by content (outlives replay_)
   std::unique_ptr<Replayer> replay_;  // the recording replayed (none: not replaying)
   std::string last_recording_error_;
   uint64_t last_recording_bytes_ = 0;
