@@ -55,7 +55,8 @@ stop_session() {
   done
   kill -TERM "$NS_PID" 2>/dev/null || true
   wait 2>/dev/null || true
-  rm -f "$LATEST"
+  # the pointer to the newest session, unless a newer session has written its own since
+  if [ "$(sed -n 3p "$LATEST" 2>/dev/null)" = "$SESSION_DIR" ]; then rm -f "$LATEST"; fi
   # sockets of processes that did not unlink theirs (omniNames, a killed component)
   find "$CALIPER_SOCKET_DIR" -maxdepth 1 -type s -delete 2>/dev/null
   # a socket directory made under /tmp because the session's path was too long

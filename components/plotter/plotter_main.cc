@@ -29,7 +29,8 @@ several curves in each plot and stack plots on one time axis; pause, zoom (drag)
 
 options:
   --nameservice corbaname::HOST:PORT   the naming service (default: $CALIPER_NAMESERVICE,
-                                       else corbaname::127.0.0.1:2809)
+                                       else the newest running session, else
+                                       corbaname::127.0.0.1:2809)
   --model INSTANCE      the Model to plot from (default model0)
   --layout FILE         open a saved layout (File > Save layout writes one)
   --ids ID,ID,...       a plot with these ids (a vector element is ID[i], a matrix element

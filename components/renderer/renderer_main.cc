@@ -174,9 +174,33 @@ class GuiControl : public renderer::ViewControl {
 
 }  // namespace
 
+rtc::ComponentType RendererType() {
+  rtc::ComponentType type;
+  type.name = "renderer";
+  type.description =
+      "Scene Renderer: draws the Model's scene with Coin3D. Its own options:\n"
+      "  --screenshot FILE    write a PNG of the scene after --after SECONDS (3) and exit\n"
+      "  --geometry WxH+X+Y   where the viewer window goes\n"
+      "  --session FILE       the GUI session file (window places; the Main Window passes it)\n"
+      "It needs an X display with GLX (Xvfb when headless).";
+  type.category = "viewer";
+  type.config_keys = renderer::RendererComponent::ConfigKeys();
+  return type;
+}
+
 int main(int argc, char** argv) {
   Options options;
   if (!ParseOptions(argc, argv, &options)) return 2;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word != "-h" && word != "--help") continue;
+    // the help needs no display: RunComponent prints it before it makes anything
+    int rest_argc = static_cast<int>(options.rest.size()) - 1;
+    return rtc::RunComponent(
+        rest_argc, options.rest.data(), RendererType(),
+        [](rtc::Runtime&) -> std::unique_ptr<rtc::Component> { return nullptr; },
+        [](rtc::Runtime&, rtc::Component&) -> PortableServer::Servant { return nullptr; });
+  }
   // every thread inherits this mask; the runtime's signal watcher takes SIGINT/SIGTERM/SIGHUP
   sigset_t blocked;
   sigemptyset(&blocked);
@@ -230,16 +254,9 @@ int main(int argc, char** argv) {
   // the component runtime; when it ends (signal, exit(), bad arguments), the GUI ends too
   std::atomic<int> rtc_exit{0};
   std::thread runtime_thread([&] {
-    rtc::ComponentType type;
-    type.name = "renderer";
-    type.description =
-        "Scene Renderer: draws the Model's scene with Coin3D (options of caliper-renderer: "
-        "--screenshot FILE --after SECONDS)";
-    type.category = "viewer";
-    type.config_keys = renderer::RendererComponent::ConfigKeys();
     int rest_argc = static_cast<int>(options.rest.size()) - 1;
     rtc_exit = rtc::RunComponent(
-        rest_argc, options.rest.data(), type,
+        rest_argc, options.rest.data(), RendererType(),
         [&](rtc::Runtime& rt) {
           return std::make_unique<renderer::RendererComponent>(rt, mailbox, model_ref);
         },

@@ -73,6 +73,10 @@ models=$(grep -c '^model' "$WORK/ls.out")
 # ---------------------------------------------------------------- network mode vs loopback
 if ctl status --model hostc/model0 >/dev/null 2>&1; then pass "a network-mode Model on hostc answers hosta over TLS"
 else fail "hostc/model0 does not answer from hosta"; fi
+# the name batch summaries print works as well: INSTANCE@HOST
+if ctl status --model model0@hostc 2>&1 | grep -q "hostc.host_cxt/model0.rtc"; then
+  pass "model0@hostc names hostc's model0"
+else fail "model0@hostc does not name hostc's model0"; fi
 if in_ns b ss -ltn | grep -q '198.51.100.2:'; then pass "hostb's Models listen on 198.51.100.2"
 else fail "nothing listens on 198.51.100.2 in hostb"; fi
 # without TLS: hostc's Models refuse plain GIOP, and so does the naming service

@@ -1,17 +1,30 @@
-"""docs/python.md runs as written: every ```python block of the page, in order, in one namespace
-(the ```py blocks are the ones that need a running session of yours or files of yours)."""
+"""docs/python.md runs as written and prints what its comments promise: every ```python block of
+the page, in order, in one namespace, as tests/docs/run_doc_blocks.py extracts them (its markers
+honoured: `skip` blocks are left out, `fails` blocks must raise, `expect` must match). The ```py
+blocks are the ones that need a running session of yours or files of yours. The runner itself
+runs the whole page, sh blocks too, in a fresh HOME (ctest docs_python)."""
 
+import importlib.util
 import os
 import re
+
+import pytest
 
 ROOT = os.environ.get("CALIPER_SOURCE_DIR",
                       os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 PAGE = os.path.join(ROOT, "docs", "python.md")
 
 
+def load_runner():
+    spec = importlib.util.spec_from_file_location(
+        "run_doc_blocks", os.path.join(ROOT, "tests", "docs", "run_doc_blocks.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def blocks():
-    text = open(PAGE).read()
-    return re.findall(r"^```python\n(.*?)^```", text, flags=re.S | re.M)
+    return [b for b in load_runner().extract(PAGE, "docs/python.md") if b.language == "python"]
 
 
 def test_the_page_has_examples():
@@ -20,13 +33,26 @@ def test_the_page_has_examples():
 
 def test_the_page_runs_as_written(capsys):
     namespace = {"__name__": "docs_python"}
+    out = []
     try:
-        for i, block in enumerate(blocks()):
-            exec(compile(block, f"{PAGE} block {i + 1}", "exec"), namespace)
+        for block in blocks():
+            if "skip" in block.options:
+                continue
+            code = compile("\n" * block.line + block.code, PAGE, "exec")  # the page's line numbers
+            if "fails" in block.options:
+                with pytest.raises(Exception):
+                    exec(code, namespace)
+            else:
+                exec(code, namespace)
+            printed = capsys.readouterr()
+            out.append(printed.out)
+            if "expect" in block.options:
+                assert re.search(block.options["expect"], printed.out + printed.err,
+                                 re.M), block.where
     finally:
         if "local" in namespace:
             namespace["local"].close()
-    out = capsys.readouterr().out
+    out = "".join(out) + capsys.readouterr().out
     # what the page's comments promise
     assert "['model0@" in out and "STOPPED 0.001" in out
     assert "<caliper.Data 100 samples of 2 channels" in out

@@ -1,5 +1,9 @@
 #include "caliper/rtc/log_service_sink.h"
 
+#include <cctype>
+#include <cstdint>
+#include <cstdio>
+
 #include "caliper/rtc/naming.h"
 
 namespace caliper::rtc {
@@ -56,6 +60,21 @@ void LogServiceSink::Send(const std::vector<logging::Record>& batch) {
     logger_ = Caliper::Logging::LogService::_nil();
     throw logging::SinkUnavailable(e.what());
   }
+}
+
+std::string SessionSpoolDirectory(const std::string& base, const std::string& naming_address) {
+  // FNV-1a (64 bit): stable across builds and machines, unlike std::hash
+  uint64_t hash = 14695981039346656037ull;
+  for (const unsigned char c : naming_address) hash = (hash ^ c) * 1099511628211ull;
+  // the address's tail (the session's folder, or host and port), made a file name
+  std::string readable = naming_address.size() > 48
+                             ? naming_address.substr(naming_address.size() - 48)
+                             : naming_address;
+  for (char& c : readable)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-') c = '_';
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return base + "/" + readable + "-" + hex;
 }
 
 }  // namespace caliper::rtc

@@ -111,11 +111,17 @@ std::vector<ComponentEntry> ListComponents(CosNaming::NamingContext_ptr root) {
 }
 
 ComponentEntry FindComponent(CosNaming::NamingContext_ptr root, const std::string& name) {
+  // INSTANCE, INSTANCE@HOST (as batch summaries and the Python package print it), HOST/INSTANCE
+  // or HOST.host_cxt/INSTANCE.rtc
   std::string host, instance = name;
   const auto slash = name.find('/');
+  const auto at = name.rfind('@');
   if (slash != std::string::npos) {
     host = name.substr(0, slash);
     instance = name.substr(slash + 1);
+  } else if (at != std::string::npos && at > 0 && at + 1 < name.size()) {
+    instance = name.substr(0, at);
+    host = name.substr(at + 1);
   }
   auto strip = [](std::string* s, const std::string& suffix) {
     if (s->size() > suffix.size() && s->compare(s->size() - suffix.size(), suffix.size(), suffix) == 0)

@@ -1,5 +1,6 @@
 #include "caliper/rtc/runtime.h"
 
+#include <algorithm>
 #include <pthread.h>
 #include <signal.h>
 #include <strings.h>
@@ -66,7 +67,8 @@ std::vector<ConfigKey> CommonKeys(const std::string& type_name) {
        {"fatal", "alert", "crit", "error", "warn", "notice", "info", "debug"}},
       {"log.service", Type::kString, "logger0", "instance name of the Logging component"},
       {"log.spool_dir", Type::kString, "~/.cache/caliper/spool",
-       "where log records wait while the Logging component is unreachable"},
+       "where log records wait while the Logging component is unreachable, in a folder per "
+       "session (its naming service's address): they reach that session's log only"},
       {"log.spool_max", Type::kDouble, "64",
        "largest spool file [MiB]; records beyond it are dropped and counted (a warning record "
        "says how many once the spool is delivered)", 0.001, 1e6},
@@ -80,13 +82,18 @@ std::string ConfigDirectory() {
 }
 
 void PrintUsage(const ComponentType& type, const core::Config& config) {
-  std::cout << "Usage: caliper-" << type.name << " [options]\n"
+  std::string program = "caliper-" + type.name;  // the programs' names have '-' for '_'
+  std::replace(program.begin(), program.end(), '_', '-');
+  std::cout << "Usage: " << program << " [options]\n"
             << type.description << "\n\n"
             << "Options:\n"
             << "  -f FILE              read configuration FILE (after " << ConfigDirectory() << "/"
             << type.name << ".conf)\n"
-            << "  -o KEY=VALUE         set one configuration key (repeatable, applied last)\n"
-            << "  --nameservice ADDR   naming service, e.g. corbaname::127.0.0.1:2809\n"
+            << "  -o KEY=VALUE         set one configuration key (repeatable, applied last;\n"
+            << "                       $CALIPER_LISTEN, $CALIPER_INSECURE and $CALIPER_LOOPBACK_TCP\n"
+            << "                       apply after the -f files, before -o)\n"
+            << "  --nameservice ADDR   naming service (default $CALIPER_NAMESERVICE, else\n"
+            << "                       corbaname::127.0.0.1:2809; the launcher passes its session's)\n"
             << "  --instance NAME      instance base name (bound as NAME0, NAME1, ...)\n"
             << "  --listen ADDR        network mode: listen on ADDR (an address of this host that\n"
             << "                       the others reach) instead of loopback, over TLS with the\n"
@@ -403,7 +410,9 @@ void AddOrbOptions(const core::Config& config, const TransportSecurity& security
 void AddRemoteLogging(const ComponentType& type, const core::Config& config, CORBA::ORB_ptr orb,
                       const std::string& naming_address) {
   logging::AppenderOptions options;
-  options.spool_dir = core::ExpandHome(config.GetString("log.spool_dir"));
+  // a folder per session: what waits there is delivered into its own session's log only
+  options.spool_dir =
+      SessionSpoolDirectory(core::ExpandHome(config.GetString("log.spool_dir")), naming_address);
   options.spool_name = type.name + "-" + std::to_string(getpid());
   options.max_spool_bytes = static_cast<uint64_t>(config.GetDouble("log.spool_max") * 1024 * 1024);
   logging::AddAppender(new logging::BatchingAppender(

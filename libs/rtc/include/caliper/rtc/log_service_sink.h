@@ -24,6 +24,13 @@ class LogServiceSink : public logging::RecordSink {
   Caliper::Logging::LogService_var logger_;
 };
 
+/// Where a component of the session at `naming_address` spools its records: a folder of `base`
+/// of that session alone (a readable form of the address and a hash of it). Records spooled
+/// while a session's logger was gone are delivered only into that session's log, never into the
+/// next session's (whose address differs: a launcher session's naming service listens in the
+/// session's own folder); they wait there, kept with their session.
+std::string SessionSpoolDirectory(const std::string& base, const std::string& naming_address);
+
 /// IDL record for a C++ one and back.
 Caliper::Logging::Record ToIdl(const logging::Record& r);
 logging::Record FromIdl(const Caliper::Logging::Record& r);

@@ -39,7 +39,7 @@ struct ComponentEntry {
 /// Every `<host>.host_cxt/<instance>.rtc` binding, sorted by host and instance.
 std::vector<ComponentEntry> ListComponents(CosNaming::NamingContext_ptr root);
 
-/// Finds `model0`, `host/model0` or `host.host_cxt/model0.rtc`; prefers this host when several
+/// Finds `model0`, `model0@host`, `host/model0` or `host.host_cxt/model0.rtc`; prefers this host when several
 /// hosts have the instance. Throws NotFound listing what is bound.
 ComponentEntry FindComponent(CosNaming::NamingContext_ptr root, const std::string& name);
 
