@@ -337,7 +337,8 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
             << "runs, else the one of `launch/caliper nameserver start`, else\n"
             << "corbaname::127.0.0.1:2809; a $CALIPER_NAMESERVICE where nothing listens any more\n"
             << "gives way to a running session, with a note on stderr (`address` says which).\n"
-            << "NAME is an instance name (model0), host/model0, or host.host_cxt/model0.rtc.\n"
+            << "NAME is an instance name (model0), model0@host (as batch summaries print it),\n"
+            << "host/model0, or host.host_cxt/model0.rtc.\n"
             << "`inspect` reads a file and needs no session.\n";
   const std::pair<const char*, const char*> groups[] = {
       {"components", "Components"},
