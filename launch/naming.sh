@@ -125,8 +125,10 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
     proto=ssl
     scheme="corbaname:ssliop:"
   fi
-  for try in 1 2 3; do
-    NS_PORT=$(free_port)
+  local tries=3
+  [ -z "${CALIPER_NAMING_PORT:-}" ] || tries=1
+  for try in $(seq 1 $tries); do
+    NS_PORT=${CALIPER_NAMING_PORT:-$(free_port)}
     mkdir -p "$dir/omninames-$NS_PORT"
     ("${run[@]}" omniNames -start "$NS_PORT" -always -nohostname \
       -datadir "$dir/omninames-$NS_PORT" -ORBendPoint "giop:$proto:$addr:$NS_PORT" \
@@ -136,6 +138,8 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
     naming_started && return 0
     say "omniNames did not start on port $NS_PORT (try $try), see $dir/omninames.log"
   done
+  [ -z "${CALIPER_NAMING_PORT:-}" ] ||
+    die "the naming service could not listen on port $CALIPER_NAMING_PORT (--port): is it taken? (ss -ltnp)"
   die "could not start the naming service"
 }
 
