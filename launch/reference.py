@@ -94,6 +94,9 @@ ENVIRONMENT = {
     "CALIPER_LISTEN": (
         "user", "network mode: the address of this host that components listen on (as "
         "`--listen ADDR`); set by `launch/caliper session --listen` and `node --listen`"),
+    "CALIPER_NAMING_PORT": (
+        "internal", "network mode: the naming service's TCP port; set by `launch/caliper session "
+        "--port N` (default: a free port of 20000-39999)"),
     "CALIPER_INSECURE": (
         "user", "`1`: network mode without TLS, plain GIOP, no authentication (as `--insecure`; "
         "warns)"),

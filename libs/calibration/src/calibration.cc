@@ -108,6 +108,17 @@ Measured LoadMeasured(const std::string& path) {
   return m;
 }
 
+// A key of `node` not in `known` is a typo (a "scael" would otherwise be taken for the default).
+void RejectUnknownKeys(const ptree& node, const std::vector<std::string>& known,
+                       const std::string& where) {
+  for (const auto& [key, child] : node) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    Fail(where, "unknown key '" + key + "' (known: " + list + ")");
+  }
+}
+
 Spec LoadSpec(const std::string& path) {
   ptree root;
   try {
@@ -150,6 +161,7 @@ Spec LoadSpec(const std::string& path) {
     p.id = node.get<std::string>("id", "");
     const std::string where = path + ": parameters: '" + p.id + "'";
     if (p.id.empty()) Fail(path, "parameters: an entry without \"id\"");
+    RejectUnknownKeys(node, {"id", "lower", "upper", "scale"}, where);
     if (!ids.insert(p.id).second) Fail(where, "listed twice");
     p.lower = Number(node.get<std::string>("lower", ""), where + ": lower");
     p.upper = Number(node.get<std::string>("upper", ""), where + ": upper");
@@ -168,6 +180,8 @@ Spec LoadSpec(const std::string& path) {
     for (const auto& [k, node] : *channels) {
       const std::string id = node.get<std::string>("id", "");
       const std::string where = path + ": channels: '" + id + "'";
+      if (id.empty()) Fail(path, "channels: an entry without \"id\"");
+      RejectUnknownKeys(node, {"id", "weight", "window_s"}, where);
       ChannelWeight w;
       w.weight = Number(node.get<std::string>("weight", "1"), where + ": weight");
       if (!(w.weight >= 0)) Fail(where, "weight must be >= 0");
@@ -183,6 +197,7 @@ Spec LoadSpec(const std::string& path) {
     }
   if (const auto o = root.get_child_optional("optimiser")) {
     const std::string where = path + ": optimiser";
+    RejectUnknownKeys(*o, {"algorithm", "generations", "population", "sigma0"}, where);
     spec.optimiser.algorithm = o->get<std::string>("algorithm", "cmaes");
     if (spec.optimiser.algorithm != "cmaes" && spec.optimiser.algorithm != "xnes")
       Fail(where, "algorithm is cmaes or xnes (pagmo's evolution strategies)");

@@ -99,6 +99,15 @@ TEST_F(CalibrationFiles, ErrorsNameTheFileAndTheProblem) {
       {base + R"(, "parameters": [{"id": "x", "lower": "one", "upper": 2}])", "'one' is not a finite number"},
       {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "optimiser": {"algorithm": "mine"})", "cmaes or xnes"},
       {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "colour": 1)", "unknown key 'colour'"},
+      // a typo inside an entry is not taken for the default
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2, "scael": "log"}])",
+       "parameters: 'x': unknown key 'scael' (known: id, lower, upper, scale)"},
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "channels": [{"id": "y", "wieght": 2}])",
+       "channels: 'y': unknown key 'wieght'"},
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "channels": [{"weight": 2}])",
+       "channels: an entry without \"id\""},
+      {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "optimiser": {"generation": 5})",
+       "optimiser: unknown key 'generation'"},
       // found by fuzzing (tests/data/fuzz/calibration_spec/regressions): a negative seed was cast
       // to an unsigned (undefined), spans too wide mapped every value to inf or NaN
       {base + R"(, "parameters": [{"id": "x", "lower": 1, "upper": 2}], "seed": -1)", "seed: a whole number in [0, 2^53]"},
