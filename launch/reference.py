@@ -283,8 +283,8 @@ FILE_FORMATS = [
             "JSON. Read by `caliper-calibrate FILE` (and `launch/caliper calibrate`, "
             "`launch/caliper slurm calibrate`). Names an experiment file, a measured CSV per "
             "experiment and the parameters to fit with their bounds. Paths are relative to the "
-            "file. An unknown top-level key is an error; keys inside `parameters`, `channels` "
-            "and `optimiser` other than those below are ignored."),
+            "file. An unknown key is an error, at the top level and inside `parameters`, "
+            "`channels` and `optimiser` (a typo is never taken for a default)."),
         "keys": [
             ("experiments", "string (path)", "required", "",
              "the experiment file (format above): scene, schedules, recorded ids, durations"),

@@ -102,15 +102,21 @@ def helper_call_names(text, function):
                                              text)]
 
 
+def string_end(text, i):
+    """The index of the quote that closes the C++ string literal opening at text[i]."""
+    i += 1
+    while i < len(text) and text[i] != '"':
+        i += 2 if text[i] == "\\" else 1
+    return i
+
+
 def top_level_split(body):
     """Elements of a brace initializer's body, split at top-level commas."""
     items, depth, start, i = [], 0, 0, 0
     while i < len(body):
         c = body[i]
         if c == '"':
-            i += 1
-            while i < len(body) and body[i] != '"':
-                i += 2 if body[i] == "\\" else 1
+            i = string_end(body, i)
         elif c in "{([":
             depth += 1
         elif c in "})]":
@@ -130,9 +136,7 @@ def brace_groups(text):
     while i < len(text):
         c = text[i]
         if c == '"':
-            i += 1
-            while i < len(text) and text[i] != '"':
-                i += 2 if text[i] == "\\" else 1
+            i = string_end(text, i)
         elif c == "{":
             stack.append(i)
         elif c == "}" and stack:

@@ -8,9 +8,8 @@
 set -uo pipefail
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?set CALIPER_SOURCE_DIR to the source tree}
-FAILS=0
-fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
-pass() { echo "ok: $*"; }
+# shellcheck source=../integration/support/checks.sh
+source "$SRC/tests/integration/support/checks.sh"
 
 WORK=$(mktemp -d)
 PIDS=()
@@ -115,4 +114,4 @@ if (launcher session --headless --listen 127.0.0.1 --port 99999) >"$WORK/port" 2
 else grep -q -- "--port needs a TCP port number" "$WORK/port" && pass "--port 99999 refused" ||
   { cat "$WORK/port"; fail "--port 99999: no reason"; }; fi
 
-[ "$FAILS" = 0 ] && echo "all passed" || { echo "$FAILS failed"; exit 1; }
+finish
