@@ -75,7 +75,8 @@ naming_answers() {  # ADDRESS
 # the omniNames of NS_PID answers at NS_ADDR within 5 s; else it is stopped and 1 returned
 naming_started() {
   for _ in $(seq 1 50); do
-    naming_answers "$NS_ADDR" && return 0
+    # ours answers (not another that took the port first: ours would have ended)
+    naming_answers "$NS_ADDR" && kill -0 "$NS_PID" 2>/dev/null && return 0
     kill -0 "$NS_PID" 2>/dev/null || break
     sleep 0.1
   done
@@ -126,7 +127,13 @@ start_nameserver() {  # DIR [LISTEN_ADDRESS [local|tls|plain]]
     scheme="corbaname:ssliop:"
   fi
   local tries=3
-  [ -z "${CALIPER_NAMING_PORT:-}" ] || tries=1
+  if [ -n "${CALIPER_NAMING_PORT:-}" ]; then
+    tries=1
+    # a port already served (another session's naming service) would seem to answer for ours
+    if (exec 3<>"/dev/tcp/$addr/$CALIPER_NAMING_PORT") 2>/dev/null; then
+      die "port $CALIPER_NAMING_PORT (--port) of $addr is taken: another session or program listens there (ss -ltnp)"
+    fi
+  fi
   for try in $(seq 1 $tries); do
     NS_PORT=${CALIPER_NAMING_PORT:-$(free_port)}
     mkdir -p "$dir/omninames-$NS_PORT"

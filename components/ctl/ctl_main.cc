@@ -281,10 +281,15 @@ int Address(Client& client, std::vector<std::string>& args) {
   if (!args.empty()) throw UsageError("address takes no arguments but --export");
   CosNaming::NamingContext_var root = client.Root();  // ConnectionError when nothing answers
   std::cerr << "caliper-ctl: the naming service of " << client.address_source() << "\n";
-  if (as_export)
-    std::cout << "export CALIPER_NAMESERVICE='" << client.address() << "'\n";
-  else
+  if (as_export) {
+    // single quotes for the shell, a quote inside written as '\''
+    std::string quoted;
+    for (const char c : client.address())
+      quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    std::cout << "export CALIPER_NAMESERVICE='" << quoted << "'\n";
+  } else {
     std::cout << client.address() << "\n";
+  }
   return 0;
 }
 

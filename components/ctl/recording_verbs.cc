@@ -306,7 +306,7 @@ int Replay(Client& client, std::vector<std::string>& args) {
     const std::string path = Absolute(what);
     client::OpenedReplay opened;
     try {
-      opened = Call(m, [&] { return client::OpenReplay(m.model, path, m.local, send); });
+      opened = Call(m, [&] { return client::OpenReplay(m.model, what, m.local, send); });
     } catch (const std::runtime_error& e) {
       if (dynamic_cast<const Failure*>(&e) != nullptr) throw;
       throw Failure(e.what());  // the file, read here
@@ -381,7 +381,9 @@ void AddRecordingVerbs(std::map<std::string, Verb>* verbs) {
       "  replay FILE: the Model loads the recording at its start, paused: by path when FILE\n"
       "  lies below its read directories or its write directory on this host, else (another\n"
       "  host, files elsewhere, --send) by content, as a copy it keeps while it replays it,\n"
-      "  so a recording of an earlier session replays in today's. Play it with the usual\n"
+      "  so a recording of an earlier session replays in today's. A NAME that is no file\n"
+      "  here is the Model's: relative, it starts from its write directory (where\n"
+      "  `recording start NAME` writes), also on another host. Play it with the usual\n"
       "  verbs: start (at the real-time factor), pause, step N, rtf F (speed; 0 as fast as\n"
       "  possible); it pauses at its end; stop and reset go back to its start. Observers and\n"
       "  `record` (the DAQ) see it as a running Model. Commands, parameter writes and edits\n"

@@ -191,15 +191,20 @@ rtc::ComponentType RendererType() {
 int main(int argc, char** argv) {
   Options options;
   if (!ParseOptions(argc, argv, &options)) return 2;
-  for (int i = 1; i < argc; ++i) {
-    const std::string word = argv[i];
+  for (size_t i = 1; i + 1 < options.rest.size(); ++i) {
+    const std::string word = options.rest[i];
     if (word != "-h" && word != "--help") continue;
-    // the help needs no display: RunComponent prints it before it makes anything
+    // the help needs no display: RunComponent prints it before it makes anything (should the
+    // word be an option's value instead, the component is never made: the factories refuse)
     int rest_argc = static_cast<int>(options.rest.size()) - 1;
     return rtc::RunComponent(
         rest_argc, options.rest.data(), RendererType(),
-        [](rtc::Runtime&) -> std::unique_ptr<rtc::Component> { return nullptr; },
-        [](rtc::Runtime&, rtc::Component&) -> PortableServer::Servant { return nullptr; });
+        [](rtc::Runtime&) -> std::unique_ptr<rtc::Component> {
+          throw std::runtime_error("the Scene Renderer needs an X display (DISPLAY is not set)");
+        },
+        [](rtc::Runtime&, rtc::Component&) -> PortableServer::Servant {
+          throw std::runtime_error("the Scene Renderer needs an X display (DISPLAY is not set)");
+        });
   }
   // every thread inherits this mask; the runtime's signal watcher takes SIGINT/SIGTERM/SIGHUP
   sigset_t blocked;

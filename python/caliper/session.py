@@ -34,8 +34,10 @@ def connect(nameservice: Optional[str] = None, timeout_s: float = 5.0) -> Sessio
     """Connects to a Caliper session.
 
     `nameservice` is its naming service, ``corbaname::HOST:PORT``; without it, as caliper-ctl:
-    ``$CALIPER_NAMESERVICE``, else the newest session ``launch/caliper session`` (or ``demo``)
-    started on this host, else ``corbaname::127.0.0.1:2809``. A naming service on another host
+    ``$CALIPER_NAMESERVICE`` (unless nothing listens there and a session runs: then that one,
+    with a note on stderr), else the newest session ``launch/caliper session`` (or ``demo``)
+    started on this host, else the naming service of ``launch/caliper nameserver start``, else
+    ``corbaname::127.0.0.1:2809``. A naming service on another host
     means network mode: TLS with the certificates of ``launch/caliper certs`` (see
     docs/cluster.md). `timeout_s` is the deadline of ordinary calls [s]; loads, steps and
     experiments take as long as their work.

@@ -1,7 +1,6 @@
 // caliper.Model's session recordings (the Model writes one SQLite file on its host) and replay:
 // open, seek, fork.
 #include <cmath>
-#include <filesystem>
 
 #include "caliper/client/scene_transfer.h"
 #include "model_object.h"
@@ -69,16 +68,16 @@ size. Read the file with caliper.Recording.)doc")
       .def(
           "open_replay",
           [](ModelObject& m, const std::string& path, bool send) {
-            const std::string absolute = std::filesystem::absolute(path).string();
             const client::OpenedReplay opened = m.Run(
-                [&] { return client::OpenReplay(m.ref.model, absolute, m.ref.local, send); },
+                [&] { return client::OpenReplay(m.ref.model, path, m.ref.local, send); },
                 kLongCallS);
             return ReplayStatusObject(opened.status);
           },
           py::arg("path"), py::arg("send") = false,
           "The Model replays a recording, paused at its start; start(), step() and seek() play "
           "it, fork() simulates on. A file the Model cannot read itself (on another host, outside "
-          "its directories, or send=True) goes by content.")
+          "its directories, or send=True) goes by content; a name that is no file here is the Model's "
+          "(relative: from its write directory, where start_recording writes).")
       .def(
           "seek",
           [](ModelObject& m, double time_s) {

@@ -210,6 +210,9 @@ def extract(page, display):
             raise PageError(f"{where}: 'ready' needs 'background'")
         if "background" in options and "fails" in options:
             raise PageError(f"{where}: a background block cannot be 'fails'")
+        if "fails" in options and "expect" not in options:
+            raise PageError(f"{where}: 'fails' needs 'expect' (the error the page shows: any "
+                            "failure, even a command not found, would pass otherwise)")
         if language == "python" and ("background" in options or "host" in options):
             raise PageError(f"{where}: python blocks run in the page's interpreter: no "
                             "'background' or 'host' (use a sh block)")

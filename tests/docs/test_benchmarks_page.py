@@ -40,6 +40,9 @@ def strip_cc_comments(text):
             i = j + 1
         elif c == "'" and i + 2 < n:
             j = text.find("'", i + 1 if text[i + 1] != "\\" else i + 2)
+            if j < 0:  # an apostrophe in a comment or a stray one: the rest is plain text
+                out.append(text[i:])
+                break
             out.append(text[i:j + 1])
             i = j + 1
         elif text.startswith("//", i):

@@ -86,6 +86,7 @@ FAILING = [
                                r".*1 later block\(s\) not run"),
     ("fail_background.md", r"FAILED \(exited \(status 3\) before its output matched ready: is up"),
     ("bad_marker.md", r"bad_marker\.md:4: unknown doc-test option 'retry'"),
+    ("bad_fails.md", r"bad_fails\.md:\d+: 'fails' needs 'expect'"),
 ]
 
 

@@ -124,8 +124,13 @@ grep -q "replaying $WORK/yesterday.caliper (sent by content)" "$WORK/open" &&
   grep -q "^time / end \[s\]  *0 / 10$" "$WORK/open" &&
   pass "a recording outside the Model's directories replays by content: $(head -1 "$WORK/open" | cut -c1-110)" ||
   { cat "$WORK/open"; fail "replay of a file outside the Model's directories"; }
-ctl replay "$F/run.caliper" >/dev/null 2>&1 && ctl replay seek 0.5 >/dev/null && ctl step 1 >/dev/null ||
-  fail "back to the replay by path"
+# a name that is no file here is the Model's: relative, from its write directory (as recording
+# start names it)
+(cd "$WORK" && ctl replay run.caliper) >"$WORK/open" 2>&1 || { cat "$WORK/open"; fail "replay NAME"; }
+grep -q "replaying $F/run.caliper (paused" "$WORK/open" &&
+  pass "replay run.caliper: the Model's $F/run.caliper, by path" ||
+  { cat "$WORK/open"; fail "replay run.caliper did not open the write directory's file"; }
+ctl replay seek 0.5 >/dev/null && ctl step 1 >/dev/null || fail "back to the replay by path"
 
 ctl replay fork >/dev/null 2>&1 || fail "fork"
 ctl motor elbow_flexor 1 >/dev/null 2>&1 && ctl step 10 >/dev/null 2>&1 &&

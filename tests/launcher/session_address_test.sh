@@ -32,7 +32,11 @@ launcher() {
     "$SRC/launch/caliper" "$@"
 }
 env_of() { echo HOME="$WORK/home" XDG_RUNTIME_DIR="$WORK/run" CALIPER_BUILD_DIR="$BIN/.." CALIPER_NO_BUILD=1; }
-in_env() { env -u CALIPER_NAMESERVICE $(env_of) "$@"; }
+in_env() {
+  local vars
+  read -r -a vars <<<"$(env_of)"
+  env -u CALIPER_NAMESERVICE "${vars[@]}" "$@"
+}
 
 # NAME: a headless session in the background; waits until it runs (30 s at most)
 start_session() {
@@ -87,7 +91,7 @@ launcher node --models 1 >"$WORK/node.out" 2>&1 &
 NODE=$!
 PIDS+=("$NODE")
 for _ in $(seq 1 300); do grep -q "manager pid" "$WORK/node.out" && break; sleep 0.1; done
-if grep -q "joining the newest running session, $B_ADDR" "$WORK/node.out" &&
+if grep -q "joining $B_ADDR (the naming service of the newest running session" "$WORK/node.out" &&
   in_env "$SRC/launch/caliper" ctl managers 2>&1 | grep -q "1/.* running"; then
   pass "node without --nameservice joined session B and started its Model"
 else cat "$WORK/node.out"; fail "node without --nameservice"; fi
@@ -113,5 +117,10 @@ if (launcher session --headless --listen 127.0.0.1 --port 99999) >"$WORK/port" 2
   fail "--port 99999 accepted"
 else grep -q -- "--port needs a TCP port number" "$WORK/port" && pass "--port 99999 refused" ||
   { cat "$WORK/port"; fail "--port 99999: no reason"; }; fi
+
+if (launcher session --headless --port 2809) >"$WORK/port2" 2>&1; then
+  fail "--port without --listen accepted"
+else grep -q -- "--port is for network mode" "$WORK/port2" && pass "--port without --listen refused" ||
+  { cat "$WORK/port2"; fail "--port without --listen: no reason"; }; fi
 
 finish

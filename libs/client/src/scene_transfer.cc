@@ -95,9 +95,22 @@ SentScene LoadScene(M::Model_ptr model, const std::string& path, bool by_content
   return sent;
 }
 
-OpenedReplay OpenReplay(M::Model_ptr model, const std::string& path, bool local,
+OpenedReplay OpenReplay(M::Model_ptr model, const std::string& file, bool local,
                         bool force_content) {
   OpenedReplay opened;
+  std::error_code ec;
+  const std::string path = std::filesystem::absolute(file, ec).string();
+  if (!force_content && !std::filesystem::exists(path, ec)) {
+    // not a file of this host: the Model's own, a relative name starting from its write
+    // directory, as `recording start NAME` names them (also on another host)
+    std::string for_model = file;
+    M::FileAccess_var files = model->file_access();
+    if (std::filesystem::path(file).is_relative() && *files->write_dir.in() != '\0')
+      for_model = std::string(files->write_dir.in()) + "/" + file;
+    M::ReplayStatus_var s = model->open_replay(for_model.c_str());
+    opened.status = s.in();
+    return opened;
+  }
   bool by_path = local && !force_content;
   if (by_path) {
     // the Model reads recordings below its read directories and its write directory

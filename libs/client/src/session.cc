@@ -69,7 +69,9 @@ bool NamingListens(const std::string& address) {
   addrinfo hints{};
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* list = nullptr;
-  if (getaddrinfo(host.c_str(), port.c_str(), &hints, &list) != 0) return false;
+  const int resolved = getaddrinfo(host.c_str(), port.c_str(), &hints, &list);
+  if (resolved == EAI_AGAIN) return true;  // a passing DNS failure says nothing of the service
+  if (resolved != 0) return false;
   bool open_port = false;
   for (addrinfo* a = list; a != nullptr && !open_port; a = a->ai_next) {
     const int fd = socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -119,11 +121,20 @@ NamingChoice ChooseNamingAddress(const std::string& option) {
   return {rtc::NamingAddress(""), "the default (no running session of yours was found)"};
 }
 
-std::string ResolveNamingAddress(const std::string& option) {
-  const NamingChoice choice = ChooseNamingAddress(option);
+namespace {
+
+// the note of a passed-over $CALIPER_NAMESERVICE, once a process
+void SayNote(const NamingChoice& choice) {
   static std::once_flag said;
   if (!choice.note.empty())
     std::call_once(said, [&] { std::cerr << "caliper: " << choice.note << "\n"; });
+}
+
+}  // namespace
+
+std::string ResolveNamingAddress(const std::string& option) {
+  const NamingChoice choice = ChooseNamingAddress(option);
+  SayNote(choice);
   return choice.address;
 }
 
@@ -203,8 +214,10 @@ const std::string& Session::address() {
 
 void Session::Connect() {
   if (!CORBA::is_nil(orb_)) return;
-  address_ = ResolveNamingAddress(options_.nameservice);
-  source_ = ChooseNamingAddress(options_.nameservice).source;
+  const NamingChoice choice = ChooseNamingAddress(options_.nameservice);
+  SayNote(choice);
+  address_ = choice.address;
+  source_ = choice.source;
   // TLS when on a network
   orb_ = rtc::ClientOrb(options_.program.c_str(), options_.timeout_s, address_);
 }

@@ -27,7 +27,12 @@ BatchingAppender::BatchingAppender(const std::string& name, std::unique_ptr<Reco
   thread_ = std::thread([this] { Run(); });
 }
 
-BatchingAppender::~BatchingAppender() { Stop(std::chrono::milliseconds(2000)); }
+BatchingAppender::~BatchingAppender() {
+  Stop(std::chrono::milliseconds(2000));
+  // the spool folder goes once nothing waits in it (rmdir leaves a folder with files alone), so
+  // folders of ended sessions do not pile up
+  rmdir(options_.spool_dir.c_str());
+}
 
 void BatchingAppender::ClaimOrphans() {
   DIR* dir = opendir(options_.spool_dir.c_str());
@@ -104,6 +109,7 @@ void BatchingAppender::SpoolLocked(const std::vector<Record>& records) {
     stats_.dropped += records.size() - kept;
   }
   if (text.empty()) return;
+  core::MakeDirectories(options_.spool_dir);  // another process may have removed it, empty
   std::ofstream out(spool_path_, std::ios::app | std::ios::binary);
   out << text;
   out.flush();

@@ -223,7 +223,7 @@ RunResult ModelCore::RunExperiment(const experiment::Experiment& e, const std::s
   std::unique_lock<std::mutex> lock(mutex_);
   if (loaded_) loaded_->commands.clear();
   EndRecordingLocked("an experiment was run");
-  replay_.reset();
+  EndReplayLocked();
   fork_reset_every_ = 0;
   BuildLocked(std::move(loaded));
   history_.Forget();
@@ -281,7 +281,7 @@ void ModelCore::LoadScene(const sgal::Scene& scene, const std::string& source) {
   const auto lock = Lock();
   RequireIdle();  // again: an experiment may have begun while this scene was built
   EndRecordingLocked("another scene was loaded");
-  replay_.reset();
+  EndReplayLocked();
   fork_reset_every_ = 0;
   BuildLocked(std::move(loaded));
   state_ = RunState::kStopped;

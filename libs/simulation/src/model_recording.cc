@@ -277,6 +277,11 @@ ModelCore::ReplayStatus ModelCore::OpenReplay(const std::string& path) {
   history_.ClearUndo();
   state_ = RunState::kPaused;
   last_error_.clear();
+  // a copy sent by content before goes once this replay is another file
+  if (replay_copy_ && path.rfind(replay_copy_->path() + "/", 0) != 0) {
+    previous.reset();
+    replay_copy_.reset();
+  }
   logging::Get("model").notice("replaying %s: %.3f s of %s", path.c_str(), replay_->duration(),
                                replay_->header().model_name.c_str());
   return ReplayStatusLocked();
@@ -288,6 +293,10 @@ ModelCore::ReplayStatus ModelCore::OpenReplayData(const std::string& file_name,
   if (name.empty() || name == "." || name == "..")
     throw recording::RecordingError("a recording sent by content needs a file name, got '" +
                                     file_name + "'");
+  {
+    const auto lock = Lock();
+    RequireIdle();  // before writing up to a message's worth of copy for nothing
+  }
   auto copy = std::make_unique<core::ScratchDirectory>("caliper-replay");
   const std::string path = copy->path() + "/" + name;
   {
@@ -300,6 +309,11 @@ ModelCore::ReplayStatus ModelCore::OpenReplayData(const std::string& file_name,
   const auto lock = Lock();
   if (replay_ && replay_->path() == path) replay_copy_ = std::move(copy);
   return status;
+}
+
+void ModelCore::EndReplayLocked() {
+  replay_.reset();
+  replay_copy_.reset();  // a copy sent by content goes with its replay
 }
 
 ModelCore::ReplayStatus ModelCore::Seek(double time_s) {
@@ -332,7 +346,7 @@ void ModelCore::Fork() {
   const std::string path = replay_->path();
   loaded_->source = path + " (forked at t = " + std::to_string(loaded_->physics->time()) + " s)";
   fork_reset_every_ = replay_->keyframe_every();  // as the recorded run did, so it goes on alike
-  replay_.reset();
+  EndReplayLocked();
   loaded_->physics->ClearPull();  // a replayed pull ends: its client was the recording
   if (state_ == RunState::kRunning) state_ = RunState::kPaused;
   logging::Get("model").notice("forked from %s at t = %.3f s: simulating on", path.c_str(),

@@ -1,8 +1,12 @@
-// Where a client finds its session: an address given, $CALIPER_NAMESERVICE, the newest session
-// the launcher started that still runs, the default; no naming service is needed.
+// Where a client finds its session: an address given, $CALIPER_NAMESERVICE (unless nothing listens
+// there and a session runs), the newest session the launcher started that still runs, the
+// default; no naming service is needed (a loopback port of this process stands in for one).
 #include "caliper/client/session.h"
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -53,11 +57,58 @@ TEST_F(SessionAddress, IgnoresAMissingOrMalformedFile) {
   EXPECT_EQ(LatestSession(), "");
 }
 
+// A TCP port of this process that accepts connections (a naming service stand-in: the choice
+// asks only whether something listens).
+class Listener {
+ public:
+  Listener() {
+    fd_ = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t n = sizeof a;
+    if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&a), n) != 0 || listen(fd_, 4) != 0 ||
+        getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &n) != 0)
+      ADD_FAILURE() << "cannot listen on loopback";
+    port_ = ntohs(a.sin_port);
+  }
+  ~Listener() { close(fd_); }
+  std::string address() const { return "corbaname::127.0.0.1:" + std::to_string(port_); }
+
+ private:
+  int fd_ = -1;
+  int port_ = 0;
+};
+
 TEST_F(SessionAddress, TheVariableAndTheOptionComeFirst) {
+  const Listener live;
   WriteLatest("corbaname::127.0.0.1:40123", getpid());
-  setenv("CALIPER_NAMESERVICE", "corbaname::127.0.0.1:40999", 1);
-  EXPECT_EQ(ResolveNamingAddress(""), "corbaname::127.0.0.1:40999");
+  setenv("CALIPER_NAMESERVICE", live.address().c_str(), 1);
+  EXPECT_EQ(ResolveNamingAddress(""), live.address());
+  const NamingChoice choice = ChooseNamingAddress("");
+  EXPECT_EQ(choice.source, "$CALIPER_NAMESERVICE");
+  EXPECT_EQ(choice.note, "");
   EXPECT_EQ(ResolveNamingAddress("corbaname::10.0.0.1:2809"), "corbaname::10.0.0.1:2809");
+  unsetenv("CALIPER_NAMESERVICE");
+}
+
+TEST_F(SessionAddress, AVariableWhereNothingListensGivesWayToTheRunningSession) {
+  std::string gone;
+  {
+    const Listener ended;  // a naming service that has ended: its port is closed again
+    gone = ended.address();
+  }
+  WriteLatest("corbaname::127.0.0.1:40123", getpid());
+  setenv("CALIPER_NAMESERVICE", gone.c_str(), 1);
+  const NamingChoice choice = ChooseNamingAddress("");
+  EXPECT_EQ(choice.address, "corbaname::127.0.0.1:40123");
+  EXPECT_NE(choice.note.find("$CALIPER_NAMESERVICE (" + gone + ") does not answer"),
+            std::string::npos)
+      << choice.note;
+  EXPECT_NE(choice.source.find("the newest running session"), std::string::npos) << choice.source;
+  // without a running session the variable stays: there is nothing better to give way to
+  fs::remove(dir_ / ("caliper-" + std::to_string(getuid())) / "latest-session");
+  EXPECT_EQ(ChooseNamingAddress("").address, gone);
   unsetenv("CALIPER_NAMESERVICE");
 }
 

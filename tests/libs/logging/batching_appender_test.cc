@@ -231,6 +231,24 @@ TEST_F(BatchingAppenderTest, NamesSpoolFileAfterSpoolName) {
   EXPECT_TRUE(fs::is_directory(options_.spool_dir));  // created by the appender
 }
 
+TEST_F(BatchingAppenderTest, AnEmptySpoolFolderGoesWithTheAppenderAFullOneStays) {
+  {
+    auto appender = MakeAppender();
+    AppendMessages(*appender, 1, 3);
+    ASSERT_TRUE(appender->Flush(milliseconds(1000)));  // delivered: nothing waits
+  }
+  EXPECT_FALSE(fs::exists(options_.spool_dir)) << "an empty spool folder was left behind";
+  sink_->SetReachable(false);
+  {
+    auto appender = MakeAppender();
+    AppendMessages(*appender, 4, 6);
+    appender->Stop(milliseconds(50));
+  }
+  // what waits for its session's logger stays, and so does its folder
+  EXPECT_EQ(SpoolSeqs(options_.spool_dir + "/test-" + std::to_string(getpid()) + ".spool"),
+            Range(1, 3));  // the second appender's three records (its own numbering)
+}
+
 TEST_F(BatchingAppenderTest, SpoolsWhileSinkIsUnreachable) {
   sink_->SetReachable(false);
   auto appender = MakeAppender();

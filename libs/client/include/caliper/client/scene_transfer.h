@@ -58,12 +58,13 @@ struct OpenedReplay {
   ::Caliper::Simulation::ReplayStatus status;
 };
 
-/// The Model replays the recording at the absolute `path`: by path when it is on this host
-/// (`local`) and below the Model's read or write directories, else by content (a copy the Model
-/// keeps while it replays), also when `force_content` (--send). std::runtime_error when the file
-/// cannot be read here or exceeds one message; the Model's exceptions (LoadFailed, ...) and
-/// CORBA's pass.
-OpenedReplay OpenReplay(::Caliper::Simulation::Model_ptr model, const std::string& path,
+/// The Model replays the recording `file`. A file of this host goes by path when the Model is on
+/// this host (`local`) and it lies below the Model's read or write directories, else by content
+/// (a copy the Model keeps while it replays), also when `force_content` (--send). A name that is
+/// no file here is the Model's own: a relative one starts from its write directory (where
+/// `recording start NAME` writes), on its host. std::runtime_error when the file cannot be read
+/// here or exceeds one message; the Model's exceptions (LoadFailed, ...) and CORBA's pass.
+OpenedReplay OpenReplay(::Caliper::Simulation::Model_ptr model, const std::string& file,
                         bool local, bool force_content);
 
 }  // namespace caliper::client

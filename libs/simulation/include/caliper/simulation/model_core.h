@@ -336,6 +336,8 @@ class ModelCore {
   /// before it, the pull then).
   void RestoreReplayLocked(uint64_t step);
   ReplayStatus ReplayStatusLocked() const;
+  /// No replay any more (a load, an experiment, a fork): its copy sent by content goes too.
+  void EndReplayLocked();
   std::unique_ptr<SessionRecorder> recorder_session_;
   std::unique_ptr<core::ScratchDirectory> replay_copy_;  // a replay sent by content (outlives replay_)
   std::unique_ptr<Replayer> replay_;  // the recording replayed (none: not replaying)
