@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <memory>
 
+#include "caliper/client/session.h"
 #include "caliper/gui_session/tool_window.h"
 #include "selection_panel.h"
 
@@ -459,8 +460,10 @@ QString MainWindow::BinPath(const QString& name) const {
 }
 
 QStringList MainWindow::NameserviceArgs() const {
-  const std::string& ns = link_->options().nameservice;
-  if (ns.empty()) return {};
+  // the tools get the address this window chose (a component started without one would take a
+  // stale $CALIPER_NAMESERVICE as it is)
+  std::string ns = link_->options().nameservice;
+  if (ns.empty()) ns = client::ChooseNamingAddress("").address;
   return {"--nameservice", QString::fromStdString(ns)};
 }
 
