@@ -74,7 +74,8 @@ for _ in $(seq 1 50); do said_full && break; sleep 0.1; done
 if said_full; then pass "the logger says so: $(grep -m1 'cannot write session log' "$WORK/logger.out" | cut -c1-160)..."
 else tail -n 5 "$WORK/logger.out"; fail "the logger did not report the full disk"; fi
 sleep 6  # 600 records, about 90 KiB: more than the sender's spool may hold
-spool_bytes=$(cat "$SPOOL"/sample-"$SAMPLE".spool 2>/dev/null | wc -c)
+# the spool lies in the session's folder below log.spool_dir (a folder per naming service)
+spool_bytes=$(cat "$SPOOL"/*/sample-"$SAMPLE".spool 2>/dev/null | wc -c)
 BOUND=52428  # log.spool_max = 0.05 MiB
 if [ "$spool_bytes" -gt $((BOUND / 2)) ] && [ "$spool_bytes" -le "$BOUND" ]; then
   pass "the sender's spool stays within its bound: $spool_bytes of $BOUND bytes"
