@@ -39,6 +39,9 @@ ROOT = os.path.abspath(os.environ.get("CALIPER_SOURCE_DIR") or
                        os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 PYTHON = "/usr/bin/python3"
 RUN_LANGUAGES = ("sh", "python")
+#: fences that look runnable but are not: refused, so that no command hides from the test
+#: (```py stays allowed: snippets that need the reader's own session, shown, never run)
+SHELL_LOOKALIKES = ("bash", "shell", "zsh", "console", "shell-session")
 DEFAULT_TIMEOUT_S = 300.0
 READY_TIMEOUT_S = 120.0      # the longest wait for a background block's `ready:`
 STOP_GRACE_S = 15.0          # SIGINT -> TERM of background blocks at the end of a page
@@ -204,6 +207,10 @@ def extract(page, display):
             raise PageError(f"{where}: a doc-test marker on a ```{language or '(no language)'} "
                             "block, which is never run")
         pending = None
+        if language in SHELL_LOOKALIKES:
+            # a shell block under another name would silently never run
+            raise PageError(f"{where}: a ```{language} block is never run: write ```sh (run) or "
+                            "```text (output)")
         if language not in RUN_LANGUAGES:
             continue
         if "ready" in options and "background" not in options:

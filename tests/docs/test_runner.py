@@ -87,6 +87,7 @@ FAILING = [
     ("fail_background.md", r"FAILED \(exited \(status 3\) before its output matched ready: is up"),
     ("bad_marker.md", r"bad_marker\.md:4: unknown doc-test option 'retry'"),
     ("bad_fails.md", r"bad_fails\.md:\d+: 'fails' needs 'expect'"),
+    ("bad_fence.md", r"bad_fence\.md:\d+: a ```bash block is never run"),
 ]
 
 

@@ -77,6 +77,10 @@ else fail "hostc/model0 does not answer from hosta"; fi
 if ctl status --model model0@hostc 2>&1 | grep -q "hostc.host_cxt/model0.rtc"; then
   pass "model0@hostc names hostc's model0"
 else fail "model0@hostc does not name hostc's model0"; fi
+# a name that is not bound: the message lists what is, each as INSTANCE@HOST (hosts differ)
+if ctl status --model model9@hostc >"$WORK/nf.out" 2>&1; then fail "model9@hostc found"
+elif grep -q "bound: .*model0@hostc" "$WORK/nf.out"; then pass "an unknown name lists the bound ones as INSTANCE@HOST"
+else cat "$WORK/nf.out"; fail "the unknown name's message does not list INSTANCE@HOST"; fi
 if in_ns b ss -ltn | grep -q '198.51.100.2:'; then pass "hostb's Models listen on 198.51.100.2"
 else fail "nothing listens on 198.51.100.2 in hostb"; fi
 # without TLS: hostc's Models refuse plain GIOP, and so does the naming service

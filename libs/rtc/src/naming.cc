@@ -137,8 +137,12 @@ ComponentEntry FindComponent(CosNaming::NamingContext_ptr root, const std::strin
     if (found == nullptr || e.host == here) found = &e;
   }
   if (found == nullptr) {
+    // with several hosts, each as INSTANCE@HOST (the name that finds it)
+    bool hosts = false;
+    for (const auto& e : entries) hosts = hosts || e.host != entries.front().host;
     std::string known;
-    for (const auto& e : entries) known += (known.empty() ? "" : ", ") + e.instance;
+    for (const auto& e : entries)
+      known += (known.empty() ? "" : ", ") + e.instance + (hosts ? "@" + e.host : std::string());
     throw NotFound("no component named '" + name + "' in the naming service (bound: " +
                    (known.empty() ? std::string("none") : known) + ")");
   }
