@@ -15,9 +15,17 @@ WORK=$(mktemp -d)
 PIDS=()
 cleanup() {
   local p
+  # Ctrl-C lets each launcher shut its session down (components, then the naming service);
+  # KILL only what is still there after 15 s
   for p in "${PIDS[@]}"; do kill -INT "$p" 2>/dev/null; done
-  sleep 1
+  for _ in $(seq 1 150); do
+    local alive=0
+    for p in "${PIDS[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.1
+  done
   for p in "${PIDS[@]}"; do kill -KILL "$p" 2>/dev/null; done
+  pkill -KILL -f "$WORK/" 2>/dev/null  # a component orphaned by a KILLed launcher
   (launcher nameserver stop >/dev/null 2>&1)
   wait 2>/dev/null
   rm -rf "$WORK"
