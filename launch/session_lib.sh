@@ -132,7 +132,7 @@ start_session_recording() {  # FILE
   local out
   for _ in $(seq 1 100); do
     if out=$(ctl recording start "$1" 2>&1); then
-      say "recording the session to $1 (launch/caliper ctl recording stop ends it)"
+      say "recording the session to $(sed -n 's/^.*: recording to //p' <<<"$out") (launch/caliper ctl recording stop ends it)"
       return 0
     fi
     case "$out" in *"no scene"*) sleep 0.1 ;; *) die "--record: $out" ;; esac

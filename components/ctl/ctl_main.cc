@@ -340,8 +340,9 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
             << "Talks to a running Caliper session. The naming service is --nameservice, else\n"
             << "$CALIPER_NAMESERVICE, else the newest session launch/caliper started that still\n"
             << "runs, else the one of `launch/caliper nameserver start`, else\n"
-            << "corbaname::127.0.0.1:2809; a $CALIPER_NAMESERVICE where nothing listens any more\n"
-            << "gives way to a running session, with a note on stderr (`address` says which).\n"
+            << "corbaname::127.0.0.1:2809; a $CALIPER_NAMESERVICE naming a local session that has\n"
+            << "ended gives way to a running session, with a note on stderr (`address` says\n"
+            << "which).\n"
             << "NAME is an instance name (model0), model0@host (as batch summaries print it),\n"
             << "host/model0, or host.host_cxt/model0.rtc.\n"
             << "`inspect` reads a file and needs no session.\n";

@@ -35,17 +35,6 @@ ModelRef ConnectWithLongCalls(Client& client, std::vector<std::string>& args) {
   return m;
 }
 
-// Recordings are .caliper files: FILE without an extension gets it; another extension is kept,
-// with a warning (the Main Window's dialogs and the docs look for .caliper).
-std::string RecordingFileName(const std::string& file) {
-  const std::filesystem::path p(file);
-  if (!p.has_extension()) return file + ".caliper";
-  if (p.extension() != ".caliper")
-    std::cerr << "warning: " << file
-              << ": recordings are .caliper files (the Main Window's dialogs look for them)\n";
-  return file;
-}
-
 // Where the Model reads or writes, for the message when it refuses a path.
 std::string WhereModelWrites(const ModelRef& m) {
   try {
@@ -105,8 +94,9 @@ int RecordingStart(const ModelRef& m, std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError("expected: recording start FILE [options]");
   o.channels.length(static_cast<CORBA::ULong>(channels.size()));
   for (CORBA::ULong i = 0; i < channels.size(); ++i) o.channels[i] = channels[i].c_str();
-  // relative names start from the Model's write directory (the session's files/)
-  const std::string path = RecordingFileName(args[0]);
+  // relative names start from the Model's write directory (the session's files/); the Model
+  // adds .caliper to a name without an extension
+  const std::string& path = args[0];
   M::RecordStatus_var s;
   try {
     s = Call(m, [&] { return m.model->start_recording(path.c_str(), o); });

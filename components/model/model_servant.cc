@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <set>
@@ -617,9 +618,14 @@ M::Selection* ModelServant::current_selection() {
 M::RecordStatus* ModelServant::start_recording(const char* path, const M::RecordOptions& options) {
   return Guard([&] {
     // only into the write directory: a client must not make the Model write any file
+    // one extension for every client: NAME becomes NAME.caliper
+    const std::string named = recording::WithExtension(path);
+    if (std::filesystem::path(named).extension() != recording::kExtension)
+      logging::Get("model").warn("recording to %s: recordings are %s files (the Main Window's "
+                                 "dialogs look for them)", named.c_str(), recording::kExtension);
     std::string where;
     try {
-      where = files_.write.Resolve(path, core::ConfinedPaths::Access::kWrite).string();
+      where = files_.write.Resolve(named, core::ConfinedPaths::Access::kWrite).string();
     } catch (const std::exception& e) {
       throw InvalidValue(std::string("start_recording: ") + e.what());
     }

@@ -34,7 +34,7 @@ def connect(nameservice: Optional[str] = None, timeout_s: float = 5.0) -> Sessio
     """Connects to a Caliper session.
 
     `nameservice` is its naming service, ``corbaname::HOST:PORT``; without it, as caliper-ctl:
-    ``$CALIPER_NAMESERVICE`` (unless nothing listens there and a session runs: then that one,
+    ``$CALIPER_NAMESERVICE`` (unless it names a local session that has ended and one runs: then that,
     with a note on stderr), else the newest session ``launch/caliper session`` (or ``demo``)
     started on this host, else the naming service of ``launch/caliper nameserver start``, else
     ``corbaname::127.0.0.1:2809``. A naming service on another host

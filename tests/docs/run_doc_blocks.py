@@ -48,7 +48,7 @@ STOP_GRACE_S = 15.0          # SIGINT -> TERM of background blocks at the end of
 KILL_GRACE_S = 5.0           # TERM -> KILL
 FINISH_TIMEOUT_S = 60.0      # closing the page's Python interpreter (and its LocalSessions)
 TAIL_LINES = 60
-HOSTS = {"a": "198.51.100.1", "b": "198.51.100.2", "c": "198.51.100.3"}
+HOSTS = ("a", "b", "c")  # 198.51.100.1, .2, .3 (tests/integration/support/netns_hosts.sh)
 OPTION_NAMES = ("skip", "background", "ready", "host", "expect", "fails", "timeout")
 #: what a page keeps of the caller's environment (everything else, CALIPER_NAMESERVICE,
 #: CALIPER_SOCKET_DIR, PYTHONPATH, ..., is left out so that a page starts from nothing)
@@ -333,20 +333,18 @@ def checkout_state():
 
 class Namespaces:
     """Network namespaces "host a/b/c" (198.51.100.1-3/24, lo up) joined by a bridge in a
-    namespace of its own, named with a prefix unique to this run."""
+    namespace of its own, named with a prefix unique to this run: made and removed by
+    tests/integration/support/netns_hosts.sh, the network tests' own definition."""
+
+    SCRIPT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                          "integration", "support", "netns_hosts.sh")
 
     def __init__(self):
         self.prefix = f"cdt{os.getpid()}"
-        self.names = [f"{self.prefix}-br"] + [f"{self.prefix}-{h}" for h in HOSTS]
-        self.made = []
+        self.made = False
 
     def ns(self, host):
         return f"{self.prefix}-{host}"
-
-    def run(self, *args):
-        result = subprocess.run(["ip", *args], capture_output=True, text=True, timeout=20)
-        if result.returncode != 0:
-            raise PageError(f"ip {' '.join(args)}: {result.stderr.strip()}")
 
     def make(self):
         if os.geteuid() != 0:
@@ -355,42 +353,21 @@ class Namespaces:
         if shutil.which("ip") is None:
             raise PageError("the page has host: blocks and there is no 'ip' command "
                             "(apt-get install iproute2)")
-        for name in self.names:
-            self.run("netns", "add", name)
-            self.made.append(name)
-        br = self.names[0]
-        self.run("-n", br, "link", "add", "br0", "type", "bridge")
-        self.run("-n", br, "link", "set", "br0", "up")
-        self.run("-n", br, "link", "set", "lo", "up")
-        for host, address in HOSTS.items():
-            ns = self.ns(host)
-            self.run("-n", br, "link", "add", f"v{host}", "type", "veth", "peer", "name", "eth0",
-                     "netns", ns)
-            self.run("-n", br, "link", "set", f"v{host}", "master", "br0", "up")
-            self.run("-n", ns, "addr", "add", f"{address}/24", "dev", "eth0")
-            self.run("-n", ns, "link", "set", "eth0", "up")
-            self.run("-n", ns, "link", "set", "lo", "up")
+        self.made = True  # whatever part was made goes in cleanup
+        result = subprocess.run(["bash", self.SCRIPT, "make", self.prefix], capture_output=True,
+                                text=True, timeout=60)
+        if result.returncode != 0:
+            raise PageError(f"the network namespaces: {result.stderr.strip()}")
 
     def cleanup(self):
-        for name in self.made:
-            try:
-                pids = subprocess.run(["ip", "netns", "pids", name], capture_output=True,
-                                      text=True, timeout=20).stdout.split()
-            except (OSError, subprocess.TimeoutExpired):
-                pids = []
-            for pid in pids:
-                try:
-                    os.kill(int(pid), signal.SIGKILL)
-                except (ProcessLookupError, ValueError):
-                    pass
-        if self.made:
-            time.sleep(0.2)
-        for name in self.made:
-            try:
-                subprocess.run(["ip", "netns", "del", name], capture_output=True, timeout=20)
-            except (OSError, subprocess.TimeoutExpired):
-                pass
-        self.made = []
+        if not self.made:
+            return
+        try:
+            subprocess.run(["bash", self.SCRIPT, "remove", self.prefix], capture_output=True,
+                           timeout=60)
+        except (OSError, subprocess.TimeoutExpired):
+            pass
+        self.made = False
 
 
 class PageRun:

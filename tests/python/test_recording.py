@@ -83,6 +83,10 @@ def test_start_status_and_stop(session, arm):
     with pytest.raises(caliper.InvalidParameter) as e:  # never overwritten
         arm.start_recording("status.caliper")
     assert "exists" in str(e.value) and "status.caliper" in str(e.value)
+    # one extension, whichever client: the Model names "status" status.caliper, which exists
+    with pytest.raises(caliper.InvalidParameter) as e:
+        arm.start_recording("status")
+    assert "status.caliper" in str(e.value)
 
 
 def test_a_reset_ends_a_recording(arm):

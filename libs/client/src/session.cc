@@ -1,17 +1,12 @@
 #include "caliper/client/session.h"
 
 #include <fcntl.h>
-#include <netdb.h>
-#include <poll.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <cstdlib>
 #include <iostream>
 #include <mutex>
-#include <regex>
 #include <sstream>
 #include <vector>
 
@@ -53,42 +48,12 @@ std::vector<std::string> LiveStateFile(const std::string& file) {
   return lines;
 }
 
-// Whether something listens where `address` (corbaname:omniunix:PATH or corbaname::HOST:PORT,
-// also :iiop:/:ssliop:) points: a unix socket with a listener, a TCP port that accepts within
-// 1 s. Only to tell a stale $CALIPER_NAMESERVICE; an address of another form counts as alive.
-bool NamingListens(const std::string& address) {
-  if (rtc::IsLocalSocketAddress(address))
-    return rtc::LocalSocketListening(rtc::LocalSocketPath(address));
-  static const std::regex kTcp(
-      R"(^corbaname:(?:(?:iiop|ssliop)?:)(?:\d\.\d@)?(\[[^\]]+\]|[^:/#,\[]+)(?::(\d+))?(?:[/#].*)?$)");
-  std::smatch m;
-  if (!std::regex_match(address, m, kTcp)) return true;
-  std::string host = m[1].str();
-  if (host.front() == '[') host = host.substr(1, host.size() - 2);
-  const std::string port = m[2].matched ? m[2].str() : "2809";
-  addrinfo hints{};
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* list = nullptr;
-  const int resolved = getaddrinfo(host.c_str(), port.c_str(), &hints, &list);
-  if (resolved == EAI_AGAIN) return true;  // a passing DNS failure says nothing of the service
-  if (resolved != 0) return false;
-  bool open_port = false;
-  for (addrinfo* a = list; a != nullptr && !open_port; a = a->ai_next) {
-    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd < 0) continue;
-    if (connect(fd, a->ai_addr, a->ai_addrlen) == 0) {
-      open_port = true;
-    } else if (errno == EINPROGRESS) {
-      pollfd p{fd, POLLOUT, 0};
-      int error = 0;
-      socklen_t length = sizeof error;
-      open_port = poll(&p, 1, 1000) == 1 &&
-                  getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &length) == 0 && error == 0;
-    }
-    close(fd);
-  }
-  freeaddrinfo(list);
-  return open_port;
+// A local session's address (corbaname:omniunix:PATH) whose socket nobody listens on any more:
+// what a $CALIPER_NAMESERVICE exported from a session that has ended looks like. A network
+// address someone exported on purpose is kept as it is (its errors name it).
+bool EndedLocalSession(const std::string& address) {
+  return rtc::IsLocalSocketAddress(address) &&
+         !rtc::LocalSocketListening(rtc::LocalSocketPath(address));
 }
 
 }  // namespace
@@ -111,7 +76,7 @@ NamingChoice ChooseNamingAddress(const std::string& option) {
   const char* env = std::getenv("CALIPER_NAMESERVICE");
   if (env != nullptr && *env != '\0') {
     // a variable left from a session that has ended gives way to one that runs
-    if (found.address.empty() || found.address == env || NamingListens(env))
+    if (found.address.empty() || found.address == env || !EndedLocalSession(env))
       return {env, "$CALIPER_NAMESERVICE"};
     found.note = std::string("$CALIPER_NAMESERVICE (") + env + ") does not answer; using " +
                  found.source + ", " + found.address;

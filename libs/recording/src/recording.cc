@@ -1,5 +1,6 @@
 #include "caliper/recording/recording.h"
 
+#include <filesystem>
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/stat.h>
@@ -19,6 +20,11 @@
 #include <variant>
 
 namespace caliper::recording {
+
+std::string WithExtension(const std::string& path) {
+  return std::filesystem::path(path).filename().has_extension() ? path : path + kExtension;
+}
+
 
 namespace {
 

@@ -1,7 +1,8 @@
 # Three "hosts" made of Linux network namespaces, for the network tests (sourced by
 # tests/integration/cluster_test.sh and tls_test.sh):
 #   hosta 198.51.100.1, hostb 198.51.100.2, hostc 198.51.100.3 (eth0/24 and lo up each)
-# joined by a bridge (br0) that lives in a namespace of its own. The sourcing script sets TAG (a
+# joined by a bridge (br0) that lives in a namespace of its own (support/netns_hosts.sh makes
+# and removes them; the documentation tests use it too). The sourcing script sets TAG (a
 # prefix unique to the run, e.g. cl$$) first. Sets BIN and SRC (from CALIPER_BIN_DIR and
 # CALIPER_SOURCE_DIR) and WORK, a new temporary directory; on exit, also when the test skips,
 # cleanup kills every process in the namespaces, deletes them and removes WORK. Also FAILS,
@@ -10,7 +11,6 @@
 BIN=${CALIPER_BIN_DIR:?set CALIPER_BIN_DIR to the bin folder of the build}
 SRC=${CALIPER_SOURCE_DIR:?}
 WORK=$(mktemp -d)
-NETS=("$TAG-br" "$TAG-a" "$TAG-b" "$TAG-c")
 FAILS=0
 trap cleanup EXIT  # cleanup is defined below
 
@@ -19,13 +19,11 @@ fail() { echo "FAIL: $*"; FAILS=$((FAILS + 1)); }
 pass() { echo "ok: $*"; }
 in_ns() { local n=$1; shift; ip netns exec "$TAG-$n" "$@"; }  # N COMMAND...: on host N (a, b, c)
 
+# shellcheck source=netns_hosts.sh
+source "$(dirname "${BASH_SOURCE[0]}")/netns_hosts.sh"
+
 cleanup() {
-  local n p
-  for n in "${NETS[@]}"; do
-    for p in $(ip netns pids "$n" 2>/dev/null); do kill -KILL "$p" 2>/dev/null; done
-  done
-  sleep 0.2
-  for n in "${NETS[@]}"; do ip netns del "$n" 2>/dev/null; done
+  netns_remove "$TAG"
   rm -rf "$WORK"
 }
 
@@ -39,17 +37,5 @@ netns_require() {
 
 # the namespaces, the bridge and the three hosts on it (exit 1 when a namespace cannot be added)
 netns_hosts() {
-  local n h i=1
-  for n in "${NETS[@]}"; do ip netns add "$n" || { echo "FAIL: ip netns add $n"; exit 1; }; done
-  ip -n "$TAG-br" link add br0 type bridge
-  ip -n "$TAG-br" link set br0 up
-  ip -n "$TAG-br" link set lo up
-  for h in a b c; do
-    ip -n "$TAG-br" link add "v$h" type veth peer name eth0 netns "$TAG-$h"
-    ip -n "$TAG-br" link set "v$h" master br0 up
-    ip -n "$TAG-$h" addr add "198.51.100.$i/24" dev eth0
-    ip -n "$TAG-$h" link set eth0 up
-    ip -n "$TAG-$h" link set lo up  # down by default: omniORB would then publish the host name
-    i=$((i + 1))
-  done
+  netns_make "$TAG" || { echo "FAIL: the namespaces of $TAG"; exit 1; }
 }

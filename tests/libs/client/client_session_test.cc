@@ -1,16 +1,16 @@
-// Where a client finds its session: an address given, $CALIPER_NAMESERVICE (unless nothing listens
-// there and a session runs), the newest session the launcher started that still runs, the
-// default; no naming service is needed (a loopback port of this process stands in for one).
+// Where a client finds its session: an address given, $CALIPER_NAMESERVICE (unless it names a local
+// session nobody listens on and a session runs), the newest session the launcher started that
+// still runs, the default; no naming service is needed (a unix socket of this process stands in).
 #include "caliper/client/session.h"
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -57,45 +57,49 @@ TEST_F(SessionAddress, IgnoresAMissingOrMalformedFile) {
   EXPECT_EQ(LatestSession(), "");
 }
 
-// A TCP port of this process that accepts connections (a naming service stand-in: the choice
-// asks only whether something listens).
+// A unix socket of this process that accepts connections, as a local session's naming service
+// (the choice asks only whether something listens there).
 class Listener {
  public:
-  Listener() {
-    fd_ = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t n = sizeof a;
-    if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&a), n) != 0 || listen(fd_, 4) != 0 ||
-        getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &n) != 0)
-      ADD_FAILURE() << "cannot listen on loopback";
-    port_ = ntohs(a.sin_port);
+  explicit Listener(const fs::path& path) : path_(path) {
+    fd_ = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_un a{};
+    a.sun_family = AF_UNIX;
+    std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+    if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
+        listen(fd_, 4) != 0)
+      ADD_FAILURE() << "cannot listen on " << path;
   }
-  ~Listener() { close(fd_); }
-  std::string address() const { return "corbaname::127.0.0.1:" + std::to_string(port_); }
+  ~Listener() {
+    close(fd_);
+    fs::remove(path_);
+  }
+  std::string address() const { return "corbaname:omniunix:" + path_.string(); }
 
  private:
+  fs::path path_;
   int fd_ = -1;
-  int port_ = 0;
 };
 
 TEST_F(SessionAddress, TheVariableAndTheOptionComeFirst) {
-  const Listener live;
+  const Listener live(dir_ / "live.sock");
   WriteLatest("corbaname::127.0.0.1:40123", getpid());
   setenv("CALIPER_NAMESERVICE", live.address().c_str(), 1);
   EXPECT_EQ(ResolveNamingAddress(""), live.address());
   const NamingChoice choice = ChooseNamingAddress("");
   EXPECT_EQ(choice.source, "$CALIPER_NAMESERVICE");
   EXPECT_EQ(choice.note, "");
+  // a network address is kept as exported, answering or not (nothing is probed)
+  setenv("CALIPER_NAMESERVICE", "corbaname::192.0.2.1:2809", 1);
+  EXPECT_EQ(ResolveNamingAddress(""), "corbaname::192.0.2.1:2809");
   EXPECT_EQ(ResolveNamingAddress("corbaname::10.0.0.1:2809"), "corbaname::10.0.0.1:2809");
   unsetenv("CALIPER_NAMESERVICE");
 }
 
-TEST_F(SessionAddress, AVariableWhereNothingListensGivesWayToTheRunningSession) {
+TEST_F(SessionAddress, AnEndedLocalSessionInTheVariableGivesWayToTheRunningSession) {
   std::string gone;
   {
-    const Listener ended;  // a naming service that has ended: its port is closed again
+    const Listener ended(dir_ / "ended.sock");  // a session that has ended: nobody listens
     gone = ended.address();
   }
   WriteLatest("corbaname::127.0.0.1:40123", getpid());

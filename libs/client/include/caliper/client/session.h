@@ -34,8 +34,9 @@ struct NamingChoice {
 
 /// Where a session's naming service is: `option` when given, else $CALIPER_NAMESERVICE, else
 /// the latest session (LatestSession), else the one of `launch/caliper nameserver start`, else
-/// corbaname::127.0.0.1:2809. A $CALIPER_NAMESERVICE where nothing listens (left from a session
-/// that has ended) gives way to the latest session or that naming service, with a note saying so.
+/// corbaname::127.0.0.1:2809. A $CALIPER_NAMESERVICE naming a local session whose socket nobody
+/// listens on any more (exported from a session that has ended) gives way to the latest session
+/// or that naming service, with a note saying so; a network address is always kept.
 NamingChoice ChooseNamingAddress(const std::string& option);
 
 /// ChooseNamingAddress's address; its note, when there is one, goes to stderr (once a process).

@@ -18,6 +18,12 @@
 namespace caliper::recording {
 
 /// A file that cannot be written or read as a recording: the message names the file and why.
+/// Recordings are `.caliper` files (the Main Window's dialogs and the docs look for them).
+inline constexpr const char* kExtension = ".caliper";
+
+/// `path` with `.caliper` added when its file name has no extension; any other is kept.
+std::string WithExtension(const std::string& path);
+
 class RecordingError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
