@@ -20,8 +20,8 @@
 #include <random>
 #include <thread>
 
-#include "caliper/core/system.h"
 #include "caliper/calibration/evaluator.h"
+#include "caliper/core/system.h"
 
 namespace caliper::calibration {
 
@@ -53,6 +53,8 @@ pagmo::algorithm MakeAlgorithm(const Optimiser& o, unsigned seed) {
 
 struct Search::Impl {
   Evaluator* evaluator = nullptr;
+  const Spec* spec = nullptr;
+  unsigned islands = 1;
   uint64_t evaluations_before = 0;  // by earlier runs (a resumed search)
   pagmo::problem problem;
   pagmo::archipelago archipelago;
@@ -66,34 +68,70 @@ Search::Search(const Spec& spec, Evaluator& evaluator, unsigned islands,
                const std::vector<double>& start_unit, double start_cost)
     : impl_(std::make_unique<Impl>()) {
   impl_->evaluator = &evaluator;
+  impl_->spec = &spec;
+  impl_->islands = islands;
   impl_->problem = pagmo::problem(Fit{&evaluator, spec.parameters.size()});
-  // each island: the start and population-1 points around it, evaluated in parallel
-  std::vector<std::future<pagmo::population>> made;
-  for (unsigned i = 0; i < islands; ++i)
-    made.push_back(std::async(std::launch::async, [&, i] {
-      std::mt19937_64 rng(spec.seed * 1000003u + i);
-      std::normal_distribution<double> normal(0.0, spec.optimiser.sigma0);
-      pagmo::population pop(impl_->problem, 0u, static_cast<unsigned>(spec.seed + i));
-      pop.push_back(start_unit, {start_cost});
-      for (unsigned k = 1; k < spec.optimiser.population; ++k) {
-        pagmo::vector_double x = start_unit;
-        for (double& v : x) v = std::clamp(v + normal(rng), 0.0, 1.0);
-        pop.push_back(x);
-      }
-      return pop;
-    }));
-  for (unsigned i = 0; i < islands; ++i)
-    impl_->archipelago.push_back(pagmo::thread_island{false},
-                                 MakeAlgorithm(spec.optimiser, static_cast<unsigned>(spec.seed + i)),
-                                 made[i].get());
+  progress_.population = spec.optimiser.population;
+  Populate(start_unit, start_cost, false);
   progress_.evaluations = impl_->evaluations_before + evaluator.evaluations();
   progress_.history.emplace_back(progress_.evaluations, start_cost);
   Measure();
 }
 
+void Search::Populate(const std::vector<double>& start_unit, double start_cost,
+                      bool random_others) {
+  const Spec& spec = *impl_->spec;
+  const unsigned population = progress_.population;
+  const uint64_t seed = spec.seed + 7919u * progress_.restarts;
+  // each island: the start and population-1 points around it, evaluated in parallel; after a
+  // restart the other islands start from random points of the box
+  std::vector<std::future<pagmo::population>> made;
+  for (unsigned i = 0; i < impl_->islands; ++i)
+    made.push_back(std::async(std::launch::async, [&, i] {
+      std::mt19937_64 rng(seed * 1000003u + i);
+      std::uniform_real_distribution<double> uniform(0.0, 1.0);
+      std::vector<double> centre = start_unit;
+      if (random_others && i > 0)
+        for (double& v : centre) v = uniform(rng);
+      std::normal_distribution<double> normal(0.0, spec.optimiser.sigma0);
+      pagmo::population pop(impl_->problem, 0u, static_cast<unsigned>(seed + i));
+      if (i == 0 || !random_others)
+        pop.push_back(start_unit, {start_cost});
+      else
+        pop.push_back(centre);
+      for (unsigned k = 1; k < population; ++k) {
+        pagmo::vector_double x = centre;
+        for (double& v : x) v = std::clamp(v + normal(rng), 0.0, 1.0);
+        pop.push_back(x);
+      }
+      return pop;
+    }));
+  impl_->archipelago = pagmo::archipelago();
+  for (unsigned i = 0; i < impl_->islands; ++i)
+    impl_->archipelago.push_back(pagmo::thread_island{false},
+                                 MakeAlgorithm(spec.optimiser, static_cast<unsigned>(seed + i)),
+                                 made[i].get());
+}
+
+void Search::Restart() {
+  ++progress_.restarts;
+  progress_.population *= 2;
+  progress_.restart_generation = progress_.generation;
+  Populate(progress_.best_unit, progress_.best_cost, true);
+  progress_.evaluations = impl_->evaluations_before + impl_->evaluator->evaluations();
+  Measure();
+}
+
+std::vector<double> Progress::CostsSinceRestart() const {
+  std::vector<double> out;
+  for (size_t g = restart_generation; g < history.size(); ++g) out.push_back(history[g].second);
+  return out;
+}
+
 Search::Search(const Spec& spec, Evaluator& evaluator, const std::string& checkpoint)
     : impl_(std::make_unique<Impl>()) {
   impl_->evaluator = &evaluator;
+  impl_->spec = &spec;
   impl_->problem = pagmo::problem(Fit{&evaluator, spec.parameters.size()});
   std::ifstream in(checkpoint);
   if (!in) throw std::runtime_error(checkpoint + ": cannot be read");
@@ -105,7 +143,9 @@ Search::Search(const Spec& spec, Evaluator& evaluator, const std::string& checkp
       throw std::runtime_error(checkpoint + ": " + std::to_string(dimension) +
                                " parameters, the calibration file has " +
                                std::to_string(spec.parameters.size()));
-    archive >> progress_.generation >> progress_.history;
+    archive >> progress_.generation >> progress_.history >> progress_.restarts >>
+        progress_.population >> progress_.restart_generation;
+    impl_->islands = static_cast<unsigned>(islands);
     uint64_t evaluations = 0;
     archive >> evaluations >> progress_.best_cost >> progress_.best_unit;
     for (size_t i = 0; i < islands; ++i) {
@@ -129,6 +169,7 @@ void Search::Save(const std::string& path) const {
     boost::archive::text_oarchive archive(out);
     const size_t dimension = impl_->problem.get_nx(), islands = impl_->archipelago.size();
     archive << dimension << islands << progress_.generation << progress_.history
+            << progress_.restarts << progress_.population << progress_.restart_generation
             << progress_.evaluations << progress_.best_cost << progress_.best_unit;
     for (const auto& island : impl_->archipelago) {
       const pagmo::algorithm algorithm = island.get_algorithm();

@@ -18,12 +18,17 @@ class Evaluator;
 
 /// Where the search stands after a generation.
 struct Progress {
-  unsigned generation = 0;          // completed
+  unsigned generation = 0;  // completed
   uint64_t evaluations = 0;
-  double best_cost = 0;              // the best found so far
-  std::vector<double> best_unit;    // its candidate in [0, 1]^n
-  double spread = 0;                // mean standard deviation of the populations in [0, 1]
+  double best_cost = 0;           // the best found so far
+  std::vector<double> best_unit;  // its candidate in [0, 1]^n
+  double spread = 0;              // mean standard deviation of the populations in [0, 1]
   std::vector<std::pair<uint64_t, double>> history;  // (evaluations, best cost) per generation
+  unsigned restarts = 0;                             // IPOP restarts so far
+  unsigned population = 0;                           // per island, now
+  unsigned restart_generation = 0;  // the generation the current populations started at
+  /// The best cost per generation since the last restart (the start of it first).
+  std::vector<double> CostsSinceRestart() const;
 };
 
 class Search {
@@ -40,6 +45,9 @@ class Search {
   bool Generation(const std::function<bool()>& interrupted);
   const Progress& progress() const { return progress_; }
   unsigned islands() const;
+  /// IPOP: new populations twice as large, the first island around the best so far, the
+  /// others from random points of the box (seeded), the step size back to sigma0.
+  void Restart();
   /// Everything needed to go on: algorithms with their adapted state, populations, progress
   /// (Boost.Serialization text archive, written whole or not at all).
   void Save(const std::string& path) const;
@@ -49,6 +57,7 @@ class Search {
   std::unique_ptr<Impl> impl_;
   Progress progress_;
   void Measure();
+  void Populate(const std::vector<double>& start_unit, double start_cost, bool random_others);
 };
 
 }  // namespace caliper::calibration

@@ -126,12 +126,10 @@ Spec LoadSpec(const std::string& path) {
   } catch (const boost::property_tree::json_parser_error& e) {
     throw SpecError(path + ":" + std::to_string(e.line()) + ": " + e.message());
   }
-  static const std::set<std::string> kKeys = {"experiments", "measured", "parameters",
-                                              "channels",    "optimiser", "seed"};
-  for (const auto& [key, child] : root)
-    if (!kKeys.count(key))
-      Fail(path, "unknown key '" + key + "' (known: experiments, measured, parameters, "
-                 "channels, optimiser, seed)");
+  RejectUnknownKeys(root,
+                    {"experiments", "measured", "parameters", "channels", "optimiser", "refinement",
+                     "uncertainty", "held_out", "seed"},
+                    path);
   Spec spec;
   spec.file = path;
   const std::string runs = root.get<std::string>("experiments", "");
@@ -143,9 +141,9 @@ Spec LoadSpec(const std::string& path) {
   }
   const auto measured = root.get_child_optional("measured");
   for (const auto& e : spec.experiments) {
-    const auto file = measured ? measured->get_optional<std::string>(
-                                     boost::property_tree::path(e.name, '\0'))
-                               : boost::none;
+    const auto file =
+        measured ? measured->get_optional<std::string>(boost::property_tree::path(e.name, '\0'))
+                 : boost::none;
     if (!file) Fail(path, "measured: no file for experiment '" + e.name + "'");
     try {
       spec.measured.push_back(LoadMeasured(Resolve(*file, path)));
@@ -163,6 +161,21 @@ Spec LoadSpec(const std::string& path) {
     if (p.id.empty()) Fail(path, "parameters: an entry without \"id\"");
     RejectUnknownKeys(node, {"id", "lower", "upper", "scale"}, where);
     if (!ids.insert(p.id).second) Fail(where, "listed twice");
+    const auto colon = p.id.find(':');
+    const std::string kind = colon == std::string::npos ? "" : p.id.substr(0, colon);
+    if (p.id == "time_shift") {
+      p.kind = ParameterKind::kTimeShift;
+    } else if (kind == "sensor_delay" || kind == "command_delay") {
+      p.kind = kind == "sensor_delay" ? ParameterKind::kSensorDelay : ParameterKind::kCommandDelay;
+      p.target = p.id.substr(colon + 1);
+      if (p.target.empty())
+        Fail(where, kind == "sensor_delay" ? "name the measured column: sensor_delay:CHANNEL"
+                                           : "name the actuator: command_delay:ACTUATOR");
+    } else if (!kind.empty()) {
+      Fail(where, "unknown kind '" + kind +
+                      ":' (time_shift, sensor_delay:CHANNEL, "
+                      "command_delay:ACTUATOR, or a scene parameter's id)");
+    }
     p.lower = Number(node.get<std::string>("lower", ""), where + ": lower");
     p.upper = Number(node.get<std::string>("upper", ""), where + ": upper");
     const std::string scale = node.get<std::string>("scale", "linear");
@@ -174,6 +187,15 @@ Spec LoadSpec(const std::string& path) {
     if (!std::isfinite(p.log_scale ? p.upper / p.lower : p.upper - p.lower))
       Fail(where, p.log_scale ? "upper / lower is too large for a log scale"
                               : "upper - lower is too large");
+    if (p.kind == ParameterKind::kSensorDelay || p.kind == ParameterKind::kCommandDelay)
+      if (p.lower < 0) Fail(where, "a delay cannot be negative: lower >= 0");
+    if (p.kind == ParameterKind::kSensorDelay) {
+      bool measured_somewhere = false;
+      for (const auto& m : spec.measured)
+        measured_somewhere = measured_somewhere || std::find(m.columns.begin(), m.columns.end(),
+                                                             p.target) != m.columns.end();
+      if (!measured_somewhere) Fail(where, "no measured file has a column '" + p.target + "'");
+    }
     spec.parameters.push_back(p);
   }
   if (const auto channels = root.get_child_optional("channels"))
@@ -187,7 +209,8 @@ Spec LoadSpec(const std::string& path) {
       if (!(w.weight >= 0)) Fail(where, "weight must be >= 0");
       if (const auto window = node.get_child_optional("window_s")) {
         std::vector<double> bounds;
-        for (const auto& [k2, b] : *window) bounds.push_back(Number(b.data(), where + ": window_s"));
+        for (const auto& [k2, b] : *window)
+          bounds.push_back(Number(b.data(), where + ": window_s"));
         if (bounds.size() != 2 || !(bounds[0] < bounds[1]))
           Fail(where, "window_s is [from, to] with from < to");
         w.from_s = bounds[0];
@@ -197,19 +220,75 @@ Spec LoadSpec(const std::string& path) {
     }
   if (const auto o = root.get_child_optional("optimiser")) {
     const std::string where = path + ": optimiser";
-    RejectUnknownKeys(*o, {"algorithm", "generations", "population", "sigma0"}, where);
+    RejectUnknownKeys(*o,
+                      {"algorithm", "generations", "population", "sigma0", "window",
+                       "cost_tolerance", "step_tolerance", "target_cost", "restarts"},
+                      where);
     spec.optimiser.algorithm = o->get<std::string>("algorithm", "cmaes");
     if (spec.optimiser.algorithm != "cmaes" && spec.optimiser.algorithm != "xnes")
       Fail(where, "algorithm is cmaes or xnes (pagmo's evolution strategies)");
     const double generations = Number(o->get<std::string>("generations", "40"), where);
     const double population = Number(o->get<std::string>("population", "10"), where);
-    if (generations < 1 || generations > 1e6 || population < 5 || population > 1e4)
-      Fail(where, "generations >= 1, population >= 5 (CMA-ES needs a few)");
+    if (generations < 0 || generations > 1e6 || population < 5 || population > 1e4)
+      Fail(where, "generations >= 0 (0: no global search), population >= 5 (CMA-ES needs a few)");
     spec.optimiser.generations = static_cast<unsigned>(generations);
     spec.optimiser.population = static_cast<unsigned>(population);
     spec.optimiser.sigma0 = Number(o->get<std::string>("sigma0", "0.25"), where + ": sigma0");
     if (!(spec.optimiser.sigma0 > 0 && spec.optimiser.sigma0 <= 1))
       Fail(where, "sigma0 is in (0, 1] (the search space is scaled to [0, 1])");
+    const double window = Number(o->get<std::string>("window", "20"), where + ": window");
+    if (!(window >= 2 && window <= 1e6)) Fail(where + ": window", "generations, from 2");
+    spec.optimiser.window = static_cast<unsigned>(window);
+    spec.optimiser.cost_tolerance =
+        Number(o->get<std::string>("cost_tolerance", "1e-6"), where + ": cost_tolerance");
+    spec.optimiser.step_tolerance =
+        Number(o->get<std::string>("step_tolerance", "1e-4"), where + ": step_tolerance");
+    spec.optimiser.target_cost =
+        Number(o->get<std::string>("target_cost", "0"), where + ": target_cost");
+    if (spec.optimiser.cost_tolerance < 0 || spec.optimiser.step_tolerance < 0 ||
+        spec.optimiser.target_cost < 0)
+      Fail(where, "cost_tolerance, step_tolerance and target_cost are >= 0");
+    const double restarts = Number(o->get<std::string>("restarts", "2"), where + ": restarts");
+    if (!(restarts >= 0 && restarts <= 20)) Fail(where + ": restarts", "from 0 to 20");
+    spec.optimiser.restarts = static_cast<unsigned>(restarts);
+  }
+  if (const auto r = root.get_child_optional("refinement")) {
+    const std::string where = path + ": refinement";
+    RejectUnknownKeys(*r, {"iterations", "jacobian", "step"}, where);
+    const double iterations =
+        Number(r->get<std::string>("iterations", "30"), where + ": iterations");
+    if (!(iterations >= 0 && iterations <= 10000)) Fail(where, "iterations from 0 (off) to 10000");
+    spec.refinement.iterations = static_cast<unsigned>(iterations);
+    const std::string jacobian = r->get<std::string>("jacobian", "central");
+    if (jacobian != "central" && jacobian != "forward")
+      Fail(where, "jacobian is central or forward (finite differences)");
+    spec.refinement.central = jacobian == "central";
+    spec.refinement.step = Number(r->get<std::string>("step", "1e-3"), where + ": step");
+    if (!(spec.refinement.step > 0 && spec.refinement.step <= 0.1))
+      Fail(where, "step is in (0, 0.1] of the unit search space");
+  }
+  if (const auto u = root.get_child_optional("uncertainty")) {
+    const std::string where = path + ": uncertainty";
+    RejectUnknownKeys(*u, {"max_relative_interval", "max_correlation"}, where);
+    spec.uncertainty.max_relative_interval = Number(
+        u->get<std::string>("max_relative_interval", "0.1"), where + ": max_relative_interval");
+    spec.uncertainty.max_correlation =
+        Number(u->get<std::string>("max_correlation", "0.95"), where + ": max_correlation");
+    if (!(spec.uncertainty.max_relative_interval > 0) ||
+        !(spec.uncertainty.max_correlation > 0 && spec.uncertainty.max_correlation <= 1))
+      Fail(where, "max_relative_interval > 0, max_correlation in (0, 1]");
+  }
+  spec.held_out.assign(spec.experiments.size(), false);
+  if (const auto h = root.get_child_optional("held_out")) {
+    for (const auto& [k, node] : *h) {
+      const std::string name = node.data();
+      size_t i = 0;
+      while (i < spec.experiments.size() && spec.experiments[i].name != name) ++i;
+      if (i == spec.experiments.size())
+        Fail(path + ": held_out", "no experiment named '" + name + "'");
+      spec.held_out[i] = true;
+    }
+    if (spec.Fitted() == 0) Fail(path + ": held_out", "every experiment is held out: none to fit");
   }
   const double seed = Number(root.get<std::string>("seed", "1"), path + ": seed");
   // exactly representable whole numbers only (a cast of a negative or larger one is undefined)
@@ -229,7 +308,8 @@ std::vector<std::string> ColumnNames(const std::vector<experiment::Channel>& cha
     }
     for (uint32_t k = 0; k < n; ++k) {
       if (c.rows > 1 && c.cols > 1)
-        out.push_back(c.id + "[" + std::to_string(k / c.cols) + "][" + std::to_string(k % c.cols) + "]");
+        out.push_back(c.id + "[" + std::to_string(k / c.cols) + "][" + std::to_string(k % c.cols) +
+                      "]");
       else
         out.push_back(c.id + "[" + std::to_string(k) + "]");
     }
@@ -237,8 +317,23 @@ std::vector<std::string> ColumnNames(const std::vector<experiment::Channel>& cha
   return out;
 }
 
+size_t Spec::Fitted() const {
+  return static_cast<size_t>(std::count(held_out.begin(), held_out.end(), false));
+}
+
+Timing TimingOf(const std::vector<Parameter>& parameters, const std::vector<double>& values) {
+  Timing t;
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    if (parameters[i].kind == ParameterKind::kTimeShift) t.shift_s += values[i];
+    if (parameters[i].kind == ParameterKind::kSensorDelay)
+      t.sensor_delay_s[parameters[i].target] += values[i];
+  }
+  return t;
+}
+
 std::vector<ChannelCost> CompareRecording(const experiment::Recording& sim, const Measured& m,
-                                          const std::map<std::string, ChannelWeight>& weights) {
+                                          const std::map<std::string, ChannelWeight>& weights,
+                                          const Timing& timing, std::vector<double>* residuals) {
   const std::vector<std::string> columns = ColumnNames(sim.channels);
   std::vector<ChannelCost> out;
   for (size_t c = 0; c < columns.size(); ++c) {
@@ -249,15 +344,22 @@ std::vector<ChannelCost> CompareRecording(const experiment::Recording& sim, cons
     if (const auto it = weights.find(columns[c]); it != weights.end()) w = it->second;
     ChannelCost cost;
     cost.column = columns[c];
+    cost.unit = m.units[k];
     cost.weight = w.weight;
+    double offset = timing.shift_s;
+    if (const auto d = timing.sensor_delay_s.find(columns[c]); d != timing.sensor_delay_s.end())
+      offset += d->second;
     const auto [lo, hi] = std::minmax_element(m.values[k].begin(), m.values[k].end());
     cost.range = std::max(*hi - *lo, 1e-12);
     double sum = 0;
     for (size_t i = 0; i < sim.times.size(); ++i) {
       const double t = sim.times[i];
       if (t < m.times.front() || t > m.times.back() || t < w.from_s || t > w.to_s) continue;
-      const double d = sim.data[i * sim.values_per_sample + c] - m.At(k, t);
+      // the real sensor read the state at t at t + offset; which samples count does not
+      // depend on the offset (a fixed residual vector), At holds the ends
+      const double d = sim.data[i * sim.values_per_sample + c] - m.At(k, t + offset);
       sum += d * d;
+      if (residuals) residuals->push_back(d);
       ++cost.samples;
     }
     // not finite: the caller treats the candidate as faulted (see Cost)
@@ -275,8 +377,9 @@ double Cost(const std::vector<ChannelCost>& channels) {
     weights += c.weight;
   }
   if (!(weights > 0))
-    throw SpecError("no recorded channel has measurements to compare with (the measured "
-                    "columns must be named like the recorded ids)");
+    throw SpecError(
+        "no recorded channel has measurements to compare with (the measured "
+        "columns must be named like the recorded ids)");
   return std::sqrt(sum / weights);
 }
 
@@ -284,8 +387,18 @@ experiment::Experiment WithParameters(const experiment::Experiment& e,
                                       const std::vector<Parameter>& parameters,
                                       const std::vector<double>& values) {
   experiment::Experiment out = e;
-  for (size_t i = 0; i < parameters.size(); ++i)
-    out.overrides.push_back({parameters[i].id, {values[i]}});
+  bool delayed = false;
+  for (size_t i = 0; i < parameters.size(); ++i) {
+    if (parameters[i].kind == ParameterKind::kScene)
+      out.overrides.push_back({parameters[i].id, {values[i]}});
+    if (parameters[i].kind != ParameterKind::kCommandDelay) continue;
+    for (auto& c : out.schedule)
+      if (c.actuator == parameters[i].target) c.time_s += values[i];
+    delayed = true;
+  }
+  if (delayed)
+    std::stable_sort(out.schedule.begin(), out.schedule.end(),
+                     [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
   return out;
 }
 

@@ -6,9 +6,11 @@
 
 #include <atomic>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "caliper/calibration/analysis.h"
 #include "caliper/calibration/calibration.h"
 #include "caliper/client/model_pool.h"
 
@@ -18,13 +20,24 @@ namespace caliper::calibration {
 /// so that the optimiser keeps working.
 constexpr double kFaultCost = 1e3;
 
-/// One candidate's outcome: its cost and, when asked for, the recordings.
+/// One candidate's outcome: its cost and, when asked for, the recordings and residuals.
 struct Evaluation {
-  double cost = 0;
+  double cost = 0;            // of the fitted experiments
+  double held_out_cost = -1;  // of the held-out ones, when evaluated (-1: not)
   bool faulted = false;
   std::string fault;
-  std::vector<experiment::Recording> recordings;  // per experiment
-  std::vector<ChannelCost> channels;
+  std::vector<experiment::Recording> recordings;  // per experiment evaluated, in file order
+  std::vector<size_t> recorded;                   // their experiment indices
+  std::vector<ChannelCost> channels;              // fitted experiments' channels
+  std::vector<ChannelCost> held_out_channels;
+  std::vector<double> residuals;      // fitted: simulated - measured, per sample
+  std::vector<ResidualBlock> blocks;  // their channels
+};
+
+struct EvaluateOptions {
+  bool keep_recordings = false;
+  bool residuals = false;
+  bool held_out = false;  // also run the held-out experiments
 };
 
 class Evaluator {
@@ -32,6 +45,15 @@ class Evaluator {
   Evaluator(const Spec& spec, client::ModelPool& pool);
   /// The candidate with parameter values (in their units); thread-safe.
   Evaluation Evaluate(const std::vector<double>& values, bool keep_recordings = false);
+  Evaluation Evaluate(const std::vector<double>& values, const EvaluateOptions& options);
+  /// Several candidates at once, each on a free Model (a thread per candidate, at most one per
+  /// Model of the pool at a time).
+  std::vector<Evaluation> EvaluateMany(const std::vector<std::vector<double>>& values,
+                                       const EvaluateOptions& options);
+  /// The weighted residuals (their squares sum to the cost squared) of unit points, in parallel;
+  /// nullopt for a faulted one: the refinement's batch.
+  std::vector<std::optional<std::vector<double>>> WeightedResiduals(
+      const std::vector<std::vector<double>>& units);
   /// The same from the unit search space [0, 1]^n.
   double CostOfUnit(const std::vector<double>& unit);
   std::vector<double> ValuesOf(const std::vector<double>& unit) const;
