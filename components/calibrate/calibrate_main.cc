@@ -124,8 +124,8 @@ Options Parse(int argc, char** argv) {
   return o;
 }
 
-// The parameters' values in the scene as it is (asked of a Model).
-std::vector<double> SceneValues(const Spec& spec, client::ModelPool& pool) {
+// The parameters' values in the scene as it is (asked of a Model), and their units into `spec`.
+std::vector<double> SceneValues(Spec& spec, client::ModelPool& pool) {
   // a URDF is imported here and sent converted: its import warnings are said here, once
   std::vector<std::string> warnings;
   const std::string bytes = client::ReadScene(spec.experiments.front().scene, &warnings);
@@ -149,6 +149,9 @@ std::vector<double> SceneValues(const Spec& spec, client::ModelPool& pool) {
         if (got[k].data.length() != 1)
           throw client::SetupError(spec.parameters[scene[k]].id + " is not a scalar parameter");
         values[scene[k]] = got[k].data[0];
+        ::Caliper::Daq::ChannelInfoSeq_var info =
+            model->channels(spec.parameters[scene[k]].id.c_str());
+        if (info->length() == 1) spec.parameters[scene[k]].unit = info[0].unit.in();
       }
     } catch (const M::LoadFailed& e) {
       throw client::SetupError(e.reason.in());
@@ -157,6 +160,8 @@ std::vector<double> SceneValues(const Spec& spec, client::ModelPool& pool) {
     } catch (const ::Caliper::Daq::UnknownId& e) {
       throw client::SetupError(std::string(e.reason.in()) + " (a parameter to fit)");
     } catch (const ::Caliper::Daq::NotAvailable& e) {
+      throw client::SetupError(e.reason.in());
+    } catch (const ::Caliper::Daq::LimitExceeded& e) {
       throw client::SetupError(e.reason.in());
     }
   });
@@ -466,13 +471,13 @@ std::vector<Plot> WriteParameters(const Options& o, const Spec& spec, const Outc
 HtmlReport MakeReport(const Options& o, const Spec& spec, const Outcome& r,
                       const std::vector<Plot>& cost, const ChannelPlots& channels) {
   HtmlReport h;
-  h.title = "Calibration: " + fs::path(o.file).filename().string();
+  h.title = fs::path(o.file).filename().string();
   const auto add = [&](const std::string& k, const std::string& v) {
     h.summary.emplace_back(k, v);
   };
   add("calibration file", fs::absolute(o.file).string());
-  add("result", std::string(r.converged ? "converged" : "NOT CONVERGED") + ": " +
-                    (r.refine_reason.empty() ? r.global_reason : r.refine_reason));
+  const std::string reason = r.refine_reason.empty() ? r.global_reason : r.refine_reason;
+  add("result", r.converged ? reason : "NOT CONVERGED: " + reason);
   add("global search", r.global_reason + " (" + std::to_string(r.generations) + " generations, " +
                            std::to_string(r.restarts) + " restarts)");
   if (!r.refine_reason.empty())
@@ -715,7 +720,10 @@ int Run(const Options& o) {
     ro.on_iteration = [&](const RefineProgress& p) {
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_begin).count();
-      r.refine_history.emplace_back(evaluations_before + p.evaluations, p.cost);
+      // the best so far (a rejected step's trial cost is not progress)
+      const double best =
+          r.refine_history.empty() ? p.cost : std::min(p.cost, r.refine_history.back().second);
+      r.refine_history.emplace_back(evaluations_before + p.evaluations, best);
       std::cerr << "refine " << done_before + p.iteration << "/" << spec.refinement.iterations
                 << "  evals " << evaluations_before + p.evaluations << "  "
                 << Format(p.evaluations / std::max(elapsed, 1e-9), 3) << " evals/s  cost "

@@ -21,7 +21,7 @@ from .model import (Actuator, ActuatorState, Channel, Data, EditStatus, Feed, Mo
                     ReplayStatus, Status)
 from .recording import Event, LogRecord, Recording, SceneVersion, verify
 from .experiments import Batch, load_experiments, run_batch
-from .calibration import Calibration, Evaluation
+from .calibration import Calibration, CalibrationResult, Evaluation, calibrate
 from .env import TendonEnv, VectorEnv
 from .spaces import Box
 
@@ -31,7 +31,8 @@ __all__ = [
     "connect", "Session", "LocalSession", "Component", "Model", "Status", "Channel", "Actuator",
     "ActuatorState", "EditStatus", "RecordStatus", "ReplayStatus", "Data", "Feed", "Recording",
     "Event", "LogRecord", "SceneVersion", "verify", "load_experiments", "run_batch", "Batch",
-    "Calibration", "Evaluation", "TendonEnv", "VectorEnv", "Box", "binary", "cli", "errors",
-    "Error", "ConnectionError", "UnknownId", "InvalidParameter", "NotAvailable", "LoadFailed",
-    "LimitExceeded", "RunFailed", "EditRefused", "SetupError", "FormatError", "RecordingError",
+    "Calibration", "Evaluation", "calibrate", "CalibrationResult", "TendonEnv", "VectorEnv", "Box",
+    "binary", "cli", "errors", "Error", "ConnectionError", "UnknownId", "InvalidParameter",
+    "NotAvailable", "LoadFailed", "LimitExceeded", "RunFailed", "EditRefused", "SetupError",
+    "FormatError", "RecordingError",
 ]

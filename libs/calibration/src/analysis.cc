@@ -136,7 +136,7 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
 
   // per row: the cost's weight a and the noise variance s^2
   const std::vector<double> scales = BlockScales(blocks);
-  Eigen::VectorXd a(m), s2(m);
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(m), s2 = Eigen::VectorXd::Zero(m);
   for (size_t b = 0; b < blocks.size(); ++b)
     for (size_t i = 0; i < blocks[b].samples; ++i) {
       a(static_cast<Eigen::Index>(blocks[b].begin + i)) = scales[b];
@@ -268,14 +268,20 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
           id(j) + ": only a combination of it" + (with.empty() ? "" : " with " + with) +
           " is determined by these experiments (their effects on every channel are "
           "proportional); fix one of them, or add an experiment where they act differently");
-    } else if (1.96 * pu.sigma > options.max_relative_interval * std::abs(pu.value)) {
-      out.warnings.push_back(id(j) + ": its 95 % interval is +-" + Format(1.96 * pu.sigma) + " (" +
-                             Percent(1.96 * pu.sigma / std::abs(pu.value)) +
-                             " of the value, more than " + Percent(options.max_relative_interval) +
-                             "); the channel that moves most with it is " +
-                             pu.most_sensitive_channel +
-                             ": longer or stronger excitation there, or a higher weight, would "
-                             "pin it");
+    } else if (const Parameter& q = spec.parameters[static_cast<size_t>(j)];
+               // a timing parameter's value may be near 0: its search range is the scale
+               1.96 * pu.sigma >
+               options.max_relative_interval *
+                   (q.kind == ParameterKind::kScene ? std::abs(pu.value) : q.upper - q.lower)) {
+      const bool timing = q.kind != ParameterKind::kScene;
+      const double scale = timing ? q.upper - q.lower : std::abs(pu.value);
+      out.warnings.push_back(
+          id(j) + ": its 95 % interval is +-" + Format(1.96 * pu.sigma) + " (" +
+          Percent(1.96 * pu.sigma / scale) + (timing ? " of its search range" : " of the value") +
+          ", more than " + Percent(options.max_relative_interval) +
+          "); the channel that moves most with it is " + pu.most_sensitive_channel +
+          ": longer or stronger excitation there, or a higher weight, would "
+          "pin it");
     }
   }
   for (Eigen::Index i = 0; i < n; ++i)

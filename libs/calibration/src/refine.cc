@@ -145,7 +145,8 @@ class Callback : public ceres::IterationCallback {
       p.iteration = static_cast<unsigned>(summary.iteration);
       p.cost = std::sqrt(2 * summary.cost);
       p.evaluations = f_.evaluations();
-      p.unit = x_;
+      p.unit = x_;  // Ceres' point may lie beyond the box; the residuals are those of its clamp
+      for (double& v : p.unit) v = std::clamp(v, 0.0, 1.0);
       options_.on_iteration(p);
     }
     if (options_.interrupted && options_.interrupted()) {

@@ -56,8 +56,9 @@ struct Parameter {
   bool log_scale = false;       // search log(value) uniformly
   ParameterKind kind = ParameterKind::kScene;
   std::string target;  // the channel or actuator of a delay
-  /// The unit shown for it: "s" for the timing ones, "" (the scene's) otherwise.
-  std::string Unit() const { return kind == ParameterKind::kScene ? "" : "s"; }
+  std::string unit;    // a scene parameter's, as its Model gives it
+  /// The unit shown for it: "s" for the timing ones, the scene's otherwise.
+  std::string Unit() const { return kind == ParameterKind::kScene ? unit : "s"; }
   /// The value at `u` in [0, 1] of the search space, and back.
   double FromUnit(double u) const;
   double ToUnit(double value) const;
