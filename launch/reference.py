@@ -284,7 +284,8 @@ FILE_FORMATS = [
             "`launch/caliper slurm calibrate`). Names an experiment file, a measured CSV per "
             "experiment and the parameters to fit with their bounds. Paths are relative to the "
             "file. An unknown key is an error, at the top level and inside `parameters`, "
-            "`channels` and `optimiser` (a typo is never taken for a default)."),
+            "`channels`, `optimiser`, `refinement` and `uncertainty` (a typo is never taken for "
+            "a default)."),
         "keys": [
             ("experiments", "string (path)", "required", "",
              "the experiment file (format above): scene, schedules, recorded ids, durations"),
@@ -294,7 +295,9 @@ FILE_FORMATS = [
             ("parameters", "list of objects", "required (at least one)", "",
              "the parameters to fit"),
             ("parameters[].id", "string", "required", "", "the parameter's id "
-             "(`caliper-ctl params`); each once"),
+             "(`caliper-ctl params`); each once. Or a timing parameter [s]: `time_shift` (the "
+             "measurements' clock minus the simulation's), `sensor_delay:CHANNEL` (that measured "
+             "column lags), `command_delay:ACTUATOR` (that actuator acts late)"),
             ("parameters[].lower", "number", "required", "the parameter's unit",
              "lower bound of the search"),
             ("parameters[].upper", "number", "required", "the parameter's unit",
@@ -312,11 +315,40 @@ FILE_FORMATS = [
             ("optimiser.algorithm", "`cmaes` or `xnes`", "default `cmaes`", "",
              "pagmo's evolution strategy"),
             ("optimiser.generations", "integer", "default 40", "",
-             "generations (>= 1); `--generations N` overrides it"),
+             "the budget of generations (>= 0; 0: no global search); `--generations N` "
+             "overrides it"),
             ("optimiser.population", "integer", "default 10", "",
              "candidates per island and generation (>= 5)"),
             ("optimiser.sigma0", "number", "default 0.25", "",
              "initial step in the search space scaled to [0, 1], in (0, 1]"),
+            ("optimiser.window", "integer", "default 20", "generations",
+             "the window over which the cost's change is judged (>= 2)"),
+            ("optimiser.cost_tolerance", "number", "default 1e-6", "",
+             "converged when the best cost changed less than this, relatively, over the window"),
+            ("optimiser.step_tolerance", "number", "default 1e-4", "",
+             "converged when the populations' spread in the unit box is below this"),
+            ("optimiser.target_cost", "number", "default 0 (none)", "",
+             "converged when the best cost is this low"),
+            ("optimiser.restarts", "integer", "default 2", "",
+             "IPOP restarts (populations doubled) when the search stalls above twice the "
+             "measurements' noise floor (0 to 20)"),
+            ("refinement", "object", "default: the values below", "",
+             "the Levenberg-Marquardt refinement (Ceres) after the global search"),
+            ("refinement.iterations", "integer", "default 30", "",
+             "its budget (0: no refinement); `--iterations N` overrides it"),
+            ("refinement.jacobian", "`central` or `forward`", "default `central`", "",
+             "finite differences: 2 or 1 runs per parameter, one batch over every Model"),
+            ("refinement.step", "number", "default 1e-3", "",
+             "the finite-difference step in the unit box, in (0, 0.1]"),
+            ("uncertainty", "object", "default: the values below", "",
+             "when the fit's intervals and correlations are warned about"),
+            ("uncertainty.max_relative_interval", "number", "default 0.1", "",
+             "warn when a 95 % half-width exceeds this fraction of the value (of the search "
+             "range for a timing parameter)"),
+            ("uncertainty.max_correlation", "number", "default 0.95", "",
+             "warn when two parameters' |correlation| exceeds this, in (0, 1]"),
+            ("held_out", "list of experiment names", "default: none", "",
+             "experiments not fitted: their cost before and after is reported (not all)"),
             ("seed", "integer", "default 1", "", "random seed, a whole number in [0, 2^53]"),
         ],
         "example_name": "calibration.json",
