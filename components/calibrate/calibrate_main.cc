@@ -422,8 +422,11 @@ void WriteUncertainty(const Options& o, const Spec& spec, const Uncertainty& u) 
 
 std::string Interval(const ParameterUncertainty& u) {
   if (!u.determined) return "not determined";
-  return "[" + Format(u.lower95, 6) + ", " + Format(u.upper95, 6) + "] (+-" +
-         Format(100 * 1.96 * u.sigma / std::max(std::abs(u.value), 1e-300), 2) + " %)";
+  const std::string interval = "[" + Format(u.lower95, 6) + ", " + Format(u.upper95, 6) + "]";
+  // relative to the value, unless that is (near) 0: a delay fitted at its bound
+  if (std::abs(u.value) < 1e3 * 1.96 * u.sigma * 1e-6 || u.value == 0)
+    return interval + " (+-" + Format(1.96 * u.sigma, 2) + ")";
+  return interval + " (+-" + Format(100 * 1.96 * u.sigma / std::abs(u.value), 2) + " %)";
 }
 
 // parameters.csv, cost.csv and the cost curve's plot (global search, then the refinement).
@@ -625,8 +628,15 @@ int Run(const Options& o) {
   }
   std::vector<double> best_unit = start_unit;
   r.global_cost = r.before.cost;
+  // evaluations of earlier runs of this calibration (a resumed one)
+  uint64_t prior = search ? search->progress().evaluations - evaluator.evaluations() : 0;
+  if (resumed_refinement) prior += resumed_refinement->evaluations;
   if (resumed_refinement) {
     r.global_reason = "resumed in the refinement";
+    if (search) {
+      r.generations = search->progress().generation;
+      r.restarts = search->progress().restarts;
+    }
   } else if (!search) {
     r.global_reason = "no global search (generations 0)";
   } else {
@@ -754,8 +764,6 @@ int Run(const Options& o) {
   // 3. at the optimum: the recordings, the Jacobian and how sure
   r.fitted = evaluator.ValuesOf(best_unit);
   r.after = evaluator.Evaluate(r.fitted, full);
-  r.evaluations = evaluator.evaluations() +
-                  (search ? search->progress().evaluations - evaluator.evaluations() : 0);
   if (r.after.faulted) {
     r.uncertainty_error = "the fitted model faults: " + r.after.fault;
   } else if (!r.interrupted) {
@@ -786,8 +794,7 @@ int Run(const Options& o) {
   } else {
     r.uncertainty_error = "interrupted before the uncertainty was computed";
   }
-  r.evaluations = evaluator.evaluations();
-  if (search) r.evaluations = std::max<uint64_t>(r.evaluations, search->progress().evaluations);
+  r.evaluations = prior + evaluator.evaluations();
   r.wall_s = wall();
 
   // the files: parameters, cost, channels, report pages, result.json, the tuned scene last

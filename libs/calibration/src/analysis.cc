@@ -24,7 +24,9 @@ std::string Percent(double fraction) {
 
 double ImprovementPerGeneration(const std::vector<double>& history, unsigned window) {
   if (history.size() < 2) return 0;
-  const size_t k = std::min<size_t>(window, history.size() - 1);
+  // recent progress: the last third of the run at most (an early drop is not "still improving")
+  const size_t generations = history.size() - 1;
+  const size_t k = std::min<size_t>({window, std::max<size_t>(3, generations / 3), generations});
   const double before = history[history.size() - 1 - k], now = history.back();
   if (!(before > 0) || !(now > 0)) return before > now ? 1 : 0;
   return 1 - std::pow(now / before, 1.0 / static_cast<double>(k));

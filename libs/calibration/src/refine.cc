@@ -184,9 +184,9 @@ RefineResult Refine(const BatchResiduals& batch, const std::vector<double>& star
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = static_cast<int>(options.max_iterations);
-  so.function_tolerance = 1e-10;
+  so.function_tolerance = 1e-8;  // the simulator's round-off makes smaller changes noise
   so.gradient_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-9;
+  so.parameter_tolerance = 1e-8;
   so.num_threads = 1;  // the parallelism is in the batches
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;

@@ -148,14 +148,20 @@ TEST(CheckStop, NothingMetGoesOn) {
   EXPECT_FALSE(CheckStop({}, 0.05, 60, Rule()).stop);
 }
 
-TEST(ImprovementPerGeneration, IsTheGeometricMeanOverTheLastWindow) {
+TEST(ImprovementPerGeneration, IsTheGeometricMeanOverTheRecentGenerations) {
   // 10 % per generation for 5 generations, then 1 % for 4
   std::vector<double> h = Geometric(1.0, 0.9, 5);
   for (int g = 0; g < 4; ++g) h.push_back(h.back() * 0.99);
   EXPECT_NEAR(ImprovementPerGeneration(h, 4), 0.01, 1e-12);
-  // over the whole history when the window is longer than it
-  EXPECT_NEAR(ImprovementPerGeneration(h, 100),
-              1 - std::pow(std::pow(0.9, 5) * std::pow(0.99, 4), 1.0 / 9), 1e-12);
+  // a window longer than the run: its last third (at least 3), not the early drop
+  EXPECT_NEAR(ImprovementPerGeneration(h, 100), 0.01, 1e-12);
+  // 12 generations at 10 %, then 6 at 1 %: the last 6 (a third of 18)
+  std::vector<double> g = Geometric(1.0, 0.9, 12);
+  for (int k = 0; k < 6; ++k) g.push_back(g.back() * 0.99);
+  EXPECT_NEAR(ImprovementPerGeneration(g, 100), 0.01, 1e-12);
+  // 5 generations: at least 3 of them
+  const std::vector<double> five = {1.0, 0.5, 0.5, 0.5 * 0.9, 0.5 * 0.81, 0.5 * 0.729};
+  EXPECT_NEAR(ImprovementPerGeneration(five, 100), 0.1, 1e-12);
   EXPECT_EQ(ImprovementPerGeneration({1.0}, 20), 0);
   EXPECT_EQ(ImprovementPerGeneration({1.0, 2.0, 2.0}, 1), 0);
 }

@@ -28,8 +28,9 @@ struct StopCheck {
 StopCheck CheckStop(const std::vector<double>& history, double spread, unsigned budget,
                     const Optimiser& rule);
 
-/// The relative improvement per generation over the last `window` generations of `history`
-/// (geometric mean; 0.03 = the cost fell 3 % per generation).
+/// The relative improvement per generation over the recent generations of `history`: the last
+/// `window`, at most a third of them (at least 3) (geometric mean; 0.03 = the cost fell 3 % per
+/// generation).
 double ImprovementPerGeneration(const std::vector<double>& history, unsigned window);
 
 /// The cost a perfect model would have against these measurements, from the noise of each
