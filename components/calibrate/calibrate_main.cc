@@ -537,6 +537,210 @@ HtmlReport MakeReport(const Options& o, const Spec& spec, const Outcome& r,
   return h;
 }
 
+// The global search until a stopping rule or the budget says so, with IPOP restarts.
+void SearchStage(const Spec& spec, Search& search, const std::string& checkpoint,
+                 client::ModelPool& pool, Outcome& r, std::vector<double>& best_unit) {
+  std::cerr << search.islands() << " island(s) of " << search.progress().population << " ("
+            << spec.optimiser.algorithm << ")\n";
+  const uint64_t evaluations_at_start = search.progress().evaluations;
+  const unsigned first_generation = search.progress().generation;
+  const auto search_begin = std::chrono::steady_clock::now();
+  for (;;) {
+    const Progress& p = search.progress();
+    StopCheck check = CheckStop(
+        p.CostsSinceRestart(), p.spread,
+        spec.optimiser.generations - std::min(spec.optimiser.generations, p.restart_generation),
+        spec.optimiser);
+    if (p.generation >= spec.optimiser.generations && !check.stop) check.stop = true;
+    if (check.stop) {
+      // IPOP: stalled far above the noise: start again with larger populations
+      const bool far = p.best_cost > 2 * r.noise_floor && p.best_cost > spec.optimiser.target_cost;
+      if (check.stalled && far && p.restarts < spec.optimiser.restarts &&
+          p.generation < spec.optimiser.generations) {
+        std::cerr << "restart " << p.restarts + 1 << "/" << spec.optimiser.restarts << ": "
+                  << check.reason.substr(check.reason.find(':') + 2) << " at cost "
+                  << Format(p.best_cost) << ", "
+                  << Format(p.best_cost / std::max(r.noise_floor, 1e-300), 3)
+                  << "x the noise floor; populations of " << 2 * p.population << "\n";
+        search.Restart();
+        continue;
+      }
+      if (p.generation >= spec.optimiser.generations && !check.converged) {
+        const double rate = ImprovementPerGeneration(p.CostsSinceRestart(), spec.optimiser.window);
+        check.reason =
+            "stopped: budget of " + std::to_string(spec.optimiser.generations) +
+            " generations spent, " +
+            (rate > 1e-4 ? "still improving " + Format(100 * rate, 3) + " % per generation"
+                         : "improving less than 0.01 % per generation");
+      }
+      r.global_reason = check.reason;
+      r.converged = check.converged;
+      break;
+    }
+    r.interrupted = !search.Generation(core::InterruptPending);
+    search.Save(checkpoint);
+    pool.Refresh();  // Models that appeared or came back join the next generation
+    const Progress& q = search.progress();
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - search_begin).count();
+    const double rate = static_cast<double>(q.evaluations - evaluations_at_start) / elapsed;
+    const double per_generation = elapsed / (q.generation - first_generation);
+    std::cerr << "gen " << q.generation << "/" << spec.optimiser.generations << "  evals "
+              << q.evaluations << "  " << Format(rate, 3) << " evals/s  best "
+              << Format(q.best_cost) << " (initial " << Format(r.before.cost) << ")  step "
+              << Format(q.spread, 3) << "  ETA "
+              << Duration(per_generation * (spec.optimiser.generations - q.generation)) << "\n";
+    if (r.interrupted) {
+      std::cerr << "interrupted: keeping the best so far; --resume goes on from generation "
+                << q.generation << "\n";
+      r.global_reason = "stopped: interrupted at generation " + std::to_string(q.generation);
+      break;
+    }
+  }
+  best_unit = search.progress().best_unit;
+  r.global_cost = search.progress().best_cost;
+  r.generations = search.progress().generation;
+  r.restarts = search.progress().restarts;
+  std::cerr << "global search: " << r.global_reason << " (cost " << Format(r.global_cost) << ", "
+            << r.generations << " generations, " << r.restarts << " restart(s))\n";
+}
+
+// The Levenberg-Marquardt refinement from `best_unit` (the global search's best or a
+// checkpoint's point), which it moves to the refined point.
+void RefineStage(const Spec& spec, const BatchResiduals& batch,
+                 const std::optional<RefineCheckpoint>& resumed, const std::vector<double>& steps,
+                 const std::string& refine_checkpoint, size_t models, bool have_search, Outcome& r,
+                 std::vector<double>& best_unit) {
+  if (!r.interrupted && spec.refinement.iterations > 0) {
+    const unsigned done_before = resumed ? resumed->iterations : 0;
+    const uint64_t evaluations_before = resumed ? resumed->evaluations : 0;
+    RefineOptions ro;
+    ro.max_iterations =
+        spec.refinement.iterations - std::min(spec.refinement.iterations, done_before);
+    ro.central = spec.refinement.central;
+    ro.steps = steps;
+    ro.interrupted = core::InterruptPending;
+    const auto refine_begin = std::chrono::steady_clock::now();
+    ro.on_iteration = [&](const RefineProgress& p) {
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_begin).count();
+      // the best so far (a rejected step's trial cost is not progress)
+      const double best =
+          r.refine_history.empty() ? p.cost : std::min(p.cost, r.refine_history.back().second);
+      r.refine_history.emplace_back(evaluations_before + p.evaluations, best);
+      std::cerr << "refine " << done_before + p.iteration << "/" << spec.refinement.iterations
+                << "  evals " << evaluations_before + p.evaluations << "  "
+                << Format(p.evaluations / std::max(elapsed, 1e-9), 3) << " evals/s  cost "
+                << Format(p.cost) << " (global " << Format(r.global_cost) << ")\n";
+      SaveRefine(refine_checkpoint,
+                 {p.unit, done_before + p.iteration, evaluations_before + p.evaluations, p.cost});
+    };
+    const size_t residuals = r.before.residuals.size();
+    std::cerr << "refinement: Levenberg-Marquardt on " << residuals << " residuals, "
+              << (ro.central ? 2 : 1) * spec.parameters.size() << " runs per Jacobian over "
+              << models << " Model(s)\n";
+    const RefineResult refined = Refine(batch, best_unit, residuals, ro);
+    const double refine_wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_begin).count();
+    r.refine_reason = refined.reason;
+    r.refine_iterations = done_before + refined.iterations;
+    r.refine_evaluations = evaluations_before + refined.evaluations;
+    r.interrupted = refined.interrupted;
+    r.converged = refined.converged;
+    if (refined.cost <= r.global_cost || !have_search) best_unit = refined.unit;
+    std::cerr << "refinement: " << refined.reason << " (cost " << Format(refined.start_cost)
+              << " -> " << Format(refined.cost) << ", " << refined.iterations << " iterations, "
+              << refined.evaluations << " evaluations in " << Format(refine_wall, 3) << " s)\n";
+    if (refined.interrupted)
+      std::cerr << "interrupted: keeping the best so far; --resume goes on in the refinement\n";
+  }
+}
+
+// At the optimum: one more Jacobian, and how sure the fit is (or why that is not known).
+void UncertaintyStage(const Options& o, const Spec& spec, const BatchResiduals& batch,
+                      const std::vector<double>& best_unit, const std::vector<double>& steps,
+                      size_t pool_size, Outcome& r) {
+  if (r.after.faulted) {
+    r.uncertainty_error = "the fitted model faults: " + r.after.fault;
+  } else if (!r.interrupted) {
+    try {
+      const std::vector<double> scales = BlockScales(r.after.blocks);
+      Residuals base = r.after.residuals;
+      for (size_t b = 0; b < r.after.blocks.size(); ++b)
+        for (size_t i = 0; i < r.after.blocks[b].samples; ++i)
+          base[r.after.blocks[b].begin + i] *= std::sqrt(scales[b]);
+      // the raw residuals' Jacobian: the weighted one unscaled row by row
+      const auto jacobian_begin = std::chrono::steady_clock::now();
+      Eigen::MatrixXd j = Jacobian(batch, best_unit, base, steps, spec.refinement.central);
+      const double jacobian_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - jacobian_begin).count();
+      std::cerr << "Jacobian at the optimum: "
+                << (spec.refinement.central ? 2 : 1) * spec.parameters.size() << " runs in "
+                << Format(jacobian_s, 4) << " s over " << pool_size << " Model(s)\n";
+      for (size_t b = 0; b < r.after.blocks.size(); ++b)
+        j.middleRows(static_cast<Eigen::Index>(r.after.blocks[b].begin),
+                     static_cast<Eigen::Index>(r.after.blocks[b].samples)) /=
+            std::sqrt(std::max(scales[b], 1e-300));
+      r.uncertainty =
+          Analyse(spec, j, r.after.residuals, r.after.blocks, r.fitted, spec.uncertainty);
+      WriteUncertainty(o, spec, *r.uncertainty);
+    } catch (const std::runtime_error& e) {
+      r.uncertainty_error = e.what();
+    }
+  } else {
+    r.uncertainty_error = "interrupted before the uncertainty was computed";
+  }
+}
+
+// The end on stdout: the costs, the verdict, the parameters with intervals, noise, warnings.
+void PrintSummary(const Options& o, const Spec& spec, const Outcome& r, uint64_t faults,
+                  const std::string& tuned, const std::string& export_error, const std::string& png,
+                  const std::string& why, const std::string& html_why) {
+  std::cout << "cost " << Format(r.before.cost, 6) << " -> " << Format(r.after.cost, 6) << " ("
+            << Format(r.before.cost / std::max(r.after.cost, 1e-300), 3) << "x lower) after "
+            << r.evaluations << " evaluations in " << Duration(r.wall_s) << " (" << r.generations
+            << " generations, " << r.refine_iterations << " refinement iterations; " << faults
+            << " faulted)\n";
+  std::cout << (r.converged ? "" : "NOT CONVERGED: ")
+            << (r.refine_reason.empty() ? r.global_reason : r.refine_reason) << "\n";
+  if (!r.refine_reason.empty()) std::cout << "global search: " << r.global_reason << "\n";
+  if (r.after.held_out_cost >= 0)
+    std::cout << "held-out cost " << Format(r.before.held_out_cost, 6) << " -> "
+              << Format(r.after.held_out_cost, 6) << " (fitted " << Format(r.after.cost, 6) << ")"
+              << (r.after.held_out_cost > 2 * r.after.cost ? ": worse than the fitted "
+                                                             "experiments, over-fitted?"
+                                                           : "")
+              << "\n";
+  std::cout << "  " << std::left << std::setw(44) << "parameter" << std::right << std::setw(12)
+            << "initial" << std::setw(14) << "fitted"
+            << "   95 % interval\n";
+  for (size_t i = 0; i < r.fitted.size(); ++i) {
+    const std::string unit =
+        spec.parameters[i].Unit().empty() ? "" : " " + spec.parameters[i].Unit();
+    std::cout << "  " << std::left << std::setw(44) << spec.parameters[i].id << std::right
+              << std::setw(12) << Format(r.initial[i], 6) << " -> " << std::setw(11)
+              << Format(r.fitted[i], 6) << "   "
+              << (r.uncertainty ? Interval(r.uncertainty->parameters[i]) : "-") << unit << "\n";
+  }
+  if (r.uncertainty) {
+    std::cout << "noise per channel (from the residuals):\n";
+    for (const auto& n : r.uncertainty->noise)
+      std::cout << "  " << std::left << std::setw(56) << (n.experiment + ": " + n.column)
+                << std::right << " " << Format(n.sigma, 3) << (n.unit.empty() ? "" : " " + n.unit)
+                << "\n";
+    for (const auto& w : r.uncertainty->warnings) std::cout << "warning: " << w << "\n";
+  } else {
+    std::cout << "no uncertainty: " << r.uncertainty_error << "\n";
+  }
+  std::cout << "results: " << o.out << "/result.json, parameters.csv, "
+            << (export_error.empty() ? "tuned scene: " + tuned
+                                     : "no tuned scene (" + export_error + ")")
+            << ", "
+            << (html_why.empty() ? "report: " + o.out + "/report.html"
+                                 : "no HTML report: " + html_why)
+            << (why.empty() ? ", " + png : ", no plots: " + why) << "\n";
+}
+
 int Run(const Options& o) {
   Spec spec = LoadSpec(o.file);
   if (o.generations_set) spec.optimiser.generations = o.generations;
@@ -640,71 +844,7 @@ int Run(const Options& o) {
   } else if (!search) {
     r.global_reason = "no global search (generations 0)";
   } else {
-    std::cerr << search->islands() << " island(s) of " << search->progress().population << " ("
-              << spec.optimiser.algorithm << ")\n";
-    const uint64_t evaluations_at_start = search->progress().evaluations;
-    const unsigned first_generation = search->progress().generation;
-    const auto search_begin = std::chrono::steady_clock::now();
-    for (;;) {
-      const Progress& p = search->progress();
-      StopCheck check = CheckStop(
-          p.CostsSinceRestart(), p.spread,
-          spec.optimiser.generations - std::min(spec.optimiser.generations, p.restart_generation),
-          spec.optimiser);
-      if (p.generation >= spec.optimiser.generations && !check.stop) check.stop = true;
-      if (check.stop) {
-        // IPOP: stalled far above the noise: start again with larger populations
-        const bool far =
-            p.best_cost > 2 * r.noise_floor && p.best_cost > spec.optimiser.target_cost;
-        if (check.stalled && far && p.restarts < spec.optimiser.restarts &&
-            p.generation < spec.optimiser.generations) {
-          std::cerr << "restart " << p.restarts + 1 << "/" << spec.optimiser.restarts << ": "
-                    << check.reason.substr(check.reason.find(':') + 2) << " at cost "
-                    << Format(p.best_cost) << ", "
-                    << Format(p.best_cost / std::max(r.noise_floor, 1e-300), 3)
-                    << "x the noise floor; populations of " << 2 * p.population << "\n";
-          search->Restart();
-          continue;
-        }
-        if (p.generation >= spec.optimiser.generations && !check.converged) {
-          const double rate =
-              ImprovementPerGeneration(p.CostsSinceRestart(), spec.optimiser.window);
-          check.reason =
-              "stopped: budget of " + std::to_string(spec.optimiser.generations) +
-              " generations spent, " +
-              (rate > 1e-4 ? "still improving " + Format(100 * rate, 3) + " % per generation"
-                           : "improving less than 0.01 % per generation");
-        }
-        r.global_reason = check.reason;
-        r.converged = check.converged;
-        break;
-      }
-      r.interrupted = !search->Generation(core::InterruptPending);
-      search->Save(checkpoint);
-      pool.Refresh();  // Models that appeared or came back join the next generation
-      const Progress& q = search->progress();
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - search_begin).count();
-      const double rate = static_cast<double>(q.evaluations - evaluations_at_start) / elapsed;
-      const double per_generation = elapsed / (q.generation - first_generation);
-      std::cerr << "gen " << q.generation << "/" << spec.optimiser.generations << "  evals "
-                << q.evaluations << "  " << Format(rate, 3) << " evals/s  best "
-                << Format(q.best_cost) << " (initial " << Format(r.before.cost) << ")  step "
-                << Format(q.spread, 3) << "  ETA "
-                << Duration(per_generation * (spec.optimiser.generations - q.generation)) << "\n";
-      if (r.interrupted) {
-        std::cerr << "interrupted: keeping the best so far; --resume goes on from generation "
-                  << q.generation << "\n";
-        r.global_reason = "stopped: interrupted at generation " + std::to_string(q.generation);
-        break;
-      }
-    }
-    best_unit = search->progress().best_unit;
-    r.global_cost = search->progress().best_cost;
-    r.generations = search->progress().generation;
-    r.restarts = search->progress().restarts;
-    std::cerr << "global search: " << r.global_reason << " (cost " << Format(r.global_cost) << ", "
-              << r.generations << " generations, " << r.restarts << " restart(s))\n";
+    SearchStage(spec, *search, checkpoint, pool, r, best_unit);
   }
 
   // 2. the refinement: Levenberg-Marquardt from the best point
@@ -717,83 +857,13 @@ int Run(const Options& o) {
   const BatchResiduals batch = [&](const std::vector<std::vector<double>>& units) {
     return evaluator.WeightedResiduals(units);
   };
-  if (!r.interrupted && spec.refinement.iterations > 0) {
-    const unsigned done_before = resumed_refinement ? resumed_refinement->iterations : 0;
-    const uint64_t evaluations_before = resumed_refinement ? resumed_refinement->evaluations : 0;
-    RefineOptions ro;
-    ro.max_iterations =
-        spec.refinement.iterations - std::min(spec.refinement.iterations, done_before);
-    ro.central = spec.refinement.central;
-    ro.steps = steps;
-    ro.interrupted = core::InterruptPending;
-    const auto refine_begin = std::chrono::steady_clock::now();
-    ro.on_iteration = [&](const RefineProgress& p) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_begin).count();
-      // the best so far (a rejected step's trial cost is not progress)
-      const double best =
-          r.refine_history.empty() ? p.cost : std::min(p.cost, r.refine_history.back().second);
-      r.refine_history.emplace_back(evaluations_before + p.evaluations, best);
-      std::cerr << "refine " << done_before + p.iteration << "/" << spec.refinement.iterations
-                << "  evals " << evaluations_before + p.evaluations << "  "
-                << Format(p.evaluations / std::max(elapsed, 1e-9), 3) << " evals/s  cost "
-                << Format(p.cost) << " (global " << Format(r.global_cost) << ")\n";
-      SaveRefine(refine_checkpoint,
-                 {p.unit, done_before + p.iteration, evaluations_before + p.evaluations, p.cost});
-    };
-    const size_t residuals = r.before.residuals.size();
-    std::cerr << "refinement: Levenberg-Marquardt on " << residuals << " residuals, "
-              << (ro.central ? 2 : 1) * spec.parameters.size() << " runs per Jacobian over "
-              << models << " Model(s)\n";
-    const RefineResult refined = Refine(batch, best_unit, residuals, ro);
-    const double refine_wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_begin).count();
-    r.refine_reason = refined.reason;
-    r.refine_iterations = done_before + refined.iterations;
-    r.refine_evaluations = evaluations_before + refined.evaluations;
-    r.interrupted = refined.interrupted;
-    r.converged = refined.converged;
-    if (refined.cost <= r.global_cost || !search) best_unit = refined.unit;
-    std::cerr << "refinement: " << refined.reason << " (cost " << Format(refined.start_cost)
-              << " -> " << Format(refined.cost) << ", " << refined.iterations << " iterations, "
-              << refined.evaluations << " evaluations in " << Format(refine_wall, 3) << " s)\n";
-    if (refined.interrupted)
-      std::cerr << "interrupted: keeping the best so far; --resume goes on in the refinement\n";
-  }
+  RefineStage(spec, batch, resumed_refinement, steps, refine_checkpoint, models, search != nullptr,
+              r, best_unit);
 
   // 3. at the optimum: the recordings, the Jacobian and how sure
   r.fitted = evaluator.ValuesOf(best_unit);
   r.after = evaluator.Evaluate(r.fitted, full);
-  if (r.after.faulted) {
-    r.uncertainty_error = "the fitted model faults: " + r.after.fault;
-  } else if (!r.interrupted) {
-    try {
-      const std::vector<double> scales = BlockScales(r.after.blocks);
-      Residuals base = r.after.residuals;
-      for (size_t b = 0; b < r.after.blocks.size(); ++b)
-        for (size_t i = 0; i < r.after.blocks[b].samples; ++i)
-          base[r.after.blocks[b].begin + i] *= std::sqrt(scales[b]);
-      // the raw residuals' Jacobian: the weighted one unscaled row by row
-      const auto jacobian_begin = std::chrono::steady_clock::now();
-      Eigen::MatrixXd j = Jacobian(batch, best_unit, base, steps, spec.refinement.central);
-      const double jacobian_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - jacobian_begin).count();
-      std::cerr << "Jacobian at the optimum: "
-                << (spec.refinement.central ? 2 : 1) * spec.parameters.size() << " runs in "
-                << Format(jacobian_s, 4) << " s over " << pool.size() << " Model(s)\n";
-      for (size_t b = 0; b < r.after.blocks.size(); ++b)
-        j.middleRows(static_cast<Eigen::Index>(r.after.blocks[b].begin),
-                     static_cast<Eigen::Index>(r.after.blocks[b].samples)) /=
-            std::sqrt(std::max(scales[b], 1e-300));
-      r.uncertainty =
-          Analyse(spec, j, r.after.residuals, r.after.blocks, r.fitted, spec.uncertainty);
-      WriteUncertainty(o, spec, *r.uncertainty);
-    } catch (const std::runtime_error& e) {
-      r.uncertainty_error = e.what();
-    }
-  } else {
-    r.uncertainty_error = "interrupted before the uncertainty was computed";
-  }
+  UncertaintyStage(o, spec, batch, best_unit, steps, pool.size(), r);
   r.evaluations = prior + evaluator.evaluations();
   r.wall_s = wall();
 
@@ -813,49 +883,7 @@ int Run(const Options& o) {
   const std::string tuned = o.out + "/tuned.dae";
   const std::string export_error = ExportTuned(pool, spec, r.fitted, tuned);
 
-  std::cout << "cost " << Format(r.before.cost, 6) << " -> " << Format(r.after.cost, 6) << " ("
-            << Format(r.before.cost / std::max(r.after.cost, 1e-300), 3) << "x lower) after "
-            << r.evaluations << " evaluations in " << Duration(r.wall_s) << " (" << r.generations
-            << " generations, " << r.refine_iterations << " refinement iterations; "
-            << evaluator.faults() << " faulted)\n";
-  std::cout << (r.converged ? "" : "NOT CONVERGED: ")
-            << (r.refine_reason.empty() ? r.global_reason : r.refine_reason) << "\n";
-  if (!r.refine_reason.empty()) std::cout << "global search: " << r.global_reason << "\n";
-  if (r.after.held_out_cost >= 0)
-    std::cout << "held-out cost " << Format(r.before.held_out_cost, 6) << " -> "
-              << Format(r.after.held_out_cost, 6) << " (fitted " << Format(r.after.cost, 6) << ")"
-              << (r.after.held_out_cost > 2 * r.after.cost ? ": worse than the fitted "
-                                                             "experiments, over-fitted?"
-                                                           : "")
-              << "\n";
-  std::cout << "  " << std::left << std::setw(44) << "parameter" << std::right << std::setw(12)
-            << "initial" << std::setw(14) << "fitted"
-            << "   95 % interval\n";
-  for (size_t i = 0; i < r.fitted.size(); ++i) {
-    const std::string unit =
-        spec.parameters[i].Unit().empty() ? "" : " " + spec.parameters[i].Unit();
-    std::cout << "  " << std::left << std::setw(44) << spec.parameters[i].id << std::right
-              << std::setw(12) << Format(r.initial[i], 6) << " -> " << std::setw(11)
-              << Format(r.fitted[i], 6) << "   "
-              << (r.uncertainty ? Interval(r.uncertainty->parameters[i]) : "-") << unit << "\n";
-  }
-  if (r.uncertainty) {
-    std::cout << "noise per channel (from the residuals):\n";
-    for (const auto& n : r.uncertainty->noise)
-      std::cout << "  " << std::left << std::setw(56) << (n.experiment + ": " + n.column)
-                << std::right << " " << Format(n.sigma, 3) << (n.unit.empty() ? "" : " " + n.unit)
-                << "\n";
-    for (const auto& w : r.uncertainty->warnings) std::cout << "warning: " << w << "\n";
-  } else {
-    std::cout << "no uncertainty: " << r.uncertainty_error << "\n";
-  }
-  std::cout << "results: " << o.out << "/result.json, parameters.csv, "
-            << (export_error.empty() ? "tuned scene: " + tuned
-                                     : "no tuned scene (" + export_error + ")")
-            << ", "
-            << (html_why.empty() ? "report: " + o.out + "/report.html"
-                                 : "no HTML report: " + html_why)
-            << (why.empty() ? ", " + png : ", no plots: " + why) << "\n";
+  PrintSummary(o, spec, r, evaluator.faults(), tuned, export_error, png, why, html_why);
   if (r.interrupted) return 130;
   return export_error.empty() ? 0 : 1;
 }

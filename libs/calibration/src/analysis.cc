@@ -110,6 +110,80 @@ std::vector<double> BlockScales(const std::vector<ResidualBlock>& blocks) {
   return out;
 }
 
+namespace {
+
+// The warnings of Analyse, each with what would help.
+void AddWarnings(const Spec& spec, const Eigen::MatrixXd& jacobian,
+                 const std::vector<ResidualBlock>& blocks, const std::vector<bool>& moves,
+                 const std::vector<bool>& determined, const UncertaintyOptions& options,
+                 Uncertainty& out) {
+  const Eigen::Index n = jacobian.cols();
+  const auto name = [&](const ResidualBlock& b) {
+    return spec.experiments[b.experiment].name + ": " + b.column;
+  };
+  const auto id = [&](Eigen::Index j) { return spec.parameters[static_cast<size_t>(j)].id; };
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const auto& pu = out.parameters[static_cast<size_t>(j)];
+    if (!moves[static_cast<size_t>(j)]) {
+      out.warnings.push_back(id(j) +
+                             ": no channel of the fitted experiments changes with it, so they "
+                             "cannot determine it; record a channel it drives, or add an "
+                             "experiment that excites it");
+    } else if (!pu.determined) {
+      std::string with;
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (i != j && moves[static_cast<size_t>(i)] && !determined[static_cast<size_t>(i)])
+          with += (with.empty() ? "" : ", ") + id(i);
+      out.warnings.push_back(
+          id(j) + ": only a combination of it" + (with.empty() ? "" : " with " + with) +
+          " is determined by these experiments (their effects on every channel are "
+          "proportional); fix one of them, or add an experiment where they act differently");
+    } else if (const Parameter& q = spec.parameters[static_cast<size_t>(j)];
+               // a timing parameter's value may be near 0: its search range is the scale
+               1.96 * pu.sigma >
+               options.max_relative_interval *
+                   (q.kind == ParameterKind::kScene ? std::abs(pu.value) : q.upper - q.lower)) {
+      const bool timing = q.kind != ParameterKind::kScene;
+      const double scale = timing ? q.upper - q.lower : std::abs(pu.value);
+      out.warnings.push_back(
+          id(j) + ": its 95 % interval is +-" + Format(1.96 * pu.sigma) + " (" +
+          Percent(1.96 * pu.sigma / scale) + (timing ? " of its search range" : " of the value") +
+          ", more than " + Percent(options.max_relative_interval) +
+          "); the channel that moves most with it is " + pu.most_sensitive_channel +
+          ": longer or stronger excitation there, or a higher weight, would "
+          "pin it");
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = i + 1; j < n; ++j) {
+      const double rho = out.correlation(i, j);
+      if (!(std::abs(rho) > options.max_correlation)) continue;
+      // the channel where the two act least alike separates them best
+      std::string separates;
+      double least = 2;
+      for (size_t b = 0; b < blocks.size(); ++b) {
+        const auto rows = static_cast<Eigen::Index>(blocks[b].samples);
+        const auto begin = static_cast<Eigen::Index>(blocks[b].begin);
+        const Eigen::VectorXd ci = jacobian.block(begin, i, rows, 1);
+        const Eigen::VectorXd cj = jacobian.block(begin, j, rows, 1);
+        if (ci.norm() < 1e-300 || cj.norm() < 1e-300) continue;
+        const double alike = std::abs(ci.dot(cj)) / (ci.norm() * cj.norm());
+        if (alike < least) {
+          least = alike;
+          separates = name(blocks[b]);
+        }
+      }
+      out.warnings.push_back(id(i) + " and " + id(j) + " are correlated (" + Format(rho) +
+                             "): these experiments determine mainly a combination of the two" +
+                             (separates.empty() ? std::string()
+                                                : "; " + separates +
+                                                      " tells them apart best: weight it more, "
+                                                      "or add an experiment that excites it"));
+    }
+}
+
+}  // namespace
+
 Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
                     const std::vector<double>& residuals, const std::vector<ResidualBlock>& blocks,
                     const std::vector<double>& values, const UncertaintyOptions& options) {
@@ -252,66 +326,7 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
     pu.upper95 = pu.value + 1.96 * pu.sigma;
   }
 
-  // warnings, each with what would help
-  const auto id = [&](Eigen::Index j) { return spec.parameters[static_cast<size_t>(j)].id; };
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const auto& pu = out.parameters[static_cast<size_t>(j)];
-    if (!moves[static_cast<size_t>(j)]) {
-      out.warnings.push_back(id(j) +
-                             ": no channel of the fitted experiments changes with it, so they "
-                             "cannot determine it; record a channel it drives, or add an "
-                             "experiment that excites it");
-    } else if (!pu.determined) {
-      std::string with;
-      for (Eigen::Index i = 0; i < n; ++i)
-        if (i != j && moves[static_cast<size_t>(i)] && !determined[static_cast<size_t>(i)])
-          with += (with.empty() ? "" : ", ") + id(i);
-      out.warnings.push_back(
-          id(j) + ": only a combination of it" + (with.empty() ? "" : " with " + with) +
-          " is determined by these experiments (their effects on every channel are "
-          "proportional); fix one of them, or add an experiment where they act differently");
-    } else if (const Parameter& q = spec.parameters[static_cast<size_t>(j)];
-               // a timing parameter's value may be near 0: its search range is the scale
-               1.96 * pu.sigma >
-               options.max_relative_interval *
-                   (q.kind == ParameterKind::kScene ? std::abs(pu.value) : q.upper - q.lower)) {
-      const bool timing = q.kind != ParameterKind::kScene;
-      const double scale = timing ? q.upper - q.lower : std::abs(pu.value);
-      out.warnings.push_back(
-          id(j) + ": its 95 % interval is +-" + Format(1.96 * pu.sigma) + " (" +
-          Percent(1.96 * pu.sigma / scale) + (timing ? " of its search range" : " of the value") +
-          ", more than " + Percent(options.max_relative_interval) +
-          "); the channel that moves most with it is " + pu.most_sensitive_channel +
-          ": longer or stronger excitation there, or a higher weight, would "
-          "pin it");
-    }
-  }
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = i + 1; j < n; ++j) {
-      const double rho = out.correlation(i, j);
-      if (!(std::abs(rho) > options.max_correlation)) continue;
-      // the channel where the two act least alike separates them best
-      std::string separates;
-      double least = 2;
-      for (size_t b = 0; b < blocks.size(); ++b) {
-        const auto rows = static_cast<Eigen::Index>(blocks[b].samples);
-        const auto begin = static_cast<Eigen::Index>(blocks[b].begin);
-        const Eigen::VectorXd ci = jacobian.block(begin, i, rows, 1);
-        const Eigen::VectorXd cj = jacobian.block(begin, j, rows, 1);
-        if (ci.norm() < 1e-300 || cj.norm() < 1e-300) continue;
-        const double alike = std::abs(ci.dot(cj)) / (ci.norm() * cj.norm());
-        if (alike < least) {
-          least = alike;
-          separates = name(blocks[b]);
-        }
-      }
-      out.warnings.push_back(id(i) + " and " + id(j) + " are correlated (" + Format(rho) +
-                             "): these experiments determine mainly a combination of the two" +
-                             (separates.empty() ? std::string()
-                                                : "; " + separates +
-                                                      " tells them apart best: weight it more, "
-                                                      "or add an experiment that excites it"));
-    }
+  AddWarnings(spec, jacobian, blocks, moves, determined, options, out);
   return out;
 }
 

@@ -119,6 +119,82 @@ void RejectUnknownKeys(const ptree& node, const std::vector<std::string>& known,
   }
 }
 
+// The optimiser, refinement, uncertainty and held_out keys of a calibration file.
+void ReadSearchKeys(const ptree& root, const std::string& path, Spec& spec) {
+  if (const auto o = root.get_child_optional("optimiser")) {
+    const std::string where = path + ": optimiser";
+    RejectUnknownKeys(*o,
+                      {"algorithm", "generations", "population", "sigma0", "window",
+                       "cost_tolerance", "step_tolerance", "target_cost", "restarts"},
+                      where);
+    spec.optimiser.algorithm = o->get<std::string>("algorithm", "cmaes");
+    if (spec.optimiser.algorithm != "cmaes" && spec.optimiser.algorithm != "xnes")
+      Fail(where, "algorithm is cmaes or xnes (pagmo's evolution strategies)");
+    const double generations = Number(o->get<std::string>("generations", "40"), where);
+    const double population = Number(o->get<std::string>("population", "10"), where);
+    if (generations < 0 || generations > 1e6 || population < 5 || population > 1e4)
+      Fail(where, "generations >= 0 (0: no global search), population >= 5 (CMA-ES needs a few)");
+    spec.optimiser.generations = static_cast<unsigned>(generations);
+    spec.optimiser.population = static_cast<unsigned>(population);
+    spec.optimiser.sigma0 = Number(o->get<std::string>("sigma0", "0.25"), where + ": sigma0");
+    if (!(spec.optimiser.sigma0 > 0 && spec.optimiser.sigma0 <= 1))
+      Fail(where, "sigma0 is in (0, 1] (the search space is scaled to [0, 1])");
+    const double window = Number(o->get<std::string>("window", "20"), where + ": window");
+    if (!(window >= 2 && window <= 1e6)) Fail(where + ": window", "generations, from 2");
+    spec.optimiser.window = static_cast<unsigned>(window);
+    spec.optimiser.cost_tolerance =
+        Number(o->get<std::string>("cost_tolerance", "1e-6"), where + ": cost_tolerance");
+    spec.optimiser.step_tolerance =
+        Number(o->get<std::string>("step_tolerance", "1e-4"), where + ": step_tolerance");
+    spec.optimiser.target_cost =
+        Number(o->get<std::string>("target_cost", "0"), where + ": target_cost");
+    if (spec.optimiser.cost_tolerance < 0 || spec.optimiser.step_tolerance < 0 ||
+        spec.optimiser.target_cost < 0)
+      Fail(where, "cost_tolerance, step_tolerance and target_cost are >= 0");
+    const double restarts = Number(o->get<std::string>("restarts", "2"), where + ": restarts");
+    if (!(restarts >= 0 && restarts <= 20)) Fail(where + ": restarts", "from 0 to 20");
+    spec.optimiser.restarts = static_cast<unsigned>(restarts);
+  }
+  if (const auto r = root.get_child_optional("refinement")) {
+    const std::string where = path + ": refinement";
+    RejectUnknownKeys(*r, {"iterations", "jacobian", "step"}, where);
+    const double iterations =
+        Number(r->get<std::string>("iterations", "30"), where + ": iterations");
+    if (!(iterations >= 0 && iterations <= 10000)) Fail(where, "iterations from 0 (off) to 10000");
+    spec.refinement.iterations = static_cast<unsigned>(iterations);
+    const std::string jacobian = r->get<std::string>("jacobian", "central");
+    if (jacobian != "central" && jacobian != "forward")
+      Fail(where, "jacobian is central or forward (finite differences)");
+    spec.refinement.central = jacobian == "central";
+    spec.refinement.step = Number(r->get<std::string>("step", "1e-3"), where + ": step");
+    if (!(spec.refinement.step > 0 && spec.refinement.step <= 0.1))
+      Fail(where, "step is in (0, 0.1] of the unit search space");
+  }
+  if (const auto u = root.get_child_optional("uncertainty")) {
+    const std::string where = path + ": uncertainty";
+    RejectUnknownKeys(*u, {"max_relative_interval", "max_correlation"}, where);
+    spec.uncertainty.max_relative_interval = Number(
+        u->get<std::string>("max_relative_interval", "0.1"), where + ": max_relative_interval");
+    spec.uncertainty.max_correlation =
+        Number(u->get<std::string>("max_correlation", "0.95"), where + ": max_correlation");
+    if (!(spec.uncertainty.max_relative_interval > 0) ||
+        !(spec.uncertainty.max_correlation > 0 && spec.uncertainty.max_correlation <= 1))
+      Fail(where, "max_relative_interval > 0, max_correlation in (0, 1]");
+  }
+  spec.held_out.assign(spec.experiments.size(), false);
+  if (const auto h = root.get_child_optional("held_out")) {
+    for (const auto& [k, node] : *h) {
+      const std::string name = node.data();
+      size_t i = 0;
+      while (i < spec.experiments.size() && spec.experiments[i].name != name) ++i;
+      if (i == spec.experiments.size())
+        Fail(path + ": held_out", "no experiment named '" + name + "'");
+      spec.held_out[i] = true;
+    }
+    if (spec.Fitted() == 0) Fail(path + ": held_out", "every experiment is held out: none to fit");
+  }
+}
+
 Spec LoadSpec(const std::string& path) {
   ptree root;
   try {
@@ -218,78 +294,7 @@ Spec LoadSpec(const std::string& path) {
       }
       spec.channels[id] = w;
     }
-  if (const auto o = root.get_child_optional("optimiser")) {
-    const std::string where = path + ": optimiser";
-    RejectUnknownKeys(*o,
-                      {"algorithm", "generations", "population", "sigma0", "window",
-                       "cost_tolerance", "step_tolerance", "target_cost", "restarts"},
-                      where);
-    spec.optimiser.algorithm = o->get<std::string>("algorithm", "cmaes");
-    if (spec.optimiser.algorithm != "cmaes" && spec.optimiser.algorithm != "xnes")
-      Fail(where, "algorithm is cmaes or xnes (pagmo's evolution strategies)");
-    const double generations = Number(o->get<std::string>("generations", "40"), where);
-    const double population = Number(o->get<std::string>("population", "10"), where);
-    if (generations < 0 || generations > 1e6 || population < 5 || population > 1e4)
-      Fail(where, "generations >= 0 (0: no global search), population >= 5 (CMA-ES needs a few)");
-    spec.optimiser.generations = static_cast<unsigned>(generations);
-    spec.optimiser.population = static_cast<unsigned>(population);
-    spec.optimiser.sigma0 = Number(o->get<std::string>("sigma0", "0.25"), where + ": sigma0");
-    if (!(spec.optimiser.sigma0 > 0 && spec.optimiser.sigma0 <= 1))
-      Fail(where, "sigma0 is in (0, 1] (the search space is scaled to [0, 1])");
-    const double window = Number(o->get<std::string>("window", "20"), where + ": window");
-    if (!(window >= 2 && window <= 1e6)) Fail(where + ": window", "generations, from 2");
-    spec.optimiser.window = static_cast<unsigned>(window);
-    spec.optimiser.cost_tolerance =
-        Number(o->get<std::string>("cost_tolerance", "1e-6"), where + ": cost_tolerance");
-    spec.optimiser.step_tolerance =
-        Number(o->get<std::string>("step_tolerance", "1e-4"), where + ": step_tolerance");
-    spec.optimiser.target_cost =
-        Number(o->get<std::string>("target_cost", "0"), where + ": target_cost");
-    if (spec.optimiser.cost_tolerance < 0 || spec.optimiser.step_tolerance < 0 ||
-        spec.optimiser.target_cost < 0)
-      Fail(where, "cost_tolerance, step_tolerance and target_cost are >= 0");
-    const double restarts = Number(o->get<std::string>("restarts", "2"), where + ": restarts");
-    if (!(restarts >= 0 && restarts <= 20)) Fail(where + ": restarts", "from 0 to 20");
-    spec.optimiser.restarts = static_cast<unsigned>(restarts);
-  }
-  if (const auto r = root.get_child_optional("refinement")) {
-    const std::string where = path + ": refinement";
-    RejectUnknownKeys(*r, {"iterations", "jacobian", "step"}, where);
-    const double iterations =
-        Number(r->get<std::string>("iterations", "30"), where + ": iterations");
-    if (!(iterations >= 0 && iterations <= 10000)) Fail(where, "iterations from 0 (off) to 10000");
-    spec.refinement.iterations = static_cast<unsigned>(iterations);
-    const std::string jacobian = r->get<std::string>("jacobian", "central");
-    if (jacobian != "central" && jacobian != "forward")
-      Fail(where, "jacobian is central or forward (finite differences)");
-    spec.refinement.central = jacobian == "central";
-    spec.refinement.step = Number(r->get<std::string>("step", "1e-3"), where + ": step");
-    if (!(spec.refinement.step > 0 && spec.refinement.step <= 0.1))
-      Fail(where, "step is in (0, 0.1] of the unit search space");
-  }
-  if (const auto u = root.get_child_optional("uncertainty")) {
-    const std::string where = path + ": uncertainty";
-    RejectUnknownKeys(*u, {"max_relative_interval", "max_correlation"}, where);
-    spec.uncertainty.max_relative_interval = Number(
-        u->get<std::string>("max_relative_interval", "0.1"), where + ": max_relative_interval");
-    spec.uncertainty.max_correlation =
-        Number(u->get<std::string>("max_correlation", "0.95"), where + ": max_correlation");
-    if (!(spec.uncertainty.max_relative_interval > 0) ||
-        !(spec.uncertainty.max_correlation > 0 && spec.uncertainty.max_correlation <= 1))
-      Fail(where, "max_relative_interval > 0, max_correlation in (0, 1]");
-  }
-  spec.held_out.assign(spec.experiments.size(), false);
-  if (const auto h = root.get_child_optional("held_out")) {
-    for (const auto& [k, node] : *h) {
-      const std::string name = node.data();
-      size_t i = 0;
-      while (i < spec.experiments.size() && spec.experiments[i].name != name) ++i;
-      if (i == spec.experiments.size())
-        Fail(path + ": held_out", "no experiment named '" + name + "'");
-      spec.held_out[i] = true;
-    }
-    if (spec.Fitted() == 0) Fail(path + ": held_out", "every experiment is held out: none to fit");
-  }
+  ReadSearchKeys(root, path, spec);
   const double seed = Number(root.get<std::string>("seed", "1"), path + ": seed");
   // exactly representable whole numbers only (a cast of a negative or larger one is undefined)
   if (!(seed >= 0 && seed <= 9007199254740992.0 && seed == std::floor(seed)))
