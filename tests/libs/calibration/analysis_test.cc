@@ -19,6 +19,17 @@
 namespace caliper::calibration {
 namespace {
 
+// A spec of one fitted experiment named `name` with these parameters (what Analyse reads).
+Spec OneExperiment(const std::string& name, std::vector<Parameter> parameters = {}) {
+  experiment::Experiment e;
+  e.name = name;
+  Spec spec;
+  spec.experiments = {e};
+  spec.held_out = {false};
+  spec.parameters = std::move(parameters);
+  return spec;
+}
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const double kPi = std::acos(-1.0);
 
@@ -173,11 +184,7 @@ TEST(NoiseFloorCost, IsTheNoiseOverTheRange) {
   const double s = 0.02, range = 2;
   std::mt19937_64 random(3);
   std::normal_distribution<double> noise(0, 1);
-  experiment::Experiment e;
-  e.name = "e";
-  Spec spec;
-  spec.experiments = {e};
-  spec.held_out = {false};
+  Spec spec = OneExperiment("e");
   Measured m;
   m.columns = {"y"};
   m.units = {"m"};
@@ -212,8 +219,9 @@ TEST(NoiseFloorCost, IsTheNoiseOverTheRange) {
   Measured loud = m;
   for (auto& column : loud.values)
     for (auto& v : column) v += 0.5 * noise(random);
-  e.name = "loud";
-  spec.experiments.push_back(e);
+  experiment::Experiment louder;
+  louder.name = "loud";
+  spec.experiments.push_back(louder);
   spec.measured.push_back(loud);
   spec.held_out = {false, true};
   EXPECT_DOUBLE_EQ(NoiseFloorCost(spec), two);
@@ -222,11 +230,7 @@ TEST(NoiseFloorCost, IsTheNoiseOverTheRange) {
 }
 
 TEST(NoiseFloorCost, IsZeroForASmoothSignal) {
-  experiment::Experiment e;
-  e.name = "e";
-  Spec spec;
-  spec.experiments = {e};
-  spec.held_out = {false};
+  Spec spec = OneExperiment("e");
   Measured m;
   m.columns = {"y"};
   m.values.resize(1);
@@ -253,11 +257,7 @@ struct Synthetic {
 
   Synthetic(std::vector<Parameter> parameters, std::vector<std::string> channel_names,
             size_t samples, double duration) {
-    experiment::Experiment e;
-    e.name = "e";
-    spec.experiments = {e};
-    spec.held_out = {false};
-    spec.parameters = std::move(parameters);
+    spec = OneExperiment("e", std::move(parameters));
     columns = std::move(channel_names);
     for (size_t i = 0; i < samples; ++i)
       times.push_back(duration * static_cast<double>(i) / static_cast<double>(samples - 1));
@@ -553,12 +553,7 @@ TEST(Refine, ReportsAnExhaustedBudgetAndAnInterruption) {
 TEST(Analyse, OneOffsetOverTwoChannelsHasTheWeightedMeansVariance) {
   // y = c in two channels of 100 and 300 samples, weights 1 and 3, ranges 1 and 4; residuals of
   // +-0.01 and +-0.1: the estimate is the weighted mean, of variance sum(n a^2 s^2) / (sum n a)^2
-  experiment::Experiment e;
-  e.name = "e";
-  Spec spec;
-  spec.experiments = {e};
-  spec.held_out = {false};
-  spec.parameters = {{"c", -1, 1, false}};
+  Spec spec = OneExperiment("e", {{"c", -1, 1, false}});
   const size_t n1 = 100, n2 = 300;
   std::vector<ResidualBlock> blocks = {{0, "p", "m", 1, 1, 0, n1}, {0, "q", "m", 3, 4, n1, n2}};
   std::vector<double> residuals;
@@ -593,12 +588,7 @@ TEST(Analyse, OneOffsetOverTwoChannelsHasTheWeightedMeansVariance) {
 TEST(Analyse, AStraightLineHasTheOrdinaryLeastSquaresCovariance) {
   // y = a + b t, a linear in [-1, 1], b log-scale in [0.1, 10]: one channel, so the weights
   // cancel and the covariance is s^2 (X'X)^-1 in the parameters' units whatever the scaling
-  experiment::Experiment e;
-  e.name = "line";
-  Spec spec;
-  spec.experiments = {e};
-  spec.held_out = {false};
-  spec.parameters = {{"a", -1, 1, false}, {"b", 0.1, 10, true}};
+  Spec spec = OneExperiment("line", {{"a", -1, 1, false}, {"b", 0.1, 10, true}});
   const double a = 0.3, b = 2;
   const size_t m = 41;
   Eigen::MatrixXd x(m, 2), j(m, 2);
