@@ -423,10 +423,11 @@ void WriteUncertainty(const Options& o, const Spec& spec, const Uncertainty& u) 
 std::string Interval(const ParameterUncertainty& u) {
   if (!u.determined) return "not determined";
   const std::string interval = "[" + Format(u.lower95, 6) + ", " + Format(u.upper95, 6) + "]";
-  // relative to the value, unless that is (near) 0: a delay fitted at its bound
-  if (std::abs(u.value) < 1e3 * 1.96 * u.sigma * 1e-6 || u.value == 0)
-    return interval + " (+-" + Format(1.96 * u.sigma, 2) + ")";
-  return interval + " (+-" + Format(100 * 1.96 * u.sigma / std::abs(u.value), 2) + " %)";
+  const double half = 1.96 * u.sigma;
+  // around 0 (a delay at its bound) a percentage of the value says nothing
+  if (u.value == 0 || std::abs(u.value) * 1e3 < half)
+    return interval + " (+-" + Format(half, 2) + ")";
+  return interval + " (+-" + Format(100 * half / std::abs(u.value), 2) + " %)";
 }
 
 // parameters.csv, cost.csv and the cost curve's plot (global search, then the refinement).
@@ -547,11 +548,8 @@ void SearchStage(const Spec& spec, Search& search, const std::string& checkpoint
   const auto search_begin = std::chrono::steady_clock::now();
   for (;;) {
     const Progress& p = search.progress();
-    StopCheck check = CheckStop(
-        p.CostsSinceRestart(), p.spread,
-        spec.optimiser.generations - std::min(spec.optimiser.generations, p.restart_generation),
-        spec.optimiser);
-    if (p.generation >= spec.optimiser.generations && !check.stop) check.stop = true;
+    StopCheck check = CheckStop(p.CostsSinceRestart(), p.spread, spec.optimiser.generations,
+                                spec.optimiser, p.generation);
     if (check.stop) {
       // IPOP: stalled far above the noise: start again with larger populations
       const bool far = p.best_cost > 2 * r.noise_floor && p.best_cost > spec.optimiser.target_cost;
@@ -564,14 +562,6 @@ void SearchStage(const Spec& spec, Search& search, const std::string& checkpoint
                   << "x the noise floor; populations of " << 2 * p.population << "\n";
         search.Restart();
         continue;
-      }
-      if (p.generation >= spec.optimiser.generations && !check.converged) {
-        const double rate = ImprovementPerGeneration(p.CostsSinceRestart(), spec.optimiser.window);
-        check.reason =
-            "stopped: budget of " + std::to_string(spec.optimiser.generations) +
-            " generations spent, " +
-            (rate > 1e-4 ? "still improving " + Format(100 * rate, 3) + " % per generation"
-                         : "improving less than 0.01 % per generation");
       }
       r.global_reason = check.reason;
       r.converged = check.converged;
@@ -657,30 +647,25 @@ void RefineStage(const Spec& spec, const BatchResiduals& batch,
 }
 
 // At the optimum: one more Jacobian, and how sure the fit is (or why that is not known).
-void UncertaintyStage(const Options& o, const Spec& spec, const BatchResiduals& batch,
+void UncertaintyStage(const Options& o, const Spec& spec, Evaluator& evaluator,
                       const std::vector<double>& best_unit, const std::vector<double>& steps,
                       size_t pool_size, Outcome& r) {
   if (r.after.faulted) {
     r.uncertainty_error = "the fitted model faults: " + r.after.fault;
   } else if (!r.interrupted) {
     try {
-      const std::vector<double> scales = BlockScales(r.after.blocks);
-      Residuals base = r.after.residuals;
-      for (size_t b = 0; b < r.after.blocks.size(); ++b)
-        for (size_t i = 0; i < r.after.blocks[b].samples; ++i)
-          base[r.after.blocks[b].begin + i] *= std::sqrt(scales[b]);
-      // the raw residuals' Jacobian: the weighted one unscaled row by row
+      // the Jacobian of the raw residuals (simulated - measured, each in its channel's unit)
+      const BatchResiduals raw = [&](const std::vector<std::vector<double>>& units) {
+        return evaluator.Residuals(units, false);
+      };
       const auto jacobian_begin = std::chrono::steady_clock::now();
-      Eigen::MatrixXd j = Jacobian(batch, best_unit, base, steps, spec.refinement.central);
+      const Eigen::MatrixXd j =
+          Jacobian(raw, best_unit, r.after.residuals, steps, spec.refinement.central);
       const double jacobian_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - jacobian_begin).count();
       std::cerr << "Jacobian at the optimum: "
                 << (spec.refinement.central ? 2 : 1) * spec.parameters.size() << " runs in "
                 << Format(jacobian_s, 4) << " s over " << pool_size << " Model(s)\n";
-      for (size_t b = 0; b < r.after.blocks.size(); ++b)
-        j.middleRows(static_cast<Eigen::Index>(r.after.blocks[b].begin),
-                     static_cast<Eigen::Index>(r.after.blocks[b].samples)) /=
-            std::sqrt(std::max(scales[b], 1e-300));
       r.uncertainty =
           Analyse(spec, j, r.after.residuals, r.after.blocks, r.fitted, spec.uncertainty);
       WriteUncertainty(o, spec, *r.uncertainty);
@@ -697,10 +682,11 @@ void PrintSummary(const Options& o, const Spec& spec, const Outcome& r, uint64_t
                   const std::string& tuned, const std::string& export_error, const std::string& png,
                   const std::string& why, const std::string& html_why) {
   std::cout << "cost " << Format(r.before.cost, 6) << " -> " << Format(r.after.cost, 6) << " ("
-            << Format(r.before.cost / std::max(r.after.cost, 1e-300), 3) << "x lower) after "
-            << r.evaluations << " evaluations in " << Duration(r.wall_s) << " (" << r.generations
-            << " generations, " << r.refine_iterations << " refinement iterations; " << faults
-            << " faulted)\n";
+            << (r.after.cost > 0 ? Format(r.before.cost / r.after.cost, 3) + "x lower"
+                                 : std::string("an exact fit"))
+            << ") after " << r.evaluations << " evaluations in " << Duration(r.wall_s) << " ("
+            << r.generations << " generations, " << r.refine_iterations
+            << " refinement iterations; " << faults << " faulted)\n";
   std::cout << (r.converged ? "" : "NOT CONVERGED: ")
             << (r.refine_reason.empty() ? r.global_reason : r.refine_reason) << "\n";
   if (!r.refine_reason.empty()) std::cout << "global search: " << r.global_reason << "\n";
@@ -813,9 +799,11 @@ int Run(const Options& o) {
                               spec.experiments[r.before.recorded.front()].every_n_steps
                         : 0;
   for (size_t i = 0; i < steps.size(); ++i)
-    if (spec.parameters[i].kind == ParameterKind::kCommandDelay)
+    if (spec.parameters[i].kind == ParameterKind::kCommandDelay) {
       steps[i] =
           std::max(steps[i], 1.01 * dt / (spec.parameters[i].upper - spec.parameters[i].lower));
+      spec.parameters[i].resolution = dt;
+    }
 
   // 1. the global search
   std::optional<RefineCheckpoint> resumed_refinement =
@@ -855,7 +843,7 @@ int Run(const Options& o) {
               << " (cost " << Format(resumed_refinement->cost) << ")\n";
   }
   const BatchResiduals batch = [&](const std::vector<std::vector<double>>& units) {
-    return evaluator.WeightedResiduals(units);
+    return evaluator.Residuals(units, true);
   };
   RefineStage(spec, batch, resumed_refinement, steps, refine_checkpoint, models, search != nullptr,
               r, best_unit);
@@ -863,7 +851,7 @@ int Run(const Options& o) {
   // 3. at the optimum: the recordings, the Jacobian and how sure
   r.fitted = evaluator.ValuesOf(best_unit);
   r.after = evaluator.Evaluate(r.fitted, full);
-  UncertaintyStage(o, spec, batch, best_unit, steps, pool.size(), r);
+  UncertaintyStage(o, spec, evaluator, best_unit, steps, pool.size(), r);
   r.evaluations = prior + evaluator.evaluations();
   r.wall_s = wall();
 

@@ -34,8 +34,6 @@ struct ReportParameter {
   double initial = 0, fitted = 0, lower = 0, upper = 0;  // lower/upper: the search bounds
   double sigma = 0, lower95 = 0, upper95 = 0;            // +-inf when not determined
   bool determined = true;
-  double truth = 0;  // shown when has_truth (synthetic tests)
-  bool has_truth = false;
 };
 
 struct ReportNoise {
@@ -45,7 +43,7 @@ struct ReportNoise {
 };
 
 struct HtmlReport {
-  std::string title;                                      // e.g. the calibration file
+  std::string title;                                         // e.g. the calibration file
   std::vector<std::pair<std::string, std::string>> summary;  // (label, value) rows, in order
   std::vector<std::string> warnings;
   std::vector<ReportParameter> parameters;

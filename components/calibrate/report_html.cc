@@ -33,7 +33,6 @@ table.summary th { background: #f5f5f5; font-weight: normal; color: #555; }
 table.correlation td { text-align: center; min-width: 3.2em; font-variant-numeric: tabular-nums; }
 table.correlation td.nan { background: #c8c8c8; color: #555; }
 .nd { color: #a33; font-style: italic; }
-.outside { color: #b00; font-weight: bold; }
 .warnings { background: #fff4d6; border-left: 6px solid #e0a000; margin: 0.5em 0;
             padding: 0.6em 1em 0.6em 2.2em; }
 .warnings li { margin: 0.2em 0; }
@@ -156,12 +155,9 @@ void WriteParameters(std::ostream& out, const HtmlReport& report) {
     out << "<p>No parameters.</p>\n</section>\n";
     return;
   }
-  const bool truth = std::any_of(report.parameters.begin(), report.parameters.end(),
-                                 [](const ReportParameter& p) { return p.has_truth; });
   out << "<table class=\"parameters\">\n<tr><th>#</th><th>parameter</th><th>unit</th>"
          "<th>initial</th><th>fitted</th><th>95&nbsp;% interval</th>"
-         "<th>&plusmn; [% of fitted]</th><th>search bounds</th>"
-      << (truth ? "<th>truth</th>" : "") << "</tr>\n";
+         "<th>&plusmn; [% of fitted]</th><th>search bounds</th></tr>\n";
   for (size_t i = 0; i < report.parameters.size(); ++i) {
     const ReportParameter& p = report.parameters[i];
     out << "<tr><td class=\"num\">" << i + 1 << "</td><td>" << Escape(p.id) << "</td><td>"
@@ -179,22 +175,9 @@ void WriteParameters(std::ostream& out, const HtmlReport& report) {
       out << "<td colspan=\"2\" class=\"nd\">not determined</td>";
     }
     out << "<td class=\"num\">[" << Number(p.lower) << ", " << Number(p.upper) << "]</td>";
-    if (truth) {
-      if (!p.has_truth) {
-        out << "<td class=\"num\">&ndash;</td>";
-      } else if (p.determined && (p.truth < p.lower95 || p.truth > p.upper95)) {
-        out << "<td class=\"num outside\" title=\"outside the 95 % interval\">" << Number(p.truth)
-            << "</td>";
-      } else {
-        out << "<td class=\"num\">" << Number(p.truth) << "</td>";
-      }
-    }
     out << "</tr>\n";
   }
   out << "</table>\n";
-  if (truth)
-    out << "<p class=\"legend\">Truths in <span class=\"outside\">red</span> lie outside their "
-           "95&nbsp;% interval.</p>\n";
   out << "</section>\n";
 }
 

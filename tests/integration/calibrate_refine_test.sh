@@ -158,6 +158,23 @@ near "$shift_s" 0.015 0.05 && near "$delay_s" 0.02 0.1 && near "$mass" 1.3 0.01 
   pass "time shift $shift_s s (truth 0.015), sensor delay $delay_s s (truth 0.02), mass $mass kg" ||
   { cat "$WORK/timing.out"; fail "timing: shift $shift_s s, delay $delay_s s, mass $mass kg"; }
 
+# 5b. an actuator command delay: the real flexor acts 23 ms after its commands; the delay acts
+# in whole time steps (1 ms), and its interval says so
+sed 's/\[0, "elbow_flexor", 6\], \[0.7, "elbow_flexor", 1\]/[0.123, "elbow_flexor", 6], [0.723, "elbow_flexor", 1]/' \
+  "$WORK/runs.json" >"$WORK/delayed.json"  # the scene's own mass and stiffness: only the delay differs
+sed -i 's/\[0, "elbow_flexor", 6\], \[0.7, "elbow_flexor", 1\]/[0.1, "elbow_flexor", 6], [0.7, "elbow_flexor", 1]/' \
+  "$WORK/runs.json"
+"$BIN/caliper-ctl" batch "$WORK/delayed.json" --out "$WORK/delayed" >/dev/null 2>&1 || fail "recording the delayed flexor"
+calibration delay.json delayed '{"id": "command_delay:elbow_flexor", "lower": 0, "upper": 0.05}' \
+  '"optimiser": {"generations": 0}, "held_out": ["other"], "seed": 3'
+"$BIN/caliper-calibrate" "$WORK/delay.json" --out "$WORK/delay" >"$WORK/delay.out" 2>&1
+r="$WORK/delay/result.json"
+if [ "$(json "$r" 'abs(r["parameters"][0]["fitted"] - 0.023) <= 0.001 and r["parameters"][0]["lower95"] <= 0.023 <= r["parameters"][0]["upper95"] and r["parameters"][0]["upper95"] - r["parameters"][0]["lower95"] > 0.0005')" = True ]; then
+  pass "command delay $(json "$r" 'r["parameters"][0]["fitted"]') s (truth 0.023), 95 % in [$(json "$r" 'r["parameters"][0]["lower95"]'), $(json "$r" 'r["parameters"][0]["upper95"]')]"
+else cat "$WORK/delay.out"; fail "the command delay"; fi
+sed -i 's/\[0.1, "elbow_flexor", 6\], \[0.7, "elbow_flexor", 1\]/[0, "elbow_flexor", 6], [0.7, "elbow_flexor", 1]/' \
+  "$WORK/runs.json"
+
 # 6. Ctrl-C in the refinement, then --resume
 calibration slow.json truth "$MASS, $STIFF" \
   '"optimiser": {"generations": 0}, "refinement": {"iterations": 40, "step": 1e-4}, "seed": 3'

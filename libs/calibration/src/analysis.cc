@@ -33,7 +33,7 @@ double ImprovementPerGeneration(const std::vector<double>& history, unsigned win
 }
 
 StopCheck CheckStop(const std::vector<double>& history, double spread, unsigned budget,
-                    const Optimiser& rule) {
+                    const Optimiser& rule, unsigned generations) {
   StopCheck out;
   const unsigned generation = history.empty() ? 0 : static_cast<unsigned>(history.size() - 1);
   const double best = history.empty() ? HUGE_VAL : history.back();
@@ -60,7 +60,7 @@ StopCheck CheckStop(const std::vector<double>& history, double spread, unsigned 
                  " of the search box (step_tolerance " + Format(rule.step_tolerance) + ")";
     return out;
   }
-  if (generation >= budget) {
+  if ((generations == ~0u ? generation : generations) >= budget) {
     out.stop = true;
     out.reason =
         "stopped: budget of " + std::to_string(budget) + " generations spent, " +
@@ -306,6 +306,11 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
       if (!determined[static_cast<size_t>(i)] || !determined[static_cast<size_t>(j)]) continue;
       out.covariance(i, j) = dvalue(i) * cov_unit_k(r, c) * dvalue(j);
     }
+  // a parameter that acts only in steps (a command delay: whole time steps) is known to a step
+  // at best: the variance of a uniform quantisation, resolution^2 / 12, on top
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (determined[static_cast<size_t>(i)])
+      out.covariance(i, i) += std::pow(spec.parameters[static_cast<size_t>(i)].resolution, 2) / 12;
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j)
       if (determined[static_cast<size_t>(i)] && determined[static_cast<size_t>(j)])

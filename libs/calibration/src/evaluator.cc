@@ -95,8 +95,8 @@ std::vector<Evaluation> Evaluator::EvaluateMany(const std::vector<std::vector<do
   return out;
 }
 
-std::vector<std::optional<std::vector<double>>> Evaluator::WeightedResiduals(
-    const std::vector<std::vector<double>>& units) {
+std::vector<std::optional<std::vector<double>>> Evaluator::Residuals(
+    const std::vector<std::vector<double>>& units, bool weighted) {
   std::vector<std::vector<double>> values;
   for (const auto& u : units) values.push_back(ValuesOf(u));
   EvaluateOptions options;
@@ -106,6 +106,10 @@ std::vector<std::optional<std::vector<double>>> Evaluator::WeightedResiduals(
   for (const auto& e : evaluations) {
     if (e.faulted) {
       out.emplace_back();
+      continue;
+    }
+    if (!weighted) {
+      out.emplace_back(e.residuals);
       continue;
     }
     const std::vector<double> scales = BlockScales(e.blocks);

@@ -585,6 +585,25 @@ TEST(Analyse, OneOffsetOverTwoChannelsHasTheWeightedMeansVariance) {
   EXPECT_EQ(c.most_sensitive_channel, "e: p");
 }
 
+TEST(Analyse, AParameterActingInStepsIsKnownToAStepAtBest) {
+  // one channel that moves exactly with the parameter, residuals of +-1e-9: without a
+  // resolution the interval is next to nothing; with one of 1 ms, sigma is 1 ms / sqrt(12)
+  Spec spec = OneExperiment("e", {{"command_delay:m", 0, 0.05, false}});
+  spec.parameters[0].kind = ParameterKind::kCommandDelay;
+  const size_t n = 200;
+  std::vector<ResidualBlock> blocks = {{0, "p", "rad", 1, 1, 0, n}};
+  std::vector<double> residuals;
+  for (size_t i = 0; i < n; ++i) residuals.push_back(i % 2 ? 1e-9 : -1e-9);
+  const Eigen::MatrixXd j = Eigen::MatrixXd::Constant(n, 1, 1.0);
+  const double fine = Analyse(spec, j, residuals, blocks, {0.02}, {}).parameters[0].sigma;
+  EXPECT_LT(fine, 1e-8);
+  spec.parameters[0].resolution = 0.001;
+  const auto u = Analyse(spec, j, residuals, blocks, {0.02}, {}).parameters[0];
+  EXPECT_NEAR(u.sigma, std::sqrt(0.001 * 0.001 / 12 + fine * fine), 1e-12);
+  EXPECT_LT(u.lower95, 0.02 - 0.0005);
+  EXPECT_GT(u.upper95, 0.02 + 0.0005);
+}
+
 TEST(Analyse, AStraightLineHasTheOrdinaryLeastSquaresCovariance) {
   // y = a + b t, a linear in [-1, 1], b log-scale in [0.1, 10]: one channel, so the weights
   // cancel and the covariance is s^2 (X'X)^-1 in the parameters' units whatever the scaling

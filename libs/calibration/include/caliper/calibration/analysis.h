@@ -23,10 +23,11 @@ struct StopCheck {
   double improvement_per_generation = 0;  ///< relative, over the last window (0.03 = 3 %)
 };
 
-/// `history` holds the best cost after each generation, the start first (history[g] after g
-/// generations); `spread` the populations' mean standard deviation in the unit box.
+/// `history` holds the best cost after each generation since the search (re)started, its start
+/// first; `spread` the populations' mean standard deviation in the unit box; `generations` those
+/// done in all, against the `budget` (default: the history's).
 StopCheck CheckStop(const std::vector<double>& history, double spread, unsigned budget,
-                    const Optimiser& rule);
+                    const Optimiser& rule, unsigned generations = ~0u);
 
 /// The relative improvement per generation over the recent generations of `history`: the last
 /// `window`, at most a third of them (at least 3) (geometric mean; 0.03 = the cost fell 3 % per

@@ -55,8 +55,9 @@ struct Parameter {
   double lower = 0, upper = 0;  // bounds, in the parameter's unit
   bool log_scale = false;       // search log(value) uniformly
   ParameterKind kind = ParameterKind::kScene;
-  std::string target;  // the channel or actuator of a delay
-  std::string unit;    // a scene parameter's, as its Model gives it
+  std::string target;     // the channel or actuator of a delay
+  std::string unit;       // a scene parameter's, as its Model gives it
+  double resolution = 0;  // the smallest change that acts (a command delay: one time step)
   /// The unit shown for it: "s" for the timing ones, the scene's otherwise.
   std::string Unit() const { return kind == ParameterKind::kScene ? unit : "s"; }
   /// The value at `u` in [0, 1] of the search space, and back.

@@ -50,10 +50,11 @@ class Evaluator {
   /// Model of the pool at a time).
   std::vector<Evaluation> EvaluateMany(const std::vector<std::vector<double>>& values,
                                        const EvaluateOptions& options);
-  /// The weighted residuals (their squares sum to the cost squared) of unit points, in parallel;
-  /// nullopt for a faulted one: the refinement's batch.
-  std::vector<std::optional<std::vector<double>>> WeightedResiduals(
-      const std::vector<std::vector<double>>& units);
+  /// The residuals of unit points, in parallel; nullopt for a faulted one. Weighted: their
+  /// squares sum to the cost squared (the refinement's batch); else raw, simulated - measured
+  /// in each channel's unit (the uncertainty's Jacobian).
+  std::vector<std::optional<std::vector<double>>> Residuals(
+      const std::vector<std::vector<double>>& units, bool weighted);
   /// The same from the unit search space [0, 1]^n.
   double CostOfUnit(const std::vector<double>& unit);
   std::vector<double> ValuesOf(const std::vector<double>& unit) const;
