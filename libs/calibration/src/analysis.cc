@@ -112,6 +112,25 @@ std::vector<double> BlockScales(const std::vector<ResidualBlock>& blocks) {
 
 namespace {
 
+// The noise variance of each channel, from its residuals (degrees of freedom shared out by
+// samples), also into out.noise as standard deviations.
+std::vector<double> NoiseVariances(const Spec& spec, const std::vector<double>& residuals,
+                                   const std::vector<ResidualBlock>& blocks, Eigen::Index n,
+                                   Eigen::Index m, Uncertainty& out) {
+  const double dof = m > n ? 1.0 - static_cast<double>(n) / static_cast<double>(m) : 1.0;
+  std::vector<double> variance(blocks.size());
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    double square = 0;
+    for (size_t i = 0; i < blocks[b].samples; ++i)
+      square += residuals[blocks[b].begin + i] * residuals[blocks[b].begin + i];
+    const double samples = static_cast<double>(std::max<size_t>(blocks[b].samples, 1));
+    variance[b] = square / (samples * dof);
+    out.noise.push_back({spec.experiments[blocks[b].experiment].name, blocks[b].column,
+                         blocks[b].unit, std::sqrt(variance[b]), blocks[b].samples});
+  }
+  return variance;
+}
+
 // The warnings of Analyse, each with what would help.
 void AddWarnings(const Spec& spec, const Eigen::MatrixXd& jacobian,
                  const std::vector<ResidualBlock>& blocks, const std::vector<bool>& moves,
@@ -197,18 +216,7 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
     return spec.experiments[b.experiment].name + ": " + b.column;
   };
 
-  // the noise of each channel, from its residuals (degrees of freedom shared out by samples)
-  const double dof = m > n ? 1.0 - static_cast<double>(n) / static_cast<double>(m) : 1.0;
-  std::vector<double> variance(blocks.size());
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    double square = 0;
-    for (size_t i = 0; i < blocks[b].samples; ++i)
-      square += residuals[blocks[b].begin + i] * residuals[blocks[b].begin + i];
-    const double samples = static_cast<double>(std::max<size_t>(blocks[b].samples, 1));
-    variance[b] = square / (samples * dof);
-    out.noise.push_back({spec.experiments[blocks[b].experiment].name, blocks[b].column,
-                         blocks[b].unit, std::sqrt(variance[b]), blocks[b].samples});
-  }
+  const std::vector<double> variance = NoiseVariances(spec, residuals, blocks, n, m, out);
 
   // per row: the cost's weight a and the noise variance s^2
   const std::vector<double> scales = BlockScales(blocks);
@@ -291,7 +299,8 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
     const Eigen::MatrixXd hs_inverse =
         eigen.eigenvectors() * inverse_lambda.asDiagonal() * eigen.eigenvectors().transpose();
     const Eigen::MatrixXd h_inverse = d.asDiagonal() * hs_inverse * d.asDiagonal();
-    cov_unit_k = h_inverse * meat * h_inverse;
+    const Eigen::MatrixXd sandwich = h_inverse * meat * h_inverse;
+    cov_unit_k = (sandwich + sandwich.transpose()) / 2;  // symmetric exactly
   }
 
   out.covariance = Eigen::MatrixXd::Constant(n, n, nan);
@@ -304,18 +313,19 @@ Uncertainty Analyse(const Spec& spec, const Eigen::MatrixXd& jacobian,
     for (Eigen::Index c = 0; c < k; ++c) {
       const Eigen::Index i = kept[static_cast<size_t>(r)], j = kept[static_cast<size_t>(c)];
       if (!determined[static_cast<size_t>(i)] || !determined[static_cast<size_t>(j)]) continue;
-      out.covariance(i, j) = dvalue(i) * cov_unit_k(r, c) * dvalue(j);
+      // (a product that commutes exactly: the matrix stays symmetric); a parameter that acts only
+      // in steps (a command delay: time steps) is known to a step at best: a uniform
+      // quantisation's variance, resolution^2 / 12, on top
+      const double resolution = i == j ? spec.parameters[static_cast<size_t>(i)].resolution : 0;
+      out.covariance(i, j) =
+          dvalue(i) * dvalue(j) * cov_unit_k(r, c) + resolution * resolution / 12;
     }
-  // a parameter that acts only in steps (a command delay: whole time steps) is known to a step
-  // at best: the variance of a uniform quantisation, resolution^2 / 12, on top
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (determined[static_cast<size_t>(i)])
-      out.covariance(i, i) += std::pow(spec.parameters[static_cast<size_t>(i)].resolution, 2) / 12;
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j)
       if (determined[static_cast<size_t>(i)] && determined[static_cast<size_t>(j)])
         out.correlation(i, j) =
-            out.covariance(i, j) / std::sqrt(out.covariance(i, i) * out.covariance(j, j));
+            i == j ? 1.0
+                   : out.covariance(i, j) / std::sqrt(out.covariance(i, i) * out.covariance(j, j));
 
   for (Eigen::Index j = 0; j < n; ++j) {
     auto& pu = out.parameters[static_cast<size_t>(j)];
