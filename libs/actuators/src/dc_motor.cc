@@ -144,6 +144,58 @@ void DcMotorParameters::Validate() const {
   Check("current_limit", "A", current_limit, Range::kNonNegative);
   Check("spool_radius", "m", spool_radius, Range::kPositive);
   Check("max_substep", "s", max_substep, Range::kPositive);
+  Check("coulomb_friction", "N m", coulomb_friction, Range::kNonNegative);
+  Check("static_friction", "N m", static_friction, Range::kNonNegative);
+  if (static_friction > 0 && static_friction < coulomb_friction)
+    throw std::invalid_argument("parameter 'static_friction' (" + Text(static_friction) +
+                                " N m) must be 0 or at least coulomb_friction (" +
+                                Text(coulomb_friction) + " N m)");
+  Check("stribeck_speed", "rad/s", stribeck_speed, Range::kPositive);
+  Check("viscous_friction", "N m s/rad", viscous_friction, Range::kNonNegative);
+  Check("friction_smoothing_speed", "rad/s", friction_smoothing_speed, Range::kPositive);
+  Check("cogging_amplitude", "N m", cogging_amplitude, Range::kNonNegative);
+  Check("cogging_count", "", cogging_count, Range::kPositive);
+  if (cogging_count != std::floor(cogging_count) || cogging_count > 1e6)
+    throw std::invalid_argument("parameter 'cogging_count' must be a whole number of periods "
+                                "per rotor turn in [1, 1e6], got " + Text(cogging_count));
+  if (!std::isfinite(cogging_phase))
+    throw std::invalid_argument("parameter 'cogging_phase' must be finite [rad]");
+  Check("thermal_resistance_winding_housing", "K/W", thermal_resistance_winding_housing,
+        Range::kNonNegative);
+  Check("thermal_resistance_housing_ambient", "K/W", thermal_resistance_housing_ambient,
+        Range::kNonNegative);
+  Check("thermal_time_constant_winding", "s", thermal_time_constant_winding, Range::kNonNegative);
+  Check("thermal_time_constant_motor", "s", thermal_time_constant_motor, Range::kNonNegative);
+  const bool any_thermal = thermal_resistance_winding_housing > 0 ||
+                           thermal_resistance_housing_ambient > 0 ||
+                           thermal_time_constant_winding > 0 || thermal_time_constant_motor > 0;
+  if (any_thermal) {
+    try {
+      thermal_parameters().Validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(e.what()) +
+                                  " (the thermal model needs all four thermal constants; all 0 "
+                                  "turns it off)");
+    }
+  }
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"ambient_temperature", ambient_temperature},
+        {"reference_temperature", reference_temperature},
+        {"resistance_temperature_coefficient", resistance_temperature_coefficient},
+        {"torque_constant_temperature_coefficient", torque_constant_temperature_coefficient}})
+    if (!std::isfinite(value))
+      throw std::invalid_argument(std::string("parameter '") + name + "' must be finite, got " +
+                                  Text(value));
+  if (ambient_temperature < -273.15)
+    throw std::invalid_argument("parameter 'ambient_temperature' must be above -273.15 degC, got " +
+                                Text(ambient_temperature));
+  Check("max_winding_temperature", "degC", max_winding_temperature, Range::kNonNegative);
+  if (any_thermal && max_winding_temperature > 0 && max_winding_temperature <= ambient_temperature)
+    throw std::invalid_argument("parameter 'max_winding_temperature' (" +
+                                Text(max_winding_temperature) +
+                                " degC) must be above ambient_temperature (" +
+                                Text(ambient_temperature) + " degC), or 0 for no protection");
+  Check("derating_band", "K", derating_band, Range::kPositive);
 }
 
 double GearEfficiencyFactor(double efficiency, double current, double spool_speed) {
@@ -175,15 +227,29 @@ DcMotor::DcMotor(const DcMotorParameters& parameters) { set_parameters(parameter
 
 void DcMotor::set_parameters(const DcMotorParameters& parameters) {
   parameters.Validate();
+  const bool was_thermal = thermal_;
   parameters_ = parameters;
-  constants_ = StageConstants{};  // recomputed at the next step
+  effective_ = parameters;
+  shaft_ = parameters.shaft_losses();
+  thermal_ = parameters.thermal();
+  thermal_model_ = TwoNodeThermal{};  // configured at the next step
+  constants_ = StageConstants{};      // recomputed at the next step
+  if (!was_thermal) {
+    // the temperatures start at the ambient when the model is turned on (or off)
+    state_.winding_temperature = state_.housing_temperature = parameters.ambient_temperature;
+    winding_change_ = housing_change_ = 0;
+  }
 }
 
 void DcMotor::Reset() {
   state_ = DcMotorState{};
+  state_.winding_temperature = state_.housing_temperature = parameters_.ambient_temperature;
   applied_voltage_ = 0;
   load_torque_ = 0;
   last_acceleration_ = 0;
+  winding_change_ = housing_change_ = 0;
+  derating_ = 0;
+  effective_ = parameters_;
 }
 
 double DcMotor::Substeps(double dt, double max_substep) {
@@ -216,7 +282,7 @@ void DcMotor::UpdateConstants(double dt) {
 }
 
 DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) const {
-  const DcMotorParameters& p = parameters_;
+  const DcMotorParameters& p = effective_;
   StageConstants k;
   const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
   const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
@@ -239,6 +305,18 @@ DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) con
   k.inverse_rho_driven = 1 / (p.efficiency + k.spread);
   k.tolerance = kNewtonTolerance / emf;  // of the no-load speed at 1 V [rad/s]
   k.current_to_speed = p.torque_constant * p.inductance / (p.gear_ratio * inertia() * resistance);
+  k.c_shaft = c_over_inertia;
+  if (shaft_) {
+    // the most tau_f can fall per rad/s of the motor: (tau_s - tau_c) max|d exp(-y^2)/dW|,
+    // max |y exp(-y^2)| 2 / W_s = sqrt(2 / e) / W_s; cogging's A n per radian of the rotor,
+    // N c radians per rad/s of w
+    const double peak = p.static_friction > p.coulomb_friction
+                            ? (p.static_friction - p.coulomb_friction) * std::sqrt(2 / M_E) /
+                                  p.stribeck_speed
+                            : 0.0;
+    k.shaft_falling = c_over_inertia * p.gear_ratio *
+                      (peak + p.cogging_amplitude * p.cogging_count * p.gear_ratio * k.c);
+  }
   return k;
 }
 
@@ -256,7 +334,7 @@ double DcMotor::Exp(double x) const {
 }
 
 DcMotor::Stage DcMotor::StageAt(const DcMotorState& a, double voltage, double w) const {
-  const DcMotorParameters& p = parameters_;
+  const DcMotorParameters& p = effective_;
   const StageConstants& k = constants_;
   Stage s;
   s.spool_speed = w;
@@ -289,6 +367,7 @@ class DcMotor::StageEquation {
     double d_inverse_x;              // d(1 / rho)/dx D^2 = (1/eta - eta) e
     double x_slope;                  // dx/dw
     double d_current;                // di/dw (0 while the current is limited)
+    double shaft, d_shaft;           // friction and cogging [N m] and d/dw (0 without them)
     int regime;  // -1, +1: saturated (rho = eta + (1/eta - eta), eta exactly); 0; kUnloaded
   };
   static constexpr int kUnloaded = 2;  // no torque, no slope: the switch does not matter
@@ -298,8 +377,8 @@ class DcMotor::StageEquation {
       : motor_(motor),
         k_(motor.constants_),
         current0_(k_.current_base * a.current + k_.current_drive * voltage),
-        limit_(motor.parameters_.current_limit),
-        efficiency_(motor.parameters_.efficiency),
+        limit_(motor.effective_.current_limit),
+        efficiency_(motor.effective_.efficiency),
         angle0_(a.spool_angle),
         speed0_(a.spool_speed),
         h_load_(h_load),
@@ -325,8 +404,14 @@ class DcMotor::StageEquation {
     v->torque = load_.TorqueAlong(angle0_ + k_.c * w, w, h_load_, k_.c, &v->d_torque,
                                   &v->affine_low, &v->affine_high);
     v->x_slope = 2 * kSwitchSharpness * (v->d_current * w + current);
-    const double linear = w - speed0_ - k_.c_torque * current;
-    const double d_linear = 1 - k_.c_torque * v->d_current;
+    double linear = w - speed0_ - k_.c_torque * current;
+    double d_linear = 1 - k_.c_torque * v->d_current;
+    v->shaft = v->d_shaft = 0;
+    if (motor_.shaft_) {
+      v->shaft = motor_.ShaftTorque(w, angle0_ + k_.c * w, k_.c, &v->d_shaft);
+      linear += k_.c_shaft * v->shaft;
+      d_linear += k_.c_shaft * v->d_shaft;
+    }
     if (v->torque == 0 && v->d_torque == 0) {
       // unloaded (a slack line): rho does not matter
       v->regime = kUnloaded;
@@ -367,6 +452,12 @@ class DcMotor::StageEquation {
       return kInfinity;
     // the load off its tangent, seen through 1/rho <= 1/eta
     double bound = 0;
+    if (motor_.shaft_) {
+      // friction and cogging off their tangent, where the step ends
+      double d_shaft;
+      const double shaft = motor_.ShaftTorque(next, angle0_ + k_.c * next, k_.c, &d_shaft);
+      bound += k_.c_shaft * std::abs(shaft - v.shaft - v.d_shaft * step) * v.scale;
+    }
     if (!(step >= v.affine_low && step <= v.affine_high)) {
       const double torque = load_.TorqueAt(angle0_ + k_.c * next, next, h_load_);
       bound = k_.c_ratio * k_.inverse_rho_driving *
@@ -399,6 +490,9 @@ class DcMotor::StageEquation {
                                                    double step) const {
     const double w_star = w_eval + step;
     const int sign = motor_.load_sign_;
+    // friction's Stribeck peak and cogging may lower dR/dw by up to shaft_falling: with at most
+    // 1/2 of it, the switch's part below must stay under 1/2; beyond, the bracketing decides
+    if (k_.shaft_falling >= 0.5) return false;
     double tau = -1;  // max |tau| at the ends, once known
     auto max_torque = [&] {
       if (tau < 0) {
@@ -507,15 +601,17 @@ double DcMotor::SolveStage(const DcMotorState& a, double voltage, double h_load,
 
 double DcMotor::SolveStageBracketing(const DcMotorState& a, double voltage, double h_load,
                                      const SpoolLoad& load) const {
-  const DcMotorParameters& p = parameters_;
+  const DcMotorParameters& p = effective_;
   const StageConstants& k = constants_;
   const double inertia = p.gear_ratio * this->inertia();  // N J [kg m^2]
   auto residual = [&](double w) {
     const Stage s = StageAt(a, voltage, w);
     const double torque = load.TorqueAt(s.spool_angle, w, h_load);
     const double rho = GearEfficiencyFactor(p.efficiency, s.current, w);
+    double d_shaft;
+    const double shaft = shaft_ ? ShaftTorque(w, s.spool_angle, k.c, &d_shaft) : 0.0;
     const double acceleration =
-        (p.torque_constant * s.current - torque / (rho * p.gear_ratio)) / inertia;
+        (p.torque_constant * s.current - torque / (rho * p.gear_ratio) - shaft) / inertia;
     return w - a.spool_speed - k.c * acceleration;
   };
   return FindRoot(residual, a.spool_speed, kSpeedTolerance);
@@ -550,6 +646,7 @@ bool DcMotor::Substep(double voltage, SpoolLoad& load, bool last, bool check) {
       return false;
   }
   last_acceleration_ = (w2 - a.spool_speed) * constants_.inverse_c;
+  if (thermal_) joule_ += 0.5 * h * (y.current * y.current + second.current * second.current);
   state_.current = second.current;
   state_.spool_speed = second.spool_speed;
   state_.spool_angle = second.spool_angle;
@@ -572,6 +669,7 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
     }
     UpdateConstants(dt);
   }
+  if (thermal_) BeginThermalStep(voltage, dt);
   load_sign_ = load.TorqueSign();
   const int n = constants_.substeps;
   for (int i = 0; i < n; ++i) {
@@ -583,6 +681,116 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
     for (int j = 0; j < m; ++j) Substep(voltage, load, last && j + 1 == m, false);
     std::swap(constants_, fine_);
   }
+  if (thermal_) EndThermalStep(dt);
+}
+
+double DcMotor::ShaftTorque(double w, double phi, double c, double* d_torque) const {
+  const DcMotorParameters& p = parameters_;
+  const double n = p.gear_ratio;
+  double slope;  // d/dW
+  double torque = FrictionTorque(p, n * w, &slope);
+  *d_torque = n * slope;
+  if (p.cogging_amplitude > 0) {
+    const double angle = p.cogging_count * n * phi + p.cogging_phase;
+    torque += p.cogging_amplitude * std::sin(angle);
+    *d_torque += p.cogging_amplitude * std::cos(angle) * p.cogging_count * n * c;
+  }
+  return torque;
+}
+
+double FrictionTorque(const DcMotorParameters& p, double speed, double* slope) {
+  double torque = p.viscous_friction * speed;
+  *slope = p.viscous_friction;
+  if (p.coulomb_friction > 0 || p.static_friction > 0) {
+    // tanh(x) is +-1 to the last bit beyond |x| = 19.1, exp(-y^2) below 3e-16 beyond |y| = 6
+    const double x = speed / p.friction_smoothing_speed;
+    double sign = x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0);
+    double d_sign = 0;
+    if (std::abs(x) < 19.1) {
+      sign = std::tanh(x);
+      d_sign = (1 - sign * sign) / p.friction_smoothing_speed;
+    }
+    double level = p.coulomb_friction;
+    double d_level = 0;
+    const double peak = p.static_friction - p.coulomb_friction;
+    if (peak > 0) {
+      const double y = speed / p.stribeck_speed;
+      if (std::abs(y) < 6) {
+        const double e = std::exp(-y * y);
+        level += peak * e;
+        d_level = -2 * y * peak * e / p.stribeck_speed;
+      }
+    }
+    torque += level * sign;
+    *slope += d_level * sign + level * d_sign;
+  }
+  return torque;
+}
+
+double DcMotor::friction_torque() const {
+  double slope;
+  return FrictionTorque(parameters_, motor_speed(), &slope);
+}
+
+double DcMotor::cogging_torque() const {
+  const DcMotorParameters& p = parameters_;
+  if (p.cogging_amplitude == 0) return 0;
+  return p.cogging_amplitude *
+         std::sin(p.cogging_count * p.gear_ratio * state_.spool_angle + p.cogging_phase);
+}
+
+double DcMotor::continuous_current() const {
+  const DcMotorParameters& p = parameters_;
+  if (!thermal_ || p.max_winding_temperature == 0) return 0;
+  const double hot = p.resistance * (1 + p.resistance_temperature_coefficient *
+                                             (p.max_winding_temperature - p.reference_temperature));
+  return ContinuousCurrent(p.thermal_parameters(), p.max_winding_temperature,
+                           p.ambient_temperature, hot);
+}
+
+void DcMotor::BeginThermalStep(double voltage, double dt) {
+  const DcMotorParameters& p = parameters_;
+  if (thermal_model_.dt() != dt) thermal_model_.Configure(p.thermal_parameters(), dt);
+  // the step's middle, extrapolated from the last step's change
+  const double winding = state_.winding_temperature + 0.5 * winding_change_;
+  const double housing = state_.housing_temperature + 0.5 * housing_change_;
+  // kept positive however cold (the coefficients are linear fits near room temperature)
+  const double r_factor =
+      std::max(0.05, 1 + p.resistance_temperature_coefficient * (winding - p.reference_temperature));
+  const double k_factor = std::max(
+      0.05, 1 + p.torque_constant_temperature_coefficient * (housing - p.reference_temperature));
+  effective_.resistance = p.resistance * r_factor;
+  effective_.torque_constant = p.torque_constant * k_factor;
+  effective_.back_emf_constant = p.back_emf_constant * k_factor;
+  // the driver's protection, from the winding's temperature at the start of the step
+  derating_ = 0;
+  effective_.current_limit = p.current_limit;
+  if (p.max_winding_temperature > 0) {
+    const double start = p.max_winding_temperature - p.derating_band;
+    derating_ = std::clamp((state_.winding_temperature - start) / p.derating_band, 0.0, 1.0);
+    if (derating_ > 0) {
+      const double continuous = continuous_current();
+      // without a limit of its own the driver starts from the stall current at this voltage
+      const double top = p.current_limit > 0
+                             ? p.current_limit
+                             : std::abs(voltage) / (effective_.resistance + p.bridge_resistance);
+      if (top > continuous) effective_.current_limit = top + (continuous - top) * derating_;
+    }
+  }
+  UpdateConstants(dt);
+  joule_ = 0;
+}
+
+void DcMotor::EndThermalStep(double dt) {
+  const double ambient = parameters_.ambient_temperature;
+  double winding = state_.winding_temperature - ambient;
+  double housing = state_.housing_temperature - ambient;
+  // the Joule power in the winding (the bridge's resistance heats the driver, not the motor)
+  thermal_model_.Step(effective_.resistance * joule_ / dt, &winding, &housing);
+  winding_change_ = winding + ambient - state_.winding_temperature;
+  housing_change_ = housing + ambient - state_.housing_temperature;
+  state_.winding_temperature = winding + ambient;
+  state_.housing_temperature = housing + ambient;
 }
 
 void DcMotor::Step(double voltage, double dt, double load_torque) {

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -43,7 +44,65 @@ const MotorField kMotorFields[] = {
     {"current_limit", "A", &DcMotorParameters::current_limit, "driver current limit (0: none)"},
     {"spool_radius", "m", &DcMotorParameters::spool_radius, "spool radius r_s"},
     {"max_substep", "s", &DcMotorParameters::max_substep, "longest internal integration step"},
+    {"coulomb_friction", "N m", &DcMotorParameters::coulomb_friction,
+     "Coulomb friction at the motor shaft tau_c (about k_t times the no-load current)"},
+    {"static_friction", "N m", &DcMotorParameters::static_friction,
+     "breakaway friction at the motor shaft tau_s (0: tau_c, no Stribeck peak)"},
+    {"stribeck_speed", "rad/s", &DcMotorParameters::stribeck_speed,
+     "motor speed W_s over which friction falls from tau_s to tau_c"},
+    {"viscous_friction", "N m s/rad", &DcMotorParameters::viscous_friction,
+     "viscous friction at the motor shaft b"},
+    {"friction_smoothing_speed", "rad/s", &DcMotorParameters::friction_smoothing_speed,
+     "motor speed W_e over which friction changes sign (tanh)"},
+    {"cogging_amplitude", "N m", &DcMotorParameters::cogging_amplitude,
+     "cogging torque amplitude A at the motor shaft"},
+    {"cogging_count", "", &DcMotorParameters::cogging_count,
+     "cogging periods per rotor turn n (a whole number)"},
+    {"cogging_phase", "rad", &DcMotorParameters::cogging_phase, "cogging phase psi"},
+    {"thermal_resistance_winding_housing", "K/W",
+     &DcMotorParameters::thermal_resistance_winding_housing,
+     "thermal resistance winding-housing R_wh (datasheet)"},
+    {"thermal_resistance_housing_ambient", "K/W",
+     &DcMotorParameters::thermal_resistance_housing_ambient,
+     "thermal resistance housing-ambient R_ha (datasheet; 0: no thermal model)"},
+    {"thermal_time_constant_winding", "s", &DcMotorParameters::thermal_time_constant_winding,
+     "thermal time constant of the winding tau_w (datasheet)"},
+    {"thermal_time_constant_motor", "s", &DcMotorParameters::thermal_time_constant_motor,
+     "thermal time constant of the motor tau_m (datasheet)"},
+    {"ambient_temperature", "degC", &DcMotorParameters::ambient_temperature,
+     "ambient temperature T_a (and the motor's at reset)"},
+    {"reference_temperature", "degC", &DcMotorParameters::reference_temperature,
+     "temperature T_ref at which resistance and torque_constant are given"},
+    {"resistance_temperature_coefficient", "1/K",
+     &DcMotorParameters::resistance_temperature_coefficient,
+     "winding resistance change per kelvin alpha (copper 0.0039)"},
+    {"torque_constant_temperature_coefficient", "1/K",
+     &DcMotorParameters::torque_constant_temperature_coefficient,
+     "torque and back-EMF constant change per kelvin of the housing beta (NdFeB about -0.001)"},
+    {"max_winding_temperature", "degC", &DcMotorParameters::max_winding_temperature,
+     "winding temperature the driver protects (0: none)"},
+    {"derating_band", "K", &DcMotorParameters::derating_band,
+     "below max_winding_temperature, the band over which the driver lowers its current limit"},
 };
+
+// the driver's own parameters: kind parameters beside supply_voltage and pretension
+struct DriverField {
+  const char* name;
+  const char* unit;
+  double default_value;
+  const char* help;
+};
+
+const DriverField kDriverFields[] = {
+    {"pwm_levels", "", 0,
+     "PWM duty steps from 0 to full supply (e.g. 1024 for 10 bits; 0: continuous)"},
+    {"slew_rate", "V/s", 0, "fastest change of the driver's output voltage (0: none)"},
+    {"command_delay", "s", 0,
+     "time from a command to the driver, rounded to whole time steps (at most 200 of them)"},
+};
+
+// the most time steps a command may be delayed by (the actuator's state holds as many)
+constexpr int kMaxCommandDelaySteps = 200;
 
 constexpr double kDefaultSupplyVoltage = 12;  // [V]
 
@@ -142,6 +201,8 @@ class DcMotorTendon : public TendonActuator {
       p.*field.member = ParameterOr(a, field.name, p.*field.member);
     supply_voltage_ = ParameterOr(a, "supply_voltage", kDefaultSupplyVoltage);
     pretension_ = ParameterOr(a, "pretension", 0);
+    for (const DriverField& field : kDriverFields)
+      *Driver(field.name) = ParameterOr(a, field.name, field.default_value);
     const auto input = a.options.find("input");
     if (input != a.options.end()) {
       if (input->second == "duty")
@@ -154,6 +215,7 @@ class DcMotorTendon : public TendonActuator {
       motor_.set_parameters(p);
       CheckSupplyVoltage(supply_voltage_);
       CheckPretension(pretension_);
+      for (const DriverField& field : kDriverFields) CheckDriver(field.name, *Driver(field.name));
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -174,6 +236,13 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + "pretension: " + e.what());
     }
     elastic_->Reset(length);
+    // the driver has given the present command since ever
+    pending_count_ = 0;
+    pending_head_ = 0;
+    steps_ = 0;
+    delayed_command_ = command_;
+    driver_voltage_ = TargetVoltage();
+    warned_ = false;
     path_length_ = path_length;
     path_speed_ = 0;
     line_length_ = path_length - length;
@@ -191,7 +260,10 @@ class DcMotorTendon : public TendonActuator {
     const double angle = motor_.state().spool_angle;
     TendonSpoolLoad load(elastic_.get(), linear_, path_length, path_speed, line_length_, angle,
                          motor_.parameters().spool_radius);
-    motor_.Step(voltage(), dt, load);
+    DriveStep(dt);
+    motor_.Step(driver_voltage_, dt, load);
+    ++steps_;
+    if (motor_.parameters().thermal()) WatchTemperature();
     // everything reported is at the end of the step, where the tension is
     path_length_ = path_length + path_speed * dt;
     path_speed_ = path_speed;
@@ -211,8 +283,9 @@ class DcMotorTendon : public TendonActuator {
 
   double tension() const override { return tension_; }
 
-  // the motor's, the elastic element's, and what the step reports
-  std::size_t StateSize() const override { return kOwnState + elastic_state_; }
+  // the motor's, the elastic element's, what the step reports and the driver's (its delay line
+  // last: only its pending commands are written)
+  std::size_t StateSize() const override { return kOwnState + elastic_state_ + kDelayState; }
 
   void SaveState(double* out) const override {
     motor_.SaveState(out);
@@ -222,7 +295,19 @@ class DcMotorTendon : public TendonActuator {
     out[2] = line_length_;
     out[3] = elastic_length_;
     out[4] = tension_;
-    if (elastic_state_ > 0) elastic_->SaveState(out + 5);
+    out[5] = static_cast<double>(steps_);
+    out[6] = delayed_command_;
+    out[7] = driver_voltage_;
+    out[8] = warned_ ? 1 : 0;
+    out += kOwnState - DcMotor::kStateSize;
+    if (elastic_state_ > 0) elastic_->SaveState(out);
+    out += elastic_state_;
+    out[0] = pending_count_;
+    for (int k = 0; k < pending_count_; ++k) {
+      const Pending& p = pending_[(pending_head_ + k) % kPendingCapacity];
+      out[1 + 2 * k] = static_cast<double>(p.issued);
+      out[2 + 2 * k] = p.value;
+    }
   }
 
   void RestoreState(const double* in) override {
@@ -233,7 +318,17 @@ class DcMotorTendon : public TendonActuator {
     line_length_ = in[2];
     elastic_length_ = in[3];
     tension_ = in[4];
-    if (elastic_state_ > 0) elastic_->RestoreState(in + 5);
+    steps_ = static_cast<std::int64_t>(in[5]);
+    delayed_command_ = in[6];
+    driver_voltage_ = in[7];
+    warned_ = in[8] != 0;
+    in += kOwnState - DcMotor::kStateSize;
+    if (elastic_state_ > 0) elastic_->RestoreState(in);
+    in += elastic_state_;
+    pending_head_ = 0;
+    pending_count_ = static_cast<int>(std::clamp(in[0], 0.0, double(kPendingCapacity)));
+    for (int k = 0; k < pending_count_; ++k)
+      pending_[k] = {static_cast<std::int64_t>(in[1 + 2 * k]), in[2 + 2 * k]};
   }
 
   void SetTimeStep(double dt) override {
@@ -241,6 +336,7 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     try {
       DcMotor::CheckSubsteps(dt, motor_.parameters().max_substep);
+      CheckDelay(command_delay_, dt);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -250,6 +346,27 @@ class DcMotorTendon : public TendonActuator {
   void SetCommand(double value) override {
     RequireFinite(prefix_, "command", value);
     command_ = duty_input_ ? std::clamp(value, -1.0, 1.0) : value;
+    if (command_delay_ == 0 && pending_count_ == 0) {
+      delayed_command_ = command_;
+      return;
+    }
+    // into the delay line, issued before step steps_; a later command before the same step
+    // replaces the earlier
+    if (pending_count_ > 0) {
+      Pending& back = pending_[(pending_head_ + pending_count_ - 1) % kPendingCapacity];
+      if (back.issued == steps_) {
+        back.value = command_;
+        return;
+      }
+    }
+    if (pending_count_ == kPendingCapacity) {
+      // only when the delay grew past what the line holds: the oldest is applied now
+      delayed_command_ = pending_[pending_head_].value;
+      pending_head_ = (pending_head_ + 1) % kPendingCapacity;
+      --pending_count_;
+    }
+    pending_[(pending_head_ + pending_count_) % kPendingCapacity] = {steps_, command_};
+    ++pending_count_;
   }
   double command() const override { return command_; }
   std::string command_unit() const override { return duty_input_ ? "" : "V"; }
@@ -259,6 +376,7 @@ class DcMotorTendon : public TendonActuator {
     for (const MotorField& field : kMotorFields) q.push_back({field.name, field.unit, true, true});
     q.push_back({"supply_voltage", "V", true, true});
     q.push_back({"pretension", "N", true, true});
+    for (const DriverField& field : kDriverFields) q.push_back({field.name, field.unit, true, true});
     for (const Quantity& e : elastic_->Quantities()) q.push_back(e);
     for (const auto& [name, unit] : kStates) q.push_back({name, unit, false, false});
     return q;
@@ -270,6 +388,8 @@ class DcMotorTendon : public TendonActuator {
       if (name == field.name) return p.*field.member;
     if (name == "supply_voltage") return supply_voltage_;
     if (name == "pretension") return pretension_;
+    for (const DriverField& field : kDriverFields)
+      if (name == field.name) return *Driver(field.name);
     const DcMotorState& s = motor_.state();
     if (name == "current") return s.current;
     if (name == "spool_speed") return s.spool_speed;
@@ -280,6 +400,17 @@ class DcMotorTendon : public TendonActuator {
     if (name == "tension") return tension_;
     if (name == "voltage") return motor_.applied_voltage();
     if (name == "power") return motor_.electrical_power();
+    if (name == "winding_temperature") return s.winding_temperature;
+    if (name == "housing_temperature") return s.housing_temperature;
+    if (name == "motor_torque") return motor_.motor_torque();
+    if (name == "friction_torque") return motor_.friction_torque();
+    if (name == "cogging_torque") return motor_.cogging_torque();
+    if (name == "hot_resistance") return motor_.hot_resistance();
+    if (name == "hot_torque_constant") return motor_.hot_torque_constant();
+    if (name == "current_limit_now") return motor_.current_limit();
+    if (name == "derating") return motor_.derating();
+    if (name == "driver_voltage") return driver_voltage_;
+    if (name == "delayed_command") return delayed_command_;
     if (HasElastic(name)) return elastic_->Get(name);
     throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
   }
@@ -313,6 +444,13 @@ class DcMotorTendon : public TendonActuator {
         pretension_ = value;
         return;
       }
+      for (const DriverField& field : kDriverFields) {
+        if (name != field.name) continue;
+        CheckDriver(field.name, value);
+        if (name == std::string("command_delay") && time_step_ > 0) CheckDelay(value, time_step_);
+        *Driver(field.name) = value;
+        return;
+      }
       for (const auto& [state, unit] : kStates)
         if (name == state)
           throw std::invalid_argument("'" + name + "' [" + unit + "] is a state, not writable");
@@ -325,9 +463,111 @@ class DcMotorTendon : public TendonActuator {
 
  private:
   static constexpr std::pair<const char*, const char*> kStates[] = {
-      {"current", "A"},         {"spool_speed", "rad/s"}, {"spool_angle", "rad"},
-      {"motor_speed", "rad/s"}, {"line_length", "m"},     {"elastic_length", "m"},
-      {"tension", "N"},         {"voltage", "V"},         {"power", "W"}};
+      {"current", "A"},
+      {"spool_speed", "rad/s"},
+      {"spool_angle", "rad"},
+      {"motor_speed", "rad/s"},
+      {"line_length", "m"},
+      {"elastic_length", "m"},
+      {"tension", "N"},
+      {"voltage", "V"},
+      {"power", "W"},
+      {"winding_temperature", "degC"},
+      {"housing_temperature", "degC"},
+      {"motor_torque", "N m"},
+      {"friction_torque", "N m"},
+      {"cogging_torque", "N m"},
+      {"hot_resistance", "ohm"},
+      {"hot_torque_constant", "N m/A"},
+      {"current_limit_now", "A"},
+      {"derating", ""},
+      {"driver_voltage", "V"},
+      {"delayed_command", ""}};
+
+  struct Pending {
+    std::int64_t issued;  // before this step (steps_ then)
+    double value;         // the command
+  };
+  static constexpr int kPendingCapacity = kMaxCommandDelaySteps + 1;
+  static constexpr std::size_t kDelayState = 1 + 2 * kPendingCapacity;
+
+  double* Driver(const std::string& name) {
+    return const_cast<double*>(static_cast<const DcMotorTendon*>(this)->Driver(name));
+  }
+  const double* Driver(const std::string& name) const {
+    if (name == "pwm_levels") return &pwm_levels_;
+    if (name == "slew_rate") return &slew_rate_;
+    return &command_delay_;
+  }
+  static void CheckDriver(const char* name, double value) {
+    if (!(value >= 0) || !std::isfinite(value))
+      throw std::invalid_argument(std::string("parameter '") + name + "' must be >= 0, got " +
+                                  Number(value));
+    if (name == std::string("pwm_levels") && value != std::floor(value))
+      throw std::invalid_argument("parameter 'pwm_levels' must be a whole number, got " +
+                                  Number(value));
+  }
+  static int DelaySteps(double delay, double dt) {
+    // beyond the line's capacity, any larger number says the same
+    return static_cast<int>(std::min(std::round(delay / dt), 1e9));
+  }
+  static void CheckDelay(double delay, double dt) {
+    const int steps = DelaySteps(delay, dt);
+    if (steps > kMaxCommandDelaySteps)
+      throw std::invalid_argument("parameter 'command_delay' = " + Number(delay) + " s is " +
+                                  std::to_string(steps) + " time steps of " + Number(dt) +
+                                  " s; at most " + std::to_string(kMaxCommandDelaySteps) +
+                                  " (" + Number(kMaxCommandDelaySteps * dt) + " s)");
+  }
+
+  // the driver's output for the delayed command: quantised to the PWM's duty steps, within the
+  // supply, then moved toward it at the slew rate
+  double TargetVoltage() const {
+    double target = voltage(delayed_command_);
+    if (pwm_levels_ > 0) {
+      const double duty = std::clamp(target / supply_voltage_, -1.0, 1.0);
+      target = supply_voltage_ * std::round(duty * pwm_levels_) / pwm_levels_;
+    }
+    return target;
+  }
+  void DriveStep(double dt) {
+    if (pending_count_ > 0) {
+      const int delay = DelaySteps(command_delay_, dt);
+      if (delay > kMaxCommandDelaySteps) CheckDelay(command_delay_, dt);  // throws
+      while (pending_count_ > 0 && steps_ - pending_[pending_head_].issued >= delay) {
+        delayed_command_ = pending_[pending_head_].value;
+        pending_head_ = (pending_head_ + 1) % kPendingCapacity;
+        --pending_count_;
+      }
+    }
+    const double target = TargetVoltage();
+    if (slew_rate_ > 0) {
+      const double most = slew_rate_ * dt;
+      driver_voltage_ += std::clamp(target - driver_voltage_, -most, most);
+    } else {
+      driver_voltage_ = target;
+    }
+  }
+
+  // the thermal protection's warning when it starts lowering the current, and a notice when the
+  // winding has cooled 2 K below where it starts
+  void WatchTemperature() {
+    const DcMotorParameters& p = motor_.parameters();
+    const double winding = motor_.state().winding_temperature;
+    if (!warned_ && motor_.derating() > 0) {
+      warned_ = true;
+      logging::Get("actuators")
+          .warn("%swinding at %.1f degC, within %g K of its maximum %g degC: the driver lowers "
+                "its current limit (to %.3g A, the continuous current, at %g degC)",
+                prefix_.c_str(), winding, p.derating_band, p.max_winding_temperature,
+                motor_.continuous_current(), p.max_winding_temperature);
+    } else if (warned_ && winding < p.max_winding_temperature - p.derating_band - 2) {
+      warned_ = false;
+      logging::Get("actuators")
+          .notice("%swinding cooled to %.1f degC: the driver's full current limit is back",
+                  prefix_.c_str(), winding);
+    }
+  }
 
   static void CheckSupplyVoltage(double value) {
     if (!(value > 0) || !std::isfinite(value))
@@ -345,7 +585,9 @@ class DcMotorTendon : public TendonActuator {
     return false;
   }
 
-  double voltage() const { return duty_input_ ? command_ * supply_voltage_ : command_; }
+  double voltage(double command) const {
+    return duty_input_ ? command * supply_voltage_ : command;
+  }
 
   // Reset keeps the element just taut at the pretension, whatever the path: a relaxed element
   // longer than the path leaves a negative line, which a file author rarely means (a rest_length
@@ -374,11 +616,21 @@ class DcMotorTendon : public TendonActuator {
   std::unique_ptr<ElasticElement> elastic_;
   const LinearSpringDamper* linear_ = nullptr;  // elastic_ when it is linear (no virtual calls)
   std::size_t elastic_state_ = 0;               // elastic_->StateSize()
-  static constexpr std::size_t kOwnState = DcMotor::kStateSize + 5;
+  static constexpr std::size_t kOwnState = DcMotor::kStateSize + 9;
   bool duty_input_ = false;
   double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
   double pretension_ = 0;                          // at Reset [N]
   double command_ = 0;                             // [V] or duty [-]
+  double pwm_levels_ = 0;                          // [-]
+  double slew_rate_ = 0;                           // [V/s]
+  double command_delay_ = 0;                       // [s]
+  Pending pending_[kPendingCapacity] = {};         // the delay line, oldest at pending_head_
+  int pending_head_ = 0;
+  int pending_count_ = 0;
+  std::int64_t steps_ = 0;                         // since Reset
+  double delayed_command_ = 0;                     // the command the driver follows
+  double driver_voltage_ = 0;                      // its output [V]
+  bool warned_ = false;                            // of the thermal protection
   double time_step_ = 0;                           // the engine's, once told [s]
   double path_length_ = 0;                         // [m]
   double path_speed_ = 0;                          // [m/s]
@@ -499,6 +751,8 @@ std::vector<ParameterSpec> DcMotorTendonParameters() {
   specs.push_back({"supply_voltage", "V", kDefaultSupplyVoltage, false,
                    "supply voltage, scaled by the duty with options[\"input\"] = duty"});
   specs.push_back({"pretension", "N", 0, false, "tension of the elastic element at Reset"});
+  for (const DriverField& field : kDriverFields)
+    specs.push_back({field.name, field.unit, field.default_value, false, field.help});
   for (const ParameterSpec& spec : ElasticParameterSpecs()) specs.push_back(spec);
   return specs;
 }

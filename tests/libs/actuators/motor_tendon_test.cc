@@ -75,7 +75,9 @@ TEST(MotorKinds, AreRegisteredWithTheirParameters) {
     ++count;
   }
   EXPECT_EQ(resistance, 0.516);
-  EXPECT_EQ(count, 12 + 2 + 12);
+  // motor (12 electrical and mechanical, 8 friction and cogging, 10 thermal), supply and
+  // pretension, the driver (pwm_levels, slew_rate, command_delay), the elastic element
+  EXPECT_EQ(count, 30 + 2 + 3 + 12);
 }
 
 TEST(MotorKinds, RejectUnknownKindsParametersAndOptionsNamingTheActuator) {
@@ -315,7 +317,7 @@ TEST(DcMotorTendon, QuantitiesCanBeReadAndEdited) {
   }
   EXPECT_TRUE(found_current);
   EXPECT_TRUE(found_resistance);
-  EXPECT_EQ(motor->Quantities().size(), 12u + 2u + 3u + 9u);
+  EXPECT_EQ(motor->Quantities().size(), 30u + 2u + 3u + 3u + 20u);
   EXPECT_EQ(motor->Get("gear_ratio"), 128);
   EXPECT_EQ(motor->Get("stiffness"), 2e5);
 

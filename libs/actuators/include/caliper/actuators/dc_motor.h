@@ -9,6 +9,7 @@
 #include <string>
 
 #include "caliper/actuators/actuator.h"
+#include "caliper/actuators/thermal.h"
 
 namespace caliper::actuators {
 
@@ -30,10 +31,56 @@ struct DcMotorParameters {
                                        // refined to 1/3 ms after jumps); a step takes at most
                                        // kMaxSubstepsPerStep of them
 
+  // Friction of the motor and the gearbox, lumped at the motor shaft (a datasheet's no-load
+  // current i_0 gives a Coulomb friction of about k_t i_0):
+  //   tau_f(W) = (tau_c + (tau_s - tau_c) exp(-(W / W_s)^2)) tanh(W / W_e) + b W,  W = N w
+  // Coulomb with a Stribeck peak and viscous friction, made smooth through zero speed by the
+  // tanh over W_e so that the implicit stages solve it like any other stiff term (a stuck motor
+  // creeps at a speed of order W_e under a load below the breakaway torque).
+  double coulomb_friction = 0;            // tau_c [N m]
+  double static_friction = 0;             // tau_s, breakaway [N m]; 0: tau_c (no Stribeck peak)
+  double stribeck_speed = 10;             // W_s [rad/s] at the motor shaft
+  double viscous_friction = 0;            // b [N m s/rad] at the motor shaft
+  double friction_smoothing_speed = 0.1;  // W_e [rad/s] at the motor shaft
+  // Cogging: tau_cog = A sin(n N phi + psi), periodic in the rotor angle N phi.
+  double cogging_amplitude = 0;  // A [N m]
+  double cogging_count = 1;      // n, periods per rotor turn [-] (an integer >= 1)
+  double cogging_phase = 0;      // psi [rad]
+  // Heat (thermal.h): off while thermal_resistance_housing_ambient is 0; on, all four of its
+  // constants must be > 0. The winding resistance follows the copper's temperature,
+  // R (1 + alpha (T_w - T_ref)), the torque and back-EMF constants the magnets' (the housing's),
+  // k (1 + beta (T_h - T_ref)); R and k_t above are the datasheet's values at T_ref.
+  double thermal_resistance_winding_housing = 0;  // R_wh [K/W]
+  double thermal_resistance_housing_ambient = 0;  // R_ha [K/W]; 0: no thermal model
+  double thermal_time_constant_winding = 0;       // tau_w [s]
+  double thermal_time_constant_motor = 0;         // tau_m [s]
+  double ambient_temperature = 25;                // T_a [degC], also the temperatures at Reset
+  double reference_temperature = 25;              // T_ref [degC] of R and k_t
+  double resistance_temperature_coefficient = 0.0039;  // alpha [1/K], copper
+  double torque_constant_temperature_coefficient = 0;  // beta [1/K] (NdFeB about -0.001)
+  // The driver's thermal protection (with the thermal model): from max - band up to max the
+  // winding temperature lowers the current limit linearly to the continuous current that holds
+  // the winding at max in the steady state (ContinuousCurrent()); above max it stays there.
+  double max_winding_temperature = 125;  // [degC]; 0: no protection
+  double derating_band = 10;             // [K]
+
   /// Throws std::invalid_argument naming the first parameter out of range (non-finite values,
   /// non-positive R, L, k_t, k_e, rotor inertia, N, r_s, max_substep, an efficiency outside
-  /// (0, 1], negative gear inertia, bridge resistance or current limit).
+  /// (0, 1], negative gear inertia, bridge resistance, current limit, friction or cogging, a
+  /// static friction below the Coulomb friction, a cogging count that is not a whole number
+  /// >= 1, thermal constants given in part, a maximum winding temperature not above ambient).
   void Validate() const;
+  /// Whether friction or cogging act.
+  bool shaft_losses() const {
+    return coulomb_friction > 0 || static_friction > 0 || viscous_friction > 0 ||
+           cogging_amplitude > 0;
+  }
+  /// Whether the thermal model runs.
+  bool thermal() const { return thermal_resistance_housing_ambient > 0; }
+  ThermalParameters thermal_parameters() const {
+    return {thermal_resistance_winding_housing, thermal_resistance_housing_ambient,
+            thermal_time_constant_winding, thermal_time_constant_motor};
+  }
 };
 
 /// The state of the motor and spool.
@@ -41,6 +88,8 @@ struct DcMotorState {
   double current = 0;      // armature current i [A]
   double spool_speed = 0;  // gearbox output speed w [rad/s], positive winds the line in
   double spool_angle = 0;  // phi [rad]
+  double winding_temperature = 25;  // T_w [degC] (the ambient while there is no thermal model)
+  double housing_temperature = 25;  // T_h [degC]
 };
 
 /// rho of TENDONS.md: the factor dividing the spool torque seen by the motor, eta when the motor
@@ -49,6 +98,10 @@ struct DcMotorState {
 /// eta + (1/eta - eta) / (1 + exp(1000 i w + 10)) (one exp; exactly eta or eta + (1/eta - eta)
 /// where tanh is +-1 to the last bit).
 double GearEfficiencyFactor(double efficiency, double current, double spool_speed);
+
+/// The friction torque tau_f(W) [N m] at the motor shaft speed W [rad/s] (DcMotorParameters) and
+/// its derivative by W [N m s/rad] in *slope.
+double FrictionTorque(const DcMotorParameters& parameters, double motor_speed, double* slope);
 
 /// A load on the spool that may depend on the spool's angle and speed and carry state of its own
 /// (a series-elastic element). The motor solves for the end of each sub-step with the load
@@ -128,6 +181,15 @@ class ConstantSpoolLoad : public SpoolLoad {
 /// solution must be the first from the stage's base speed, or the stage falls back to the
 /// bracketing search from there and TOMS 748 (Boost.Math; as it does should Newton fail).
 /// With a current limit the driver lowers the voltage so that |i| stays at the limit.
+/// Friction and cogging (DcMotorParameters) enter the speed equation at the motor shaft,
+///   N J dw/dt = k_t i - tau / (rho N) - tau_f(N w) - tau_cog(N phi),
+/// implicit in each stage like the load; where their falling parts (the Stribeck peak, cogging)
+/// could give a stage several solutions, the bracketing search picks the first from the base.
+/// With the thermal model a step uses the resistance and constants at the temperatures of its
+/// middle (extrapolated from the last step's change), then advances the temperatures exactly
+/// (TwoNodeThermal) on the Joule power in the winding over the step, R(T) times the mean of i^2
+/// (trapezoidal over the sub-steps); the driver's thermal protection sets the current limit at
+/// the start of each step from the winding's temperature.
 class DcMotor {
  public:
   /// Throws std::invalid_argument when the parameters are out of range.
@@ -165,8 +227,8 @@ class DcMotor {
   static void CheckSubsteps(double dt, double max_substep);
 
   /// Writes everything Step() changes (kStateSize values: the state, the applied voltage and
-  /// load torque, the Newton start value's memory and the exp() cache) for RestoreState(), after
-  /// which a repeated Step() gives the same result bit for bit.
+  /// load torque, the Newton start value's memory, the exp() cache and the temperatures' last
+  /// change) for RestoreState(), after which a repeated Step() gives the same result bit for bit.
   void SaveState(double* out) const {
     out[0] = state_.current;
     out[1] = state_.spool_speed;
@@ -176,6 +238,10 @@ class DcMotor {
     out[5] = last_acceleration_;
     out[6] = exp_argument_;
     out[7] = exp_value_;
+    out[8] = state_.winding_temperature;
+    out[9] = state_.housing_temperature;
+    out[10] = winding_change_;
+    out[11] = housing_change_;
   }
   /// Reads back the kStateSize values SaveState() wrote.
   void RestoreState(const double* in) {
@@ -187,8 +253,12 @@ class DcMotor {
     last_acceleration_ = in[5];
     exp_argument_ = in[6];
     exp_value_ = in[7];
+    state_.winding_temperature = in[8];
+    state_.housing_temperature = in[9];
+    winding_change_ = in[10];
+    housing_change_ = in[11];
   }
-  static constexpr std::size_t kStateSize = 8;
+  static constexpr std::size_t kStateSize = 12;
 
   /// The voltage the driver applied at the end of the last step [V] (lower than the command
   /// while the current is limited).
@@ -201,6 +271,21 @@ class DcMotor {
   double electrical_power() const { return applied_voltage_ * state_.current; }
   /// The total inertia J_rotor + J_gear at the motor shaft [kg m^2].
   double inertia() const { return parameters_.rotor_inertia + parameters_.gear_inertia; }
+  /// The resistance, torque constant and current limit of the last step (at its temperatures;
+  /// the parameters' without the thermal model) [ohm], [N m/A], [A] (0: none).
+  double hot_resistance() const { return effective_.resistance; }
+  double hot_torque_constant() const { return effective_.torque_constant; }
+  double current_limit() const { return effective_.current_limit; }
+  /// The motor torque k_t i at the end of the last step [N m].
+  double motor_torque() const { return effective_.torque_constant * state_.current; }
+  /// Friction and cogging torques at the motor shaft at the end of the last step [N m].
+  double friction_torque() const;
+  double cogging_torque() const;
+  /// How far the thermal protection has lowered the current limit in the last step: 0 not at
+  /// all, 1 down to the continuous current.
+  double derating() const { return derating_; }
+  /// The continuous current at the maximum winding temperature [A] (0 without protection).
+  double continuous_current() const;
 
  private:
   // the sub-steps of a step of dt and the constants of their implicit stages (all stages share
@@ -222,6 +307,8 @@ class DcMotor {
     double inverse_rho_driven = 0;   // 1 / (eta + 1/eta - eta) [-]
     double tolerance = 0;            // of the stage speeds at w = 0 [rad/s]
     double current_to_speed = 0;     // k_t L / (N J R): a current error as a speed [rad/(s A)]
+    double c_shaft = 0;              // C = c / (N J) [rad/(s N m)]
+    double shaft_falling = 0;        // C times the most the shaft torque can fall per rad/s [-]
   };
   struct Stage {
     double current = 0;      // [A]
@@ -248,7 +335,22 @@ class DcMotor {
   // too large.
   bool Substep(double voltage, SpoolLoad& load, bool last, bool check);
 
+  // the shaft's friction and cogging torque [N m] at spool speed w [rad/s] and spool angle phi
+  // [rad], and its derivative along a stage (phi moving by c per rad/s of w) by w
+  double ShaftTorque(double w, double phi, double c, double* d_torque) const;
+  // the temperatures' effect on effective_ at the start of a step (thermal model on)
+  void BeginThermalStep(double voltage, double dt);
+  void EndThermalStep(double dt);
+
   DcMotorParameters parameters_;
+  DcMotorParameters effective_;      // parameters_ at the step's temperatures and derating
+  bool shaft_ = false;               // parameters_.shaft_losses()
+  bool thermal_ = false;             // parameters_.thermal()
+  TwoNodeThermal thermal_model_;     // for steps of thermal_model_.dt()
+  double joule_ = 0;                 // integral of i^2 over the step so far [A^2 s]
+  double winding_change_ = 0;        // in the last step [K]
+  double housing_change_ = 0;        // [K]
+  double derating_ = 0;              // [-]
   DcMotorState state_;
   bool locked_ = false;
   double applied_voltage_ = 0;       // [V]
