@@ -96,15 +96,17 @@ void Check(const char* name, const char* unit, double value, Range range) {
 }
 
 // A root of f near x0, for f dominated by x - x0 far from the root (slope about one).
+// With first_step > 0 the search starts with a step no longer than that and doubles it, so that
+// of roots whose distances from x0 differ by more than a factor of two it brackets the nearest.
 template <class Function>
-double FindRoot(const Function& f, double x0, double tolerance) {
+double FindRoot(const Function& f, double x0, double tolerance, double first_step = 0) {
   double f0 = f(x0);
   if (f0 == 0) return x0;
-  double step = -f0;
+  double step = first_step > 0 ? std::copysign(std::min(first_step, std::abs(f0)), -f0) : -f0;
   double x1 = x0 + step;
   double f1 = f(x1);
   for (int expansion = 0; (f1 > 0) == (f0 > 0) && f1 != 0; ++expansion) {
-    if (expansion > 100 || !std::isfinite(f1))
+    if (expansion > 200 || !std::isfinite(f1))
       throw std::runtime_error("dc motor: no solution for the implicit stage");
     x0 = x1;
     f0 = f1;
@@ -614,7 +616,15 @@ double DcMotor::SolveStageBracketing(const DcMotorState& a, double voltage, doub
         (p.torque_constant * s.current - torque / (rho * p.gear_ratio) - shaft) / inertia;
     return w - a.spool_speed - k.c * acceleration;
   };
-  return FindRoot(residual, a.spool_speed, kSpeedTolerance);
+  // friction and cogging may give a stage several solutions close together: the first from the
+  // base is found by steps from a fraction of the smoothing speed or of a cogging period
+  double first_step = 0;
+  if (shaft_) {
+    first_step = 0.01 * p.friction_smoothing_speed / p.gear_ratio;
+    if (p.cogging_amplitude > 0)
+      first_step = std::min(first_step, 0.1 * 2 * M_PI / (p.cogging_count * p.gear_ratio * k.c));
+  }
+  return FindRoot(residual, a.spool_speed, kSpeedTolerance, first_step);
 }
 
 bool DcMotor::Substep(double voltage, SpoolLoad& load, bool last, bool check) {
