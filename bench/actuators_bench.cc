@@ -156,6 +156,28 @@ std::vector<Case> Cases() {
   // the same, driven by a voltage swinging +-3 V against a moving path
   cases.push_back(
       {"dc_motor_driven_step_ns_per_1ms", "dc_motor_tendon", {}, {}, 0.3, 0.01, 1, driven, 300});
+  // the same with heat (a datasheet's thermal data), friction (Coulomb, Stribeck, viscous),
+  // cogging and the driver's PWM and slew limit: RATIO dc_motor_realism_vs_plain divides it by
+  // the figure above
+  cases.push_back({"dc_motor_realistic_step_ns_per_1ms",
+                   "dc_motor_tendon",
+                   {},
+                   {{"thermal_resistance_winding_housing", 1.6},
+                    {"thermal_resistance_housing_ambient", 4.65},
+                    {"thermal_time_constant_winding", 41.6},
+                    {"thermal_time_constant_motor", 1120},
+                    {"coulomb_friction", 1.5e-3},
+                    {"static_friction", 2e-3},
+                    {"viscous_friction", 1e-7},
+                    {"cogging_amplitude", 3e-4},
+                    {"cogging_count", 14},
+                    {"pwm_levels", 1024},
+                    {"slew_rate", 2000}},
+                   0.3,
+                   0.01,
+                   1,
+                   driven,
+                   0});
   cases.push_back({"dc_motor_linear_step_ns_per_1ms",
                    "dc_motor_tendon",
                    {{"elastic", "linear"}},
@@ -242,8 +264,10 @@ int main(int argc, char** argv) {
       repeats = std::max(1, std::atoi(argv[++i]));
   }
   std::printf("# actuator step cost, %d steps of 1 ms, median of %d runs\n", steps, repeats);
+  std::map<std::string, double> medians;
   for (const Case& c : Cases()) {
     const Timing t = TimeCase(c);
+    medians[c.name] = t.median;
     std::printf("# %s: %s, best %.1f ns, median %.1f ns\n", c.name.c_str(), c.kind.c_str(), t.best,
                 t.median);
     if (c.target_ns > 0)
@@ -254,5 +278,9 @@ int main(int argc, char** argv) {
       PrintAccuracy(c);
     std::fflush(stdout);
   }
+  std::printf("# heat, friction, cogging, PWM and slew on against the plain driven motor\n");
+  std::printf("RATIO dc_motor_realism_vs_plain %.3f (target 1.3)\n",
+              medians["dc_motor_realistic_step_ns_per_1ms"] /
+                  medians["dc_motor_driven_step_ns_per_1ms"]);
   return 0;
 }

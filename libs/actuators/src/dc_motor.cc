@@ -277,6 +277,9 @@ void DcMotor::set_locked(bool locked) {
 
 void DcMotor::UpdateConstants(double dt) {
   constants_ = ConstantsFor(dt, parameters_.max_substep);
+  constants_resistance_ = effective_.resistance;
+  constants_torque_constant_ = effective_.torque_constant;
+  fine_stale_ = false;
   // the refined sub-steps, never more than kMaxSubstepsPerStep in one step
   const double fine = std::max(kFineSubstep, dt / kMaxSubstepsPerStep);
   refine_ = constants_.h > fine;
@@ -286,28 +289,20 @@ void DcMotor::UpdateConstants(double dt) {
 DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) const {
   const DcMotorParameters& p = effective_;
   StageConstants k;
-  const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
-  const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
   k.dt = dt;
   k.substeps = static_cast<int>(Substeps(dt, max_substep));  // checked by Step()
   k.h = dt / k.substeps;
   k.c = kGamma * k.h;
   k.inverse_c = 1 / k.c;
   k.second_base = (1 - kGamma) / kGamma;
-  // the current at the end of a stage, L (i - i_a) / c = U - R i - emf w, solved for i
-  const double denominator = 1 + k.c * resistance / p.inductance;
-  k.current_base = 1 / denominator;
-  k.current_drive = k.c / p.inductance / denominator;
-  k.current_slope = -k.c * emf / p.inductance / denominator;
   const double c_over_inertia = k.c / (p.gear_ratio * inertia());  // C = c / (N J)
-  k.c_torque = c_over_inertia * p.torque_constant;
+  k.c_over_inductance = k.c / p.inductance;
   k.c_ratio = c_over_inertia / p.gear_ratio;
   k.spread = 1 / p.efficiency - p.efficiency;
   k.inverse_rho_driving = 1 / p.efficiency;
   k.inverse_rho_driven = 1 / (p.efficiency + k.spread);
-  k.tolerance = kNewtonTolerance / emf;  // of the no-load speed at 1 V [rad/s]
-  k.current_to_speed = p.torque_constant * p.inductance / (p.gear_ratio * inertia() * resistance);
   k.c_shaft = c_over_inertia;
+  Retune(&k);
   if (shaft_) {
     // the most tau_f can fall per rad/s of the motor: (tau_s - tau_c) max|d exp(-y^2)/dW|,
     // max |y exp(-y^2)| 2 / W_s = sqrt(2 / e) / W_s; cogging's A n per radian of the rotor,
@@ -320,6 +315,21 @@ DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) con
                       (peak + p.cogging_amplitude * p.cogging_count * p.gear_ratio * k.c);
   }
   return k;
+}
+
+void DcMotor::Retune(StageConstants* constants) const {
+  StageConstants& k = *constants;
+  const DcMotorParameters& p = effective_;
+  const double resistance = p.resistance + p.bridge_resistance;  // [ohm]
+  const double emf = p.back_emf_constant * p.gear_ratio;         // [V s/rad] at the spool
+  // the current at the end of a stage, L (i - i_a) / c = U - R i - emf w, solved for i
+  const double inverse = 1 / (1 + k.c_over_inductance * resistance);
+  k.current_base = inverse;
+  k.current_drive = k.c_over_inductance * inverse;
+  k.current_slope = -k.c_over_inductance * emf * inverse;
+  k.c_torque = k.c_shaft * p.torque_constant;
+  k.tolerance = kNewtonTolerance / emf;  // of the no-load speed at 1 V [rad/s]
+  k.current_to_speed = p.torque_constant * p.inductance / (p.gear_ratio * inertia() * resistance);
 }
 
 double DcMotor::Exp(double x) const {
@@ -686,6 +696,10 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
     const bool last = i + 1 == n;
     if (Substep(voltage, load, last, refine_)) continue;
     // redone in shorter sub-steps (the stages' constants swapped in for them)
+    if (fine_stale_) {
+      Retune(&fine_);
+      fine_stale_ = false;
+    }
     std::swap(constants_, fine_);
     const int m = constants_.substeps;
     for (int j = 0; j < m; ++j) Substep(voltage, load, last && j + 1 == m, false);
@@ -701,11 +715,33 @@ double DcMotor::ShaftTorque(double w, double phi, double c, double* d_torque) co
   double torque = FrictionTorque(p, n * w, &slope);
   *d_torque = n * slope;
   if (p.cogging_amplitude > 0) {
-    const double angle = p.cogging_count * n * phi + p.cogging_phase;
-    torque += p.cogging_amplitude * std::sin(angle);
-    *d_torque += p.cogging_amplitude * std::cos(angle) * p.cogging_count * n * c;
+    double sine;
+    double cosine;
+    SinCos(p.cogging_count * n * phi + p.cogging_phase, &sine, &cosine);
+    torque += p.cogging_amplitude * sine;
+    *d_torque += p.cogging_amplitude * cosine * p.cogging_count * n * c;
   }
   return torque;
+}
+
+void DcMotor::SinCos(double x, double* sine, double* cosine) const {
+  // sin and cos of x_last + d by the angle sum, with d's own by their Taylor polynomials while
+  // |d| < 2^-8 (errors below d^8/8! < 1.4e-24): a Newton iteration moves the cogging angle by
+  // far less, and only each stage's first evaluation calls sin and cos
+  const double d = x - sin_argument_;
+  if (std::abs(d) < 1.0 / (1 << 8)) {
+    const double d2 = d * d;
+    const double cd = 1 - d2 * (0.5 - d2 * (1.0 / 24 - d2 * (1.0 / 720)));
+    const double sd = d * (1 - d2 * (1.0 / 6 - d2 * (1.0 / 120 - d2 * (1.0 / 5040))));
+    *sine = sin_value_ * cd + cos_value_ * sd;
+    *cosine = cos_value_ * cd - sin_value_ * sd;
+    return;
+  }
+  sin_argument_ = x;
+  sin_value_ = std::sin(x);
+  cos_value_ = std::cos(x);
+  *sine = sin_value_;
+  *cosine = cos_value_;
 }
 
 double FrictionTorque(const DcMotorParameters& p, double speed, double* slope) {
@@ -787,7 +823,15 @@ void DcMotor::BeginThermalStep(double voltage, double dt) {
       if (top > continuous) effective_.current_limit = top + (continuous - top) * derating_;
     }
   }
-  UpdateConstants(dt);
+  // only what the temperatures change, and only when they changed it; the refined sub-steps'
+  // when they are needed
+  if (effective_.resistance != constants_resistance_ ||
+      effective_.torque_constant != constants_torque_constant_) {
+    Retune(&constants_);
+    fine_stale_ = refine_;
+    constants_resistance_ = effective_.resistance;
+    constants_torque_constant_ = effective_.torque_constant;
+  }
   joule_ = 0;
 }
 

@@ -227,8 +227,8 @@ class DcMotor {
   static void CheckSubsteps(double dt, double max_substep);
 
   /// Writes everything Step() changes (kStateSize values: the state, the applied voltage and
-  /// load torque, the Newton start value's memory, the exp() cache and the temperatures' last
-  /// change) for RestoreState(), after which a repeated Step() gives the same result bit for bit.
+  /// load torque, the Newton start value's memory, the exp() and sin() caches and the
+  /// temperatures' last change) for RestoreState(), after which a repeated Step() gives the same result bit for bit.
   void SaveState(double* out) const {
     out[0] = state_.current;
     out[1] = state_.spool_speed;
@@ -242,6 +242,9 @@ class DcMotor {
     out[9] = state_.housing_temperature;
     out[10] = winding_change_;
     out[11] = housing_change_;
+    out[12] = sin_argument_;
+    out[13] = sin_value_;
+    out[14] = cos_value_;
   }
   /// Reads back the kStateSize values SaveState() wrote.
   void RestoreState(const double* in) {
@@ -257,8 +260,11 @@ class DcMotor {
     state_.housing_temperature = in[9];
     winding_change_ = in[10];
     housing_change_ = in[11];
+    sin_argument_ = in[12];
+    sin_value_ = in[13];
+    cos_value_ = in[14];
   }
-  static constexpr std::size_t kStateSize = 12;
+  static constexpr std::size_t kStateSize = 15;
 
   /// The voltage the driver applied at the end of the last step [V] (lower than the command
   /// while the current is limited).
@@ -308,6 +314,7 @@ class DcMotor {
     double tolerance = 0;            // of the stage speeds at w = 0 [rad/s]
     double current_to_speed = 0;     // k_t L / (N J R): a current error as a speed [rad/(s A)]
     double c_shaft = 0;              // C = c / (N J) [rad/(s N m)]
+    double c_over_inductance = 0;    // c / L [s/H]
     double shaft_falling = 0;        // C times the most the shaft torque can fall per rad/s [-]
   };
   struct Stage {
@@ -317,6 +324,10 @@ class DcMotor {
     double voltage = 0;      // applied [V]
   };
   void UpdateConstants(double dt);
+  // the constants that depend on the resistance and the motor constants (effective_)
+  void Retune(StageConstants* constants) const;
+  // sin(x) and cos(x), from the last exact values while x moves little
+  void SinCos(double x, double* sine, double* cosine) const;
   StageConstants ConstantsFor(double dt, double max_substep) const;
   // exp(x), from the last exact value while x moves little
   double Exp(double x) const;
@@ -351,6 +362,12 @@ class DcMotor {
   double winding_change_ = 0;        // in the last step [K]
   double housing_change_ = 0;        // [K]
   double derating_ = 0;              // [-]
+  double constants_resistance_ = 0;  // effective_'s when constants_ were last tuned [ohm]
+  double constants_torque_constant_ = 0;  // [N m/A]
+  bool fine_stale_ = false;               // fine_ still to be retuned
+  mutable double sin_argument_ = 0;       // the last exact sin() and cos(): argument [rad]
+  mutable double sin_value_ = 0;          // and values
+  mutable double cos_value_ = 1;
   DcMotorState state_;
   bool locked_ = false;
   double applied_voltage_ = 0;       // [V]
