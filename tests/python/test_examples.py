@@ -202,3 +202,15 @@ def test_notebook(tmp_path, monkeypatch):
     fitted = number(r"fitted forearm mass (\S+) kg", text)
     assert fitted == pytest.approx(1.4, rel=0.05), text
     assert "done in" in text, text
+
+
+def test_co_contraction(tmp_path):
+    out = run("co_contraction.py", tmp_path)
+    # the windings heat toward the maximum; the driver derates before they reach it
+    highest = number(r"^highest winding temperature: ([0-9.]+) degC", out)
+    assert 115 < highest < 125, out
+    derating_from = number(r"^the driver derated from ([0-9.]+) s", out)
+    assert 40 < derating_from < 120, out
+    final = number(r"final current ([0-9.]+) A against a limit of 6 A", out)
+    assert final < 5, out
+    figures(out, tmp_path)

@@ -168,16 +168,15 @@ void DcMotorParameters::Validate() const {
         Range::kNonNegative);
   Check("thermal_time_constant_winding", "s", thermal_time_constant_winding, Range::kNonNegative);
   Check("thermal_time_constant_motor", "s", thermal_time_constant_motor, Range::kNonNegative);
-  const bool any_thermal = thermal_resistance_winding_housing > 0 ||
-                           thermal_resistance_housing_ambient > 0 ||
-                           thermal_time_constant_winding > 0 || thermal_time_constant_motor > 0;
+  // on with R_ha, which a live edit sets last: the other three may be set before
+  const bool any_thermal = thermal();
   if (any_thermal) {
     try {
       thermal_parameters().Validate();
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(std::string(e.what()) +
-                                  " (the thermal model needs all four thermal constants; all 0 "
-                                  "turns it off)");
+                                  " (thermal_resistance_housing_ambient > 0 turns the thermal "
+                                  "model on; it needs the other three thermal constants > 0)");
     }
   }
   for (const auto& [name, value] :

@@ -39,8 +39,7 @@ ThermalParameters Datasheet() {
 // the rises x = (T_w - T_a, T_h - T_a) of x' = A x + b P from x(0) = 0 at time t, by Eigen's
 // eigen-decomposition of A: x(t) = x_ss - V exp(L t) V^-1 x_ss, x_ss = -A^-1 b P; `feedback`
 // [W/K] adds a power proportional to the winding's rise (the resistance's temperature)
-Eigen::Vector2d ClosedForm(const ThermalParameters& t, double power, double feedback,
-                           double time) {
+Eigen::Vector2d ClosedForm(const ThermalParameters& t, double power, double feedback, double time) {
   const double cw = t.time_constant_winding / t.resistance_winding_housing;
   const double ch = t.time_constant_motor / t.resistance_housing_ambient;
   const double gwh = 1 / t.resistance_winding_housing;
@@ -161,9 +160,10 @@ TEST(Thermal, HotRunDriftsResistanceAndTorqueConstantAsTheAnalyticRun) {
   EXPECT_LT(worst_t, 1e-6 * final_rise) << worst_t;
   EXPECT_LT(worst_r, 1e-8) << worst_r;
   EXPECT_LT(worst_k, 1e-8) << worst_k;
-  std::printf("hot run 600 s at 7 A: winding +%.2f K, worst %.3g K; R %.4f -> %.4f ohm "
-              "(worst rel. %.2g), k_t worst rel. %.2g\n",
-              final_rise, worst_t, p.resistance, motor.hot_resistance(), worst_r, worst_k);
+  std::printf(
+      "hot run 600 s at 7 A: winding +%.2f K, worst %.3g K; R %.4f -> %.4f ohm "
+      "(worst rel. %.2g), k_t worst rel. %.2g\n",
+      final_rise, worst_t, p.resistance, motor.hot_resistance(), worst_r, worst_k);
 }
 
 TEST(Thermal, DriverDeratesToTheContinuousCurrentAtTheMaximum) {
@@ -189,18 +189,19 @@ TEST(Thermal, DriverDeratesToTheContinuousCurrentAtTheMaximum) {
   // settled near the maximum: the current is within the derating's range, near the continuous
   EXPECT_LT(std::abs(motor.state().current), 6 / hot);
   EXPECT_NEAR(std::abs(motor.state().current), continuous, 0.25 * continuous);
-  std::printf("derating from %.1f s; highest winding %.2f degC; after 900 s %.2f degC, %.3f A "
-              "(continuous %.3f A)\n",
-              first_derating, highest, motor.state().winding_temperature,
-              motor.state().current, continuous);
+  std::printf(
+      "derating from %.1f s; highest winding %.2f degC; after 900 s %.2f degC, %.3f A "
+      "(continuous %.3f A)\n",
+      first_derating, highest, motor.state().winding_temperature, motor.state().current,
+      continuous);
 }
 
 TEST(Friction, NoLoadSpeedBalancesCoulombAndViscousFriction) {
   DcMotorParameters p;
-  p.coulomb_friction = 2e-3;    // [N m]
-  p.static_friction = 3e-3;     // its Stribeck peak is far below the speed reached
-  p.stribeck_speed = 5;         // [rad/s]
-  p.viscous_friction = 2e-6;    // [N m s/rad]
+  p.coulomb_friction = 2e-3;  // [N m]
+  p.static_friction = 3e-3;   // its Stribeck peak is far below the speed reached
+  p.stribeck_speed = 5;       // [rad/s]
+  p.viscous_friction = 2e-6;  // [N m s/rad]
   DcMotor motor(p);
   const double u = 6;
   for (int i = 0; i < 3000; ++i) motor.Step(u, 1e-3, 0.0);
@@ -244,8 +245,8 @@ class DraggedSpring : public SpoolLoad {
   double time() const { return time_; }
 
  private:
-  double k_;       // [N m/rad]
-  double speed_;   // [rad/s]
+  double k_;      // [N m/rad]
+  double speed_;  // [rad/s]
   double time_ = 0;
 };
 
@@ -261,8 +262,8 @@ TEST(Friction, StickSlipMatchesTheCoulombClosedForm) {
   p.stribeck_speed = 0.05;
   p.friction_smoothing_speed = 1e-4;
   DcMotor motor(p);
-  const double k = 0.05;      // [N m/rad]
-  const double speed = 0.5;   // [rad/s]
+  const double k = 0.05;     // [N m/rad]
+  const double speed = 0.5;  // [rad/s]
   DraggedSpring load(k, speed);
   const double dt = 1e-4;
   // slips start where the speed rises through 1 rad/s; the spring's peak pull before each
@@ -301,10 +302,11 @@ TEST(Friction, StickSlipMatchesTheCoulombClosedForm) {
     EXPECT_NEAR(peaks[j], p.static_friction, 0.01 * p.static_friction) << j;
     EXPECT_NEAR(troughs[j], 2 * p.coulomb_friction - p.static_friction, 0.01 * 0.02) << j;
   }
-  std::printf("stick-slip: period %.5f s (closed form %.5f s), peak pull %.5f N m (tau_s %.3f), "
-              "trough %.5f N m (%.3f)\n",
-              starts.back() - starts[starts.size() - 2], period, peaks.back(), p.static_friction,
-              troughs.back(), 2 * p.coulomb_friction - p.static_friction);
+  std::printf(
+      "stick-slip: period %.5f s (closed form %.5f s), peak pull %.5f N m (tau_s %.3f), "
+      "trough %.5f N m (%.3f)\n",
+      starts.back() - starts[starts.size() - 2], period, peaks.back(), p.static_friction,
+      troughs.back(), 2 * p.coulomb_friction - p.static_friction);
 }
 
 TEST(Cogging, RotorSwingsInACoggingWellAsAPendulum) {

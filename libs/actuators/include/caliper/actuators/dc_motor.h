@@ -46,16 +46,17 @@ struct DcMotorParameters {
   double cogging_amplitude = 0;  // A [N m]
   double cogging_count = 1;      // n, periods per rotor turn [-] (an integer >= 1)
   double cogging_phase = 0;      // psi [rad]
-  // Heat (thermal.h): off while thermal_resistance_housing_ambient is 0; on, all four of its
-  // constants must be > 0. The winding resistance follows the copper's temperature,
-  // R (1 + alpha (T_w - T_ref)), the torque and back-EMF constants the magnets' (the housing's),
-  // k (1 + beta (T_h - T_ref)); R and k_t above are the datasheet's values at T_ref.
-  double thermal_resistance_winding_housing = 0;  // R_wh [K/W]
-  double thermal_resistance_housing_ambient = 0;  // R_ha [K/W]; 0: no thermal model
-  double thermal_time_constant_winding = 0;       // tau_w [s]
-  double thermal_time_constant_motor = 0;         // tau_m [s]
-  double ambient_temperature = 25;                // T_a [degC], also the temperatures at Reset
-  double reference_temperature = 25;              // T_ref [degC] of R and k_t
+  // Heat (thermal.h): off while thermal_resistance_housing_ambient is 0; on, the other three
+  // thermal constants must be > 0 too (a live edit sets R_ha last). The winding resistance follows
+  // the copper's temperature, R (1 + alpha (T_w - T_ref)), the torque and back-EMF constants the
+  // magnets' (the housing's), k (1 + beta (T_h - T_ref)); R and k_t above are the datasheet's
+  // values at T_ref.
+  double thermal_resistance_winding_housing = 0;       // R_wh [K/W]
+  double thermal_resistance_housing_ambient = 0;       // R_ha [K/W]; 0: no thermal model
+  double thermal_time_constant_winding = 0;            // tau_w [s]
+  double thermal_time_constant_motor = 0;              // tau_m [s]
+  double ambient_temperature = 25;                     // T_a [degC], also the temperatures at Reset
+  double reference_temperature = 25;                   // T_ref [degC] of R and k_t
   double resistance_temperature_coefficient = 0.0039;  // alpha [1/K], copper
   double torque_constant_temperature_coefficient = 0;  // beta [1/K] (NdFeB about -0.001)
   // The driver's thermal protection (with the thermal model): from max - band up to max the
@@ -68,7 +69,8 @@ struct DcMotorParameters {
   /// non-positive R, L, k_t, k_e, rotor inertia, N, r_s, max_substep, an efficiency outside
   /// (0, 1], negative gear inertia, bridge resistance, current limit, friction or cogging, a
   /// static friction below the Coulomb friction, a cogging count that is not a whole number
-  /// >= 1, thermal constants given in part, a maximum winding temperature not above ambient).
+  /// >= 1, R_ha > 0 without the other thermal constants, a maximum winding temperature not above
+  /// ambient).
   void Validate() const;
   /// Whether friction or cogging act.
   bool shaft_losses() const {
@@ -85,9 +87,9 @@ struct DcMotorParameters {
 
 /// The state of the motor and spool.
 struct DcMotorState {
-  double current = 0;      // armature current i [A]
-  double spool_speed = 0;  // gearbox output speed w [rad/s], positive winds the line in
-  double spool_angle = 0;  // phi [rad]
+  double current = 0;               // armature current i [A]
+  double spool_speed = 0;           // gearbox output speed w [rad/s], positive winds the line in
+  double spool_angle = 0;           // phi [rad]
   double winding_temperature = 25;  // T_w [degC] (the ambient while there is no thermal model)
   double housing_temperature = 25;  // T_h [degC]
 };
@@ -228,7 +230,8 @@ class DcMotor {
 
   /// Writes everything Step() changes (kStateSize values: the state, the applied voltage and
   /// load torque, the Newton start value's memory, the exp() and sin() caches and the
-  /// temperatures' last change) for RestoreState(), after which a repeated Step() gives the same result bit for bit.
+  /// temperatures' last change) for RestoreState(), after which a repeated Step() gives the same
+  /// result bit for bit.
   void SaveState(double* out) const {
     out[0] = state_.current;
     out[1] = state_.spool_speed;
@@ -354,15 +357,15 @@ class DcMotor {
   void EndThermalStep(double dt);
 
   DcMotorParameters parameters_;
-  DcMotorParameters effective_;      // parameters_ at the step's temperatures and derating
-  bool shaft_ = false;               // parameters_.shaft_losses()
-  bool thermal_ = false;             // parameters_.thermal()
-  TwoNodeThermal thermal_model_;     // for steps of thermal_model_.dt()
-  double joule_ = 0;                 // integral of i^2 over the step so far [A^2 s]
-  double winding_change_ = 0;        // in the last step [K]
-  double housing_change_ = 0;        // [K]
-  double derating_ = 0;              // [-]
-  double constants_resistance_ = 0;  // effective_'s when constants_ were last tuned [ohm]
+  DcMotorParameters effective_;           // parameters_ at the step's temperatures and derating
+  bool shaft_ = false;                    // parameters_.shaft_losses()
+  bool thermal_ = false;                  // parameters_.thermal()
+  TwoNodeThermal thermal_model_;          // for steps of thermal_model_.dt()
+  double joule_ = 0;                      // integral of i^2 over the step so far [A^2 s]
+  double winding_change_ = 0;             // in the last step [K]
+  double housing_change_ = 0;             // [K]
+  double derating_ = 0;                   // [-]
+  double constants_resistance_ = 0;       // effective_'s when constants_ were last tuned [ohm]
   double constants_torque_constant_ = 0;  // [N m/A]
   bool fine_stale_ = false;               // fine_ still to be retuned
   mutable double sin_argument_ = 0;       // the last exact sin() and cos(): argument [rad]
