@@ -1,0 +1,106 @@
+"""Heat, friction, cogging and the driver (PWM, slew, command delay) on the Model of the shipped
+arm: set live as parameters, read as DAQ channels, exported with the scene, recorded and
+re-simulated bit for bit, and the thermal protection's warning in the Model's log."""
+
+import glob
+import math
+import os
+
+import numpy as np
+import pytest
+
+import caliper
+
+MOTORS = ("elbow_flexor", "elbow_extensor")
+PREFIX = "ecce_arm."
+
+# a datasheet's thermal data, short time constants so that a test heats quickly; R_ha last
+THERMAL = (("thermal_resistance_winding_housing", 2.9),
+           ("thermal_time_constant_winding", 3.0),
+           ("thermal_time_constant_motor", 30.0),
+           ("thermal_resistance_housing_ambient", 11.5))
+REALISM = (("coulomb_friction", 1.5e-3), ("static_friction", 2e-3), ("viscous_friction", 1e-7),
+           ("cogging_amplitude", 3e-4), ("cogging_count", 14), ("pwm_levels", 1024),
+           ("slew_rate", 2000), ("command_delay", 0.004), ("current_limit", 6))
+
+
+def configure(model, settings):
+    for motor in MOTORS:
+        for name, value in settings:
+            model.set(f"{PREFIX}{motor}.{name}", value)
+
+
+def test_parameters_and_channels(arm):
+    configure(arm, THERMAL + REALISM)
+    try:
+        params = arm.parameters(f"{PREFIX}elbow_flexor.*")
+        assert params[f"{PREFIX}elbow_flexor.thermal_resistance_winding_housing"] == (2.9, "K/W")
+        assert params[f"{PREFIX}elbow_flexor.command_delay"] == (0.004, "s")
+        units = {c.id: c.unit for c in arm.channels(f"{PREFIX}elbow_flexor.*")}
+        assert units[f"{PREFIX}elbow_flexor.winding_temperature"] == "degC"
+        assert units[f"{PREFIX}elbow_flexor.friction_torque"] == "N m"
+        assert units[f"{PREFIX}elbow_flexor.current_limit_now"] == "A"
+        # a bad value is refused with the parameter's name and why
+        with pytest.raises(caliper.InvalidParameter) as e:
+            arm.set(f"{PREFIX}elbow_flexor.cogging_count", 2.5)
+        assert "cogging_count" in str(e.value) and "whole" in str(e.value)
+        with pytest.raises(caliper.InvalidParameter) as e:
+            arm.set(f"{PREFIX}elbow_flexor.command_delay", 1.0)
+        assert "at most 200" in str(e.value)
+        # the export carries what was set live
+        scene = arm.export_scene().decode()
+        assert 'name="thermal_time_constant_motor"' in scene and 'name="cogging_count"' in scene
+    finally:
+        configure(arm, (("thermal_resistance_housing_ambient", 0),) + tuple(
+            (name, 0) for name, _ in REALISM if name not in ("current_limit", "cogging_count")) +
+            (("current_limit", 3), ("cogging_count", 1)))
+
+
+def test_co_contraction_heats_derates_and_warns(new_session):
+    with new_session(options=["log.level=notice"]) as s:
+        arm = s.model("model0")
+        configure(arm, THERMAL + (("current_limit", 6.0),))
+        ids = [f"{PREFIX}{m}.{q}" for m in MOTORS
+               for q in ("winding_temperature", "current", "current_limit_now")]
+        arm.set_commands({m: 12.0 for m in MOTORS})
+        rows = []
+        for _ in range(60):
+            arm.step(500)
+            rows.append(arm.get_values(ids))
+        rows = np.array(rows)
+        winding = rows[:, 0]
+        assert winding[0] < winding[10] < winding[-1] < 125, winding
+        assert winding[-1] > 115, winding
+        assert rows[-1, 2] < 6.0 and abs(rows[-1, 1]) <= rows[-1, 2] + 1e-9, rows[-1]
+        arm.set_commands({m: 0.0 for m in MOTORS})
+        logs = "".join(open(p, errors="replace").read()
+                       for p in glob.glob(os.path.join(s.directory, "model0.out")))
+        assert "elbow_flexor" in logs and "the driver lowers its current limit" in logs, logs[-2000:]
+
+
+def test_record_and_verify_bit_for_bit(new_session):
+    with new_session() as s:
+        arm = s.model("model0")
+        configure(arm, THERMAL + REALISM)
+        ids = [f"{PREFIX}elbow_flexor.winding_temperature", f"{PREFIX}elbow_flexor.current",
+               f"{PREFIX}elbow_flexor.driver_voltage", f"{PREFIX}elbow_flexor.cogging_torque",
+               "ecce_arm.elbow.position"]
+        started = arm.start_recording("realism.caliper", ids, every=1, keyframe_every=250)
+        for k in range(150):
+            u = 3 + 3 * math.sin(0.2 * k)
+            arm.set_commands({"elbow_flexor": u, "elbow_extensor": 6 - u})
+            arm.step(10)
+        stopped = arm.stop_recording()
+        assert started.recording and stopped.steps == 1500 and stopped.error == ""
+        ok, report = caliper.verify(stopped.path)
+        assert ok, report
+        data = caliper.Recording(stopped.path).channels_data()
+        assert data[ids[0]][-1] > 25.0  # it heated
+        # the delayed, slewed driver voltage moved; a replay from a keyframe gives it again
+        arm.open_replay(stopped.path)
+        arm.seek(1.1)
+        at = int(np.searchsorted(data.steps, 1100))
+        assert arm.get(ids[2]) == data[ids[2]][at]
+        assert arm.get(ids[0]) == data[ids[0]][at]
+        arm.step(37)
+        assert arm.get(ids[3]) == data[ids[3]][at + 37]
