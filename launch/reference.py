@@ -29,7 +29,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 REGENERATE = "launch/caliper docs"
-PAGES = ["launcher.md", "ctl.md", "calibrate.md", "config.md", "environment.md", "file-formats.md"]
+PAGES = ["launcher.md", "ctl.md", "actuators.md", "calibrate.md", "config.md", "environment.md", "file-formats.md"]
 
 
 class Problem(Exception):
@@ -604,6 +604,20 @@ def page_ctl(runner):
     return "".join(out)
 
 
+def page_actuators(runner):
+    ctl = str(runner.bin_dir / "caliper-ctl")
+    tables = runner.help([ctl, "kinds", "--markdown"])
+    if "| parameter |" not in tables:
+        raise Problem("`caliper-ctl kinds --markdown` printed no table")
+    return (header("`caliper-ctl kinds --markdown`", "Actuator kinds and their parameters") +
+            "Every parameter an actuator of each registered kind takes: in a model file's "
+            "`<param name=...>` (any unit of the same dimension, [collada-extension.md]"
+            "(../collada-extension.md#units)), and on a Model as `ACTUATOR.PARAMETER` "
+            "(`launch/caliper ctl set`). A parameter a file leaves out has its default. What the "
+            "DC motor's heat, friction, cogging and driver parameters do: "
+            "[actuators.md](../actuators.md).\n\n" + tables)
+
+
 # ---------------------------------------------------------------- programs and configuration
 
 def programs(bin_dir):
@@ -970,6 +984,7 @@ def generate(bin_dir, only=None):
     makers = {
         "launcher.md": lambda: page_launcher(runner),
         "ctl.md": lambda: page_ctl(runner),
+        "actuators.md": lambda: page_actuators(runner),
         "calibrate.md": program_pages(page_programs),
         "config.md": program_pages(page_config),
         "environment.md": page_environment,

@@ -1,6 +1,7 @@
 // caliper-ctl: the command line client, in the spirit of rtshell.
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
@@ -9,9 +10,11 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "caliper/actuators/actuator.h"
 #include "caliper/collada/exporter.h"
 #include "caliper/collada/importer.h"
 #include "caliper/model_file/model_file.h"
@@ -241,6 +244,43 @@ int Log(Client& client, std::vector<std::string>& args) {
   }
 }
 
+// The registry of actuator kinds, with no session.
+int Kinds(Client&, std::vector<std::string>& args) {
+  const bool markdown = core::TakeFlag(args, "--markdown");
+  for (const auto& a : args)
+    if (a.size() > 1 && a[0] == '-') throw UsageError("unknown option '" + a + "'");
+  if (args.size() > 1) throw UsageError("expected at most one KIND");
+  std::vector<std::string> kinds = actuators::Kinds();
+  if (!args.empty()) {
+    if (std::find(kinds.begin(), kinds.end(), args[0]) == kinds.end())
+      throw Failure("no actuator kind '" + args[0] + "'");
+    kinds = {args[0]};
+  }
+  auto number = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  for (const auto& kind : kinds) {
+    const auto& specs = actuators::KindParameters(kind);
+    if (markdown) {
+      std::cout << "## " << kind << "\n\n| parameter | unit | default | what |\n| --- | --- | --- | --- |\n";
+      for (const auto& p : specs)
+        std::cout << "| `" << p.name << "` | " << (p.unit.empty() ? "-" : p.unit) << " | "
+                  << (p.required ? "required" : number(p.default_value)) << " | " << p.help
+                  << " |\n";
+      std::cout << "\n";
+      continue;
+    }
+    std::cout << kind << " (" << specs.size() << " parameters)\n";
+    for (const auto& p : specs)
+      std::cout << "  " << std::left << std::setw(42) << p.name << std::setw(11)
+                << (p.unit.empty() ? "-" : p.unit) << std::setw(10)
+                << (p.required ? "required" : number(p.default_value)) << " " << p.help << "\n";
+  }
+  return 0;
+}
+
 // Reads a scene file with no session: the ORB is never started.
 int Inspect(Client&, std::vector<std::string>& args) {
   std::string out_path;
@@ -322,6 +362,13 @@ std::map<std::string, Verb> Verbs() {
       std::to_string(logging::kMaxPatternBytes) +
       " bytes, searched anywhere in the message\n"
       "  --limit N     the logger returns at most 10000 records per query\n";
+  verbs["kinds"] = {"kinds [KIND] [--markdown]",
+                    "list the actuator kinds and every parameter each takes, with its unit and "
+                    "default (no session needed)",
+                    Kinds, "files"};
+  verbs["kinds"].details =
+      "  The parameters a model file's <param> may give an actuator of that kind (and the\n"
+      "  Model's `ACTUATOR.PARAMETER` ids); --markdown prints tables (docs/reference).\n";
   verbs["inspect"] = {"inspect FILE [--export OUT.dae]",
                       "report what a model file (COLLADA .dae, .zae or URDF .urdf) holds, or why "
                       "it does not import (no session needed); --export writes the imported scene "
@@ -345,7 +392,7 @@ void PrintHelp(const std::map<std::string, Verb>& verbs) {
             << "which).\n"
             << "NAME is an instance name (model0), model0@host (as batch summaries print it),\n"
             << "host/model0, or host.host_cxt/model0.rtc.\n"
-            << "`inspect` reads a file and needs no session.\n";
+            << "`inspect` and `kinds` need no session.\n";
   const std::pair<const char*, const char*> groups[] = {
       {"components", "Components"},
       {"model", "Model (model0, or --model NAME on each verb)"},
