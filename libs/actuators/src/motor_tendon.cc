@@ -378,7 +378,9 @@ class DcMotorTendon : public TendonActuator {
     q.push_back({"pretension", "N", true, true});
     for (const DriverField& field : kDriverFields) q.push_back({field.name, field.unit, true, true});
     for (const Quantity& e : elastic_->Quantities()) q.push_back(e);
-    for (const auto& [name, unit] : kStates) q.push_back({name, unit, false, false});
+    for (const auto& [name, unit] : kStates)
+      q.push_back({name, name == std::string("delayed_command") ? command_unit() : unit, false,
+                   false});
     return q;
   }
 
