@@ -232,6 +232,8 @@ void DcMotor::set_parameters(const DcMotorParameters& parameters) {
   parameters_ = parameters;
   effective_ = parameters;
   shaft_ = parameters.shaft_losses();
+  friction_ = parameters.coulomb_friction > 0 || parameters.static_friction > 0 ||
+              parameters.viscous_friction > 0;
   thermal_ = parameters.thermal();
   thermal_model_ = TwoNodeThermal{};  // configured at the next step
   constants_ = StageConstants{};      // recomputed at the next step
@@ -301,6 +303,9 @@ DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) con
   k.inverse_rho_driving = 1 / p.efficiency;
   k.inverse_rho_driven = 1 / (p.efficiency + k.spread);
   k.c_shaft = c_over_inertia;
+  k.cogging_per_angle = p.cogging_count * p.gear_ratio;
+  k.cogging_slope = p.cogging_amplitude * k.cogging_per_angle * k.c;
+  k.cogging_curvature = 0.5 * k.cogging_slope * k.cogging_per_angle * k.c;
   Retune(&k);
   if (shaft_) {
     // the most tau_f can fall per rad/s of the motor: (tau_s - tau_c) max|d exp(-y^2)/dW|,
@@ -379,6 +384,7 @@ class DcMotor::StageEquation {
     double x_slope;                  // dx/dw
     double d_current;                // di/dw (0 while the current is limited)
     double shaft, d_shaft;           // friction and cogging [N m] and d/dw (0 without them)
+    double friction, d_friction;     // friction alone [N m] and d/dw
     int regime;  // -1, +1: saturated (rho = eta + (1/eta - eta), eta exactly); 0; kUnloaded
   };
   static constexpr int kUnloaded = 2;  // no torque, no slope: the switch does not matter
@@ -417,9 +423,23 @@ class DcMotor::StageEquation {
     v->x_slope = 2 * kSwitchSharpness * (v->d_current * w + current);
     double linear = w - speed0_ - k_.c_torque * current;
     double d_linear = 1 - k_.c_torque * v->d_current;
-    v->shaft = v->d_shaft = 0;
+    v->shaft = v->d_shaft = v->friction = v->d_friction = 0;
     if (motor_.shaft_) {
-      v->shaft = motor_.ShaftTorque(w, angle0_ + k_.c * w, k_.c, &v->d_shaft);
+      const DcMotorParameters& p = motor_.parameters_;
+      if (motor_.friction_) {
+        v->friction = FrictionTorque(p, p.gear_ratio * w, &v->d_friction);
+        v->d_friction *= p.gear_ratio;
+      }
+      v->shaft = v->friction;
+      v->d_shaft = v->d_friction;
+      if (p.cogging_amplitude > 0) {
+        double sine;
+        double cosine;
+        motor_.SinCos(k_.cogging_per_angle * (angle0_ + k_.c * w) + p.cogging_phase, &sine,
+                      &cosine);
+        v->shaft += p.cogging_amplitude * sine;
+        v->d_shaft += k_.cogging_slope * cosine;
+      }
       linear += k_.c_shaft * v->shaft;
       d_linear += k_.c_shaft * v->d_shaft;
     }
@@ -464,10 +484,16 @@ class DcMotor::StageEquation {
     // the load off its tangent, seen through 1/rho <= 1/eta
     double bound = 0;
     if (motor_.shaft_) {
-      // friction and cogging off their tangent, where the step ends
-      double d_shaft;
-      const double shaft = motor_.ShaftTorque(next, angle0_ + k_.c * next, k_.c, &d_shaft);
-      bound += k_.c_shaft * std::abs(shaft - v.shaft - v.d_shaft * step) * v.scale;
+      // friction off its tangent where the step ends (unless it is affine between: viscous, or
+      // the sign and the Stribeck peak saturated at both ends), cogging by its curvature's bound
+      // A (n N c)^2 / 2 per (rad/s)^2
+      const DcMotorParameters& p = motor_.parameters_;
+      if (motor_.friction_ && !FrictionAffine(p, p.gear_ratio * w, p.gear_ratio * next)) {
+        double d_friction;
+        const double friction = FrictionTorque(p, p.gear_ratio * next, &d_friction);
+        bound += k_.c_shaft * std::abs(friction - v.friction - v.d_friction * step) * v.scale;
+      }
+      bound += k_.c_shaft * k_.cogging_curvature * step * step * v.scale;
     }
     if (!(step >= v.affine_low && step <= v.affine_high)) {
       const double torque = load_.TorqueAt(angle0_ + k_.c * next, next, h_load_);
@@ -741,6 +767,18 @@ void DcMotor::SinCos(double x, double* sine, double* cosine) const {
   cos_value_ = std::cos(x);
   *sine = sin_value_;
   *cosine = cos_value_;
+}
+
+bool FrictionAffine(const DcMotorParameters& p, double speed0, double speed1) {
+  if (p.coulomb_friction == 0 && p.static_friction == 0) return true;
+  // the same sign, tanh at +-1 to the last bit, the Stribeck term skipped (FrictionTorque)
+  const double sign_speed = 19.1 * p.friction_smoothing_speed;
+  if (!((speed0 >= sign_speed && speed1 >= sign_speed) ||
+        (speed0 <= -sign_speed && speed1 <= -sign_speed)))
+    return false;
+  if (p.static_friction <= p.coulomb_friction) return true;
+  const double peak_speed = 6 * p.stribeck_speed;
+  return std::abs(speed0) >= peak_speed && std::abs(speed1) >= peak_speed;
 }
 
 double FrictionTorque(const DcMotorParameters& p, double speed, double* slope) {

@@ -104,6 +104,9 @@ double GearEfficiencyFactor(double efficiency, double current, double spool_spee
 /// The friction torque tau_f(W) [N m] at the motor shaft speed W [rad/s] (DcMotorParameters) and
 /// its derivative by W [N m s/rad] in *slope.
 double FrictionTorque(const DcMotorParameters& parameters, double motor_speed, double* slope);
+/// Whether FrictionTorque is exactly affine between two motor speeds [rad/s] (viscous only, or
+/// beyond the smoothing and the Stribeck peak on one side of zero).
+bool FrictionAffine(const DcMotorParameters& parameters, double speed0, double speed1);
 
 /// A load on the spool that may depend on the spool's angle and speed and carry state of its own
 /// (a series-elastic element). The motor solves for the end of each sub-step with the load
@@ -318,6 +321,9 @@ class DcMotor {
     double current_to_speed = 0;     // k_t L / (N J R): a current error as a speed [rad/(s A)]
     double c_shaft = 0;              // C = c / (N J) [rad/(s N m)]
     double c_over_inductance = 0;    // c / L [s/H]
+    double cogging_per_angle = 0;    // n N: cogging radians per spool radian [-]
+    double cogging_slope = 0;        // A n N c: d(tau_cog)/dw over cos [N m s/rad]
+    double cogging_curvature = 0;    // A (n N c)^2 / 2: bound of the remainder [N m s^2/rad^2]
     double shaft_falling = 0;        // C times the most the shaft torque can fall per rad/s [-]
   };
   struct Stage {
@@ -359,6 +365,7 @@ class DcMotor {
   DcMotorParameters parameters_;
   DcMotorParameters effective_;           // parameters_ at the step's temperatures and derating
   bool shaft_ = false;                    // parameters_.shaft_losses()
+  bool friction_ = false;                 // any friction
   bool thermal_ = false;                  // parameters_.thermal()
   TwoNodeThermal thermal_model_;          // for steps of thermal_model_.dt()
   double joule_ = 0;                      // integral of i^2 over the step so far [A^2 s]
