@@ -46,7 +46,7 @@ def test_parameters_and_channels(arm):
         assert "cogging_count" in str(e.value) and "whole" in str(e.value)
         with pytest.raises(caliper.InvalidParameter) as e:
             arm.set(f"{PREFIX}elbow_flexor.command_delay", 1.0)
-        assert "at most 200" in str(e.value)
+        assert "at most 50 " in str(e.value)
         # the export carries what was set live
         scene = arm.export_scene().decode()
         assert 'name="thermal_time_constant_motor"' in scene and 'name="cogging_count"' in scene

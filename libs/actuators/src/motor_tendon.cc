@@ -98,11 +98,13 @@ const DriverField kDriverFields[] = {
      "PWM duty steps from 0 to full supply (e.g. 1024 for 10 bits; 0: continuous)"},
     {"slew_rate", "V/s", 0, "fastest change of the driver's output voltage (0: none)"},
     {"command_delay", "s", 0,
-     "time from a command to the driver, rounded to whole time steps (at most 200 of them)"},
+     "time from a command to the driver, rounded to whole time steps (at most 50 of them)"},
 };
 
-// the most time steps a command may be delayed by (the actuator's state holds as many)
-constexpr int kMaxCommandDelaySteps = 200;
+// the most time steps a command may be delayed by: the actuator's state holds as many commands
+// in flight, each motor the same (a state's size may not depend on a parameter a live edit
+// changes: recordings restore keyframes into scenes built from the edited description)
+constexpr int kMaxCommandDelaySteps = 50;
 
 constexpr double kDefaultSupplyVoltage = 12;  // [V]
 
@@ -203,6 +205,7 @@ class DcMotorTendon : public TendonActuator {
     pretension_ = ParameterOr(a, "pretension", 0);
     for (const DriverField& field : kDriverFields)
       *Driver(field.name) = ParameterOr(a, field.name, field.default_value);
+    pending_.resize(kMaxCommandDelaySteps + 1);
     const auto input = a.options.find("input");
     if (input != a.options.end()) {
       if (input->second == "duty")
@@ -274,10 +277,11 @@ class DcMotorTendon : public TendonActuator {
     // its own (zener) integrated them along the mean speed and has no such direct term
     const double spool_line_speed =
         motor_.parameters().spool_radius * motor_.state().spool_speed;  // [m/s]
-    tension_ = linear_ ? linear_->LinearSpringDamper::Peek(elastic_length_,
-                                                           end_speed + spool_line_speed, dt)
-               : elastic_state_ == 0 ? elastic_->Peek(elastic_length_, end_speed + spool_line_speed, dt)
-                                     : load.force();
+    tension_ =
+        linear_
+            ? linear_->LinearSpringDamper::Peek(elastic_length_, end_speed + spool_line_speed, dt)
+        : elastic_state_ == 0 ? elastic_->Peek(elastic_length_, end_speed + spool_line_speed, dt)
+                              : load.force();
     return tension_;
   }
 
@@ -285,7 +289,9 @@ class DcMotorTendon : public TendonActuator {
 
   // the motor's, the elastic element's, what the step reports and the driver's (its delay line
   // last: only its pending commands are written)
-  std::size_t StateSize() const override { return kOwnState + elastic_state_ + kDelayState; }
+  std::size_t StateSize() const override {
+    return kOwnState + elastic_state_ + 1 + 2 * pending_.size();
+  }
 
   void SaveState(double* out) const override {
     motor_.SaveState(out);
@@ -304,7 +310,7 @@ class DcMotorTendon : public TendonActuator {
     out += elastic_state_;
     out[0] = pending_count_;
     for (int k = 0; k < pending_count_; ++k) {
-      const Pending& p = pending_[(pending_head_ + k) % kPendingCapacity];
+      const Pending& p = pending_[(pending_head_ + k) % capacity()];
       out[1 + 2 * k] = static_cast<double>(p.issued);
       out[2 + 2 * k] = p.value;
     }
@@ -326,7 +332,7 @@ class DcMotorTendon : public TendonActuator {
     if (elastic_state_ > 0) elastic_->RestoreState(in);
     in += elastic_state_;
     pending_head_ = 0;
-    pending_count_ = static_cast<int>(std::clamp(in[0], 0.0, double(kPendingCapacity)));
+    pending_count_ = static_cast<int>(std::clamp(in[0], 0.0, double(capacity())));
     for (int k = 0; k < pending_count_; ++k)
       pending_[k] = {static_cast<std::int64_t>(in[1 + 2 * k]), in[2 + 2 * k]};
   }
@@ -336,7 +342,7 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     try {
       DcMotor::CheckSubsteps(dt, motor_.parameters().max_substep);
-      CheckDelay(command_delay_, dt);
+      CheckDelay(command_delay_, dt, capacity() - 1);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -353,19 +359,19 @@ class DcMotorTendon : public TendonActuator {
     // into the delay line, issued before step steps_; a later command before the same step
     // replaces the earlier
     if (pending_count_ > 0) {
-      Pending& back = pending_[(pending_head_ + pending_count_ - 1) % kPendingCapacity];
+      Pending& back = pending_[(pending_head_ + pending_count_ - 1) % capacity()];
       if (back.issued == steps_) {
         back.value = command_;
         return;
       }
     }
-    if (pending_count_ == kPendingCapacity) {
+    if (pending_count_ == capacity()) {
       // only when the delay grew past what the line holds: the oldest is applied now
       delayed_command_ = pending_[pending_head_].value;
-      pending_head_ = (pending_head_ + 1) % kPendingCapacity;
+      pending_head_ = (pending_head_ + 1) % capacity();
       --pending_count_;
     }
-    pending_[(pending_head_ + pending_count_) % kPendingCapacity] = {steps_, command_};
+    pending_[(pending_head_ + pending_count_) % capacity()] = {steps_, command_};
     ++pending_count_;
   }
   double command() const override { return command_; }
@@ -376,11 +382,12 @@ class DcMotorTendon : public TendonActuator {
     for (const MotorField& field : kMotorFields) q.push_back({field.name, field.unit, true, true});
     q.push_back({"supply_voltage", "V", true, true});
     q.push_back({"pretension", "N", true, true});
-    for (const DriverField& field : kDriverFields) q.push_back({field.name, field.unit, true, true});
+    for (const DriverField& field : kDriverFields)
+      q.push_back({field.name, field.unit, true, true});
     for (const Quantity& e : elastic_->Quantities()) q.push_back(e);
     for (const auto& [name, unit] : kStates)
-      q.push_back({name, name == std::string("delayed_command") ? command_unit() : unit, false,
-                   false});
+      q.push_back(
+          {name, name == std::string("delayed_command") ? command_unit() : unit, false, false});
     return q;
   }
 
@@ -449,7 +456,8 @@ class DcMotorTendon : public TendonActuator {
       for (const DriverField& field : kDriverFields) {
         if (name != field.name) continue;
         CheckDriver(field.name, value);
-        if (name == std::string("command_delay") && time_step_ > 0) CheckDelay(value, time_step_);
+        if (name == std::string("command_delay") && time_step_ > 0)
+          CheckDelay(value, time_step_, capacity() - 1);
         *Driver(field.name) = value;
         return;
       }
@@ -490,8 +498,7 @@ class DcMotorTendon : public TendonActuator {
     std::int64_t issued;  // before this step (steps_ then)
     double value;         // the command
   };
-  static constexpr int kPendingCapacity = kMaxCommandDelaySteps + 1;
-  static constexpr std::size_t kDelayState = 1 + 2 * kPendingCapacity;
+  int capacity() const { return static_cast<int>(pending_.size()); }
 
   double* Driver(const std::string& name) {
     return const_cast<double*>(static_cast<const DcMotorTendon*>(this)->Driver(name));
@@ -513,13 +520,13 @@ class DcMotorTendon : public TendonActuator {
     // beyond the line's capacity, any larger number says the same
     return static_cast<int>(std::min(std::round(delay / dt), 1e9));
   }
-  static void CheckDelay(double delay, double dt) {
+  static void CheckDelay(double delay, double dt, int most) {
     const int steps = DelaySteps(delay, dt);
-    if (steps > kMaxCommandDelaySteps)
+    if (steps > most)
       throw std::invalid_argument("parameter 'command_delay' = " + Number(delay) + " s is " +
                                   std::to_string(steps) + " time steps of " + Number(dt) +
-                                  " s; at most " + std::to_string(kMaxCommandDelaySteps) +
-                                  " (" + Number(kMaxCommandDelaySteps * dt) + " s)");
+                                  " s; at most " + std::to_string(most) + " (" + Number(most * dt) +
+                                  " s at this time step)");
   }
 
   // the driver's output for the delayed command: quantised to the PWM's duty steps, within the
@@ -535,10 +542,10 @@ class DcMotorTendon : public TendonActuator {
   void DriveStep(double dt) {
     if (pending_count_ > 0) {
       const int delay = DelaySteps(command_delay_, dt);
-      if (delay > kMaxCommandDelaySteps) CheckDelay(command_delay_, dt);  // throws
+      if (delay > capacity() - 1) CheckDelay(command_delay_, dt, capacity() - 1);  // throws
       while (pending_count_ > 0 && steps_ - pending_[pending_head_].issued >= delay) {
         delayed_command_ = pending_[pending_head_].value;
-        pending_head_ = (pending_head_ + 1) % kPendingCapacity;
+        pending_head_ = (pending_head_ + 1) % capacity();
         --pending_count_;
       }
     }
@@ -559,10 +566,11 @@ class DcMotorTendon : public TendonActuator {
     if (!warned_ && motor_.derating() > 0) {
       warned_ = true;
       logging::Get("actuators")
-          .warn("%swinding at %.1f degC, within %g K of its maximum %g degC: the driver lowers "
-                "its current limit (to %.3g A, the continuous current, at %g degC)",
-                prefix_.c_str(), winding, p.derating_band, p.max_winding_temperature,
-                motor_.continuous_current(), p.max_winding_temperature);
+          .warn(
+              "%swinding at %.1f degC, within %g K of its maximum %g degC: the driver lowers "
+              "its current limit (to %.3g A, the continuous current, at %g degC)",
+              prefix_.c_str(), winding, p.derating_band, p.max_winding_temperature,
+              motor_.continuous_current(), p.max_winding_temperature);
     } else if (warned_ && winding < p.max_winding_temperature - p.derating_band - 2) {
       warned_ = false;
       logging::Get("actuators")
@@ -587,9 +595,7 @@ class DcMotorTendon : public TendonActuator {
     return false;
   }
 
-  double voltage(double command) const {
-    return duty_input_ ? command * supply_voltage_ : command;
-  }
+  double voltage(double command) const { return duty_input_ ? command * supply_voltage_ : command; }
 
   // Reset keeps the element just taut at the pretension, whatever the path: a relaxed element
   // longer than the path leaves a negative line, which a file author rarely means (a rest_length
@@ -626,19 +632,19 @@ class DcMotorTendon : public TendonActuator {
   double pwm_levels_ = 0;                          // [-]
   double slew_rate_ = 0;                           // [V/s]
   double command_delay_ = 0;                       // [s]
-  Pending pending_[kPendingCapacity] = {};         // the delay line, oldest at pending_head_
+  std::vector<Pending> pending_;                   // the delay line, oldest at pending_head_
   int pending_head_ = 0;
   int pending_count_ = 0;
-  std::int64_t steps_ = 0;                         // since Reset
-  double delayed_command_ = 0;                     // the command the driver follows
-  double driver_voltage_ = 0;                      // its output [V]
-  bool warned_ = false;                            // of the thermal protection
-  double time_step_ = 0;                           // the engine's, once told [s]
-  double path_length_ = 0;                         // [m]
-  double path_speed_ = 0;                          // [m/s]
-  double line_length_ = 0;                         // free kite line [m]
-  double elastic_length_ = 0;                      // [m]
-  double tension_ = 0;                             // [N]
+  std::int64_t steps_ = 0;      // since Reset
+  double delayed_command_ = 0;  // the command the driver follows
+  double driver_voltage_ = 0;   // its output [V]
+  bool warned_ = false;         // of the thermal protection
+  double time_step_ = 0;        // the engine's, once told [s]
+  double path_length_ = 0;      // [m]
+  double path_speed_ = 0;       // [m/s]
+  double line_length_ = 0;      // free kite line [m]
+  double elastic_length_ = 0;   // [m]
+  double tension_ = 0;          // [N]
 };
 
 // a passive tension-only spring-damper along the tendon

@@ -35,6 +35,8 @@ class ExtensionReader {
         Actuator(*c);
       else if (n == "coupling")
         Coupling(*c);
+      else if (n == "measurement_delay")
+        MeasurementDelay(*c);
       else
         Unknown(*c, "the Caliper technique");
     }
@@ -322,6 +324,29 @@ class ExtensionReader {
     ctx_.scene.couplings.push_back(c);
   }
 
+  // <measurement_delay channel="motor.current" delay="4" unit="ms"/>: the channel's id is checked
+  // by the engine that builds the scene (it knows the parameters), the rest here
+  void MeasurementDelay(const Element& e) {
+    sgal::MeasurementDelay d;
+    d.id = Required(e, "channel");
+    double scale = 1;
+    if (const std::string* unit = e.FindAttribute("unit"); unit != nullptr) {
+      const Unit u = ParseUnitOf(e, *unit);
+      if (u.dimension != std::array<int, 5>{0, 0, 1, 0, 0})
+        ctx_.Fail(&e, "unit '" + *unit + "' is not a time");
+      scale = u.scale;
+    }
+    Required(e, "delay");
+    d.delay = AttributeNumber(e, "delay", 0) * scale;
+    if (!std::isfinite(d.delay) || d.delay < 0)
+      ctx_.Fail(&e, "channel '" + d.id + "': delay=\"" + e.Attribute("delay") +
+                        "\" must be finite and not negative");
+    for (const auto& m : ctx_.scene.measurement_delays)
+      if (m.id == d.id) ctx_.Fail(&e, "channel '" + d.id + "' is delayed twice");
+    for (const auto& child : e.children) Unknown(*child, "a measurement_delay");
+    ctx_.scene.measurement_delays.push_back(d);
+  }
+
   Context& ctx_;
   const Element* technique_ = nullptr;  // the technique being read
 };
@@ -415,6 +440,12 @@ void ExportExtension(const sgal::Scene& scene, Element* technique) {
     e->Set("follower", c.follower);
     e->Set("ratio", FormatNumber(c.ratio));
     e->Set("offset", FormatNumber(c.offset));
+  }
+  for (const auto& d : scene.measurement_delays) {
+    Element* e = technique->Add("measurement_delay");
+    e->Set("channel", d.id);
+    e->Set("delay", FormatNumber(d.delay));
+    e->Set("unit", "s");
   }
 }
 

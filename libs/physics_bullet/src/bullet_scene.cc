@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -151,6 +152,22 @@ struct StepStage {
   int index = -1;
 };
 
+/// A parameter read late (sgal::MeasurementDelay): a ring of its last steps + 1 true values, one
+/// pushed after every completed step; the oldest, at `head`, is what the parameter reads.
+struct DelayLine {
+  std::function<double()> truth;  // the parameter's true value now
+  StepStage stage;                // whose value it is (an actuator's, a tendon's, the world's)
+  int steps = 0;                  // round(delay / dt)
+  std::vector<double> ring;       // steps + 1 values [the parameter's unit]
+  size_t head = 0;                // index of the oldest value
+  // where the step's push wrote and what it overwrote, put back when the step fails
+  size_t saved_head = 0;
+  double saved_oldest = 0;
+};
+
+// the most steps a channel may lag (each one a double per step and channel kept and recorded)
+constexpr int kMaxDelaySteps = 1000;
+
 /// A number as text, shortest round-trip form, independent of the locale.
 std::string Text(double v) {
   char text[32];
@@ -235,7 +252,20 @@ class BulletScene : public sgal::PhysicsScene {
   void PushJoint(const JointData& j, double load);
   void CheckState();
   void BuildParameters();
-  // the state at the start of a step (bodies, tendons, actuators), and putting it back
+  // the delayed channels (after BuildParameters): their rings, their parameters read late and
+  // the `.undelayed` parameters
+  void BuildMeasurementDelays();
+  // each measurement delay in steps of `dt`; std::invalid_argument starting with `refused` and
+  // naming the id for a delay that is negative, not finite or longer than kMaxDelaySteps
+  std::vector<int> DelaySteps(double dt, const std::string& refused) const;
+  // appends every delayed channel's true value now to its ring (the end of a step)
+  void PushMeasurements();
+  // the part of the scene a parameter id belongs to, for a fault's message
+  StepStage OwnerOf(const std::string& id) const;
+  // the rings from a dynamic state's measurements, or filled with the present values (empty)
+  void RestoreMeasurements(const std::vector<double>& values);
+  // the state at the start of a step (bodies, tendons, actuators, delayed channels), and putting
+  // it back
   void SaveStepState();
   void RestoreStepState();
   [[noreturn]] void FailStep();
@@ -294,7 +324,15 @@ class BulletScene : public sgal::PhysicsScene {
                    std::vector<const actuators::WorldShape*>* out);
   std::vector<ParameterEntry> parameters_;
   std::unordered_map<std::string, int> parameter_index_;
+  // in Scene::measurement_delays order, sized once (the delayed parameters' getters point here)
+  std::vector<DelayLine> delays_;
 };
+
+// A ring holding the present value `steps` + 1 times: a sensor that read it since ever.
+void Fill(DelayLine* line) {
+  line->ring.assign(static_cast<size_t>(line->steps) + 1, line->truth());
+  line->head = 0;
+}
 
 std::unique_ptr<btCollisionShape> MakeShape(const sgal::Geometry& geometry, double s, bool dynamic,
                                             const std::string& where) {
@@ -387,6 +425,7 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
   BuildCouplings();
   BuildTendons();
   BuildParameters();
+  BuildMeasurementDelays();
 }
 
 BulletScene::~BulletScene() {
@@ -982,6 +1021,10 @@ void BulletScene::SaveStepState() {
     t.saved_tension = t.tension;
   }
   for (const auto& a : actuators_) a.model->SaveState(actuator_states_.data() + a.state_offset);
+  for (auto& d : delays_) {
+    d.saved_head = d.head;
+    d.saved_oldest = d.ring[d.head];
+  }
 }
 
 void BulletScene::RestoreStepState() {
@@ -1000,6 +1043,10 @@ void BulletScene::RestoreStepState() {
     t.tension = t.saved_tension;
   }
   for (auto& a : actuators_) a.model->RestoreState(actuator_states_.data() + a.state_offset);
+  for (auto& d : delays_) {
+    d.head = d.saved_head;
+    d.ring[d.head] = d.saved_oldest;
+  }
   CacheBodyPoses();
   UpdateJoints();
   // the paths where the step started, as the last step's end evaluated them (the same poses and
@@ -1055,9 +1102,9 @@ void BulletScene::FailStep() {
 
 void BulletScene::Step() {
   // A failing step leaves the scene as it was at its start: bodies, tendons, every actuator's
-  // state, time and step count. Bullet's contact cache (warm-start impulses) is not rolled back:
-  // after a fault inside stepSimulation or an exploding body, a scene with contacts that steps on
-  // may differ in the last bits from one that never faulted.
+  // state, the delayed channels, time and step count. Bullet's contact cache (warm-start impulses)
+  // is not rolled back: after a fault inside stepSimulation or an exploding body, a scene with
+  // contacts that steps on may differ in the last bits from one that never faulted.
   //
   // Actuators and bodies take turns in Stormer-Verlet order (second order in dt, see
   // TendonActuator::Step): the bodies advance on the tendons' tensions and paths at the start of
@@ -1118,6 +1165,7 @@ void BulletScene::Step() {
         t.tension += f;
       }
     }
+    PushMeasurements();
   } catch (...) {
     FailStep();
   }
@@ -1210,6 +1258,9 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
     s.actuators.push_back(std::move(state));
     s.commands.push_back(a.model->command());
   }
+  for (const auto& d : delays_)
+    for (size_t i = 0; i < d.ring.size(); ++i)
+      s.measurements.push_back(d.ring[(d.head + i) % d.ring.size()]);
   return s;
 }
 
@@ -1251,6 +1302,11 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
       refuse("actuator '" + actuators_[k].desc->name + "' has " +
              std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
              std::to_string(s.actuators[k].size()));
+  size_t remembered = 0;  // the values the delayed channels hold
+  for (const auto& d : delays_) remembered += d.ring.size();
+  if (!s.measurements.empty() && s.measurements.size() != remembered)
+    refuse(std::to_string(s.measurements.size()) + " measurements for a scene whose " +
+           std::to_string(delays_.size()) + " delayed channels hold " + std::to_string(remembered));
   const bool exact = !s.engine.empty();
   if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 4 * tendons_.size())
     refuse("the engine state has " + std::to_string(s.engine.size()) + " values, too few for " +
@@ -1345,6 +1401,20 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     t.tension = 0;
     for (int index : t.actuators) t.tension += actuators_[index].model->tension();
   }
+  RestoreMeasurements(s.measurements);  // last: an empty one reads the state restored
+}
+
+void BulletScene::RestoreMeasurements(const std::vector<double>& values) {
+  const double* in = values.data();
+  for (auto& d : delays_) {
+    if (values.empty()) {
+      Fill(&d);
+      continue;
+    }
+    std::copy(in, in + d.ring.size(), d.ring.begin());
+    in += d.ring.size();
+    d.head = 0;
+  }
 }
 
 std::vector<sgal::BodyState> BulletScene::BodyStates() const {
@@ -1421,6 +1491,9 @@ void BulletScene::BuildParameters() {
   }
   add({"simulation.time_step", "s", true, true}, [this] { return dt_; }, [this](double v) {
     if (!(v > 0 && v <= 0.1)) throw std::invalid_argument("simulation.time_step: must be in (0, 0.1] s");
+    // the delayed channels' lags in the new steps, checked before anything changes
+    const std::vector<int> lags =
+        DelaySteps(v, "simulation.time_step = " + Text(v) + " s refused: ");
     // A time step that an actuator cannot take within its bound of sub-steps per step is refused
     // (rather than clamping its sub-steps, which would change its accuracy silently): every
     // actuator is told first, and all keep the old one if one refuses.
@@ -1438,6 +1511,12 @@ void BulletScene::BuildParameters() {
       for (auto& t : tendons_) t.previous_length = -1;
     dt_ = v;
     scene_.settings.time_step = v;
+    // a channel whose lag in steps changed starts again from its present value
+    for (size_t k = 0; k < delays_.size(); ++k)
+      if (delays_[k].steps != lags[k]) {
+        delays_[k].steps = lags[k];
+        Fill(&delays_[k]);
+      }
   });
   add({"simulation.time", "s", false, false}, [this] { return time_; });
   for (size_t i = 0; i < bodies_.size(); ++i) {
@@ -1510,6 +1589,82 @@ void BulletScene::BuildParameters() {
       add({n + field, q.unit, q.writable, q.is_static}, [model, field] { return model->Get(field); },
           std::move(set));
     }
+  }
+}
+
+std::vector<int> BulletScene::DelaySteps(double dt, const std::string& refused) const {
+  std::vector<int> steps;
+  for (const auto& d : scene_.measurement_delays) {
+    const std::string what =
+        refused + "measurement delay of '" + d.id + "': delay " + Text(d.delay) + " s ";
+    if (!std::isfinite(d.delay) || d.delay < 0)
+      throw std::invalid_argument(what + "must be finite and not negative");
+    const double lag = std::round(d.delay / dt);
+    if (!(lag <= kMaxDelaySteps))  // also a NaN
+      throw std::invalid_argument(what + "is " + Text(lag) + " steps of " + Text(dt) +
+                                  " s, more than the " + std::to_string(kMaxDelaySteps) +
+                                  " steps a channel may lag");
+    steps.push_back(static_cast<int>(lag));
+  }
+  return steps;
+}
+
+void BulletScene::BuildMeasurementDelays() {
+  const std::string refused = (scene_.source.empty() ? scene_.name : scene_.source) + ": ";
+  const std::vector<int> steps = DelaySteps(dt_, refused);
+  delays_.resize(scene_.measurement_delays.size());
+  std::unordered_map<std::string, int> delayed;  // id -> its index in parameters_
+  for (size_t k = 0; k < delays_.size(); ++k) {
+    const std::string& id = scene_.measurement_delays[k].id;
+    auto refuse = [&](const std::string& why) {
+      throw std::invalid_argument(refused + "measurement delay of '" + id + "': " + why);
+    };
+    const int index = ParameterIndex(id);
+    if (index < 0)
+      refuse(std::string("the scene has no such parameter (a state as Parameters() lists it, ") +
+             "e.g. an actuator's current, a joint's position, a tendon's tendon.tension)");
+    ParameterEntry& p = parameters_[index];
+    if (p.info.is_static)
+      refuse("a model parameter, not a measurement: only a state that changes every step lags");
+    if (id == "simulation.time") refuse("the simulation's clock is not a measurement");
+    if (!delayed.emplace(id, index).second) refuse("the channel is delayed twice");
+    DelayLine& line = delays_[k];
+    line.truth = p.get;
+    line.stage = OwnerOf(id);
+    line.steps = steps[k];
+    Fill(&line);
+    // what the controller, the DAQ and recordings read: the oldest value of the ring
+    p.get = [&line] { return line.ring[line.head]; };
+  }
+  // the true values under ids of their own, after every other parameter
+  for (size_t k = 0; k < delays_.size(); ++k) {
+    const std::string& id = scene_.measurement_delays[k].id;
+    sgal::ParameterInfo info = parameters_[delayed.at(id)].info;
+    info.id = id + ".undelayed";
+    info.writable = false;
+    parameter_index_[info.id] = static_cast<int>(parameters_.size());
+    parameters_.push_back({std::move(info), delays_[k].truth, nullptr});
+  }
+}
+
+StepStage BulletScene::OwnerOf(const std::string& id) const {
+  auto under = [&id](const std::string& prefix) {
+    return id.compare(0, prefix.size(), prefix) == 0;
+  };
+  // a tendon's states first: a tendon often shares its actuator's name
+  for (size_t t = 0; t < tendons_.size(); ++t)
+    if (under(tendons_[t].desc->name + ".tendon."))
+      return {StepStage::kTendon, static_cast<int>(t)};
+  for (size_t k = 0; k < actuators_.size(); ++k)
+    if (under(actuators_[k].desc->name + ".")) return {StepStage::kActuator, static_cast<int>(k)};
+  return {StepStage::kWorld, -1};
+}
+
+void BulletScene::PushMeasurements() {
+  for (auto& d : delays_) {
+    stage_ = d.stage;  // a reading that fails names its owner
+    d.ring[d.head] = d.truth();
+    d.head = d.head + 1 == d.ring.size() ? 0 : d.head + 1;
   }
 }
 

@@ -30,9 +30,11 @@ namespace {
 
 constexpr char kFormat[] = "caliper-recording";
 constexpr int kFormatVersion = 1;
-// the first bytes of an encoded DynamicState and its layout's version
+// the first bytes of an encoded DynamicState and its layout's versions: 2 adds the delayed
+// channels' measurements, and a state without any is written as 1 (as before them)
 constexpr char kStateMagic[4] = {'C', 'L', 'D', 'S'};
-constexpr uint32_t kStateVersion = 1;
+constexpr uint32_t kStateVersion = 2;
+constexpr uint32_t kStateVersionWithoutMeasurements = 1;
 
 // a double's text that reads back as the same double
 std::string ExactText(double v) {
@@ -232,11 +234,12 @@ void RemoveFiles(const std::string& path) {
 
 // magic "CLDS", u64 version, then time, steps, the bodies (13 doubles each: position, quaternion
 // w x y z, linear and angular velocity), joint positions, actuators (each a counted vector),
-// commands and the engine's numbers: every vector as a u64 count and its doubles, all
-// little-endian
+// commands, the engine's numbers and (version 2) the measurements: every vector as a u64 count and
+// its doubles, all little-endian
 std::string EncodeState(const sgal::DynamicState& state) {
   std::string out(kStateMagic, 4);
-  PutU64(&out, kStateVersion);
+  const bool measured = !state.measurements.empty();
+  PutU64(&out, measured ? kStateVersion : kStateVersionWithoutMeasurements);
   PutDouble(&out, state.time);
   PutU64(&out, state.steps);
   PutU64(&out, state.bodies.size());
@@ -258,6 +261,7 @@ std::string EncodeState(const sgal::DynamicState& state) {
   for (const auto& a : state.actuators) put_vector(a);
   put_vector(state.commands);
   put_vector(state.engine);
+  if (measured) put_vector(state.measurements);
   return out;
 }
 
@@ -268,9 +272,11 @@ sgal::DynamicState DecodeState(const std::string& bytes) {
   StateReader in(bytes);
   in.Skip(4);
   const uint64_t version = in.U64("the version");
-  if (version != kStateVersion)
+  if (version != kStateVersion && version != kStateVersionWithoutMeasurements)
     throw RecordingError("a dynamic state of layout version " + std::to_string(version) +
-                         ", this build reads version " + std::to_string(kStateVersion));
+                         ", this build reads versions " +
+                         std::to_string(kStateVersionWithoutMeasurements) + " and " +
+                         std::to_string(kStateVersion));
   sgal::DynamicState state;
   state.time = in.Double("the time");
   state.steps = in.U64("the step count");
@@ -288,6 +294,14 @@ sgal::DynamicState DecodeState(const std::string& bytes) {
   for (auto& a : state.actuators) a = in.Doubles("an actuator's state");
   state.commands = in.Doubles("the commands");
   state.engine = in.Doubles("the engine's numbers");
+  if (version == kStateVersion) {
+    state.measurements = in.Doubles("the measurements");
+    // one encoding per state: none is written as version 1
+    if (state.measurements.empty())
+      throw RecordingError("not a dynamic state: version " + std::to_string(kStateVersion) +
+                           " with no measurements (written as version " +
+                           std::to_string(kStateVersionWithoutMeasurements) + ")");
+  }
   if (in.left() != 0)
     throw RecordingError("not a dynamic state: " + std::to_string(in.left()) +
                          " bytes follow its end");

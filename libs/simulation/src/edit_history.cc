@@ -56,6 +56,14 @@ sgal::DynamicState EditHistory::CarryOver(const sgal::Scene& before,
   // its state and command aside, for the undo that brings it back
   sgal::DynamicState state = old_state;
   state.engine.clear();  // the engine's own numbers belong to the scene before the edit
+  // the delayed channels' memory fits only the same channels lagging the same steps
+  const auto same_delay = [](const sgal::MeasurementDelay& a, const sgal::MeasurementDelay& b) {
+    return a.id == b.id && a.delay == b.delay;
+  };
+  if (before.settings.time_step != edited.settings.time_step ||
+      !std::equal(before.measurement_delays.begin(), before.measurement_delays.end(),
+                  edited.measurement_delays.begin(), edited.measurement_delays.end(), same_delay))
+    state.measurements.clear();
   state.actuators.assign(edited.actuators.size(), {});
   state.commands.assign(edited.actuators.size(), 0.0);
   std::map<std::string, size_t> was_at;

@@ -441,6 +441,16 @@ std::string Difference(const sgal::DynamicState& got, const sgal::DynamicState& 
     if (!Same(got.joint_positions[j], recorded.joint_positions[j]))
       return "joint '" + scene.constraints.at(j).name + "' position " +
              Number(got.joint_positions[j]) + ", recorded " + Number(recorded.joint_positions[j]);
+  // a recording of an older build has none: the delayed channels then went unchecked
+  if (!recorded.measurements.empty()) {
+    if (got.measurements.size() != recorded.measurements.size())
+      return "the delayed channels hold " + std::to_string(got.measurements.size()) +
+             " values, recorded " + std::to_string(recorded.measurements.size());
+    for (size_t m = 0; m < got.measurements.size(); ++m)
+      if (!Same(got.measurements[m], recorded.measurements[m]))
+        return "delayed channel value " + std::to_string(m) + ": " + Number(got.measurements[m]) +
+               ", recorded " + Number(recorded.measurements[m]);
+  }
   return "";
 }
 

@@ -535,9 +535,22 @@ TEST(Driver, RefusesDelaysBeyondItsLineAndBadValues) {
     const std::string m = e.what();
     EXPECT_NE(m.find("flexor"), std::string::npos) << m;
     EXPECT_NE(m.find("500 time steps"), std::string::npos) << m;
-    EXPECT_NE(m.find("at most 200"), std::string::npos) << m;
+    EXPECT_NE(m.find("at most 50 "), std::string::npos) << m;
   }
+  // live, the same bound
   description.parameters["command_delay"] = 0;
+  auto live = Make(description);
+  live->SetTimeStep(1e-3);
+  live->Set("command_delay", 0.05);
+  try {
+    live->Set("command_delay", 0.051);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("51 time steps"), std::string::npos) << m;
+    EXPECT_NE(m.find("at most 50 "), std::string::npos) << m;
+  }
+  EXPECT_EQ(live->Get("command_delay"), 0.05);
   description.parameters["pwm_levels"] = 10.5;
   EXPECT_THROW(Make(description), std::invalid_argument);
   description.parameters["pwm_levels"] = 0;

@@ -444,6 +444,12 @@ TEST(ColladaImportTest, RejectsMalformedFilesNamingFileLineElementAndProblem) {
       {"malformed_negative_friction.dae",
        {"malformed_negative_friction.dae:86:", "friction", "-0.5",
         "(N or N m) must be finite and not negative"}},
+      {"malformed_measurement_delay.dae",
+       {"malformed_measurement_delay.dae:107:", "measurement_delay", "channel 'hinge.position'",
+        "delay=\"-2\" must be finite and not negative"}},
+      {"malformed_measurement_delay_unit.dae",
+       {"malformed_measurement_delay_unit.dae:107:", "measurement_delay",
+        "unit 'mm' is not a time"}},
       {"no_such_file.dae", {"no_such_file.dae", "cannot open"}},
   };
   for (const auto& c : cases) {
@@ -678,6 +684,17 @@ TEST(ColladaImportTest, ImportsTheExtensionExample) {
   EXPECT_TRUE(std::holds_alternative<sgal::Capsule>(s.bodies[1].shapes[0].geometry));
   EXPECT_NEAR((s.bodies[1].shapes[0].pose.orientation * Eigen::Vector3d::UnitZ()).z(), 1.0, 1e-12);
   EXPECT_NEAR(s.bodies[1].inertia.com.z(), 0.01, 1e-15);
+}
+
+TEST(ColladaImportTest, ReadsMeasurementDelaysInTheirUnits) {
+  std::vector<std::string> warnings;
+  const sgal::Scene s = Load(Data("measurement_delays.dae"), &warnings);
+  for (const auto& w : warnings) ADD_FAILURE() << "unexpected warning: " << w;
+  ASSERT_EQ(s.measurement_delays.size(), 2u);
+  EXPECT_EQ(s.measurement_delays[0].id, "line.tendon.tension");
+  EXPECT_DOUBLE_EQ(s.measurement_delays[0].delay, 0.004);  // 4 ms
+  EXPECT_EQ(s.measurement_delays[1].id, "hinge.position");
+  EXPECT_DOUBLE_EQ(s.measurement_delays[1].delay, 0.002);  // seconds without a unit
 }
 
 TEST(ColladaImportTest, TheDocumentedExampleIsTheTestedFile) {

@@ -74,6 +74,13 @@ class SceneComparison {
           }
         Eq(w + " options", x.options, y.options);
       }
+    if (Eq("measurement delay count", a.measurement_delays.size(), b.measurement_delays.size()))
+      for (size_t i = 0; i < a.measurement_delays.size(); ++i) {
+        const auto &x = a.measurement_delays[i], &y = b.measurement_delays[i];
+        const std::string w = "measurement delay of '" + x.id + "'";
+        Eq(w + " channel", x.id, y.id);
+        Num(w + " delay", x.delay, y.delay);
+      }
     return failures_;
   }
 

@@ -469,6 +469,58 @@ TEST(BulletScene, AnyFaultInAStepEndsAtTheStartOfThatStep) {
   }
 }
 
+TEST(BulletScene, AFaultingStepPutsTheDelayedChannelsBack) {
+  testing::RegisterTestKinds();
+  // a fault in an actuator's step, before the channels are read, and one in the reading itself
+  // (faulty.current, after motor.current's ring took its value and before ligament.tension's)
+  const std::pair<int, std::string> faults[] = {
+      {1, "failed at t = 0.026000 s: std::runtime_error: injected fault;"},
+      {5, "failed at t = 0.026000 s: std::runtime_error: injected reading fault;"}};
+  sgal::Scene s = PulledPendulum(false);
+  s.measurement_delays = {{"motor.current", 0.003},
+                          {"faulty.current", 0.002},
+                          {"ligament.tension", 0.004},
+                          {"pivot.position", 0.0}};
+  for (const auto& [mode, detail] : faults) {
+    SCOPED_TRACE("fail = " + std::to_string(mode));
+    auto faulting = MakeScene(s);
+    auto reference = MakeScene(s);
+    for (auto* scene : {faulting.get(), reference.get()}) {
+      scene->SetCommand("motor", 0.05);  // [V]
+      scene->SetCommand("muscle", 0.4);
+      scene->SetCommand("faulty", -0.03);
+      for (int i = 0; i < 25; ++i) scene->Step();
+    }
+    const auto before = Everything(*faulting);
+    const std::vector<double> rings = faulting->SaveDynamicState().measurements;
+    ASSERT_EQ(rings.size(), 4u + 3u + 5u + 1u);
+    faulting->SetParameter("faulty.fail", mode);
+    try {
+      faulting->Step();
+      ADD_FAILURE() << "the step must fail";
+    } catch (const sgal::SimulationFault& fault) {
+      const std::string what = fault.what();
+      EXPECT_EQ(fault.element(), "faulty");
+      EXPECT_EQ(what.rfind("actuator 'faulty' (test_faulty_motor)", 0), 0u) << what;
+      EXPECT_NE(what.find(detail), std::string::npos) << what;
+    }
+    faulting->SetParameter("faulty.fail", 0);
+    EXPECT_EQ(faulting->steps(), 25u);
+    ExpectSameBits(before, Everything(*faulting));  // the delayed and true values among them
+    const std::vector<double> after = faulting->SaveDynamicState().measurements;
+    ASSERT_EQ(after.size(), rings.size());
+    EXPECT_EQ(std::memcmp(after.data(), rings.data(), rings.size() * sizeof(double)), 0);
+    // it steps on exactly as a scene that never faulted, the delayed channels too
+    for (int i = 0; i < 25; ++i) {
+      faulting->Step();
+      reference->Step();
+    }
+    ExpectSameBits(Everything(*reference), Everything(*faulting));
+    EXPECT_NE(faulting->GetParameter("motor.current"),
+              faulting->GetParameter("motor.current.undelayed"));
+  }
+}
+
 TEST(BulletScene, AnExplodingBodyPutsTheActuatorsBackToo) {
   sgal::Scene s;
   s.gravity = Vector3d(5000, 0, 0);  // 5 m/s more each step: over the 1000 m/s limit at step 5

@@ -49,7 +49,10 @@ class ConstantTension : public actuators::TendonActuator {
 
 /// A dc_motor_tendon (all its parameters and options) that fails on purpose after its own step
 /// while its parameter `fail` is set: 1 throws std::runtime_error("injected fault"), 2
-/// std::bad_alloc, 3 returns a NaN tension, 4 throws an int. Its state is the motor's.
+/// std::bad_alloc, 3 returns a NaN tension, 4 throws an int; 5 steps well, but the next reading
+/// of one of its quantities (a delayed channel's, at the end of the step) throws
+/// std::runtime_error("injected reading fault") once and sets `fail` back to 0. Its state is the
+/// motor's.
 class FaultyMotor : public actuators::TendonActuator {
  public:
   explicit FaultyMotor(const sgal::Actuator& a) : fail_(actuators::ParameterOr(a, "fail", 0)) {
@@ -88,7 +91,12 @@ class FaultyMotor : public actuators::TendonActuator {
     return q;
   }
   double Get(const std::string& name) const override {
-    return name == "fail" ? fail_ : motor_->Get(name);
+    if (name == "fail") return fail_;
+    if (fail_ == 5) {
+      fail_ = 0;
+      throw std::runtime_error("injected reading fault");
+    }
+    return motor_->Get(name);
   }
   void Set(const std::string& name, double value) override {
     if (name == "fail")
@@ -99,7 +107,7 @@ class FaultyMotor : public actuators::TendonActuator {
 
  private:
   std::unique_ptr<actuators::TendonActuator> motor_;
-  double fail_;
+  mutable double fail_;  // a reading fault happens once
 };
 
 inline void RegisterTestKinds() {
@@ -108,7 +116,8 @@ inline void RegisterTestKinds() {
       {{"tension", "N", 0, false, "constant tension"}, {"nan_after", "", 0, false, "steps"}},
       [](const sgal::Actuator& a) { return std::make_unique<ConstantTension>(a); });
   auto faulty = actuators::KindParameters("dc_motor_tendon");
-  faulty.push_back({"fail", "", 0, false, "0 none, 1 runtime_error, 2 bad_alloc, 3 NaN, 4 int"});
+  faulty.push_back(
+      {"fail", "", 0, false, "0 none, 1 runtime_error, 2 bad_alloc, 3 NaN, 4 int, 5 a reading"});
   actuators::RegisterKind("test_faulty_motor", faulty, [](const sgal::Actuator& a) {
     return std::make_unique<FaultyMotor>(a);
   });

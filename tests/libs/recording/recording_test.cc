@@ -62,6 +62,7 @@ sgal::DynamicState AwkwardState() {
   double nan;
   std::memcpy(&nan, &nan_bits, 8);
   s.engine = {nan, 1.0 / 3.0, -0.0, 4.9e-324};
+  s.measurements = {-0.0, 1.0 / 7.0, nan};
   return s;
 }
 
@@ -84,6 +85,7 @@ void ExpectSameState(const sgal::DynamicState& a, const sgal::DynamicState& b) {
   for (size_t i = 0; i < a.actuators.size(); ++i) ExpectSameBits(a.actuators[i], b.actuators[i]);
   ExpectSameBits(a.commands, b.commands);
   ExpectSameBits(a.engine, b.engine);
+  ExpectSameBits(a.measurements, b.measurements);
 }
 
 Header ArmHeader() {
@@ -140,8 +142,36 @@ TEST(RecordingState, RefusesTruncatedAndGarbageBytes) {
     EXPECT_NE(std::string(e.what()).find("the bodies counts"), std::string::npos) << e.what();
   }
   std::string version = bytes;
-  version[4] = 2;
+  version[4] = 3;
   EXPECT_THROW(DecodeState(version), RecordingError);
+}
+
+TEST(RecordingState, AStateWithoutMeasurementsKeepsTheLayoutOfOlderRecordings) {
+  // version 1 (no measurements) is what recordings held before the delayed channels: such a
+  // state is still written so, and read back with no measurements
+  sgal::DynamicState old = AwkwardState();
+  old.measurements.clear();
+  const std::string v1 = EncodeState(old);
+  EXPECT_EQ(v1[4], 1);
+  EXPECT_EQ(v1.size(), EncodeState(AwkwardState()).size() - 8 - 3 * 8);
+  ExpectSameState(DecodeState(v1), old);
+  EXPECT_TRUE(DecodeState(v1).measurements.empty());
+  // with measurements: version 2, the measurements counted after the engine's numbers
+  const std::string v2 = EncodeState(AwkwardState());
+  EXPECT_EQ(v2[4], 2);
+  EXPECT_EQ(v2.substr(0, 4), v1.substr(0, 4));
+  EXPECT_EQ(v2.substr(5, v1.size() - 5), v1.substr(5));
+  // version 2 without measurements is not how a state is written: refused (one encoding each)
+  std::string empty = v1;
+  empty[4] = 2;
+  empty += std::string(8, '\0');
+  try {
+    DecodeState(empty);
+    FAIL() << "a version 2 state without measurements decoded";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("version 2 with no measurements"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Recording, EveryRecordKindRoundTrips) {

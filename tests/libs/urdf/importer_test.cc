@@ -410,6 +410,22 @@ TEST(UrdfImport, SideFileAddsTendonsAndActuators) {
   EXPECT_TRUE(warnings.empty()) << warnings[0];
 }
 
+TEST(UrdfImport, SideFileDelaysAMeasurement) {
+  const sgal::Scene s = Import(kData + "/side.urdf", nullptr);
+  ASSERT_EQ(s.measurement_delays.size(), 1u);
+  EXPECT_EQ(s.measurement_delays[0].id, "motor.current");
+  EXPECT_DOUBLE_EQ(s.measurement_delays[0].delay, 0.004);  // 4 ms
+  // the same element as COLLADA's, with its checks: a malformed one names file, line and element
+  TempUrdf urdf("delay", Robot(InertialLink("base")));
+  std::ofstream(urdf.dir() / "robot.caliper.xml")
+      << "<caliper>\n  <measurement_delay channel=\"base.mass\" delay=\"soon\"/>\n</caliper>\n";
+  const std::string message = ImportError(urdf.file());
+  EXPECT_NE(message.find("robot.caliper.xml:2: measurement_delay: attribute delay=\"soon\" is "
+                         "not a number"),
+            std::string::npos)
+      << message;
+}
+
 // ---- import -> COLLADA export -> import gives the same scene
 
 TEST(UrdfImport, RoundTripThroughCollada) {

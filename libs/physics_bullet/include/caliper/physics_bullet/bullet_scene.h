@@ -23,10 +23,11 @@ struct Options {
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
 /// an actuator that cannot be made (unknown kind, missing parameter), or a step whose work has no
 /// bound (solver_iterations outside [1, 10^4], a time step an actuator cannot take in 10^4
-/// sub-steps). A failing Step() puts back the bodies, tendons and actuators (see
-/// sgal::PhysicsScene::Step); Bullet's contact cache (warm-start impulses) is not rolled back, so
-/// after a fault a scene with contacts that steps on may differ in the last bits from one that
-/// never faulted.
+/// sub-steps), or a measurement delay it cannot honour (sgal::MeasurementDelay: the message names
+/// the id and why). A failing Step() puts back the bodies, tendons, actuators and delayed
+/// channels (see sgal::PhysicsScene::Step); Bullet's contact cache (warm-start impulses) is not
+/// rolled back, so after a fault a scene with contacts that steps on may differ in the last bits
+/// from one that never faulted.
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options = {});
 
 /// DynamicState::engine holds this many values per body first (the centre-of-mass transform and

@@ -49,7 +49,7 @@ struct ParameterInfo {
 
 /// What changes from step to step, to carry a running simulation over into an edited copy of its
 /// scene (or to restore it later): bodies, joints' counted positions, actuators' internal states
-/// and commands, time.
+/// and commands, the delayed channels' memory, time.
 struct DynamicState {
   double time = 0;  // [s]
   uint64_t steps = 0;
@@ -57,6 +57,11 @@ struct DynamicState {
   std::vector<double> joint_positions;         // description().constraints order [rad] or [m]
   std::vector<std::vector<double>> actuators;  // description().actuators order: their states
   std::vector<double> commands;                // description().actuators order
+  /// What the delayed channels remember: for each of description().measurement_delays in order,
+  /// its steps + 1 last values (steps = round(delay / time_step)), oldest first, in the
+  /// parameter's unit. Empty: nothing known, each channel restarts as if its present value had
+  /// been constant since ever (a state of another scene, an older recording).
+  std::vector<double> measurements;
   /// The engine's own state, bit for bit (its numbers in its precision, tendon wrap sides); a
   /// restore into a scene built from the same description uses it and ignores `bodies`. Empty
   /// (a scene edit changed the description): the restore goes by `bodies`.
@@ -80,11 +85,11 @@ class PhysicsScene {
   /// Advances by one fixed time step. Whatever fails inside the step (a non-finite tension, an
   /// exploding body, or any exception of any type from an actuator, a tendon path or the
   /// engine) ends at the last consistent state, the start of the failing step: the bodies, the
-  /// tendons, every actuator's internal state, time() and steps() as they were. Then it throws
-  /// SimulationFault whose message names the element (an actuator and its kind, a tendon, a
-  /// body or the engine's world) and what happened (the original exception's type and
-  /// message), with element() that name ("world" for the engine) and time() the time the step
-  /// would have reached [s]. Nothing else escapes.
+  /// tendons, every actuator's internal state, the delayed channels, time() and steps() as they
+  /// were. Then it throws SimulationFault whose message names the element (an actuator and its
+  /// kind, a tendon, a body or the engine's world) and what happened (the original exception's
+  /// type and message), with element() that name ("world" for the engine) and time() the time
+  /// the step would have reached [s]. Nothing else escapes.
   virtual void Step() = 0;
   virtual double time() const = 0;     // simulated time [s]
   virtual uint64_t steps() const = 0;
@@ -115,8 +120,9 @@ class PhysicsScene {
 
   virtual DynamicState SaveDynamicState() const = 0;
   /// Puts the scene in `state`, which must have this scene's numbers of bodies, constraints and
-  /// actuators and each actuator's state size (else std::invalid_argument saying which); an
-  /// actuator whose state is empty keeps its own (one that a scene edit just added).
+  /// actuators, each actuator's state size and no measurements or as many as its delayed
+  /// channels hold (else std::invalid_argument saying which); an actuator whose state is empty
+  /// keeps its own (one that a scene edit just added).
   virtual void RestoreDynamicState(const DynamicState& state) = 0;
   /// From the next step on, applies the pull until ClearPull(); std::out_of_range for a body
   /// index that is not a moving body, std::invalid_argument for non-finite numbers.

@@ -212,6 +212,18 @@ struct SimulationSettings {
   double world_scale = 1.0;    // engine units per metre (keeps small robots in Bullet's range)
 };
 
+/// A sensor that reports a scene parameter late, as a DAQ channel on hardware does: a controller,
+/// the DAQ and recordings read the parameter `id` as it was round(delay / time_step) steps ago
+/// (0 to 1000 steps; 0 reads the value of the last completed step), and `<id>.undelayed` as it
+/// is now. Before the scene has stepped that far the sensor reads the value it had at load, as if
+/// constant since ever. An engine refuses (std::invalid_argument, at load or when the time step
+/// changes) an id its Parameters() does not list, a model parameter (is_static), an id delayed
+/// twice, a negative or non-finite delay, or one of more than 1000 steps.
+struct MeasurementDelay {
+  std::string id;    // a parameter id as PhysicsScene::Parameters() lists it, e.g. motor.current
+  double delay = 0;  // [s]
+};
+
 struct Scene {
   std::string name;
   std::string source;  // file it came from, for messages
@@ -224,6 +236,7 @@ struct Scene {
   std::vector<WrapObstacle> obstacles;
   std::vector<Tendon> tendons;
   std::vector<Actuator> actuators;
+  std::vector<MeasurementDelay> measurement_delays;  // channels read late
 
   const Body* FindBody(const std::string& name) const;
   const Tendon* FindTendon(const std::string& name) const;

@@ -57,7 +57,9 @@ class EditHistory {
 
   /// The dynamic state for `edited` (the scene after an edit) from `old_state` of `before`: the
   /// engine's own numbers are dropped; actuators are matched by name and kind, an actuator the
-  /// edit removed is kept aside (at most kMaxRemoved), one it brings back takes what was kept.
+  /// edit removed is kept aside (at most kMaxRemoved), one it brings back takes what was kept;
+  /// the delayed channels' memory is kept when the edit changed neither the measurement delays
+  /// nor the time step, else dropped (they restart from their present values).
   sgal::DynamicState CarryOver(const sgal::Scene& before, const sgal::DynamicState& old_state,
                                const sgal::Scene& edited);
 
