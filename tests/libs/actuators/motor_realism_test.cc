@@ -96,17 +96,22 @@ DcMotorParameters HotMotor() {
   return p;
 }
 
+// a locked motor already carrying `current` [A], steady (L di/dt = 0 from the first step)
+void LockAtCurrent(DcMotor* motor, double current) {
+  motor->set_locked(true);
+  DcMotorState s = motor->state();
+  s.current = current;
+  motor->set_state(s);
+}
+
 TEST(Thermal, LockedMotorAtConstantVoltageHeatsAsTheClosedForm) {
   // no temperature coefficient: the power U^2 / R is constant
   DcMotorParameters p = HotMotor();
   p.resistance_temperature_coefficient = 0;
   p.max_winding_temperature = 0;
   DcMotor motor(p);
-  motor.set_locked(true);
   const double voltage = 1.5;
-  DcMotorState s = motor.state();
-  s.current = voltage / p.resistance;  // already steady: L di/dt = 0
-  motor.set_state(s);
+  LockAtCurrent(&motor, voltage / p.resistance);
   const double dt = 1e-3;
   const double power = voltage * voltage / p.resistance;
   double worst = 0;
@@ -130,10 +135,7 @@ TEST(Thermal, HotRunDriftsResistanceAndTorqueConstantAsTheAnalyticRun) {
   p.current_limit = 7;
   p.torque_constant_temperature_coefficient = -0.0011;
   DcMotor motor(p);
-  motor.set_locked(true);
-  DcMotorState s = motor.state();
-  s.current = p.current_limit;
-  motor.set_state(s);
+  LockAtCurrent(&motor, p.current_limit);
   const double dt = 1e-3;
   const double i2r = p.current_limit * p.current_limit * p.resistance;  // [W] at T_ref
   const double alpha = p.resistance_temperature_coefficient;
