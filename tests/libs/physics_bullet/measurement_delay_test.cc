@@ -73,7 +73,7 @@ TEST(MeasurementDelay, ADelayedChannelIsItsTrueValueStepsEarlierBitForBit) {
   for (const Channel& c : kChannels) {
     const int index = scene->ParameterIndex(std::string(c.id) + ".undelayed");
     ASSERT_GE(index, 0) << c.id;
-    const sgal::ParameterInfo& info = scene->Parameters()[index];
+    const sgal::ParameterInfo info = scene->Parameters()[index];  // Parameters() is a copy
     EXPECT_FALSE(info.writable);
     EXPECT_FALSE(info.is_static);
     EXPECT_EQ(info.unit, scene->Parameters()[scene->ParameterIndex(c.id)].unit);
