@@ -32,9 +32,16 @@ def run(checkout, *args, timeout=60, **env):
     environment = dict(os.environ, CALIPER_SOURCE_DIR=str(checkout), CALIPER_BIN_DIR=BIN, **env)
     pages = [os.path.join(FIXTURES, a) if a.endswith(".md") else a for a in args]
     started = time.monotonic()
-    result = subprocess.run(["/usr/bin/python3", RUNNER, *pages], capture_output=True, text=True,
-                            env=environment, timeout=timeout)
+    with subprocess.Popen(["/usr/bin/python3", RUNNER, *pages], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, env=environment) as p:
+        try:
+            stdout, stderr = p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            raise
+    result = subprocess.CompletedProcess(p.args, p.returncode, stdout, stderr)
     result.seconds = time.monotonic() - started
+    result.pid = p.pid  # the runner's: its network namespaces are named cdt<pid>-...
     return result
 
 
@@ -134,4 +141,6 @@ def test_blocks_on_hosts_a_b_c(checkout):
     assert re.search(r"host\.md:\d+ \[sh\] ok \(background, stopped", result.stdout)
     names = subprocess.run(["ip", "netns", "list"], capture_output=True, text=True,
                            timeout=30).stdout
-    assert not re.search(r"^cdt\d+-", names, re.M), names  # the namespaces are removed
+    # this run's namespaces are removed (other tests' may exist meanwhile: ctest runs in
+    # parallel, and the doc pages with host: blocks make their own)
+    assert not re.search(rf"^cdt{result.pid}-", names, re.M), names
