@@ -11,7 +11,13 @@
 #include <string>
 #include <utility>
 
+#include "motor_checks.h"
+
 namespace caliper::actuators {
+
+using motor_detail::Check;
+using motor_detail::Range;
+using motor_detail::Text;
 
 namespace {
 
@@ -62,42 +68,9 @@ std::string BoundText(double v, bool up) {
   return std::to_string(v);
 }
 
-std::string Text(double v) {
-  char text[32];
-  const auto end = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, end.ptr);
-}
-
-enum class Range { kPositive, kNonNegative, kFraction };
-
-void Check(const char* name, const char* unit, double value, Range range) {
-  bool ok = std::isfinite(value);
-  const char* expected = "finite";
-  switch (range) {
-    case Range::kPositive:
-      ok = ok && value > 0;
-      expected = "> 0";
-      break;
-    case Range::kNonNegative:
-      ok = ok && value >= 0;
-      expected = ">= 0";
-      break;
-    case Range::kFraction:
-      ok = ok && value > 0 && value <= 1;
-      expected = "in (0, 1]";
-      break;
-  }
-  if (!ok) {
-    std::ostringstream message;
-    message << "parameter '" << name << "' must be " << expected << " [" << unit << "], got "
-            << value;
-    throw std::invalid_argument(message.str());
-  }
-}
-
 // A root of f near x0, for f dominated by x - x0 far from the root (slope about one).
-// With first_step > 0 the search starts with a step no longer than that and doubles it, so that
-// of roots whose distances from x0 differ by more than a factor of two it brackets the nearest.
+// With first_step > 0 the search starts with a step no longer than that and doubles it: it
+// brackets the nearest root unless another lies in the same doubled step (a heuristic).
 template <class Function>
 double FindRoot(const Function& f, double x0, double tolerance, double first_step = 0) {
   double f0 = f(x0);
@@ -158,10 +131,11 @@ void DcMotorParameters::Validate() const {
   Check("cogging_amplitude", "N m", cogging_amplitude, Range::kNonNegative);
   Check("cogging_count", "", cogging_count, Range::kPositive);
   if (cogging_count != std::floor(cogging_count) || cogging_count > 1e6)
-    throw std::invalid_argument("parameter 'cogging_count' must be a whole number of periods "
-                                "per rotor turn in [1, 1e6], got " + Text(cogging_count));
-  if (!std::isfinite(cogging_phase))
-    throw std::invalid_argument("parameter 'cogging_phase' must be finite [rad]");
+    throw std::invalid_argument(
+        "parameter 'cogging_count' must be a whole number of periods "
+        "per rotor turn in [1, 1e6], got " +
+        Text(cogging_count));
+  Check("cogging_phase", "rad", cogging_phase, Range::kFinite);
   Check("thermal_resistance_winding_housing", "K/W", thermal_resistance_winding_housing,
         Range::kNonNegative);
   Check("thermal_resistance_housing_ambient", "K/W", thermal_resistance_housing_ambient,
@@ -179,14 +153,12 @@ void DcMotorParameters::Validate() const {
                                   "model on; it needs the other three thermal constants > 0)");
     }
   }
-  for (const auto& [name, value] :
-       {std::pair<const char*, double>{"ambient_temperature", ambient_temperature},
-        {"reference_temperature", reference_temperature},
-        {"resistance_temperature_coefficient", resistance_temperature_coefficient},
-        {"torque_constant_temperature_coefficient", torque_constant_temperature_coefficient}})
-    if (!std::isfinite(value))
-      throw std::invalid_argument(std::string("parameter '") + name + "' must be finite, got " +
-                                  Text(value));
+  Check("ambient_temperature", "degC", ambient_temperature, Range::kFinite);
+  Check("reference_temperature", "degC", reference_temperature, Range::kFinite);
+  Check("resistance_temperature_coefficient", "1/K", resistance_temperature_coefficient,
+        Range::kFinite);
+  Check("torque_constant_temperature_coefficient", "1/K", torque_constant_temperature_coefficient,
+        Range::kFinite);
   if (ambient_temperature < -273.15)
     throw std::invalid_argument("parameter 'ambient_temperature' must be above -273.15 degC, got " +
                                 Text(ambient_temperature));
@@ -234,13 +206,23 @@ void DcMotor::set_parameters(const DcMotorParameters& parameters) {
   shaft_ = parameters.shaft_losses();
   friction_ = parameters.coulomb_friction > 0 || parameters.static_friction > 0 ||
               parameters.viscous_friction > 0;
+  friction_constants_ = ShaftFriction(parameters);
   thermal_ = parameters.thermal();
   thermal_model_ = TwoNodeThermal{};  // configured at the next step
   constants_ = StageConstants{};      // recomputed at the next step
-  if (!was_thermal) {
-    // the temperatures start at the ambient when the model is turned on (or off)
+  continuous_ = 0;
+  if (thermal_ && parameters.max_winding_temperature > 0)
+    continuous_ = ContinuousCurrent(
+        parameters.thermal_parameters(), parameters.max_winding_temperature,
+        parameters.ambient_temperature, ResistanceAt(parameters.max_winding_temperature));
+  if (!thermal_ || !was_thermal) {
+    // the temperatures start at the ambient when the model is turned on; without it they
+    // read the ambient
     state_.winding_temperature = state_.housing_temperature = parameters.ambient_temperature;
     winding_change_ = housing_change_ = 0;
+    derating_ = 0;
+  } else {
+    UpdateEffective(applied_voltage_);  // what a hot motor reads stays hot
   }
 }
 
@@ -311,12 +293,11 @@ DcMotor::StageConstants DcMotor::ConstantsFor(double dt, double max_substep) con
     // the most tau_f can fall per rad/s of the motor: (tau_s - tau_c) max|d exp(-y^2)/dW|,
     // max |y exp(-y^2)| 2 / W_s = sqrt(2 / e) / W_s; cogging's A n per radian of the rotor,
     // N c radians per rad/s of w
-    const double peak = p.static_friction > p.coulomb_friction
-                            ? (p.static_friction - p.coulomb_friction) * std::sqrt(2 / M_E) /
-                                  p.stribeck_speed
-                            : 0.0;
-    k.shaft_falling = c_over_inertia * p.gear_ratio *
-                      (peak + p.cogging_amplitude * p.cogging_count * p.gear_ratio * k.c);
+    const double peak =
+        p.static_friction > p.coulomb_friction
+            ? (p.static_friction - p.coulomb_friction) * std::sqrt(2 / M_E) / p.stribeck_speed
+            : 0.0;
+    k.shaft_falling = c_over_inertia * (p.gear_ratio * peak + k.cogging_slope);
   }
   return k;
 }
@@ -425,21 +406,8 @@ class DcMotor::StageEquation {
     double d_linear = 1 - k_.c_torque * v->d_current;
     v->shaft = v->d_shaft = v->friction = v->d_friction = 0;
     if (motor_.shaft_) {
-      const DcMotorParameters& p = motor_.parameters_;
-      if (motor_.friction_) {
-        v->friction = FrictionTorque(p, p.gear_ratio * w, &v->d_friction);
-        v->d_friction *= p.gear_ratio;
-      }
-      v->shaft = v->friction;
-      v->d_shaft = v->d_friction;
-      if (p.cogging_amplitude > 0) {
-        double sine;
-        double cosine;
-        motor_.SinCos(k_.cogging_per_angle * (angle0_ + k_.c * w) + p.cogging_phase, &sine,
-                      &cosine);
-        v->shaft += p.cogging_amplitude * sine;
-        v->d_shaft += k_.cogging_slope * cosine;
-      }
+      v->shaft =
+          motor_.ShaftTorque(k_, w, angle0_ + k_.c * w, &v->d_shaft, &v->friction, &v->d_friction);
       linear += k_.c_shaft * v->shaft;
       d_linear += k_.c_shaft * v->d_shaft;
     }
@@ -487,18 +455,18 @@ class DcMotor::StageEquation {
       // friction off its tangent where the step ends (unless it is affine between: viscous, or
       // the sign and the Stribeck peak saturated at both ends), cogging by its curvature's bound
       // A (n N c)^2 / 2 per (rad/s)^2
-      const DcMotorParameters& p = motor_.parameters_;
-      if (motor_.friction_ && !FrictionAffine(p, p.gear_ratio * w, p.gear_ratio * next)) {
+      const double n = motor_.parameters_.gear_ratio;
+      if (motor_.friction_ && !motor_.friction_constants_.Affine(n * w, n * next)) {
         double d_friction;
-        const double friction = FrictionTorque(p, p.gear_ratio * next, &d_friction);
-        bound += k_.c_shaft * std::abs(friction - v.friction - v.d_friction * step) * v.scale;
+        const double friction = motor_.friction_constants_.Torque(n * next, &d_friction);
+        bound += k_.c_shaft * std::abs(friction - v.friction - n * d_friction * step) * v.scale;
       }
       bound += k_.c_shaft * k_.cogging_curvature * step * step * v.scale;
     }
     if (!(step >= v.affine_low && step <= v.affine_high)) {
       const double torque = load_.TorqueAt(angle0_ + k_.c * next, next, h_load_);
-      bound = k_.c_ratio * k_.inverse_rho_driving *
-              std::abs(torque - v.torque - v.d_torque * step) * v.scale;
+      bound += k_.c_ratio * k_.inverse_rho_driving *
+               std::abs(torque - v.torque - v.d_torque * step) * v.scale;
     }
     if (v.regime == 0) {
       const double ds = std::abs(step);
@@ -527,9 +495,10 @@ class DcMotor::StageEquation {
                                                    double step) const {
     const double w_star = w_eval + step;
     const int sign = motor_.load_sign_;
-    // friction's Stribeck peak and cogging may lower dR/dw by up to shaft_falling: with at most
-    // 1/2 of it, the switch's part below must stay under 1/2; beyond, the bracketing decides
-    if (k_.shaft_falling >= 0.5) return false;
+    // friction's Stribeck peak and cogging may lower dR/dw by up to shaft_falling, the switch's
+    // part by what the tests below bound: together below 1, R increases
+    const double room = 1 - k_.shaft_falling;  // what the switch may take
+    if (room <= 0) return false;
     double tau = -1;  // max |tau| at the ends, once known
     auto max_torque = [&] {
       if (tau < 0) {
@@ -549,7 +518,7 @@ class DcMotor::StageEquation {
                    : (sign < 0 && x_slope0 <= 0 && x_slope1 <= 0))
         return true;
       const double x_slope = std::max(std::abs(x_slope0), std::abs(x_slope1));
-      if (k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5) return true;
+      if (k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5 * room) return true;
     }
     const double lo = std::min(speed0_, w_star);
     const double hi = std::max(speed0_, w_star);
@@ -590,7 +559,7 @@ class DcMotor::StageEquation {
     if (x_min > kSwitchSaturation || x_max < -kSwitchSaturation) return true;
     if ((sign > 0 && x_slope_min >= 0) || (sign < 0 && x_slope_max <= 0)) return true;
     const double x_slope = std::max(std::abs(x_slope_min), std::abs(x_slope_max));
-    return k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5;
+    return k_.c_ratio * max_torque() * 0.25 * k_.spread * x_slope < 0.5 * room;
   }
 
  private:
@@ -646,18 +615,24 @@ double DcMotor::SolveStageBracketing(const DcMotorState& a, double voltage, doub
     const double torque = load.TorqueAt(s.spool_angle, w, h_load);
     const double rho = GearEfficiencyFactor(p.efficiency, s.current, w);
     double d_shaft;
-    const double shaft = shaft_ ? ShaftTorque(w, s.spool_angle, k.c, &d_shaft) : 0.0;
+    double friction;
+    double d_friction;
+    const double shaft =
+        shaft_ ? ShaftTorque(k, w, s.spool_angle, &d_shaft, &friction, &d_friction) : 0.0;
     const double acceleration =
         (p.torque_constant * s.current - torque / (rho * p.gear_ratio) - shaft) / inertia;
     return w - a.spool_speed - k.c * acceleration;
   };
-  // friction and cogging may give a stage several solutions close together: the first from the
-  // base is found by steps from a fraction of the smoothing speed or of a cogging period
+  // where friction falls with speed (a Stribeck peak) or cogging acts, a stage may have several
+  // solutions close together (a stuck motor's creep next to a sliding one): the search starts
+  // with steps of a fraction of the smoothing speed or of a cogging period, so that it finds
+  // the first from the base unless two lie within one of its doubled steps
   double first_step = 0;
-  if (shaft_) {
+  if (p.static_friction > p.coulomb_friction)
     first_step = 0.01 * p.friction_smoothing_speed / p.gear_ratio;
-    if (p.cogging_amplitude > 0)
-      first_step = std::min(first_step, 0.1 * 2 * M_PI / (p.cogging_count * p.gear_ratio * k.c));
+  if (p.cogging_amplitude > 0) {
+    const double period = 2 * M_PI / (k.cogging_per_angle * k.c);  // of w [rad/s]
+    first_step = first_step > 0 ? std::min(first_step, 0.1 * period) : 0.1 * period;
   }
   return FindRoot(residual, a.spool_speed, kSpeedTolerance, first_step);
 }
@@ -733,18 +708,22 @@ void DcMotor::Step(double voltage, double dt, SpoolLoad& load) {
   if (thermal_) EndThermalStep(dt);
 }
 
-double DcMotor::ShaftTorque(double w, double phi, double c, double* d_torque) const {
+double DcMotor::ShaftTorque(const StageConstants& k, double w, double phi, double* d_torque,
+                            double* friction, double* d_friction) const {
   const DcMotorParameters& p = parameters_;
-  const double n = p.gear_ratio;
-  double slope;  // d/dW
-  double torque = FrictionTorque(p, n * w, &slope);
-  *d_torque = n * slope;
+  *friction = *d_friction = 0;
+  if (friction_) {
+    *friction = friction_constants_.Torque(p.gear_ratio * w, d_friction);
+    *d_friction *= p.gear_ratio;
+  }
+  double torque = *friction;
+  *d_torque = *d_friction;
   if (p.cogging_amplitude > 0) {
     double sine;
     double cosine;
-    SinCos(p.cogging_count * n * phi + p.cogging_phase, &sine, &cosine);
+    SinCos(k.cogging_per_angle * phi + p.cogging_phase, &sine, &cosine);
     torque += p.cogging_amplitude * sine;
-    *d_torque += p.cogging_amplitude * cosine * p.cogging_count * n * c;
+    *d_torque += k.cogging_slope * cosine;
   }
   return torque;
 }
@@ -769,50 +748,50 @@ void DcMotor::SinCos(double x, double* sine, double* cosine) const {
   *cosine = cos_value_;
 }
 
-bool FrictionAffine(const DcMotorParameters& p, double speed0, double speed1) {
-  if (p.coulomb_friction == 0 && p.static_friction == 0) return true;
-  // the same sign, tanh at +-1 to the last bit, the Stribeck term skipped (FrictionTorque)
-  const double sign_speed = 19.1 * p.friction_smoothing_speed;
-  if (!((speed0 >= sign_speed && speed1 >= sign_speed) ||
-        (speed0 <= -sign_speed && speed1 <= -sign_speed)))
+ShaftFriction::ShaftFriction(const DcMotorParameters& p)
+    : viscous_(p.viscous_friction),
+      coulomb_(p.coulomb_friction),
+      peak_(std::max(0.0, p.static_friction - p.coulomb_friction)),
+      inverse_smoothing_(1 / p.friction_smoothing_speed),
+      inverse_stribeck_(1 / p.stribeck_speed),
+      sign_speed_(19.1 * p.friction_smoothing_speed),
+      peak_speed_(6 * p.stribeck_speed),
+      dry_(p.coulomb_friction > 0 || p.static_friction > 0) {}
+
+bool ShaftFriction::Affine(double speed0, double speed1) const {
+  if (!dry_) return true;
+  if (!((speed0 >= sign_speed_ && speed1 >= sign_speed_) ||
+        (speed0 <= -sign_speed_ && speed1 <= -sign_speed_)))
     return false;
-  if (p.static_friction <= p.coulomb_friction) return true;
-  const double peak_speed = 6 * p.stribeck_speed;
-  return std::abs(speed0) >= peak_speed && std::abs(speed1) >= peak_speed;
+  return peak_ == 0 || (std::abs(speed0) >= peak_speed_ && std::abs(speed1) >= peak_speed_);
 }
 
-double FrictionTorque(const DcMotorParameters& p, double speed, double* slope) {
-  double torque = p.viscous_friction * speed;
-  *slope = p.viscous_friction;
-  if (p.coulomb_friction > 0 || p.static_friction > 0) {
-    // tanh(x) is +-1 to the last bit beyond |x| = 19.1, exp(-y^2) below 3e-16 beyond |y| = 6
-    const double x = speed / p.friction_smoothing_speed;
-    double sign = x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0);
-    double d_sign = 0;
-    if (std::abs(x) < 19.1) {
-      sign = std::tanh(x);
-      d_sign = (1 - sign * sign) / p.friction_smoothing_speed;
-    }
-    double level = p.coulomb_friction;
-    double d_level = 0;
-    const double peak = p.static_friction - p.coulomb_friction;
-    if (peak > 0) {
-      const double y = speed / p.stribeck_speed;
-      if (std::abs(y) < 6) {
-        const double e = std::exp(-y * y);
-        level += peak * e;
-        d_level = -2 * y * peak * e / p.stribeck_speed;
-      }
-    }
-    torque += level * sign;
-    *slope += d_level * sign + level * d_sign;
+double ShaftFriction::Torque(double speed, double* slope) const {
+  double torque = viscous_ * speed;
+  *slope = viscous_;
+  if (!dry_) return torque;
+  // tanh(x) is +-1 to the last bit beyond |x| = 19.1, exp(-y^2) below 3e-16 beyond |y| = 6
+  double sign = speed > 0 ? 1.0 : (speed < 0 ? -1.0 : 0.0);
+  double d_sign = 0;
+  if (std::abs(speed) < sign_speed_) {
+    sign = std::tanh(speed * inverse_smoothing_);
+    d_sign = (1 - sign * sign) * inverse_smoothing_;
   }
-  return torque;
+  double level = coulomb_;
+  double d_level = 0;
+  if (peak_ > 0 && std::abs(speed) < peak_speed_) {
+    const double y = speed * inverse_stribeck_;
+    const double e = std::exp(-y * y);
+    level += peak_ * e;
+    d_level = -2 * y * peak_ * e * inverse_stribeck_;
+  }
+  *slope += d_level * sign + level * d_sign;
+  return torque + level * sign;
 }
 
 double DcMotor::friction_torque() const {
   double slope;
-  return FrictionTorque(parameters_, motor_speed(), &slope);
+  return friction_ ? friction_constants_.Torque(motor_speed(), &slope) : 0.0;
 }
 
 double DcMotor::cogging_torque() const {
@@ -822,44 +801,45 @@ double DcMotor::cogging_torque() const {
          std::sin(p.cogging_count * p.gear_ratio * state_.spool_angle + p.cogging_phase);
 }
 
-double DcMotor::continuous_current() const {
+double DcMotor::continuous_current() const { return continuous_; }
+
+double DcMotor::ResistanceAt(double winding) const {
   const DcMotorParameters& p = parameters_;
-  if (!thermal_ || p.max_winding_temperature == 0) return 0;
-  const double hot = p.resistance * (1 + p.resistance_temperature_coefficient *
-                                             (p.max_winding_temperature - p.reference_temperature));
-  return ContinuousCurrent(p.thermal_parameters(), p.max_winding_temperature,
-                           p.ambient_temperature, hot);
+  return p.resistance * std::max(0.05, 1 + p.resistance_temperature_coefficient *
+                                               (winding - p.reference_temperature));
+}
+
+void DcMotor::UpdateEffective(double voltage) {
+  const DcMotorParameters& p = parameters_;
+  const double winding = state_.winding_temperature + 0.5 * winding_change_;
+  const double housing = state_.housing_temperature + 0.5 * housing_change_;
+  const double k_factor = std::max(
+      0.05, 1 + p.torque_constant_temperature_coefficient * (housing - p.reference_temperature));
+  effective_.resistance = ResistanceAt(winding);
+  effective_.torque_constant = p.torque_constant * k_factor;
+  effective_.back_emf_constant = p.back_emf_constant * k_factor;
+  // the driver's protection, from the winding's temperature at the start of the step: its limit
+  // moves from its own (without one, the most the voltage can drive now, back-EMF included)
+  // to the continuous current, never above its own
+  derating_ = 0;
+  effective_.current_limit = p.current_limit;
+  if (p.max_winding_temperature == 0) return;
+  const double start = p.max_winding_temperature - p.derating_band;
+  derating_ = std::clamp((state_.winding_temperature - start) / p.derating_band, 0.0, 1.0);
+  if (derating_ == 0) return;
+  const double top = p.current_limit > 0
+                         ? p.current_limit
+                         : (std::abs(voltage) + effective_.back_emf_constant * p.gear_ratio *
+                                                    std::abs(state_.spool_speed)) /
+                               (effective_.resistance + p.bridge_resistance);
+  double limit = top + (continuous_ - top) * derating_;
+  if (p.current_limit > 0) limit = std::min(limit, p.current_limit);
+  effective_.current_limit = limit;  // > 0: a mean of top >= 0 and continuous_ > 0
 }
 
 void DcMotor::BeginThermalStep(double voltage, double dt) {
-  const DcMotorParameters& p = parameters_;
-  if (thermal_model_.dt() != dt) thermal_model_.Configure(p.thermal_parameters(), dt);
-  // the step's middle, extrapolated from the last step's change
-  const double winding = state_.winding_temperature + 0.5 * winding_change_;
-  const double housing = state_.housing_temperature + 0.5 * housing_change_;
-  // kept positive however cold (the coefficients are linear fits near room temperature)
-  const double r_factor =
-      std::max(0.05, 1 + p.resistance_temperature_coefficient * (winding - p.reference_temperature));
-  const double k_factor = std::max(
-      0.05, 1 + p.torque_constant_temperature_coefficient * (housing - p.reference_temperature));
-  effective_.resistance = p.resistance * r_factor;
-  effective_.torque_constant = p.torque_constant * k_factor;
-  effective_.back_emf_constant = p.back_emf_constant * k_factor;
-  // the driver's protection, from the winding's temperature at the start of the step
-  derating_ = 0;
-  effective_.current_limit = p.current_limit;
-  if (p.max_winding_temperature > 0) {
-    const double start = p.max_winding_temperature - p.derating_band;
-    derating_ = std::clamp((state_.winding_temperature - start) / p.derating_band, 0.0, 1.0);
-    if (derating_ > 0) {
-      const double continuous = continuous_current();
-      // without a limit of its own the driver starts from the stall current at this voltage
-      const double top = p.current_limit > 0
-                             ? p.current_limit
-                             : std::abs(voltage) / (effective_.resistance + p.bridge_resistance);
-      if (top > continuous) effective_.current_limit = top + (continuous - top) * derating_;
-    }
-  }
+  if (thermal_model_.dt() != dt) thermal_model_.Configure(parameters_.thermal_parameters(), dt);
+  UpdateEffective(voltage);
   // only what the temperatures change, and only when they changed it; the refined sub-steps'
   // when they are needed
   if (effective_.resistance != constants_resistance_ ||

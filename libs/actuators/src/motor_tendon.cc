@@ -15,10 +15,15 @@
 #include "caliper/actuators/dc_motor.h"
 #include "caliper/actuators/elastic.h"
 #include "caliper/logging/log.h"
+#include "motor_checks.h"
 
 namespace caliper::actuators {
 
 namespace {
+
+using motor_detail::Check;
+using motor_detail::Range;
+using motor_detail::Text;
 
 // a motor parameter as a kind parameter and a quantity
 struct MotorField {
@@ -85,19 +90,29 @@ const MotorField kMotorFields[] = {
      "below max_winding_temperature, the band over which the driver lowers its current limit"},
 };
 
-// the driver's own parameters: kind parameters beside supply_voltage and pretension
+// the driver's own parameters, beside supply_voltage and pretension; each 0: off
+struct DriverParameters {
+  double pwm_levels = 0;     // [-]
+  double slew_rate = 0;      // [V/s]
+  double command_delay = 0;  // [s]
+};
+
+// a driver parameter as a kind parameter and a quantity
 struct DriverField {
   const char* name;
   const char* unit;
-  double default_value;
+  double DriverParameters::*member;
+  bool whole;  // a whole number
   const char* help;
 };
 
 const DriverField kDriverFields[] = {
-    {"pwm_levels", "", 0,
-     "PWM duty steps from 0 to full supply (e.g. 1024 for 10 bits; 0: continuous)"},
-    {"slew_rate", "V/s", 0, "fastest change of the driver's output voltage (0: none)"},
-    {"command_delay", "s", 0,
+    {"pwm_levels", "", &DriverParameters::pwm_levels, true,
+     "PWM duty steps from 0 to full supply, which also bounds the output (1023 for a 10-bit "
+     "PWM's duty values 0..1023; 0: continuous, unbounded)"},
+    {"slew_rate", "V/s", &DriverParameters::slew_rate, false,
+     "fastest change of the driver's output voltage (0: none)"},
+    {"command_delay", "s", &DriverParameters::command_delay, false,
      "time from a command to the driver, rounded to whole time steps (at most 50 of them)"},
 };
 
@@ -204,7 +219,7 @@ class DcMotorTendon : public TendonActuator {
     supply_voltage_ = ParameterOr(a, "supply_voltage", kDefaultSupplyVoltage);
     pretension_ = ParameterOr(a, "pretension", 0);
     for (const DriverField& field : kDriverFields)
-      *Driver(field.name) = ParameterOr(a, field.name, field.default_value);
+      driver_.*field.member = ParameterOr(a, field.name, driver_.*field.member);
     pending_.resize(kMaxCommandDelaySteps + 1);
     const auto input = a.options.find("input");
     if (input != a.options.end()) {
@@ -218,7 +233,7 @@ class DcMotorTendon : public TendonActuator {
       motor_.set_parameters(p);
       CheckSupplyVoltage(supply_voltage_);
       CheckPretension(pretension_);
-      for (const DriverField& field : kDriverFields) CheckDriver(field.name, *Driver(field.name));
+      for (const DriverField& field : kDriverFields) CheckDriver(field, driver_.*field.member);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -332,7 +347,8 @@ class DcMotorTendon : public TendonActuator {
     if (elastic_state_ > 0) elastic_->RestoreState(in);
     in += elastic_state_;
     pending_head_ = 0;
-    pending_count_ = static_cast<int>(std::clamp(in[0], 0.0, double(capacity())));
+    // a count out of range (not from SaveState) empties the line
+    pending_count_ = in[0] >= 0 && in[0] <= capacity() ? static_cast<int>(in[0]) : 0;
     for (int k = 0; k < pending_count_; ++k)
       pending_[k] = {static_cast<std::int64_t>(in[1 + 2 * k]), in[2 + 2 * k]};
   }
@@ -342,7 +358,7 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     try {
       DcMotor::CheckSubsteps(dt, motor_.parameters().max_substep);
-      CheckDelay(command_delay_, dt, capacity() - 1);
+      delay_steps_ = DelaySteps(driver_.command_delay, dt);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -352,7 +368,7 @@ class DcMotorTendon : public TendonActuator {
   void SetCommand(double value) override {
     RequireFinite(prefix_, "command", value);
     command_ = duty_input_ ? std::clamp(value, -1.0, 1.0) : value;
-    if (command_delay_ == 0 && pending_count_ == 0) {
+    if (driver_.command_delay == 0 && pending_count_ == 0) {
       delayed_command_ = command_;
       return;
     }
@@ -365,12 +381,8 @@ class DcMotorTendon : public TendonActuator {
         return;
       }
     }
-    if (pending_count_ == capacity()) {
-      // only when the delay grew past what the line holds: the oldest is applied now
-      delayed_command_ = pending_[pending_head_].value;
-      pending_head_ = (pending_head_ + 1) % capacity();
-      --pending_count_;
-    }
+    // the line never overflows: a step leaves at most delay_steps_ <= kMaxCommandDelaySteps
+    // commands in it, and one more arrives before the next
     pending_[(pending_head_ + pending_count_) % capacity()] = {steps_, command_};
     ++pending_count_;
   }
@@ -386,8 +398,7 @@ class DcMotorTendon : public TendonActuator {
       q.push_back({field.name, field.unit, true, true});
     for (const Quantity& e : elastic_->Quantities()) q.push_back(e);
     for (const auto& [name, unit] : kStates)
-      q.push_back(
-          {name, name == std::string("delayed_command") ? command_unit() : unit, false, false});
+      q.push_back({name, unit ? unit : command_unit(), false, false});
     return q;
   }
 
@@ -398,7 +409,7 @@ class DcMotorTendon : public TendonActuator {
     if (name == "supply_voltage") return supply_voltage_;
     if (name == "pretension") return pretension_;
     for (const DriverField& field : kDriverFields)
-      if (name == field.name) return *Driver(field.name);
+      if (name == field.name) return driver_.*field.member;
     const DcMotorState& s = motor_.state();
     if (name == "current") return s.current;
     if (name == "spool_speed") return s.spool_speed;
@@ -455,15 +466,17 @@ class DcMotorTendon : public TendonActuator {
       }
       for (const DriverField& field : kDriverFields) {
         if (name != field.name) continue;
-        CheckDriver(field.name, value);
-        if (name == std::string("command_delay") && time_step_ > 0)
-          CheckDelay(value, time_step_, capacity() - 1);
-        *Driver(field.name) = value;
+        CheckDriver(field, value);
+        DriverParameters driver = driver_;
+        driver.*field.member = value;
+        if (time_step_ > 0) delay_steps_ = DelaySteps(driver.command_delay, time_step_);
+        driver_ = driver;
         return;
       }
       for (const auto& [state, unit] : kStates)
         if (name == state)
-          throw std::invalid_argument("'" + name + "' [" + unit + "] is a state, not writable");
+          throw std::invalid_argument("'" + name + "' [" + (unit ? unit : command_unit()) +
+                                      "] is a state, not writable");
       if (HasElastic(name)) return elastic_->Set(name, value);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
@@ -492,7 +505,7 @@ class DcMotorTendon : public TendonActuator {
       {"current_limit_now", "A"},
       {"derating", ""},
       {"driver_voltage", "V"},
-      {"delayed_command", ""}};
+      {"delayed_command", nullptr}};  // null: the command's unit
 
   struct Pending {
     std::int64_t issued;  // before this step (steps_ then)
@@ -500,58 +513,50 @@ class DcMotorTendon : public TendonActuator {
   };
   int capacity() const { return static_cast<int>(pending_.size()); }
 
-  double* Driver(const std::string& name) {
-    return const_cast<double*>(static_cast<const DcMotorTendon*>(this)->Driver(name));
+  static void CheckDriver(const DriverField& field, double value) {
+    Check(field.name, field.unit, value, field.whole ? Range::kWhole : Range::kNonNegative);
   }
-  const double* Driver(const std::string& name) const {
-    if (name == "pwm_levels") return &pwm_levels_;
-    if (name == "slew_rate") return &slew_rate_;
-    return &command_delay_;
-  }
-  static void CheckDriver(const char* name, double value) {
-    if (!(value >= 0) || !std::isfinite(value))
-      throw std::invalid_argument(std::string("parameter '") + name + "' must be >= 0, got " +
-                                  Number(value));
-    if (name == std::string("pwm_levels") && value != std::floor(value))
-      throw std::invalid_argument("parameter 'pwm_levels' must be a whole number, got " +
-                                  Number(value));
-  }
+  // a delay [s] in time steps of dt [s]; throws std::invalid_argument beyond the line
   static int DelaySteps(double delay, double dt) {
-    // beyond the line's capacity, any larger number says the same
-    return static_cast<int>(std::min(std::round(delay / dt), 1e9));
-  }
-  static void CheckDelay(double delay, double dt, int most) {
-    const int steps = DelaySteps(delay, dt);
-    if (steps > most)
-      throw std::invalid_argument("parameter 'command_delay' = " + Number(delay) + " s is " +
-                                  std::to_string(steps) + " time steps of " + Number(dt) +
-                                  " s; at most " + std::to_string(most) + " (" + Number(most * dt) +
-                                  " s at this time step)");
+    const double steps = std::round(delay / dt);
+    if (steps > kMaxCommandDelaySteps)
+      throw std::invalid_argument("parameter 'command_delay' = " + Text(delay) + " s is " +
+                                  Text(steps) + " time steps of " + Text(dt) + " s; at most " +
+                                  std::to_string(kMaxCommandDelaySteps) + " (" +
+                                  Text(kMaxCommandDelaySteps * dt) + " s at this time step)");
+    return static_cast<int>(steps);
   }
 
-  // the driver's output for the delayed command: quantised to the PWM's duty steps, within the
-  // supply, then moved toward it at the slew rate
+  // the driver's output for the delayed command: with a PWM, quantised to its duty steps within
+  // the supply; then moved toward at the slew rate
   double TargetVoltage() const {
     double target = voltage(delayed_command_);
-    if (pwm_levels_ > 0) {
+    const double levels = driver_.pwm_levels;
+    if (levels > 0) {
       const double duty = std::clamp(target / supply_voltage_, -1.0, 1.0);
-      target = supply_voltage_ * std::round(duty * pwm_levels_) / pwm_levels_;
+      target = supply_voltage_ * std::round(duty * levels) / levels;
     }
     return target;
   }
   void DriveStep(double dt) {
     if (pending_count_ > 0) {
-      const int delay = DelaySteps(command_delay_, dt);
-      if (delay > capacity() - 1) CheckDelay(command_delay_, dt, capacity() - 1);  // throws
-      while (pending_count_ > 0 && steps_ - pending_[pending_head_].issued >= delay) {
+      if (dt != time_step_) {  // a caller that did not say its time step first
+        try {
+          delay_steps_ = DelaySteps(driver_.command_delay, dt);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(prefix_ + e.what());
+        }
+        time_step_ = dt;
+      }
+      while (pending_count_ > 0 && steps_ - pending_[pending_head_].issued >= delay_steps_) {
         delayed_command_ = pending_[pending_head_].value;
         pending_head_ = (pending_head_ + 1) % capacity();
         --pending_count_;
       }
     }
     const double target = TargetVoltage();
-    if (slew_rate_ > 0) {
-      const double most = slew_rate_ * dt;
+    if (driver_.slew_rate > 0) {
+      const double most = driver_.slew_rate * dt;
       driver_voltage_ += std::clamp(target - driver_voltage_, -most, most);
     } else {
       driver_voltage_ = target;
@@ -629,10 +634,9 @@ class DcMotorTendon : public TendonActuator {
   double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
   double pretension_ = 0;                          // at Reset [N]
   double command_ = 0;                             // [V] or duty [-]
-  double pwm_levels_ = 0;                          // [-]
-  double slew_rate_ = 0;                           // [V/s]
-  double command_delay_ = 0;                       // [s]
-  std::vector<Pending> pending_;                   // the delay line, oldest at pending_head_
+  DriverParameters driver_;
+  int delay_steps_ = 0;           // driver_.command_delay in steps of time_step_
+  std::vector<Pending> pending_;  // the delay line, oldest at pending_head_
   int pending_head_ = 0;
   int pending_count_ = 0;
   std::int64_t steps_ = 0;      // since Reset
@@ -759,8 +763,9 @@ std::vector<ParameterSpec> DcMotorTendonParameters() {
   specs.push_back({"supply_voltage", "V", kDefaultSupplyVoltage, false,
                    "supply voltage, scaled by the duty with options[\"input\"] = duty"});
   specs.push_back({"pretension", "N", 0, false, "tension of the elastic element at Reset"});
+  const DriverParameters driver;
   for (const DriverField& field : kDriverFields)
-    specs.push_back({field.name, field.unit, field.default_value, false, field.help});
+    specs.push_back({field.name, field.unit, driver.*field.member, false, field.help});
   for (const ParameterSpec& spec : ElasticParameterSpecs()) specs.push_back(spec);
   return specs;
 }

@@ -1,19 +1,13 @@
 #include "caliper/actuators/thermal.h"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
+
+#include "motor_checks.h"
 
 namespace caliper::actuators {
 
 namespace {
-
-void RequirePositive(const char* name, const char* unit, double value) {
-  if (std::isfinite(value) && value > 0) return;
-  std::ostringstream message;
-  message << "parameter '" << name << "' must be > 0 [" << unit << "], got " << value;
-  throw std::invalid_argument(message.str());
-}
 
 // (exp(z) - 1) / z, 1 at z = 0
 double Phi1(double z) { return z == 0 ? 1.0 : std::expm1(z) / z; }
@@ -21,17 +15,19 @@ double Phi1(double z) { return z == 0 ? 1.0 : std::expm1(z) / z; }
 }  // namespace
 
 void ThermalParameters::Validate() const {
-  RequirePositive("thermal_resistance_winding_housing", "K/W", resistance_winding_housing);
-  RequirePositive("thermal_resistance_housing_ambient", "K/W", resistance_housing_ambient);
-  RequirePositive("thermal_time_constant_winding", "s", time_constant_winding);
-  RequirePositive("thermal_time_constant_motor", "s", time_constant_motor);
+  using motor_detail::Check;
+  using motor_detail::Range;
+  Check("thermal_resistance_winding_housing", "K/W", resistance_winding_housing, Range::kPositive);
+  Check("thermal_resistance_housing_ambient", "K/W", resistance_housing_ambient, Range::kPositive);
+  Check("thermal_time_constant_winding", "s", time_constant_winding, Range::kPositive);
+  Check("thermal_time_constant_motor", "s", time_constant_motor, Range::kPositive);
 }
 
 void TwoNodeThermal::Configure(const ThermalParameters& p, double dt) {
   p.Validate();
   if (!(dt > 0) || !std::isfinite(dt))
     throw std::invalid_argument("thermal model: time step must be > 0 [s], got " +
-                                std::to_string(dt));
+                                motor_detail::Text(dt));
   const double cw = p.winding_capacity();
   const double ch = p.housing_capacity();
   const double gwh = 1 / p.resistance_winding_housing;  // [W/K]

@@ -198,6 +198,67 @@ TEST(Thermal, DriverDeratesToTheContinuousCurrentAtTheMaximum) {
       continuous);
 }
 
+// a hot motor: the winding at `winding` [degC], the housing 40 K cooler
+DcMotor HotAt(DcMotorParameters p, double winding) {
+  DcMotor motor(p);
+  DcMotorState s = motor.state();
+  s.winding_temperature = winding;
+  s.housing_temperature = winding - 40;
+  motor.set_state(s);
+  return motor;
+}
+
+TEST(Thermal, ADriverWithoutALimitOfItsOwnDeratesAtAnyVoltage) {
+  // at the maximum the limit is the continuous current, also at a voltage whose stall current
+  // is below it and for a motor the load back-drives
+  DcMotorParameters p = HotMotor();
+  DcMotor motor = HotAt(p, 126);
+  const double continuous = motor.continuous_current();
+  motor.Step(0.5, 1e-3, 0.0);
+  EXPECT_EQ(motor.derating(), 1);
+  EXPECT_EQ(motor.current_limit(), continuous);
+  // 15 N m at the spool back-drives the motor: the back-EMF's current is held too
+  for (int i = 0; i < 200; ++i) motor.Step(0, 1e-3, -15);
+  EXPECT_GT(motor.state().spool_speed, 0);
+  EXPECT_LE(std::abs(motor.state().current), continuous * (1 + 1e-12));
+  EXPECT_GT(std::abs(motor.state().current), 0.5 * continuous);
+}
+
+TEST(Thermal, ANegativeCoefficientKeepsTheProtectionOn) {
+  DcMotorParameters p = HotMotor();
+  p.resistance_temperature_coefficient = -0.02;  // R(125 degC) would be negative unclamped
+  DcMotor motor = HotAt(p, 126);
+  EXPECT_GT(motor.continuous_current(), 0);
+  motor.Step(6, 1e-3, 0.0);
+  EXPECT_GT(motor.current_limit(), 0);
+  EXPECT_LE(std::abs(motor.state().current), motor.current_limit() * (1 + 1e-12));
+}
+
+TEST(Thermal, TurnedOffTheMotorReadsTheAmbientAndARestoreReadsHot) {
+  DcMotorParameters p = HotMotor();
+  DcMotor motor = HotAt(p, 100);
+  motor.Step(3, 1e-3, 0.0);
+  const double hot = motor.hot_resistance();
+  EXPECT_GT(hot, p.resistance * 1.2);
+  // what the readouts show comes back with the state
+  double saved[DcMotor::kStateSize];
+  motor.SaveState(saved);
+  DcMotor other(p);
+  other.RestoreState(saved);
+  EXPECT_EQ(other.hot_resistance(), hot);
+  EXPECT_EQ(other.hot_torque_constant(), motor.hot_torque_constant());
+  EXPECT_EQ(other.current_limit(), motor.current_limit());
+  // a live edit keeps a hot motor hot (at the temperatures of the coming step's middle);
+  // turning the model off reads the ambient
+  p.derating_band = 12;
+  motor.set_parameters(p);
+  EXPECT_NEAR(motor.hot_resistance(), hot, 1e-4 * hot);
+  p.thermal_resistance_housing_ambient = 0;
+  motor.set_parameters(p);
+  EXPECT_EQ(motor.state().winding_temperature, p.ambient_temperature);
+  EXPECT_EQ(motor.hot_resistance(), p.resistance);
+}
+
 TEST(Friction, NoLoadSpeedBalancesCoulombAndViscousFriction) {
   DcMotorParameters p;
   p.coulomb_friction = 2e-3;  // [N m]

@@ -101,12 +101,28 @@ struct DcMotorState {
 /// where tanh is +-1 to the last bit).
 double GearEfficiencyFactor(double efficiency, double current, double spool_speed);
 
-/// The friction torque tau_f(W) [N m] at the motor shaft speed W [rad/s] (DcMotorParameters) and
-/// its derivative by W [N m s/rad] in *slope.
-double FrictionTorque(const DcMotorParameters& parameters, double motor_speed, double* slope);
-/// Whether FrictionTorque is exactly affine between two motor speeds [rad/s] (viscous only, or
-/// beyond the smoothing and the Stribeck peak on one side of zero).
-bool FrictionAffine(const DcMotorParameters& parameters, double speed0, double speed1);
+/// The friction at the motor shaft of DcMotorParameters, its constants worked out once.
+class ShaftFriction {
+ public:
+  ShaftFriction() = default;
+  explicit ShaftFriction(const DcMotorParameters& parameters);
+  /// tau_f(W) [N m] at the motor speed W [rad/s], and its derivative by W [N m s/rad] in *slope.
+  double Torque(double motor_speed, double* slope) const;
+  /// Whether Torque() is exactly affine between two motor speeds [rad/s]: viscous friction
+  /// only, or both beyond the smoothing and the Stribeck peak on one side of zero, where Torque()
+  /// takes tanh as +-1 and leaves the peak out.
+  bool Affine(double speed0, double speed1) const;
+
+ private:
+  double viscous_ = 0;            // b [N m s/rad]
+  double coulomb_ = 0;            // tau_c [N m]
+  double peak_ = 0;               // tau_s - tau_c where positive [N m]
+  double inverse_smoothing_ = 0;  // 1 / W_e [s/rad]
+  double inverse_stribeck_ = 0;   // 1 / W_s [s/rad]
+  double sign_speed_ = 0;         // beyond it tanh(W / W_e) is +-1 to the last bit [rad/s]
+  double peak_speed_ = 0;         // beyond it exp(-(W / W_s)^2) < 3e-16 [rad/s]
+  bool dry_ = false;              // Coulomb or static friction
+};
 
 /// A load on the spool that may depend on the spool's angle and speed and carry state of its own
 /// (a series-elastic element). The motor solves for the end of each sub-step with the load
@@ -232,9 +248,10 @@ class DcMotor {
   static void CheckSubsteps(double dt, double max_substep);
 
   /// Writes everything Step() changes (kStateSize values: the state, the applied voltage and
-  /// load torque, the Newton start value's memory, the exp() and sin() caches and the
-  /// temperatures' last change) for RestoreState(), after which a repeated Step() gives the same
-  /// result bit for bit.
+  /// load torque, the Newton start value's memory, the exp() and sin() caches, the
+  /// temperatures' last change, and what they made of the resistance, the constants and the
+  /// driver's limit, which the readouts show) for RestoreState(), after which a repeated Step()
+  /// gives the same result bit for bit.
   void SaveState(double* out) const {
     out[0] = state_.current;
     out[1] = state_.spool_speed;
@@ -251,6 +268,11 @@ class DcMotor {
     out[12] = sin_argument_;
     out[13] = sin_value_;
     out[14] = cos_value_;
+    out[15] = effective_.resistance;
+    out[16] = effective_.torque_constant;
+    out[17] = effective_.back_emf_constant;
+    out[18] = effective_.current_limit;
+    out[19] = derating_;
   }
   /// Reads back the kStateSize values SaveState() wrote.
   void RestoreState(const double* in) {
@@ -269,8 +291,13 @@ class DcMotor {
     sin_argument_ = in[12];
     sin_value_ = in[13];
     cos_value_ = in[14];
+    effective_.resistance = in[15];
+    effective_.torque_constant = in[16];
+    effective_.back_emf_constant = in[17];
+    effective_.current_limit = in[18];
+    derating_ = in[19];
   }
-  static constexpr std::size_t kStateSize = 15;
+  static constexpr std::size_t kStateSize = 20;
 
   /// The voltage the driver applied at the end of the last step [V] (lower than the command
   /// while the current is limited).
@@ -357,8 +384,17 @@ class DcMotor {
 
   // the shaft's friction and cogging torque [N m] at spool speed w [rad/s] and spool angle phi
   // [rad], and its derivative along a stage (phi moving by c per rad/s of w) by w
-  double ShaftTorque(double w, double phi, double c, double* d_torque) const;
-  // the temperatures' effect on effective_ at the start of a step (thermal model on)
+  // with the stage constants k: also friction alone and its derivative by w
+  double ShaftTorque(const StageConstants& k, double w, double phi, double* d_torque,
+                     double* friction, double* d_friction) const;
+  // the winding's resistance at a temperature [degC], kept positive however cold (the
+  // coefficient is a linear fit near room temperature) [ohm]
+  double ResistanceAt(double winding) const;
+  // effective_ and derating_ from the temperatures: the resistance and constants at the
+  // middle of a step (extrapolated from the last step's change), the driver's limit from the
+  // winding's temperature at its start, for a step at this voltage [V]
+  void UpdateEffective(double voltage);
+  // the temperatures' effect at the start of a step (thermal model on)
   void BeginThermalStep(double voltage, double dt);
   void EndThermalStep(double dt);
 
@@ -366,6 +402,8 @@ class DcMotor {
   DcMotorParameters effective_;           // parameters_ at the step's temperatures and derating
   bool shaft_ = false;                    // parameters_.shaft_losses()
   bool friction_ = false;                 // any friction
+  ShaftFriction friction_constants_;      // parameters_'s
+  double continuous_ = 0;                 // continuous_current() [A]
   bool thermal_ = false;                  // parameters_.thermal()
   TwoNodeThermal thermal_model_;          // for steps of thermal_model_.dt()
   double joule_ = 0;                      // integral of i^2 over the step so far [A^2 s]
