@@ -78,6 +78,16 @@ class ExtensionReader {
 
   // Metres per number of an element's lengths: the unit attribute of the element or of the
   // nearest enclosing one in the technique, else the document's unit.
+  // seconds per unit of the element's own `unit` attribute, a time (1 without one)
+  double TimeScale(const Element& e) {
+    const std::string* unit = e.FindAttribute("unit");
+    if (unit == nullptr) return 1;
+    const Unit u = ParseUnitOf(e, *unit);
+    if (u.dimension != std::array<int, 5>{0, 0, 1, 0, 0})
+      ctx_.Fail(&e, "unit '" + *unit + "' is not a time");
+    return u.scale;
+  }
+
   double LengthScale(const Element& e) {
     // up to the technique itself (a <caliper> element of a URDF file has no <technique> above it)
     for (const Element* k = &e; k != nullptr; k = k == technique_ ? nullptr : k->parent) {
@@ -104,14 +114,7 @@ class ExtensionReader {
     for (const auto& c : e.children) {
       const std::string_view n = c->local_name();
       if (n == "time_step") {
-        double scale = 1;
-        if (const std::string* unit = c->FindAttribute("unit"); unit != nullptr) {
-          const Unit u = ParseUnitOf(*c, *unit);
-          if (u.dimension != std::array<int, 5>{0, 0, 1, 0, 0})
-            ctx_.Fail(c.get(), "unit '" + *unit + "' is not a time");
-          scale = u.scale;
-        }
-        ctx_.scene.settings.time_step = ctx_.Number(c.get(), 0) * scale;
+        ctx_.scene.settings.time_step = ctx_.Number(c.get(), 0) * TimeScale(*c);
         if (!(ctx_.scene.settings.time_step > 0)) ctx_.Fail(c.get(), "time step must be positive");
       } else if (n == "solver_iterations") {
         const double v = ctx_.Number(c.get(), 10);
@@ -329,26 +332,20 @@ class ExtensionReader {
   void MeasurementDelay(const Element& e) {
     sgal::MeasurementDelay d;
     d.id = Required(e, "channel");
-    double scale = 1;
-    if (const std::string* unit = e.FindAttribute("unit"); unit != nullptr) {
-      const Unit u = ParseUnitOf(e, *unit);
-      if (u.dimension != std::array<int, 5>{0, 0, 1, 0, 0})
-        ctx_.Fail(&e, "unit '" + *unit + "' is not a time");
-      scale = u.scale;
-    }
+    const double scale = TimeScale(e);
     Required(e, "delay");
     d.delay = AttributeNumber(e, "delay", 0) * scale;
     if (!std::isfinite(d.delay) || d.delay < 0)
       ctx_.Fail(&e, "channel '" + d.id + "': delay=\"" + e.Attribute("delay") +
                         "\" must be finite and not negative");
-    for (const auto& m : ctx_.scene.measurement_delays)
-      if (m.id == d.id) ctx_.Fail(&e, "channel '" + d.id + "' is delayed twice");
+    if (!delayed_.insert(d.id).second) ctx_.Fail(&e, "channel '" + d.id + "' is delayed twice");
     for (const auto& child : e.children) Unknown(*child, "a measurement_delay");
     ctx_.scene.measurement_delays.push_back(d);
   }
 
   Context& ctx_;
   const Element* technique_ = nullptr;  // the technique being read
+  std::set<std::string> delayed_;       // the channels measurement_delay names
 };
 
 // Adds a vector as the character data of a new <tag>.

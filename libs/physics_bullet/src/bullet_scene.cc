@@ -167,6 +167,9 @@ struct DelayLine {
 
 // the most steps a channel may lag (each one a double per step and channel kept and recorded)
 constexpr int kMaxDelaySteps = 1000;
+// the most values the rings of all delayed channels hold together (each keyframe and saved
+// state carries them): 160 kB, 20 channels a second late at 1 ms
+constexpr double kMaxDelayedValues = 20000;
 
 /// A number as text, shortest round-trip form, independent of the locale.
 std::string Text(double v) {
@@ -1594,6 +1597,7 @@ void BulletScene::BuildParameters() {
 
 std::vector<int> BulletScene::DelaySteps(double dt, const std::string& refused) const {
   std::vector<int> steps;
+  double held = 0;  // values in all rings
   for (const auto& d : scene_.measurement_delays) {
     const std::string what =
         refused + "measurement delay of '" + d.id + "': delay " + Text(d.delay) + " s ";
@@ -1605,7 +1609,12 @@ std::vector<int> BulletScene::DelaySteps(double dt, const std::string& refused) 
                                   " s, more than the " + std::to_string(kMaxDelaySteps) +
                                   " steps a channel may lag");
     steps.push_back(static_cast<int>(lag));
+    held += lag + 1;
   }
+  if (held > kMaxDelayedValues)
+    throw std::invalid_argument(refused + "the measurement delays hold " + Text(held) +
+                                " values at a time step of " + Text(dt) + " s, more than the " +
+                                Text(kMaxDelayedValues) + " all channels may hold together");
   return steps;
 }
 
@@ -1627,6 +1636,9 @@ void BulletScene::BuildMeasurementDelays() {
     if (p.info.is_static)
       refuse("a model parameter, not a measurement: only a state that changes every step lags");
     if (id == "simulation.time") refuse("the simulation's clock is not a measurement");
+    if (p.info.writable)
+      refuse("it is written from outside (a command or a setting), not measured: a delayed read "
+             "would not show what was written");
     if (!delayed.emplace(id, index).second) refuse("the channel is delayed twice");
     DelayLine& line = delays_[k];
     line.truth = p.get;

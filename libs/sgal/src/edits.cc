@@ -207,8 +207,24 @@ SceneEdit AddTendon(const Scene& scene, const Tendon& tendon, const Actuator& ac
 
 SceneEdit RemoveTendon(const Scene& scene, const std::string& tendon) {
   TendonIn(scene, tendon);
-  // what goes, with where it was, to put back in place
-  auto remove = [tendon](Scene& s) {
+  // what goes: the tendon, its actuators, and the measurement delays of their channels
+  // (`<tendon>.tendon.*`, `<actuator>.*`, as engines name them), each put back in place on revert
+  std::vector<std::string> owners = {tendon + ".tendon."};
+  std::vector<std::pair<size_t, Actuator>> actuators;
+  for (size_t i = 0; i < scene.actuators.size(); ++i)
+    if (scene.actuators[i].tendon == tendon) {
+      actuators.emplace_back(i, scene.actuators[i]);
+      owners.push_back(scene.actuators[i].name + ".");
+    }
+  auto orphaned = [owners](const MeasurementDelay& d) {
+    return std::any_of(owners.begin(), owners.end(), [&](const std::string& prefix) {
+      return d.id.compare(0, prefix.size(), prefix) == 0;
+    });
+  };
+  std::vector<std::pair<size_t, MeasurementDelay>> delays;
+  for (size_t i = 0; i < scene.measurement_delays.size(); ++i)
+    if (orphaned(scene.measurement_delays[i])) delays.emplace_back(i, scene.measurement_delays[i]);
+  auto remove = [tendon, orphaned](Scene& s) {
     TendonIn(s, tendon);
     s.tendons.erase(std::remove_if(s.tendons.begin(), s.tendons.end(),
                                    [&](const Tendon& t) { return t.name == tendon; }),
@@ -216,21 +232,23 @@ SceneEdit RemoveTendon(const Scene& scene, const std::string& tendon) {
     s.actuators.erase(std::remove_if(s.actuators.begin(), s.actuators.end(),
                                      [&](const Actuator& a) { return a.tendon == tendon; }),
                       s.actuators.end());
+    auto& d = s.measurement_delays;
+    d.erase(std::remove_if(d.begin(), d.end(), orphaned), d.end());
   };
-  // the revert re-inserts the tendon and its actuators as they were in `scene`, at their places
-  std::vector<std::pair<size_t, Actuator>> actuators;
-  for (size_t i = 0; i < scene.actuators.size(); ++i)
-    if (scene.actuators[i].tendon == tendon) actuators.emplace_back(i, scene.actuators[i]);
   size_t at = 0;
   while (scene.tendons[at].name != tendon) ++at;
   const Tendon removed = scene.tendons[at];
-  auto restore = [removed, at, actuators](Scene& s) {
+  auto restore = [removed, at, actuators, delays](Scene& s) {
     s.tendons.insert(s.tendons.begin() + static_cast<long>(std::min(at, s.tendons.size())), removed);
     for (const auto& [i, a] : actuators)
       s.actuators.insert(s.actuators.begin() + static_cast<long>(std::min(i, s.actuators.size())), a);
+    auto& d = s.measurement_delays;
+    for (const auto& [i, m] : delays)
+      d.insert(d.begin() + static_cast<long>(std::min(i, d.size())), m);
   };
-  return {"remove tendon " + tendon + (actuators.empty() ? "" : " and its actuators"), remove,
-          restore};
+  std::string what = "remove tendon " + tendon + (actuators.empty() ? "" : " and its actuators");
+  if (!delays.empty()) what += " (and " + std::to_string(delays.size()) + " measurement delays)";
+  return {what, remove, restore};
 }
 
 SceneEdit SetObstacle(const Scene& scene, const WrapObstacle& obstacle) {

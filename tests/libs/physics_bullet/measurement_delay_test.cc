@@ -191,6 +191,7 @@ TEST(MeasurementDelay, RefusesADelayTheSceneCannotHonourNamingTheId) {
       {{"pendulum.mass", 0.001}, "'pendulum.mass': a model parameter, not a measurement"},
       {{"simulation.time", 0.001}, "'simulation.time': the simulation's clock"},
       {{"pivot.position", 0.001}, "'pivot.position': the channel is delayed twice"},
+      {{"motor.command", 0.001}, "'motor.command': it is written from outside"},
   };
   for (const Case& c : cases) {
     sgal::Scene s = Pendulum();
@@ -204,6 +205,17 @@ TEST(MeasurementDelay, RefusesADelayTheSceneCannotHonourNamingTheId) {
   longest.measurement_delays.push_back({"motor.motor_speed", 1.0});
   auto scene = MakeScene(longest);
   EXPECT_EQ(scene->SaveDynamicState().measurements.size(), 5u + 1u + 11u + 1001u);
+  // and the rings together hold at most 20,000 values: 20 channels of 1000 steps, not 21
+  sgal::Scene many = Pendulum();
+  many.measurement_delays.clear();
+  for (const auto& p : MakeScene(Pendulum())->Parameters())
+    if (!p.is_static && !p.writable && p.id != "simulation.time" &&
+        many.measurement_delays.size() < 21)
+      many.measurement_delays.push_back({p.id, 1.0});
+  ASSERT_EQ(many.measurement_delays.size(), 21u);
+  const std::string message = Refusal(many);
+  EXPECT_NE(message.find("the measurement delays hold 21021 values"), std::string::npos)
+      << message;
 }
 
 }  // namespace

@@ -244,6 +244,30 @@ TEST_F(ModelEdit, UndoPutsBackTunedValuesActuatorStatesAndCommands) {
   EXPECT_EQ(tension(), at_removal);
 }
 
+TEST_F(ModelEdit, RemovingATendonTakesItsChannelsDelaysAlongAndUndoBringsThemBack) {
+  // tests/data/collada/measurement_delays.dae: the tendon `line` (ligament `spring`) with its
+  // tension delayed 4 ms, the hinge's position 2 ms
+  const char* src = std::getenv("CALIPER_SOURCE_DIR");
+  core_.Load(std::string(src ? src : ".") + "/tests/data/collada/measurement_delays.dae");
+  core_.StepNow(10);
+  const auto delays = [&] {
+    std::vector<std::string> ids;
+    for (const auto& d : scene()->measurement_delays) ids.push_back(d.id);
+    return ids;
+  };
+  const std::vector<std::string> before = delays();
+  ASSERT_EQ(before, (std::vector<std::string>{"line.tendon.tension", "hinge.position"}));
+  const ModelCore::EditStatus removed =
+      core_.Edit([&](const sgal::Scene& s) { return sgal::RemoveTendon(s, "line"); });
+  EXPECT_NE(removed.undo.find("1 measurement delays"), std::string::npos) << removed.undo;
+  EXPECT_EQ(delays(), (std::vector<std::string>{"hinge.position"}));
+  core_.StepNow(10);  // the scene without the tendon runs, its other delay too
+  EXPECT_EQ(Read(core_, "measurement_delays.hinge.position").size(), 1u);
+  core_.Undo();
+  EXPECT_EQ(delays(), before);
+  EXPECT_EQ(Read(core_, "measurement_delays.line.tendon.tension.undelayed").size(), 1u);
+}
+
 TEST_F(ModelEdit, StopRewindsTimeButKeepsEditsAndLoadForgetsThem) {
   core_.StepNow(50);
   core_.Edit([&](const sgal::Scene& s) { return sgal::SetMass(s, "hand", 0.7); });
