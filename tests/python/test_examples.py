@@ -206,11 +206,13 @@ def test_notebook(tmp_path, monkeypatch):
 
 def test_co_contraction(tmp_path):
     out = run("co_contraction.py", tmp_path)
-    # the windings heat toward the maximum; the driver derates before they reach it
+    # the windings heat toward the maximum; the driver derates before they reach it. The
+    # figures docs/actuators.md quotes (121.50 degC, from 80 s, 4.124 A), within what a change
+    # of the step's rounding could move
     highest = number(r"^highest winding temperature: ([0-9.]+) degC", out)
-    assert 115 < highest < 125, out
+    assert abs(highest - 121.5) < 0.5, out
     derating_from = number(r"^the driver derated from ([0-9.]+) s", out)
-    assert 40 < derating_from < 120, out
+    assert abs(derating_from - 80) < 2, out
     final = number(r"final current ([0-9.]+) A against a limit of 6 A", out)
-    assert final < 5, out
+    assert abs(final - 4.124) < 0.05, out
     figures(out, tmp_path)

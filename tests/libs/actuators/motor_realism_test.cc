@@ -79,7 +79,7 @@ TEST(Thermal, StepResponseIsTheTwoExponentialsTo1e9) {
   EXPECT_NEAR(steady(0), power * (1.6 + 4.65), 1e-9);
   EXPECT_NEAR(steady(1), power * 4.65, 1e-9);
   // relative to the steady rise
-  EXPECT_LT(worst / steady(0), 1e-9) << "worst " << worst << " K";
+  EXPECT_LT(worst / steady(0), 1e-10) << "worst " << worst << " K";
   std::printf("thermal step: worst error %.3g K over 3000 s (steady rise %.2f K)\n", worst,
               steady(0));
 }
@@ -123,7 +123,7 @@ TEST(Thermal, LockedMotorAtConstantVoltageHeatsAsTheClosedForm) {
                         std::abs(motor.state().housing_temperature - 25 - exact(1))});
     }
   }
-  EXPECT_LT(worst, 1e-9 * power * 6.25) << worst;
+  EXPECT_LT(worst, 1e-9) << worst;  // [K]
   std::printf("locked motor at %.2f W: worst error %.3g K over 200 s\n", power, worst);
 }
 
@@ -158,17 +158,17 @@ TEST(Thermal, HotRunDriftsResistanceAndTorqueConstantAsTheAnalyticRun) {
     ASSERT_NEAR(motor.motor_torque(), k * p.current_limit, 1e-6 * k * p.current_limit);
   }
   const double final_rise = motor.state().winding_temperature - 25;
-  EXPECT_GT(final_rise, 60);  // hot: the resistance grew by a quarter
-  EXPECT_LT(worst_t, 1e-6 * final_rise) << worst_t;
-  EXPECT_LT(worst_r, 1e-8) << worst_r;
-  EXPECT_LT(worst_k, 1e-8) << worst_k;
+  EXPECT_GT(final_rise, 100);  // hot: the resistance grew by 40 %
+  EXPECT_LT(worst_t, 1e-8) << worst_t;  // [K]
+  EXPECT_LT(worst_r, 1e-10) << worst_r;
+  EXPECT_LT(worst_k, 1e-10) << worst_k;
   std::printf(
       "hot run 600 s at 7 A: winding +%.2f K, worst %.3g K; R %.4f -> %.4f ohm "
       "(worst rel. %.2g), k_t worst rel. %.2g\n",
       final_rise, worst_t, p.resistance, motor.hot_resistance(), worst_r, worst_k);
 }
 
-TEST(Thermal, DriverDeratesToTheContinuousCurrentAtTheMaximum) {
+TEST(Thermal, DriverDeratesToTheSteadyStateOfItsPolicy) {
   DcMotorParameters p = HotMotor();
   p.max_winding_temperature = 125;
   p.derating_band = 10;
@@ -178,24 +178,25 @@ TEST(Thermal, DriverDeratesToTheContinuousCurrentAtTheMaximum) {
   // (125 - 25) K over (R_wh + R_ha) at the hot resistance
   const double hot = p.resistance * (1 + 0.0039 * 100);
   EXPECT_NEAR(continuous, std::sqrt(100 / (6.25 * hot)), 1e-12);
+  // the policy's steady state: below the maximum the limit is above the continuous current and
+  // the winding warms; at it the limit is the continuous current, which holds it there. So the
+  // winding approaches the maximum from below, the current the continuous current from above.
   double highest = 0;
   double first_derating = -1;
-  for (long i = 1; i <= 900000; ++i) {
-    motor.Step(6, 1e-3, 0.0);  // a stall current of 11.6 A: 69 W
+  for (long i = 1; i <= 8000000; ++i) {  // 8000 s: seven of the housing's time constants
+    motor.Step(6, 1e-3, 0.0);             // a stall current of 11.6 A: 69 W
     highest = std::max(highest, motor.state().winding_temperature);
     if (first_derating < 0 && motor.derating() > 0) first_derating = i * 1e-3;
   }
   EXPECT_GT(first_derating, 0);
   EXPECT_LT(highest, 125.0) << "the winding passed its maximum";
-  EXPECT_GT(motor.state().winding_temperature, 115.0);
-  // settled near the maximum: the current is within the derating's range, near the continuous
-  EXPECT_LT(std::abs(motor.state().current), 6 / hot);
-  EXPECT_NEAR(std::abs(motor.state().current), continuous, 0.25 * continuous);
+  const double winding = motor.state().winding_temperature;
+  EXPECT_NEAR(winding, 125.0, 1e-4);  // [degC]
+  EXPECT_NEAR(std::abs(motor.state().current), continuous, 1e-5 * continuous);
   std::printf(
-      "derating from %.1f s; highest winding %.2f degC; after 900 s %.2f degC, %.3f A "
-      "(continuous %.3f A)\n",
-      first_derating, highest, motor.state().winding_temperature, motor.state().current,
-      continuous);
+      "derating from %.1f s; after 8000 s the winding %.3g K below its maximum, the current "
+      "%.3g A above the continuous %.4f A\n",
+      first_derating, 125.0 - winding, std::abs(motor.state().current) - continuous, continuous);
 }
 
 // a hot motor: the winding at `winding` [degC], the housing 40 K cooler
@@ -272,9 +273,11 @@ TEST(Friction, NoLoadSpeedBalancesCoulombAndViscousFriction) {
   const double r = p.resistance;
   const double w = (p.torque_constant * u / r - p.coulomb_friction) /
                    (p.torque_constant * p.back_emf_constant / r + p.viscous_friction);
-  EXPECT_NEAR(motor.motor_speed(), w, 1e-9 * w);
+  EXPECT_NEAR(motor.motor_speed(), w, 1e-12 * w);
   EXPECT_NEAR(motor.friction_torque(), p.coulomb_friction + p.viscous_friction * w, 1e-12);
   EXPECT_NEAR(motor.state().current, (u - p.back_emf_constant * w) / r, 1e-9);
+  std::printf("no-load speed with friction: %.6f rad/s, closed form %.6f (relative error %.2g)\n",
+              motor.motor_speed(), w, std::abs(motor.motor_speed() - w) / w);
 }
 
 TEST(Friction, StuckBelowTheBreakawayTorque) {
@@ -402,12 +405,14 @@ TEST(Cogging, RotorSwingsInACoggingWellAsAPendulum) {
   const double measured = (crossings.back() - crossings.front()) / 4;
   const double omega0 = std::sqrt(p.cogging_amplitude * p.cogging_count / p.rotor_inertia);
   const double exact = 4 * boost::math::ellint_1(std::sin(amplitude / 2)) / omega0;
-  EXPECT_NEAR(measured, exact, 1e-5 * exact);
+  EXPECT_NEAR(measured, exact, 2e-6 * exact);
   // and the torque it reports is the Fourier form's one harmonic, n periods per turn
   EXPECT_NEAR(motor.cogging_torque(),
               p.cogging_amplitude * std::sin(p.cogging_count * motor.state().spool_angle), 1e-15);
-  std::printf("cogging well: period %.7f s, elliptic closed form %.7f s (small-swing %.7f s)\n",
-              measured, exact, 2 * kPi / omega0);
+  std::printf(
+      "cogging well: period %.7f s, elliptic closed form %.7f s (relative error %.2g; "
+      "small-swing %.7f s)\n",
+      measured, exact, std::abs(measured - exact) / exact, 2 * kPi / omega0);
 }
 
 TEST(Cogging, RippleOfARunningMotorHasTheCountPerTurn) {
