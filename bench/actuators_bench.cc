@@ -299,5 +299,25 @@ int main(int argc, char** argv) {
   const double ratio = InterleavedRatio(named("dc_motor_driven_step_ns_per_1ms"),
                                         named("dc_motor_realistic_step_ns_per_1ms"));
   std::printf("RATIO dc_motor_realism_vs_plain %.3f (target 1.3)\n", ratio);
+  // for information: each part alone against the plain motor, the same way
+  const Case& realistic = named("dc_motor_realistic_step_ns_per_1ms");
+  const std::vector<std::pair<const char*, std::vector<const char*>>> parts = {
+      {"heat", {"thermal_"}},
+      {"friction", {"coulomb_friction", "static_friction", "viscous_friction"}},
+      {"cogging", {"cogging_"}},
+      {"PWM and slew", {"pwm_levels", "slew_rate"}},
+      {"all but cogging", {"thermal_", "coulomb_friction", "static_friction", "viscous_friction",
+                           "pwm_levels", "slew_rate"}}};
+  std::printf("# dc_motor_realism_vs_plain by part:");
+  for (const auto& [part, prefixes] : parts) {
+    Case c = realistic;
+    c.parameters.clear();
+    for (const auto& [name, value] : realistic.parameters)
+      for (const char* prefix : prefixes)
+        if (name.rfind(prefix, 0) == 0) c.parameters[name] = value;
+    std::printf(" %s %.3f;", part, InterleavedRatio(named("dc_motor_driven_step_ns_per_1ms"), c));
+    std::fflush(stdout);
+  }
+  std::printf("\n");
   return 0;
 }
