@@ -158,7 +158,7 @@ TEST(Thermal, HotRunDriftsResistanceAndTorqueConstantAsTheAnalyticRun) {
     ASSERT_NEAR(motor.motor_torque(), k * p.current_limit, 1e-6 * k * p.current_limit);
   }
   const double final_rise = motor.state().winding_temperature - 25;
-  EXPECT_GT(final_rise, 100);  // hot: the resistance grew by 40 %
+  EXPECT_GT(final_rise, 100);           // hot: the resistance grew by 40 %
   EXPECT_LT(worst_t, 1e-8) << worst_t;  // [K]
   EXPECT_LT(worst_r, 1e-10) << worst_r;
   EXPECT_LT(worst_k, 1e-10) << worst_k;
@@ -184,7 +184,7 @@ TEST(Thermal, DriverDeratesToTheSteadyStateOfItsPolicy) {
   double highest = 0;
   double first_derating = -1;
   for (long i = 1; i <= 8000000; ++i) {  // 8000 s: seven of the housing's time constants
-    motor.Step(6, 1e-3, 0.0);             // a stall current of 11.6 A: 69 W
+    motor.Step(6, 1e-3, 0.0);            // a stall current of 11.6 A: 69 W
     highest = std::max(highest, motor.state().winding_temperature);
     if (first_derating < 0 && motor.derating() > 0) first_derating = i * 1e-3;
   }
@@ -280,15 +280,24 @@ TEST(Friction, NoLoadSpeedBalancesCoulombAndViscousFriction) {
               motor.motor_speed(), w, std::abs(motor.motor_speed() - w) / w);
 }
 
-TEST(Friction, StuckBelowTheBreakawayTorque) {
+// a bare rotor: no gear, no losses in it, the winding practically open (no electrical damping)
+DcMotorParameters BareRotor(double inertia) {
   DcMotorParameters p;
   p.gear_ratio = 1;
   p.efficiency = 1;
+  p.rotor_inertia = inertia;  // [kg m^2]
+  p.gear_inertia = 0;
+  p.resistance = 1e6;
+  return p;
+}
+
+TEST(Friction, StuckBelowTheBreakawayTorque) {
+  const DcMotorParameters defaults;
+  DcMotorParameters p = BareRotor(defaults.rotor_inertia + defaults.gear_inertia);
   p.coulomb_friction = 0.01;
   p.static_friction = 0.02;
   p.stribeck_speed = 0.2;
   p.friction_smoothing_speed = 1e-3;
-  p.resistance = 1e6;  // practically open: no electrical damping
   DcMotor motor(p);
   // 0.015 N m, between the Coulomb and the breakaway torque, pushes on a motor at rest
   for (int i = 0; i < 2000; ++i) motor.Step(0, 1e-3, -0.015);
@@ -317,12 +326,7 @@ class DraggedSpring : public SpoolLoad {
 };
 
 TEST(Friction, StickSlipMatchesTheCoulombClosedForm) {
-  DcMotorParameters p;
-  p.gear_ratio = 1;
-  p.efficiency = 1;
-  p.rotor_inertia = 1e-5;
-  p.gear_inertia = 0;
-  p.resistance = 1e6;
+  DcMotorParameters p = BareRotor(1e-5);
   p.coulomb_friction = 0.01;
   p.static_friction = 0.02;
   p.stribeck_speed = 0.05;
@@ -376,12 +380,7 @@ TEST(Friction, StickSlipMatchesTheCoulombClosedForm) {
 }
 
 TEST(Cogging, RotorSwingsInACoggingWellAsAPendulum) {
-  DcMotorParameters p;
-  p.gear_ratio = 1;
-  p.efficiency = 1;
-  p.rotor_inertia = 2e-6;
-  p.gear_inertia = 0;
-  p.resistance = 1e6;
+  DcMotorParameters p = BareRotor(2e-6);
   p.cogging_amplitude = 3e-3;  // [N m]
   p.cogging_count = 12;
   DcMotor motor(p);

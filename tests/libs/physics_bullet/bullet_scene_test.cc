@@ -34,8 +34,8 @@ sgal::Scene Pendulum(double length, double angle, double dt = 1e-3) {
   sgal::Scene s;
   s.name = "pendulum";
   s.settings.time_step = dt;
-  s.bodies.push_back(Ball("bob", Vector3d(length * std::sin(angle), 0, -length * std::cos(angle)),
-                          1.0, 0.02));
+  s.bodies.push_back(
+      Ball("bob", Vector3d(length * std::sin(angle), 0, -length * std::cos(angle)), 1.0, 0.02));
   sgal::Constraint hinge;
   hinge.name = "pivot";
   hinge.kind = sgal::ConstraintKind::kHinge;
@@ -57,7 +57,8 @@ double MeasuredPeriod(sgal::PhysicsScene& scene, double duration) {
     scene.Step();
     const double x = scene.BodyStates()[0].pose.position.x();
     if (previous < 0 && x >= 0)
-      crossings.push_back(scene.time() - scene.description().settings.time_step * x / (x - previous));
+      crossings.push_back(scene.time() -
+                          scene.description().settings.time_step * x / (x - previous));
     previous = x;
   }
   if (crossings.size() < 2) return 0;
@@ -147,7 +148,8 @@ TEST(BulletScene, PendulumIsTheSameInMillimetres) {
   for (int i = 0; i < 2000; ++i) {
     a->Step();
     b->Step();
-    worst = std::max(worst, (a->BodyStates()[0].pose.position - b->BodyStates()[0].pose.position).norm());
+    worst = std::max(worst,
+                     (a->BodyStates()[0].pose.position - b->BodyStates()[0].pose.position).norm());
   }
   EXPECT_LT(worst, 1e-4) << "largest difference over 2 s [m]";
   EXPECT_GT(std::abs(a->BodyStates()[0].pose.position.x()), 0.01) << "it did move";
@@ -292,8 +294,9 @@ TEST(BulletScene, ATensionBeyondTheBoundStopsTheStepBeforeItActs) {
     FAIL() << "a tension beyond the bound must stop the step";
   } catch (const sgal::SimulationFault& fault) {
     EXPECT_EQ(fault.element(), "wild");
-    EXPECT_NE(std::string(fault.what()).find("tension 200000.000000 N beyond the engine's bound "
-                                             "of 100000.000000 N"),
+    EXPECT_NE(std::string(fault.what())
+                  .find("tension 200000.000000 N beyond the engine's bound "
+                        "of 100000.000000 N"),
               std::string::npos)
         << fault.what();
   }
@@ -343,13 +346,12 @@ sgal::Scene ThreePullers(double angle) {
   s.tendons.push_back(TendonTo("t_ligament", Vector3d(0, 0, -0.8), bob));
   s.actuators.push_back(
       {"motor", "dc_motor_tendon", "t_motor", {{"pretension", 2}}, {{"elastic", "zener"}}});
-  s.actuators.push_back({"muscle",
-                         "hill_muscle",
-                         "t_muscle",
-                         {{"optimal_fiber_length", 0.1},
-                          {"tendon_slack_length", 0.25},
-                          {"max_isometric_force", 30}},
-                         {{"tendon", "elastic"}}});
+  s.actuators.push_back(
+      {"muscle",
+       "hill_muscle",
+       "t_muscle",
+       {{"optimal_fiber_length", 0.1}, {"tendon_slack_length", 0.25}, {"max_isometric_force", 30}},
+       {{"tendon", "elastic"}}});
   s.actuators.push_back(
       {"ligament", "ligament", "t_ligament", {{"stiffness", 300}, {"rest_length", 0.39}}, {}});
   return s;
@@ -378,8 +380,8 @@ std::unique_ptr<sgal::PhysicsScene> MakePulledPendulum(bool share_tendon) {
 /// Everything a scene reports, by name: time, step count, body states, tendon states and every
 /// parameter and state (but the test kind's switch `fail`).
 std::vector<std::pair<std::string, double>> Everything(const sgal::PhysicsScene& scene) {
-  std::vector<std::pair<std::string, double>> all = {
-      {"time", scene.time()}, {"steps", static_cast<double>(scene.steps())}};
+  std::vector<std::pair<std::string, double>> all = {{"time", scene.time()},
+                                                     {"steps", static_cast<double>(scene.steps())}};
   const auto bodies = scene.BodyStates();
   for (size_t i = 0; i < bodies.size(); ++i) {
     const std::string n = scene.description().bodies[i].name + ".";
@@ -416,17 +418,33 @@ void ExpectSameBits(const std::vector<std::pair<std::string, double>>& expected,
     ASSERT_EQ(expected[i].first, actual[i].first);
     if (std::memcmp(&expected[i].second, &actual[i].second, sizeof(double)) != 0 &&
         ++differences <= 10)
-      ADD_FAILURE() << expected[i].first << ": " << expected[i].second << " != "
-                    << actual[i].second;
+      ADD_FAILURE() << expected[i].first << ": " << expected[i].second
+                    << " != " << actual[i].second;
   }
   EXPECT_EQ(differences, 0);
+}
+
+// the next step of `scene` fails in the actuator 'faulty' (test_faulty_motor) at `time` [s], its
+// message holding `detail`
+void ExpectFaultingStep(sgal::PhysicsScene* scene, const std::string& detail, double time) {
+  try {
+    scene->Step();
+    ADD_FAILURE() << "the step must fail";
+  } catch (const sgal::SimulationFault& fault) {
+    const std::string what = fault.what();
+    EXPECT_EQ(fault.element(), "faulty");
+    EXPECT_NEAR(fault.time(), time, 1e-12);
+    EXPECT_EQ(what.rfind("actuator 'faulty' (test_faulty_motor)", 0), 0u) << what;
+    EXPECT_NE(what.find(detail), std::string::npos) << what;
+  }
 }
 
 TEST(BulletScene, AnyFaultInAStepEndsAtTheStartOfThatStep) {
   testing::RegisterTestKinds();
   const std::pair<int, std::string> faults[] = {
-      {1, "failed at t = 0.026000 s: std::runtime_error: injected fault; simulation stopped at "
-          "t = 0.025000 s (step 25)"},
+      {1,
+       "failed at t = 0.026000 s: std::runtime_error: injected fault; simulation stopped at "
+       "t = 0.025000 s (step 25)"},
       {2, "failed at t = 0.026000 s: std::bad_alloc;"},
       {3, ": tension is not finite (nan) at t = 0.026000 s"},
       {4, "failed at t = 0.026000 s: an exception of type int;"}};
@@ -442,16 +460,7 @@ TEST(BulletScene, AnyFaultInAStepEndsAtTheStartOfThatStep) {
       const auto before = Everything(*faulting);
       faulting->SetParameter("faulty.fail", mode);
       for (int attempt = 0; attempt < 2; ++attempt) {  // and again: the same fault, same state
-        try {
-          faulting->Step();
-          ADD_FAILURE() << "the step must fail";
-        } catch (const sgal::SimulationFault& fault) {
-          const std::string what = fault.what();
-          EXPECT_EQ(fault.element(), "faulty");
-          EXPECT_NEAR(fault.time(), 0.026, 1e-12);
-          EXPECT_EQ(what.rfind("actuator 'faulty' (test_faulty_motor)", 0), 0u) << what;
-          EXPECT_NE(what.find(detail), std::string::npos) << what;
-        }
+        ExpectFaultingStep(faulting.get(), detail, 0.026);
         EXPECT_EQ(faulting->steps(), 25u);
         ExpectSameBits(before, Everything(*faulting));
       }
@@ -495,15 +504,7 @@ TEST(BulletScene, AFaultingStepPutsTheDelayedChannelsBack) {
     const std::vector<double> rings = faulting->SaveDynamicState().measurements;
     ASSERT_EQ(rings.size(), 4u + 3u + 5u + 1u);
     faulting->SetParameter("faulty.fail", mode);
-    try {
-      faulting->Step();
-      ADD_FAILURE() << "the step must fail";
-    } catch (const sgal::SimulationFault& fault) {
-      const std::string what = fault.what();
-      EXPECT_EQ(fault.element(), "faulty");
-      EXPECT_EQ(what.rfind("actuator 'faulty' (test_faulty_motor)", 0), 0u) << what;
-      EXPECT_NE(what.find(detail), std::string::npos) << what;
-    }
+    ExpectFaultingStep(faulting.get(), detail, 0.026);
     faulting->SetParameter("faulty.fail", 0);
     EXPECT_EQ(faulting->steps(), 25u);
     ExpectSameBits(before, Everything(*faulting));  // the delayed and true values among them
@@ -896,8 +897,9 @@ TEST(BulletSceneDynamicState, RestoredIntoAFreshSceneItGoesOnAsTheOriginal) {
   for (int i = 0; i < 500; ++i) {
     original->Step();
     fresh->Step();
-    largest = std::max(largest, (fresh->BodyStates()[0].pose.position -
-                                 original->BodyStates()[0].pose.position).norm());
+    largest = std::max(
+        largest,
+        (fresh->BodyStates()[0].pose.position - original->BodyStates()[0].pose.position).norm());
   }
   // the hinge's solver keeps warm-start impulses that a fresh scene starts without: a difference
   // in the last bits, far below what a user could see

@@ -5,8 +5,10 @@
 // (a load torque on the spool) or with a load that depends on the spool angle and speed (a
 // tendon with a series-elastic element). SI units.
 
+#include <array>
 #include <cstddef>
 #include <string>
+#include <type_traits>
 
 #include "caliper/actuators/actuator.h"
 #include "caliper/actuators/thermal.h"
@@ -253,52 +255,45 @@ class DcMotor {
   /// driver's limit, which the readouts show) for RestoreState(), after which a repeated Step()
   /// gives the same result bit for bit.
   void SaveState(double* out) const {
-    out[0] = state_.current;
-    out[1] = state_.spool_speed;
-    out[2] = state_.spool_angle;
-    out[3] = applied_voltage_;
-    out[4] = load_torque_;
-    out[5] = last_acceleration_;
-    out[6] = exp_argument_;
-    out[7] = exp_value_;
-    out[8] = state_.winding_temperature;
-    out[9] = state_.housing_temperature;
-    out[10] = winding_change_;
-    out[11] = housing_change_;
-    out[12] = sin_argument_;
-    out[13] = sin_value_;
-    out[14] = cos_value_;
-    out[15] = effective_.resistance;
-    out[16] = effective_.torque_constant;
-    out[17] = effective_.back_emf_constant;
-    out[18] = effective_.current_limit;
-    out[19] = derating_;
+    const auto fields = StateFields(*this);
+    for (std::size_t i = 0; i < kStateSize; ++i) out[i] = *fields[i];
   }
   /// Reads back the kStateSize values SaveState() wrote.
   void RestoreState(const double* in) {
-    state_.current = in[0];
-    state_.spool_speed = in[1];
-    state_.spool_angle = in[2];
-    applied_voltage_ = in[3];
-    load_torque_ = in[4];
-    last_acceleration_ = in[5];
-    exp_argument_ = in[6];
-    exp_value_ = in[7];
-    state_.winding_temperature = in[8];
-    state_.housing_temperature = in[9];
-    winding_change_ = in[10];
-    housing_change_ = in[11];
-    sin_argument_ = in[12];
-    sin_value_ = in[13];
-    cos_value_ = in[14];
-    effective_.resistance = in[15];
-    effective_.torque_constant = in[16];
-    effective_.back_emf_constant = in[17];
-    effective_.current_limit = in[18];
-    derating_ = in[19];
+    const auto fields = StateFields(*this);
+    for (std::size_t i = 0; i < kStateSize; ++i) *fields[i] = in[i];
   }
   static constexpr std::size_t kStateSize = 20;
 
+ private:
+  // what SaveState() writes and RestoreState() reads, in their order (double* or const double*)
+  template <typename Motor>
+  using StateField = std::conditional_t<std::is_const_v<Motor>, const double*, double*>;
+  template <typename Motor>
+  static std::array<StateField<Motor>, kStateSize> StateFields(Motor& m) {
+    return {&m.state_.current,
+            &m.state_.spool_speed,
+            &m.state_.spool_angle,
+            &m.applied_voltage_,
+            &m.load_torque_,
+            &m.last_acceleration_,
+            &m.exp_argument_,
+            &m.exp_value_,
+            &m.state_.winding_temperature,
+            &m.state_.housing_temperature,
+            &m.winding_change_,
+            &m.housing_change_,
+            &m.sin_argument_,
+            &m.sin_value_,
+            &m.cos_value_,
+            &m.effective_.resistance,
+            &m.effective_.torque_constant,
+            &m.effective_.back_emf_constant,
+            &m.effective_.current_limit,
+            &m.derating_};
+  }
+
+ public:
   /// The voltage the driver applied at the end of the last step [V] (lower than the command
   /// while the current is limited).
   double applied_voltage() const { return applied_voltage_; }
