@@ -788,6 +788,11 @@ int Edit(Client& client, std::vector<std::string>& args) {
   } else if (what == "mass") {
     NeedArgs(a, 2, "mass BODY KG");
     s = Call(m, [&] { return m.model->set_mass(a[0].c_str(), ParseNumber(a[1], "KG")); });
+  } else if (what == "delay") {
+    NeedArgs(a, 2, "delay CHANNEL SECONDS");
+    s = Call(m, [&] {
+      return m.model->set_measurement_delay(a[0].c_str(), ParseNumber(a[1], "SECONDS"));
+    });
   } else if (what == "undo" || what == "redo") {
     NeedArgs(a, 0, what);
     s = Call(m, [&] { return what == "undo" ? m.model->undo() : m.model->redo(); });
@@ -884,7 +889,8 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "  the Model: record then exits 1 with the Model's reason.\n",
       true);
   add("edit", "edit [WHAT ARGS...] [--model NAME]",
-      "edit the running scene: tendon routes, obstacles, shapes, masses; undo, redo; pull",
+      "edit the running scene: tendon routes, obstacles, shapes, masses, measurement delays; "
+      "undo, redo; pull",
       Edit,
       "  Without WHAT: the edit history (what undo and redo would do) and the GUI's selection.\n"
       "  Positions are metres in the named body's frame (`world` for the world); each edit is\n"
@@ -903,6 +909,9 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "    remove-obstacle NAME               one no tendon wraps around\n"
       "    shapes BODY / shape BODY INDEX DIM...   list / set a collision shape's dimensions\n"
       "    mass BODY KG                       the inertia scales with the mass\n"
+      "    delay CHANNEL SECONDS              every reader sees CHANNEL that late (whole time\n"
+      "                                       steps); 0 removes the delay; CHANNEL.undelayed\n"
+      "                                       reads the true value\n"
       "    undo / redo\n"
       "    pull BODY X Y Z [--stiffness K] [--for S]   spring the body's origin toward a world\n"
       "                                       point [m] until Ctrl-C (or S seconds), then release\n"

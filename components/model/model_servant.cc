@@ -523,6 +523,13 @@ M::EditStatus* ModelServant::set_mass(const char* body, CORBA::Double mass_kg) {
   });
 }
 
+M::EditStatus* ModelServant::set_measurement_delay(const char* id, CORBA::Double delay_s) {
+  return Guard([&] {
+    return ToIdl(core_.Edit(
+        [&](const sgal::Scene& s) { return sgal::SetMeasurementDelay(s, id, delay_s); }));
+  });
+}
+
 M::EditStatus* ModelServant::undo() {
   return Guard([&] { return ToIdl(core_.Undo()); });
 }

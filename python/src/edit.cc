@@ -150,6 +150,18 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
           },
           py::arg("body"), py::arg("mass_kg"), "Sets a body's mass [kg].")
       .def(
+          "set_measurement_delay",
+          [](ModelObject& m, const std::string& id, double delay_s) {
+            if (!std::isfinite(delay_s) || delay_s < 0)
+              throw py::value_error("delay_s must be >= 0 and finite");
+            return Edit([&](M::Model_ptr r) {
+              return r->set_measurement_delay(id.c_str(), delay_s);
+            })(m);
+          },
+          py::arg("id"), py::arg("delay_s"),
+          "Delays channel `id` by `delay_s` [s] for every reader (whole time steps); 0 removes "
+          "its delay. `id + '.undelayed'` reads the true value.")
+      .def(
           "set_shape_dims",
           [](ModelObject& m, const std::string& body, uint32_t index, const py::object& dims) {
             const std::vector<double> d = FiniteValues(dims, "dims_m");

@@ -720,6 +720,15 @@ TEST_F(HostileModelTest, SceneEditingRefusesHostileEditsAndTheModelGoesOn) {
   o.radius = 0.01;
   o.pose = {0, 0, 0, 0, 0, 0, 0};  // not a rotation
   EXPECT_REFUSED(M::EditStatus_var(ref_->set_obstacle(o)), "unit quaternion");
+  // measurement delays: bad delays, unknown and empty ids, a command
+  for (const double bad : {-1.0, kHuge, kNaN})
+    EXPECT_REFUSED(M::EditStatus_var(ref_->set_measurement_delay("pivot.position", bad)),
+                   "[0, 10] s");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_measurement_delay("no.such.channel", 0.002)),
+                 "no such parameter");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_measurement_delay("", 0.002)), "channel id");
+  EXPECT_REFUSED(M::EditStatus_var(ref_->set_measurement_delay("pivot.position", 0)),
+                 "has no measurement delay");
   // tendons: existing names, unknown kinds, huge radii
   EXPECT_REFUSED(M::EditStatus_var(ref_->add_tendon("line", point("frame", 0, 0, 0),
                                                     point("pendulum", 0, 0, 0), 0.001, "m2",

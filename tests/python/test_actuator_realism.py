@@ -126,3 +126,31 @@ def test_measurement_delays_record_and_verify_bit_for_bit(new_session):
         assert np.ptp(data[ids[3]]) > 1e-3  # it moved [rad]
         ok, report = caliper.verify(stopped.path)
         assert ok, report
+
+
+def test_a_measurement_delay_set_live_lags_its_channel(new_session):
+    """set_measurement_delay on the running arm: the channel lags its `.undelayed` value by the
+    delay's steps, the export carries the delay, undo removes it; a bad id is refused."""
+    with new_session() as s:
+        arm = s.model("model0")
+        arm.set_commands({"elbow_flexor": 6.0})
+        arm.step(20)
+        channel = f"{PREFIX}elbow_flexor.current"
+        status = arm.set_measurement_delay(channel, 0.002)  # 2 steps of 1 ms
+        assert status.last == "delay elbow_flexor.current by 2 ms"
+        truth = []
+        for k in range(12):
+            arm.step(1)
+            truth.append(arm.get(channel + ".undelayed"))
+            if k >= 2:
+                assert arm.get(channel) == truth[k - 2]
+        assert truth[0] != truth[-1]  # it moved
+        assert '<measurement_delay channel="elbow_flexor.current"' in arm.export_scene().decode()
+        with pytest.raises(caliper.EditRefused) as e:
+            arm.set_measurement_delay(f"{PREFIX}elbow_flexor.nothing", 0.002)
+        assert "elbow_flexor.nothing" in str(e.value)
+        with pytest.raises(ValueError):
+            arm.set_measurement_delay(channel, float("nan"))
+        arm.undo()
+        arm.step(1)
+        assert channel + ".undelayed" not in {c.id for c in arm.channels(f"{PREFIX}elbow_flexor.*")}

@@ -367,4 +367,38 @@ SceneEdit SetMass(const Scene& scene, const std::string& body, double mass_kg) {
   return {text.str(), set(after), set(before)};
 }
 
+SceneEdit SetMeasurementDelay(const Scene& scene, const std::string& channel, double delay_s) {
+  // the id as the model file names it, or as the DAQ lists it (after the scene's name)
+  const std::string prefix = scene.name + ".";
+  const std::string id = !scene.name.empty() && channel.rfind(prefix, 0) == 0
+                             ? channel.substr(prefix.size())
+                             : channel;
+  if (id.empty()) Refuse("a measurement delay needs a channel id");
+  if (!std::isfinite(delay_s) || delay_s < 0 || delay_s > 10)
+    Refuse("measurement delay of '" + id + "': delay must be in [0, 10] s, not " +
+           std::to_string(delay_s));
+  const auto& delays = scene.measurement_delays;
+  const auto found = std::find_if(delays.begin(), delays.end(),
+                                  [&](const MeasurementDelay& d) { return d.id == id; });
+  // the delay `d` of `id` (0: none), at its place in the list when it had one
+  const size_t at = static_cast<size_t>(found - delays.begin());
+  auto put = [id, at](double d) {
+    return [id, at, d](Scene& s) {
+      auto& list = s.measurement_delays;
+      list.erase(std::remove_if(list.begin(), list.end(),
+                                [&](const MeasurementDelay& m) { return m.id == id; }),
+                 list.end());
+      if (d > 0) list.insert(list.begin() + static_cast<long>(std::min(at, list.size())), {id, d});
+    };
+  };
+  const double before = found == delays.end() ? 0.0 : found->delay;
+  if (delay_s == 0 && before == 0) Refuse("channel '" + id + "' has no measurement delay");
+  std::ostringstream text;
+  if (delay_s == 0)
+    text << "remove the measurement delay of " << id;
+  else
+    text << "delay " << id << " by " << delay_s * 1e3 << " ms";
+  return {text.str(), put(delay_s), put(before)};
+}
+
 }  // namespace caliper::sgal

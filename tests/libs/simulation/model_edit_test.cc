@@ -268,6 +268,89 @@ TEST_F(ModelEdit, RemovingATendonTakesItsChannelsDelaysAlongAndUndoBringsThemBac
   EXPECT_EQ(Read(core_, "measurement_delays.line.tendon.tension.undelayed").size(), 1u);
 }
 
+TEST_F(ModelEdit, AMeasurementDelaySetLiveLagsItsChannelAndUndoRemovesIt) {
+  core_.SetCommands({{"elbow_flexor", 6.0}});
+  core_.StepNow(50);
+  const std::string id = "ecce_arm.elbow_flexor.current";
+  // by the DAQ's id; 3 ms at the arm's 1 ms steps
+  const ModelCore::EditStatus set = core_.Edit(
+      [&](const sgal::Scene& s) { return sgal::SetMeasurementDelay(s, id, 0.003); });
+  EXPECT_EQ(set.last, "delay elbow_flexor.current by 3 ms");
+  ASSERT_EQ(scene()->measurement_delays.size(), 1u);
+  EXPECT_EQ(scene()->measurement_delays[0].id, "elbow_flexor.current");
+  EXPECT_EQ(scene()->measurement_delays[0].delay, 0.003);
+  // from the edit on, the channel reads its true value of 3 steps before (at first, the value at
+  // the edit: the ring starts full of it)
+  std::vector<double> truth;
+  for (int i = 0; i < 20; ++i) {
+    core_.StepNow(1);
+    truth.push_back(Read(core_, id + ".undelayed").at(0));
+    if (i >= 3) {
+      EXPECT_EQ(Read(core_, id).at(0), truth[i - 3]) << i;
+    }
+  }
+  EXPECT_NE(truth.front(), truth.back());  // the current moved
+  // a change of the delay, by the file's id
+  core_.Edit([&](const sgal::Scene& s) {
+    return sgal::SetMeasurementDelay(s, "elbow_flexor.current", 0.001);
+  });
+  EXPECT_EQ(scene()->measurement_delays.at(0).delay, 0.001);
+  core_.StepNow(2);
+  const double before = Read(core_, id + ".undelayed").at(0);
+  core_.StepNow(1);
+  EXPECT_EQ(Read(core_, id).at(0), before);
+  // undo twice: no delay, the channel reads the truth and `.undelayed` is gone
+  core_.Undo();
+  EXPECT_EQ(scene()->measurement_delays.at(0).delay, 0.003);
+  core_.Undo();
+  EXPECT_TRUE(scene()->measurement_delays.empty());
+  core_.StepNow(1);
+  EXPECT_THROW(Read(core_, id + ".undelayed"), UnknownId);
+  // refusals name the reason and change nothing
+  const auto refused = [&](const std::string& channel, double delay, const std::string& why) {
+    try {
+      core_.Edit(
+          [&](const sgal::Scene& s) { return sgal::SetMeasurementDelay(s, channel, delay); });
+      ADD_FAILURE() << channel << " was delayed";
+    } catch (const sgal::EditError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(scene()->measurement_delays.empty());
+  };
+  refused("elbow_flexor.currnt", 0.002, "elbow_flexor.currnt");
+  refused("elbow_flexor.command", 0.002, "written from outside");
+  refused("elbow_flexor.current", -1, "[0, 10] s");
+  refused("elbow_flexor.current", 0, "has no measurement delay");
+}
+
+TEST_F(ModelEdit, ChangingOrRemovingADelayKeepsTheOthersInTheirOrder) {
+  const char* src = std::getenv("CALIPER_SOURCE_DIR");
+  core_.Load(std::string(src ? src : ".") + "/tests/data/collada/measurement_delays.dae");
+  const auto delays = [&] {
+    std::vector<std::pair<std::string, double>> out;
+    for (const auto& d : scene()->measurement_delays) out.emplace_back(d.id, d.delay);
+    return out;
+  };
+  using List = std::vector<std::pair<std::string, double>>;
+  const List loaded = delays();
+  ASSERT_EQ(loaded, (List{{"line.tendon.tension", 0.004}, {"hinge.position", 0.002}}));
+  core_.Edit([&](const sgal::Scene& s) {
+    return sgal::SetMeasurementDelay(s, "line.tendon.tension", 0.006);
+  });
+  EXPECT_EQ(delays(), (List{{"line.tendon.tension", 0.006}, {"hinge.position", 0.002}}));
+  const ModelCore::EditStatus removed = core_.Edit(
+      [&](const sgal::Scene& s) { return sgal::SetMeasurementDelay(s, "line.tendon.tension", 0); });
+  EXPECT_EQ(removed.last, "remove the measurement delay of line.tendon.tension");
+  EXPECT_EQ(delays(), (List{{"hinge.position", 0.002}}));
+  core_.StepNow(5);
+  core_.Undo();
+  EXPECT_EQ(delays(), (List{{"line.tendon.tension", 0.006}, {"hinge.position", 0.002}}));
+  core_.Undo();
+  EXPECT_EQ(delays(), loaded);
+  core_.StepNow(5);  // and it runs
+  EXPECT_EQ(Read(core_, "measurement_delays.line.tendon.tension.undelayed").size(), 1u);
+}
+
 TEST_F(ModelEdit, StopRewindsTimeButKeepsEditsAndLoadForgetsThem) {
   core_.StepNow(50);
   core_.Edit([&](const sgal::Scene& s) { return sgal::SetMass(s, "hand", 0.7); });

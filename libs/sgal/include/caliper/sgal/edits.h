@@ -46,6 +46,10 @@ SceneEdit SetShapeDims(const Scene& scene, const std::string& body, size_t index
                        const std::vector<double>& dims);
 /// Sets a dynamic body's mass [kg]; the inertia tensor scales with it.
 SceneEdit SetMass(const Scene& scene, const std::string& body, double mass_kg);
+/// Delays `channel` by `delay_s` [s] (a MeasurementDelay), or changes its delay; 0 removes its
+/// delay. The id as the model file names it (motor.current) or as the DAQ lists it, after the
+/// scene's name (arm.motor.current). The engine checks the id when it builds the edited scene.
+SceneEdit SetMeasurementDelay(const Scene& scene, const std::string& channel, double delay_s);
 
 /// A primitive's dimensions: box sx sy sz (full edges); sphere r; capsule, cylinder, cone r length;
 /// plane nx ny nz offset; empty for meshes [m].
