@@ -130,12 +130,17 @@ def test_measurement_delays_record_and_verify_bit_for_bit(new_session):
 
 def test_a_measurement_delay_set_live_lags_its_channel(new_session):
     """set_measurement_delay on the running arm: the channel lags its `.undelayed` value by the
-    delay's steps, the export carries the delay, undo removes it; a bad id is refused."""
+    delay's steps, the export carries the delay, undo removes it, a recording across the edits
+    verifies bit for bit; a bad id is refused."""
     with new_session() as s:
         arm = s.model("model0")
         arm.set_commands({"elbow_flexor": 6.0})
         arm.step(20)
         channel = f"{PREFIX}elbow_flexor.current"
+        # recorded across the edits: the replay re-simulates them bit for bit
+        started = arm.start_recording("delay_edit.caliper", [channel, "ecce_arm.elbow.position"],
+                                      every=1, keyframe_every=50)
+        assert started.recording
         status = arm.set_measurement_delay(channel, 0.002)  # 2 steps of 1 ms
         assert status.last == "delay elbow_flexor.current by 2 ms"
         truth = []
@@ -154,3 +159,7 @@ def test_a_measurement_delay_set_live_lags_its_channel(new_session):
         arm.undo()
         arm.step(1)
         assert channel + ".undelayed" not in {c.id for c in arm.channels(f"{PREFIX}elbow_flexor.*")}
+        stopped = arm.stop_recording()
+        assert stopped.error == "" and stopped.steps == 13
+        ok, report = caliper.verify(stopped.path)
+        assert ok, report
