@@ -2,20 +2,16 @@
 // The parameter checks and number texts of the DC motor, its thermal model and the
 // dc_motor_tendon kind's driver, in one place. Private to libs/actuators.
 
-#include <charconv>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "caliper/core/numbers.h"
+
 namespace caliper::actuators::motor_detail {
 
-/// v in the shortest form that reads back as v (locale-free).
-inline std::string Text(double v) {
-  char text[32];
-  const auto end = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, end.ptr);
-}
+using core::FormatDouble;
+inline std::string Text(double v) { return FormatDouble(v); }
 
 enum class Range { kFinite, kPositive, kNonNegative, kFraction, kWhole };
 
@@ -44,12 +40,9 @@ inline void Check(const char* name, const char* unit, double value, Range range)
       expected = "a whole number >= 0";
       break;
   }
-  if (!ok) {
-    std::ostringstream message;
-    message << "parameter '" << name << "' must be " << expected << " [" << unit << "], got "
-            << value;
-    throw std::invalid_argument(message.str());
-  }
+  if (!ok)
+    throw std::invalid_argument(std::string("parameter '") + name + "' must be " + expected +
+                                " [" + unit + "], got " + FormatDouble(value));
 }
 
 }  // namespace caliper::actuators::motor_detail

@@ -45,6 +45,12 @@ double ToDouble(std::string_view text) {
   return value;
 }
 
+std::string FormatDouble(double value) {
+  char text[32];  // the longest shortest form of a double takes 24
+  const auto end = std::to_chars(text, text + sizeof text, value);
+  return std::string(text, end.ptr);
+}
+
 bool ParseInt(std::string_view text, long long* value, std::string* why) {
   return Parse(text, value, why, "an integer");
 }

@@ -6,7 +6,6 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
@@ -24,6 +23,7 @@
 #endif
 
 #include "caliper/actuators/actuator.h"
+#include "caliper/core/numbers.h"
 #include "caliper/actuators/tendon_contact.h"
 #include "caliper/actuators/tendon_path.h"
 
@@ -172,11 +172,7 @@ constexpr int kMaxDelaySteps = 1000;
 constexpr double kMaxDelayedValues = 20000;
 
 /// A number as text, shortest round-trip form, independent of the locale.
-std::string Text(double v) {
-  char text[32];
-  const auto end = std::to_chars(text, text + sizeof text, v);
-  return std::string(text, end.ptr);
-}
+std::string Text(double v) { return core::FormatDouble(v); }
 
 /// The readable name of a type.
 std::string TypeName(const std::type_info& type) {

@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
@@ -18,6 +17,8 @@
 #include <mutex>
 #include <thread>
 #include <variant>
+
+#include "caliper/core/numbers.h"
 
 namespace caliper::recording {
 
@@ -37,11 +38,7 @@ constexpr uint32_t kStateVersion = 2;
 constexpr uint32_t kStateVersionWithoutMeasurements = 1;
 
 // a double's text that reads back as the same double
-std::string ExactText(double v) {
-  char text[32];
-  const auto end = std::to_chars(text, text + sizeof text, v).ptr;
-  return std::string(text, end);
-}
+std::string ExactText(double v) { return core::FormatDouble(v); }
 
 // little-endian bytes, whatever the host's order (the file is read by Python's struct "<d")
 void PutU64(std::string* out, uint64_t v) {

@@ -5,6 +5,7 @@
 #include <clocale>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include "comma_locale.h"
@@ -66,6 +67,24 @@ TEST(ParseDoubleTest, IgnoresACommaDecimalLocale) {
   ASSERT_TRUE(ParseDouble("1.5", &v));
   EXPECT_EQ(v, 1.5);
   EXPECT_FALSE(ParseDouble("1,5", &v));
+}
+
+TEST(FormatDoubleTest, WritesTheShortestTextThatReadsBackBitForBit) {
+  CALIPER_COMMA_DECIMAL_LOCALE(locale);  // and never a comma
+  EXPECT_EQ(FormatDouble(0.1), "0.1");
+  EXPECT_EQ(FormatDouble(1.5), "1.5");
+  EXPECT_EQ(FormatDouble(-2e-5), "-2e-05");
+  EXPECT_EQ(FormatDouble(0.0039), "0.0039");
+  EXPECT_EQ(FormatDouble(HUGE_VAL), "inf");
+  for (const double v : {0.1, 1.0 / 3, -0.0, 5e-324, 1.7976931348623157e308, 123456789.125,
+                         -HUGE_VAL}) {
+    double back = 0;
+    ASSERT_TRUE(ParseDouble(FormatDouble(v), &back)) << FormatDouble(v);
+    EXPECT_EQ(std::memcmp(&back, &v, sizeof v), 0) << FormatDouble(v);
+  }
+  double back = 0;
+  ASSERT_TRUE(ParseDouble(FormatDouble(NAN), &back));
+  EXPECT_TRUE(std::isnan(back));
 }
 
 TEST(ClassicLocaleScopeTest, GivesTheThreadTheCLocaleAndRestoresBoth) {

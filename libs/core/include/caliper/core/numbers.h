@@ -22,6 +22,10 @@ bool ParseDouble(std::string_view text, double* value, std::string* why = nullpt
 /// ParseDouble that throws std::invalid_argument with the reason.
 double ToDouble(std::string_view text);
 
+/// `value` as the shortest decimal text that ParseDouble reads back as the same double (`0.1`,
+/// `1e-05`, `inf`, `nan`), under every locale: for messages, files and ids.
+std::string FormatDouble(double value);
+
 /// Reads all of `text` as a decimal integer (`-12`, `+7`); false, with the reason in `why` when
 /// given ("'1.5' is not an integer"), when it is not one or does not fit.
 bool ParseInt(std::string_view text, long long* value, std::string* why = nullptr);
