@@ -76,9 +76,7 @@ class ExtensionReader {
     return u;
   }
 
-  // Metres per number of an element's lengths: the unit attribute of the element or of the
-  // nearest enclosing one in the technique, else the document's unit.
-  // seconds per unit of the element's own `unit` attribute, a time (1 without one)
+  // Seconds per number of an element's time: its own `unit` attribute, a time (1 without one).
   double TimeScale(const Element& e) {
     const std::string* unit = e.FindAttribute("unit");
     if (unit == nullptr) return 1;
@@ -88,6 +86,8 @@ class ExtensionReader {
     return u.scale;
   }
 
+  // Metres per number of an element's lengths: the unit attribute of the element or of the
+  // nearest enclosing one in the technique, else the document's unit.
   double LengthScale(const Element& e) {
     // up to the technique itself (a <caliper> element of a URDF file has no <technique> above it)
     for (const Element* k = &e; k != nullptr; k = k == technique_ ? nullptr : k->parent) {

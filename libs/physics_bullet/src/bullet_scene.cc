@@ -23,9 +23,9 @@
 #endif
 
 #include "caliper/actuators/actuator.h"
-#include "caliper/core/numbers.h"
 #include "caliper/actuators/tendon_contact.h"
 #include "caliper/actuators/tendon_path.h"
+#include "caliper/core/numbers.h"
 
 namespace caliper::physics_bullet {
 
