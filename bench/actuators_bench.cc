@@ -4,7 +4,7 @@
 //   RATIO <name> <ns per step> (target <target>)
 // measured in this run (the median of several repetitions; a comment line before it gives the
 // fastest repetition too, the better figure on a shared machine), never compared with stored
-// times. Options: --steps N, --repeats N.
+// times. Options: --steps N, --repeats N, --only NAME (one case alone, for a profiler).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -272,11 +272,23 @@ std::vector<Case> Cases() {
 
 int main(int argc, char** argv) {
   using namespace caliper::bench;
+  std::string only;  // one case to time alone (for a profiler)
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::string(argv[i]) == "--steps")
       steps = std::max(1, std::atoi(argv[++i]));
     else if (std::string(argv[i]) == "--repeats")
       repeats = std::max(1, std::atoi(argv[++i]));
+    else if (std::string(argv[i]) == "--only")
+      only = argv[++i];
+  }
+  if (!only.empty()) {
+    for (const Case& c : Cases())
+      if (c.name == only) {
+        std::printf("# %s: median %.1f ns per step\n", c.name.c_str(), TimeCase(c).median);
+        return 0;
+      }
+    std::fprintf(stderr, "actuators_bench: no case named '%s'\n", only.c_str());
+    return 2;
   }
   std::printf("# actuator step cost, %d steps of 1 ms, median of %d runs\n", steps, repeats);
   const std::vector<Case> cases = Cases();

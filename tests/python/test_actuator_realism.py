@@ -1,6 +1,7 @@
-"""Heat, friction, cogging and the driver (PWM, slew, command delay) on the Model of the shipped
-arm: set live as parameters, read as DAQ channels, exported with the scene, recorded and
-re-simulated bit for bit, and the thermal protection's warning in the Model's log."""
+"""Heat, friction, cogging and the driver (PWM, slew, command delay), and the biceps muscle's
+command delay, on the Model of the shipped arm: set live as parameters, read as DAQ channels,
+exported with the scene, recorded and re-simulated bit for bit, and the thermal protection's
+warning in the Model's log."""
 
 import glob
 import math
@@ -80,13 +81,16 @@ def test_record_and_verify_bit_for_bit(new_session):
     with new_session() as s:
         arm = s.model("model0")
         configure(arm, THERMAL + REALISM)
+        arm.set(f"{PREFIX}biceps.command_delay", 0.025)  # the muscle's excitation, 25 steps late
         ids = [f"{PREFIX}elbow_flexor.winding_temperature", f"{PREFIX}elbow_flexor.current",
                f"{PREFIX}elbow_flexor.driver_voltage", f"{PREFIX}elbow_flexor.cogging_torque",
-               "ecce_arm.elbow.position"]
+               "ecce_arm.elbow.position", f"{PREFIX}biceps.delayed_command",
+               f"{PREFIX}biceps.activation"]
         started = arm.start_recording("realism.caliper", ids, every=1, keyframe_every=250)
         for k in range(150):
             u = 3 + 3 * math.sin(0.2 * k)
-            arm.set_commands({"elbow_flexor": u, "elbow_extensor": 6 - u})
+            arm.set_commands({"elbow_flexor": u, "elbow_extensor": 6 - u,
+                              "biceps": 0.5 + 0.4 * math.sin(0.3 * k)})
             arm.step(10)
         stopped = arm.stop_recording()
         assert started.recording and stopped.steps == 1500 and stopped.error == ""
@@ -101,8 +105,17 @@ def test_record_and_verify_bit_for_bit(new_session):
         at = int(np.searchsorted(data.steps, 1100))
         assert arm.get(ids[2]) == data[ids[2]][at]
         assert arm.get(ids[0]) == data[ids[0]][at]
+        # the muscle followed each excitation 25 steps after it was sent (every 10 steps)
+        delayed = data[ids[5]]
+        sent = [0.5 + 0.4 * math.sin(0.3 * k) for k in range(150)]
+        for step in (400, 777, 1234):
+            at_step = int(np.searchsorted(data.steps, step))
+            assert delayed[at_step] == sent[(step - 1 - 25) // 10]
+        assert arm.get(ids[6]) == data[ids[6]][at]
         arm.step(37)
         assert arm.get(ids[3]) == data[ids[3]][at + 37]
+        assert arm.get(ids[5]) == data[ids[5]][at + 37]
+        assert arm.get(ids[6]) == data[ids[6]][at + 37]
 
 
 def test_measurement_delays_record_and_verify_bit_for_bit(new_session):

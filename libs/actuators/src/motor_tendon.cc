@@ -15,6 +15,7 @@
 #include "caliper/actuators/dc_motor.h"
 #include "caliper/actuators/elastic.h"
 #include "caliper/logging/log.h"
+#include "command_delay.h"
 #include "motor_checks.h"
 
 namespace caliper::actuators {
@@ -116,11 +117,6 @@ const DriverField kDriverFields[] = {
      "time from a command to the driver, rounded to whole time steps (at most 50 of them)"},
 };
 
-// the most time steps a command may be delayed by: the actuator's state holds as many commands
-// in flight, each motor the same (a state's size may not depend on a parameter a live edit
-// changes: recordings restore keyframes into scenes built from the edited description)
-constexpr int kMaxCommandDelaySteps = 50;
-
 constexpr double kDefaultSupplyVoltage = 12;  // [V]
 
 std::string Number(double value) {
@@ -220,7 +216,6 @@ class DcMotorTendon : public TendonActuator {
     pretension_ = ParameterOr(a, "pretension", 0);
     for (const DriverField& field : kDriverFields)
       driver_.*field.member = ParameterOr(a, field.name, driver_.*field.member);
-    pending_.resize(kMaxCommandDelaySteps + 1);
     const auto input = a.options.find("input");
     if (input != a.options.end()) {
       if (input->second == "duty")
@@ -234,6 +229,7 @@ class DcMotorTendon : public TendonActuator {
       CheckSupplyVoltage(supply_voltage_);
       CheckPretension(pretension_);
       for (const DriverField& field : kDriverFields) CheckDriver(field, driver_.*field.member);
+      delay_.SetDelay(driver_.command_delay);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -255,10 +251,7 @@ class DcMotorTendon : public TendonActuator {
     }
     elastic_->Reset(length);
     // the driver has given the present command since ever
-    pending_count_ = 0;
-    pending_head_ = 0;
-    steps_ = 0;
-    delayed_command_ = command_;
+    delay_.Reset(command_);
     driver_voltage_ = TargetVoltage();
     warned_ = false;
     path_length_ = path_length;
@@ -280,7 +273,6 @@ class DcMotorTendon : public TendonActuator {
                          motor_.parameters().spool_radius);
     DriveStep(dt);
     motor_.Step(driver_voltage_, dt, load);
-    ++steps_;
     if (motor_.parameters().thermal()) WatchTemperature();
     // everything reported is at the end of the step, where the tension is
     path_length_ = path_length + path_speed * dt;
@@ -302,10 +294,9 @@ class DcMotorTendon : public TendonActuator {
 
   double tension() const override { return tension_; }
 
-  // the motor's, the elastic element's, what the step reports and the driver's (its delay line
-  // last: only its pending commands are written)
+  // the motor's, what the step reports and the driver's, the elastic element's, the delay line's
   std::size_t StateSize() const override {
-    return kOwnState + elastic_state_ + 1 + 2 * pending_.size();
+    return kOwnState + elastic_state_ + CommandDelay::kStateSize;
   }
 
   void SaveState(double* out) const override {
@@ -316,19 +307,12 @@ class DcMotorTendon : public TendonActuator {
     out[2] = line_length_;
     out[3] = elastic_length_;
     out[4] = tension_;
-    out[5] = static_cast<double>(steps_);
-    out[6] = delayed_command_;
-    out[7] = driver_voltage_;
-    out[8] = warned_ ? 1 : 0;
+    out[5] = driver_voltage_;
+    out[6] = warned_ ? 1 : 0;
     out += kOwnState - DcMotor::kStateSize;
     if (elastic_state_ > 0) elastic_->SaveState(out);
     out += elastic_state_;
-    out[0] = pending_count_;
-    for (int k = 0; k < pending_count_; ++k) {
-      const Pending& p = pending_[(pending_head_ + k) % capacity()];
-      out[1 + 2 * k] = static_cast<double>(p.issued);
-      out[2 + 2 * k] = p.value;
-    }
+    delay_.SaveState(out);
   }
 
   void RestoreState(const double* in) override {
@@ -339,18 +323,12 @@ class DcMotorTendon : public TendonActuator {
     line_length_ = in[2];
     elastic_length_ = in[3];
     tension_ = in[4];
-    steps_ = static_cast<std::int64_t>(in[5]);
-    delayed_command_ = in[6];
-    driver_voltage_ = in[7];
-    warned_ = in[8] != 0;
+    driver_voltage_ = in[5];
+    warned_ = in[6] != 0;
     in += kOwnState - DcMotor::kStateSize;
     if (elastic_state_ > 0) elastic_->RestoreState(in);
     in += elastic_state_;
-    pending_head_ = 0;
-    // a count out of range (not from SaveState) empties the line
-    pending_count_ = in[0] >= 0 && in[0] <= capacity() ? static_cast<int>(in[0]) : 0;
-    for (int k = 0; k < pending_count_; ++k)
-      pending_[k] = {static_cast<std::int64_t>(in[1 + 2 * k]), in[2 + 2 * k]};
+    delay_.RestoreState(in);
   }
 
   void SetTimeStep(double dt) override {
@@ -358,7 +336,7 @@ class DcMotorTendon : public TendonActuator {
       throw std::invalid_argument(prefix_ + "time step must be > 0 [s], got " + Number(dt));
     try {
       DcMotor::CheckSubsteps(dt, motor_.parameters().max_substep);
-      delay_steps_ = DelaySteps(driver_.command_delay, dt);
+      delay_.SetTimeStep(dt);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(prefix_ + e.what());
     }
@@ -368,23 +346,7 @@ class DcMotorTendon : public TendonActuator {
   void SetCommand(double value) override {
     RequireFinite(prefix_, "command", value);
     command_ = duty_input_ ? std::clamp(value, -1.0, 1.0) : value;
-    if (driver_.command_delay == 0 && pending_count_ == 0) {
-      delayed_command_ = command_;
-      return;
-    }
-    // into the delay line, issued before step steps_; a later command before the same step
-    // replaces the earlier
-    if (pending_count_ > 0) {
-      Pending& back = pending_[(pending_head_ + pending_count_ - 1) % capacity()];
-      if (back.issued == steps_) {
-        back.value = command_;
-        return;
-      }
-    }
-    // the line never overflows: a step leaves at most delay_steps_ <= kMaxCommandDelaySteps
-    // commands in it, and one more arrives before the next
-    pending_[(pending_head_ + pending_count_) % capacity()] = {steps_, command_};
-    ++pending_count_;
+    delay_.Issue(command_);
   }
   double command() const override { return command_; }
   std::string command_unit() const override { return duty_input_ ? "" : "V"; }
@@ -430,7 +392,7 @@ class DcMotorTendon : public TendonActuator {
     if (name == "current_limit_now") return motor_.current_limit();
     if (name == "derating") return motor_.derating();
     if (name == "driver_voltage") return driver_voltage_;
-    if (name == "delayed_command") return delayed_command_;
+    if (name == "delayed_command") return delay_.delayed();
     if (HasElastic(name)) return elastic_->Get(name);
     throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
   }
@@ -467,10 +429,8 @@ class DcMotorTendon : public TendonActuator {
       for (const DriverField& field : kDriverFields) {
         if (name != field.name) continue;
         CheckDriver(field, value);
-        DriverParameters driver = driver_;
-        driver.*field.member = value;
-        if (time_step_ > 0) delay_steps_ = DelaySteps(driver.command_delay, time_step_);
-        driver_ = driver;
+        if (field.member == &DriverParameters::command_delay) delay_.SetDelay(value);
+        driver_.*field.member = value;
         return;
       }
       for (const auto& [state, unit] : kStates)
@@ -507,30 +467,13 @@ class DcMotorTendon : public TendonActuator {
       {"driver_voltage", "V"},
       {"delayed_command", nullptr}};  // null: the command's unit
 
-  struct Pending {
-    std::int64_t issued;  // before this step (steps_ then)
-    double value;         // the command
-  };
-  int capacity() const { return static_cast<int>(pending_.size()); }
-
   static void CheckDriver(const DriverField& field, double value) {
     Check(field.name, field.unit, value, field.whole ? Range::kWhole : Range::kNonNegative);
   }
-  // a delay [s] in time steps of dt [s]; throws std::invalid_argument beyond the line
-  static int DelaySteps(double delay, double dt) {
-    const double steps = std::round(delay / dt);
-    if (steps > kMaxCommandDelaySteps)
-      throw std::invalid_argument("parameter 'command_delay' = " + Text(delay) + " s is " +
-                                  Text(steps) + " time steps of " + Text(dt) + " s; at most " +
-                                  std::to_string(kMaxCommandDelaySteps) + " (" +
-                                  Text(kMaxCommandDelaySteps * dt) + " s at this time step)");
-    return static_cast<int>(steps);
-  }
-
   // the driver's output for the delayed command: with a PWM, quantised to its duty steps within
   // the supply; then moved toward at the slew rate
   double TargetVoltage() const {
-    double target = voltage(delayed_command_);
+    double target = voltage(delay_.delayed());
     const double levels = driver_.pwm_levels;
     if (levels > 0) {
       const double duty = std::clamp(target / supply_voltage_, -1.0, 1.0);
@@ -539,20 +482,10 @@ class DcMotorTendon : public TendonActuator {
     return target;
   }
   void DriveStep(double dt) {
-    if (pending_count_ > 0) {
-      if (dt != time_step_) {  // a caller that did not say its time step first
-        try {
-          delay_steps_ = DelaySteps(driver_.command_delay, dt);
-        } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument(prefix_ + e.what());
-        }
-        time_step_ = dt;
-      }
-      while (pending_count_ > 0 && steps_ - pending_[pending_head_].issued >= delay_steps_) {
-        delayed_command_ = pending_[pending_head_].value;
-        pending_head_ = (pending_head_ + 1) % capacity();
-        --pending_count_;
-      }
+    try {
+      delay_.Take(dt);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(prefix_ + e.what());
     }
     const double target = TargetVoltage();
     if (driver_.slew_rate > 0) {
@@ -629,18 +562,13 @@ class DcMotorTendon : public TendonActuator {
   std::unique_ptr<ElasticElement> elastic_;
   const LinearSpringDamper* linear_ = nullptr;  // elastic_ when it is linear (no virtual calls)
   std::size_t elastic_state_ = 0;               // elastic_->StateSize()
-  static constexpr std::size_t kOwnState = DcMotor::kStateSize + 9;
+  static constexpr std::size_t kOwnState = DcMotor::kStateSize + 7;
   bool duty_input_ = false;
   double supply_voltage_ = kDefaultSupplyVoltage;  // [V]
   double pretension_ = 0;                          // at Reset [N]
   double command_ = 0;                             // [V] or duty [-]
   DriverParameters driver_;
-  int delay_steps_ = 0;           // driver_.command_delay in steps of time_step_
-  std::vector<Pending> pending_;  // the delay line, oldest at pending_head_
-  int pending_head_ = 0;
-  int pending_count_ = 0;
-  std::int64_t steps_ = 0;      // since Reset
-  double delayed_command_ = 0;  // the command the driver follows
+  CommandDelay delay_;          // the command's way to the driver (driver_.command_delay)
   double driver_voltage_ = 0;   // its output [V]
   bool warned_ = false;         // of the thermal protection
   double time_step_ = 0;        // the engine's, once told [s]

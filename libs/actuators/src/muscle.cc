@@ -20,6 +20,7 @@
 
 #include "builtin_kinds.h"
 #include "caliper/actuators/actuator.h"
+#include "command_delay.h"
 #include "muscle_curves.h"
 #include "muscle_parameters.h"
 #include "muscle_validation.h"
@@ -137,6 +138,7 @@ class HillMuscle : public TendonActuator {
   void Reset(double path_length) override {
     CheckFinite("path length", path_length);
     activation_ = InitialActivation();
+    delay_.Reset(excitation_);
     if (elastic_)
       fiber_length_ = millard_ ? MillardEquilibrium(path_length, activation_)
                                : EquilibriumFiberLength(path_length, activation_);
@@ -149,15 +151,19 @@ class HillMuscle : public TendonActuator {
     CheckFinite("path speed at the end", end_speed);
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
+    try {
+      delay_.Take(dt);  // the excitation this step follows: delayed_excitation()
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(Prefix() + e.what());
+    }
     if (mujoco_integrator_) {
       // MuJoCo's order: the force of the current state, then act += dt * act_dot
       Evaluate(path_length, path_speed);
       const bool thelen = curves_ == Curves::kThelen;
-      const double rate =
-          ActivationRate(excitation_, activation_,
-                         thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act,
-                         thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact,
-                         MinimumActivation());
+      const double rate = ActivationRate(
+          delayed_excitation(), activation_,
+          thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act,
+          thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact, MinimumActivation());
       activation_ = Clamp(activation_ + dt * rate, MinimumActivation(), 1);
       return out_.tension;
     }
@@ -183,28 +189,36 @@ class HillMuscle : public TendonActuator {
   double tension() const override { return out_.tension; }
 
   // the activation, the fibre length and the outputs Get() reports (the solvers start afresh
-  // from these in every step)
-  std::size_t StateSize() const override { return 2 + kOutputValues; }
+  // from these in every step), then the excitations in flight
+  std::size_t StateSize() const override { return 2 + kOutputValues + CommandDelay::kStateSize; }
   void SaveState(double* out) const override {
     out[0] = activation_;
     out[1] = fiber_length_;
     std::memcpy(out + 2, &out_, sizeof out_);
+    delay_.SaveState(out + 2 + kOutputValues);
   }
   void RestoreState(const double* in) override {
     activation_ = in[0];
     fiber_length_ = in[1];
     std::memcpy(static_cast<void*>(&out_), in + 2, sizeof out_);
+    delay_.RestoreState(in + 2 + kOutputValues);
   }
 
   void SetTimeStep(double dt) override {
     if (!(dt > 0) || !std::isfinite(dt))
       throw std::invalid_argument(Prefix() + "time step " + Num(dt) + " s must be > 0");
     if (elastic_) FiberSubsteps(dt);  // throws when there would be too many
+    try {
+      delay_.SetTimeStep(dt);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(Prefix() + e.what());
+    }
   }
 
   void SetCommand(double value) override {
     CheckFinite("excitation", value);
     excitation_ = Clamp(value, 0, 1);
+    delay_.Issue(excitation_);
   }
   double command() const override { return excitation_; }
   std::string command_unit() const override { return ""; }
@@ -217,7 +231,9 @@ class HillMuscle : public TendonActuator {
       q.push_back({"max_isometric_force", "N", false, true});
       q.push_back({"optimal_fiber_length", "m", false, true});
     }
+    q.push_back({"command_delay", "s", true, true});
     q.push_back({"excitation", "", true, false});
+    q.push_back({"delayed_command", "", false, false});
     q.push_back({"activation", "", true, false});
     q.push_back({"fiber_length", "m", elastic_, false});
     for (const auto& [name, unit] : OutputNames()) q.push_back({name, unit, false, false});
@@ -237,7 +253,9 @@ class HillMuscle : public TendonActuator {
       }
     if (curves_ == Curves::kMujoco && name == "max_isometric_force") return MujocoF0();
     if (curves_ == Curves::kMujoco && name == "optimal_fiber_length") return MujocoL0();
+    if (name == "command_delay") return delay_.delay();
     if (name == "excitation") return excitation_;
+    if (name == "delayed_command") return delay_.delayed();
     if (name == "activation") return activation_;
     if (name == "fiber_length") return elastic_ ? fiber_length_ : out_.fiber_length;
     if (name == "fiber_velocity") return out_.fiber_velocity;
@@ -275,6 +293,14 @@ class HillMuscle : public TendonActuator {
       }
     if (name == "excitation") {
       SetCommand(value);
+      return;
+    }
+    if (name == "command_delay") {
+      try {
+        delay_.SetDelay(value);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(Prefix() + e.what());
+      }
       return;
     }
     if (name == "activation") {
@@ -322,6 +348,9 @@ class HillMuscle : public TendonActuator {
     return names;
   }
 
+  // the excitation the activation follows in this step: the command, `command_delay` late
+  double delayed_excitation() const { return delay_.delayed(); }
+
   std::string Prefix() const {
     return "hill_muscle '" + name_ + "' (curves=" + CurvesName(curves_) + "): ";
   }
@@ -350,7 +379,7 @@ class HillMuscle : public TendonActuator {
   double IntegrateActivation(double a, double h) const {
     const bool thelen = curves_ == Curves::kThelen;
     const double minimum = MinimumActivation();
-    const double u = Clamp(excitation_, minimum, 1);
+    const double u = Clamp(delayed_excitation(), minimum, 1);
     a = Clamp(a, minimum, 1);
     double tau_act = thelen ? p_.thelen.activation_time_constant : p_.mujoco.tau_act;
     double tau_deact = thelen ? p_.thelen.deactivation_time_constant : p_.mujoco.tau_deact;
@@ -760,6 +789,7 @@ class HillMuscle : public TendonActuator {
   double minimum_fiber_length_ = 0;  // [m]
   double passive_denominator_ = 1;   // exp(kshape_passive) - 1 [-]
   double excitation_ = 0;            // command u [-], in [0, 1]
+  CommandDelay delay_;               // its way to the muscle (command_delay)
   double activation_ = 0;            // [-]
   double fiber_length_ = 0;          // elastic tendon state [m]
   // the elastic-tendon curve constants (Thelen), once per parameter change
@@ -833,6 +863,7 @@ std::unique_ptr<TendonActuator> MakeHillMuscle(const sgal::Actuator& a) {
     throw std::invalid_argument(where + error.what());
   }
   auto muscle = std::make_unique<HillMuscle>(a.name, curves, elastic, p);
+  muscle->Set("command_delay", ParameterOr(a, "command_delay", 0));
   if (const auto it = a.options.find("integrator"); it != a.options.end()) {
     if (it->second == "mujoco") {
       if (elastic)
@@ -862,6 +893,9 @@ void RegisterMuscleKinds() {
     else
       same->help += "; " + std::string(e.help);
   }
+  specs.push_back({"command_delay", "s", 0, false,
+                   "time from an excitation command to the muscle (a nerve's conduction), "
+                   "rounded to whole time steps (at most 50 of them)"});
   RegisterKind("hill_muscle", std::move(specs), MakeHillMuscle);
 }
 

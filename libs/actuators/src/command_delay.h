@@ -1,0 +1,64 @@
+#pragma once
+// A command's way to an actuator, delayed by whole time steps: what a motor driver's bus or a
+// muscle's nerve takes before it acts on a command. Private to libs/actuators; every commanded
+// kind holds one (dc_motor_tendon, hill_muscle), with the parameter `command_delay` [s] and the
+// state `delayed_command`.
+
+#include <cstddef>
+#include <cstdint>
+
+namespace caliper::actuators {
+
+class CommandDelay {
+ public:
+  /// The most time steps a command may be delayed by. The line holds as many commands in flight
+  /// in every actuator alike: a state's size may not depend on a parameter a live edit changes
+  /// (recordings restore keyframes into scenes built from the edited description).
+  static constexpr int kMaxSteps = 50;
+  /// Values SaveState() writes: the step count, the delayed command, the commands in flight
+  /// and each one's (step issued, value).
+  static constexpr std::size_t kStateSize = 3 + 2 * (kMaxSteps + 1);
+
+  /// The delay [s]; throws std::invalid_argument "parameter 'command_delay' ..." when it is
+  /// negative or not finite, or longer than the line at the time step already known.
+  void SetDelay(double seconds);
+  double delay() const { return delay_; }
+  /// The engine's time step [s]; throws std::invalid_argument when the delay would take more
+  /// than kMaxSteps of it.
+  void SetTimeStep(double dt);
+
+  /// Empties the line: the actuator has followed `command` since ever.
+  void Reset(double command);
+  /// A command given before the next step; a later one before the same step replaces it.
+  void Issue(double command);
+  /// At the start of a step of dt [s]: the command the actuator follows through it (the last
+  /// one issued at least the delay's steps ago). Throws as SetTimeStep() for a dt not told
+  /// before that makes the delay too long.
+  double Take(double dt);
+  /// The command followed in the last step taken; without a delay (and nothing in flight from
+  /// an earlier one), the last command issued.
+  double delayed() const { return delayed_; }
+
+  void SaveState(double* out) const;
+  /// Reads back what SaveState() wrote; a count of commands out of range empties the line.
+  void RestoreState(const double* in);
+
+ private:
+  struct Pending {
+    std::int64_t issued;  // the step before which it was given
+    double value;
+  };
+  static constexpr int kCapacity = kMaxSteps + 1;
+  static int Steps(double delay, double dt);  // throws beyond the line
+
+  double delay_ = 0;                 // [s]
+  double time_step_ = 0;             // the engine's, once told [s]
+  int delay_steps_ = 0;              // delay_ in steps of time_step_
+  Pending pending_[kCapacity] = {};  // a ring, oldest at head_
+  int head_ = 0;
+  int count_ = 0;
+  std::int64_t steps_ = 0;  // steps taken since Reset
+  double delayed_ = 0;      // the command followed
+};
+
+}  // namespace caliper::actuators

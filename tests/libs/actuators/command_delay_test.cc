@@ -1,0 +1,180 @@
+// The command delay every commanded kind has (`command_delay` [s], state `delayed_command`), here
+// on hill_muscle in each of its forms: a delayed muscle is the same muscle fed its commands late
+// by hand, bit for bit; commands in flight survive SaveState/RestoreState; the bounds of the line.
+// dc_motor_tendon's driver delay is checked in motor_realism_test.cc (a delayed PD loop).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "caliper/actuators/actuator.h"
+#include "make_muscle.h"
+
+namespace caliper::actuators {
+namespace {
+
+using test_support::MakeMuscle;
+
+struct Form {
+  const char* name;
+  std::map<std::string, std::string> options;
+  std::map<std::string, double> parameters;
+};
+
+// the muscle's forms: each integrates the activation its own way
+std::vector<Form> Forms() {
+  const std::map<std::string, double> thelen = {{"optimal_fiber_length", 0.1},
+                                                {"tendon_slack_length", 0.2}};
+  return {{"thelen2003 rigid", {{"curves", "thelen2003"}}, thelen},
+          {"thelen2003 elastic", {{"curves", "thelen2003"}, {"tendon", "elastic"}}, thelen},
+          {"millard2012 elastic", {{"curves", "millard2012"}, {"tendon", "elastic"}}, thelen},
+          {"thelen2003, MuJoCo's integrator",
+           {{"curves", "thelen2003"}, {"integrator", "mujoco"}},
+           thelen},
+          {"mujoco",
+           {{"curves", "mujoco"}},
+           {{"lengthrange_lo", 0.10242022997},
+            {"lengthrange_hi", 0.340386464984},
+            {"acc0", 0.558692074634}}}};
+}
+
+double PathLength(const Form& form, int step) {
+  const double mean =
+      form.options.count("curves") && form.options.at("curves") == "mujoco" ? 0.22 : 0.3;
+  return mean + 0.01 * std::sin(0.002 * step);
+}
+
+// a pulse train of excitations, changing every few steps (and twice within one step below)
+double Excitation(int step) { return (step / 37) % 2 ? 0.9 : 0.1 + 0.001 * (step % 37); }
+
+TEST(CommandDelay, AMuscleFollowsItsExcitationsLateByExactlyTheDelay) {
+  const double dt = 1e-3;
+  const int delay = 9;  // steps
+  for (const Form& form : Forms()) {
+    SCOPED_TRACE(form.name);
+    std::map<std::string, double> delayed_parameters = form.parameters;
+    delayed_parameters["command_delay"] = delay * dt;
+    auto delayed = MakeMuscle(form.options, delayed_parameters);
+    auto plain = MakeMuscle(form.options, form.parameters);
+    for (auto* m : {delayed.get(), plain.get()}) {
+      m->SetTimeStep(dt);
+      m->Reset(PathLength(form, 0));
+    }
+    std::deque<double> issued(delay, 0.0);  // the plain muscle's excitations, 9 steps late
+    double gap = 0;                         // to the undelayed activation
+    auto undelayed = MakeMuscle(form.options, form.parameters);
+    undelayed->SetTimeStep(dt);
+    undelayed->Reset(PathLength(form, 0));
+    for (int i = 0; i < 600; ++i) {
+      const double length = PathLength(form, i);
+      const double speed = 0.01 * 0.002 / dt * std::cos(0.002 * i);
+      delayed->SetCommand(0.5);  // replaced by the next command before the same step
+      delayed->SetCommand(Excitation(i));
+      undelayed->SetCommand(Excitation(i));
+      issued.push_back(Excitation(i));
+      plain->SetCommand(issued.front());
+      issued.pop_front();
+      delayed->Step(length, speed, dt, speed);
+      plain->Step(length, speed, dt, speed);
+      undelayed->Step(length, speed, dt, speed);
+      ASSERT_EQ(delayed->Get("activation"), plain->Get("activation")) << "step " << i;
+      ASSERT_EQ(delayed->tension(), plain->tension()) << "step " << i;
+      // the commanded excitation at once, the followed one as the plain muscle was given it
+      ASSERT_EQ(delayed->command(), Excitation(i)) << "step " << i;
+      ASSERT_EQ(delayed->Get("delayed_command"), plain->command()) << "step " << i;
+      gap = std::max(gap, std::abs(delayed->Get("activation") - undelayed->Get("activation")));
+    }
+    EXPECT_GT(gap, 0.05);  // the delay changes what the muscle does
+    EXPECT_EQ(delayed->Get("command_delay"), delay * dt);
+    // without a delay the followed excitation is the command, from the moment it is given
+    EXPECT_EQ(undelayed->Get("delayed_command"), undelayed->command());
+  }
+}
+
+TEST(CommandDelay, ExcitationsInFlightSurviveSaveAndRestoreBitForBit) {
+  const double dt = 1e-3;
+  for (const Form& form : Forms()) {
+    SCOPED_TRACE(form.name);
+    std::map<std::string, double> parameters = form.parameters;
+    parameters["command_delay"] = 0.02;
+    auto a = MakeMuscle(form.options, parameters);
+    auto b = MakeMuscle(form.options, parameters);
+    a->SetTimeStep(dt);
+    b->SetTimeStep(dt);
+    a->Reset(PathLength(form, 0));
+    b->Reset(PathLength(form, 0));
+    std::vector<double> saved(a->StateSize());
+    EXPECT_EQ(saved.size(), b->StateSize());
+    for (int i = 0; i < 300; ++i) {
+      a->SetCommand(Excitation(i));
+      if (i == 150) {
+        // 20 steps of excitations in flight, the newest given just now
+        a->SaveState(saved.data());
+        b->RestoreState(saved.data());
+      }
+      if (i > 150) b->SetCommand(Excitation(i));
+      const double speed = 0.01 * 0.002 / dt * std::cos(0.002 * i);
+      a->Step(PathLength(form, i), speed, dt, speed);
+      if (i >= 150) {
+        b->Step(PathLength(form, i), speed, dt, speed);
+        ASSERT_EQ(a->Get("activation"), b->Get("activation")) << i;
+        ASSERT_EQ(a->Get("delayed_command"), b->Get("delayed_command")) << i;
+        ASSERT_EQ(a->tension(), b->tension()) << i;
+      }
+    }
+  }
+}
+
+TEST(CommandDelay, TheLineIsBoundedAndBadDelaysAreRefusedWithTheMuscleNamed) {
+  const Form form = Forms()[0];
+  std::map<std::string, double> parameters = form.parameters;
+  parameters["command_delay"] = 0.2;  // 200 steps of 1 ms
+  auto m = MakeMuscle(form.options, parameters);
+  try {
+    m->SetTimeStep(1e-3);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("hill_muscle 'm'"), std::string::npos) << what;
+    EXPECT_NE(what.find("200 time steps"), std::string::npos) << what;
+    EXPECT_NE(what.find("at most 50 "), std::string::npos) << what;
+  }
+  m->SetTimeStep(5e-3);  // 40 steps: within the line
+  // live, the same bound; a refused value leaves the delay as it was
+  parameters["command_delay"] = 0;
+  auto live = MakeMuscle(form.options, parameters);
+  live->SetTimeStep(1e-3);
+  live->Set("command_delay", 0.05);
+  EXPECT_THROW(live->Set("command_delay", 0.051), std::invalid_argument);
+  for (const double bad : {-0.001, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()}) {
+    try {
+      live->Set("command_delay", bad);
+      FAIL() << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("'command_delay' must be >= 0 [s]"), std::string::npos)
+          << e.what();
+    }
+    parameters["command_delay"] = bad;
+    EXPECT_THROW(MakeMuscle(form.options, parameters), std::invalid_argument) << bad;
+  }
+  EXPECT_EQ(live->Get("command_delay"), 0.05);
+  // listed with the muscle's quantities: a writable parameter and a state
+  bool parameter = false;
+  bool state = false;
+  for (const Quantity& q : live->Quantities()) {
+    if (q.name == "command_delay") parameter = q.unit == "s" && q.writable && q.is_static;
+    if (q.name == "delayed_command") state = !q.writable && !q.is_static;
+  }
+  EXPECT_TRUE(parameter);
+  EXPECT_TRUE(state);
+}
+
+}  // namespace
+}  // namespace caliper::actuators
