@@ -430,9 +430,12 @@ std::string Interval(const ParameterUncertainty& u) {
   return interval + " (+-" + Format(100 * half / std::abs(u.value), 2) + " %)";
 }
 
-// parameters.csv, cost.csv and the cost curve's plot (global search, then the refinement).
+// parameters.csv, cost.csv and the cost curve's plot (global search, then the refinement from
+// where it ended); without a global search (`searched` false) the refinement starts at the
+// start's cost, the one point before it.
 std::vector<Plot> WriteParameters(const Options& o, const Spec& spec, const Outcome& r,
-                                  const Progress& p) {
+                                  const Progress& p, bool searched) {
+  const char* first_stage = searched ? "global" : "start";
   core::WriteFileReplacing(o.out + "/parameters.csv", [&](std::ostream& out) {
     out << "id,unit,initial,fitted,sigma,lower95,upper95,lower,upper,scale,change [%]\n"
         << std::setprecision(10);
@@ -451,29 +454,33 @@ std::vector<Plot> WriteParameters(const Options& o, const Spec& spec, const Outc
   });
   core::WriteFileReplacing(o.out + "/cost.csv", [&](std::ostream& out) {
     out << "evaluations,best cost [-],stage\n" << std::setprecision(10);
-    for (const auto& [n, c] : p.history) out << n << "," << c << ",global\n";
+    for (const auto& [n, c] : p.history) out << n << "," << c << "," << first_stage << "\n";
     for (const auto& [n, c] : r.refine_history)
       out << p.history.back().first + n << "," << c << ",refinement\n";
   });
   std::vector<Plot> plots;
   Plot cost{"best cost", "evaluations", "cost [-] (normalised RMS)", {}, true};
-  Curve global{"global search", {}, {}}, refine{"refinement (LM)", {}, {}};
+  Curve global{searched ? "global search" : "start", {}, {}}, refine{"refinement (LM)", {}, {}};
   for (const auto& [n, c] : p.history) {
     global.x.push_back(static_cast<double>(n));
     global.y.push_back(c);
+  }
+  if (!r.refine_history.empty()) {
+    refine.x.push_back(global.x.back());
+    refine.y.push_back(global.y.back());
   }
   for (const auto& [n, c] : r.refine_history) {
     refine.x.push_back(static_cast<double>(p.history.back().first + n));
     refine.y.push_back(c);
   }
-  cost.curves.push_back(global);
+  if (searched || refine.x.empty()) cost.curves.push_back(global);
   if (!refine.x.empty()) cost.curves.push_back(refine);
   plots.push_back(cost);
   return plots;
 }
 
 HtmlReport MakeReport(const Options& o, const Spec& spec, const Outcome& r,
-                      const std::vector<Plot>& cost, const ChannelPlots& channels) {
+                      const std::vector<Plot>& cost, const ChannelPlots& channels, bool searched) {
   HtmlReport h;
   h.title = fs::path(o.file).filename().string();
   const auto add = [&](const std::string& k, const std::string& v) {
@@ -482,13 +489,15 @@ HtmlReport MakeReport(const Options& o, const Spec& spec, const Outcome& r,
   add("calibration file", fs::absolute(o.file).string());
   const std::string reason = r.refine_reason.empty() ? r.global_reason : r.refine_reason;
   add("result", r.converged ? reason : "NOT CONVERGED: " + reason);
-  add("global search", r.global_reason + " (" + std::to_string(r.generations) + " generations, " +
-                           std::to_string(r.restarts) + " restarts)");
+  add("global search", searched ? r.global_reason + " (" + std::to_string(r.generations) +
+                                      " generations, " + std::to_string(r.restarts) + " restarts)"
+                                : r.global_reason);
   if (!r.refine_reason.empty())
     add("refinement (Levenberg-Marquardt)",
         r.refine_reason + " (" + std::to_string(r.refine_iterations) + " iterations)");
-  add("cost [-]", Format(r.before.cost, 6) + " initial, " + Format(r.global_cost, 6) +
-                      " after the global search, " + Format(r.after.cost, 6) + " fitted");
+  add("cost [-]", Format(r.before.cost, 6) + " initial, " +
+                      (searched ? Format(r.global_cost, 6) + " after the global search, " : "") +
+                      Format(r.after.cost, 6) + " fitted");
   add("noise floor of the measurements [-]", Format(r.noise_floor, 3));
   if (r.after.held_out_cost >= 0) {
     std::string names;
@@ -859,9 +868,9 @@ int Run(const Options& o) {
   Progress no_search;
   no_search.history.emplace_back(1, r.before.cost);
   const Progress& p = search ? search->progress() : no_search;
-  std::vector<Plot> plots = WriteParameters(o, spec, r, p);
+  std::vector<Plot> plots = WriteParameters(o, spec, r, p, search != nullptr);
   auto channels = WriteChannels(o, spec, r.before, &r.after);
-  HtmlReport html = MakeReport(o, spec, r, plots, channels);
+  HtmlReport html = MakeReport(o, spec, r, plots, channels, search != nullptr);
   for (auto& plot : channels.fitted) plots.push_back(plot);
   for (auto& plot : channels.held_out) plots.push_back(plot);
   const std::string png = o.out + "/report.png";

@@ -112,6 +112,11 @@ grep -q "^warning: ecce_arm.elbow_flexor.current_limit: no channel" "$WORK/weak.
 if grep -E "^warning: .*(gear_ratio and ecce_arm.elbow_flexor.spool_radius are correlated|gear_ratio: only a combination of it with .*spool_radius)" "$WORK/weak.out" >/dev/null; then
   pass "flagged: $(grep -m1 -E 'gear_ratio (and|: only)' "$WORK/weak.out" | cut -c1-120)..."
 else cat "$WORK/weak.out"; fail "gear ratio and spool radius (only their ratio acts) were not flagged"; fi
+# no global search ran: the cost curve starts at the start's cost, not a "global" stage
+if [ "$(grep -c ',start$' "$WORK/weak/cost.csv")" -eq 1 ] && ! grep -q ',global$' "$WORK/weak/cost.csv" &&
+  grep -q ',refinement$' "$WORK/weak/cost.csv"; then
+  pass "cost.csv without a global search: a start row, then the refinement's"
+else cat "$WORK/weak/cost.csv"; fail "cost.csv names a global search that did not run"; fi
 
 # 4. over-fitted on purpose: the real forearm is 1.6 kg, the model fits tendon stiffnesses and
 # damping to one experiment instead; the held-out experiment shows it
