@@ -299,6 +299,11 @@ void ModelLink::SetMass(const std::string& body, double mass_kg) {
     return FromIdl(M::EditStatus_var(i.model->set_mass(body.c_str(), mass_kg)).in());
   });
 }
+void ModelLink::SetMeasurementDelay(const std::string& id, double delay_s) {
+  QueueEdit("delay " + id, [id, delay_s](Impl& i) {
+    return FromIdl(M::EditStatus_var(i.model->set_measurement_delay(id.c_str(), delay_s)).in());
+  });
+}
 void ModelLink::SetShapeDims(const std::string& body, unsigned index, std::vector<double> dims_m) {
   QueueEdit("set shape " + std::to_string(index) + " of " + body, [body, index, dims_m](Impl& i) {
     S::DoubleSeq dims;

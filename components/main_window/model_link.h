@@ -217,6 +217,8 @@ class ModelLink {
   void Redo();
   void Select(const std::string& kind, const std::string& name, unsigned index = 0);
   void SetMass(const std::string& body, double mass_kg);
+  /// Delays DAQ channel `id` by `delay_s` [s] for every reader (0 removes the delay).
+  void SetMeasurementDelay(const std::string& id, double delay_s);
   void SetShapeDims(const std::string& body, unsigned index, std::vector<double> dims_m);
   void SetObstacle(const ObstacleInfo& obstacle);
   void RemoveObstacle(const std::string& obstacle);

@@ -10,6 +10,7 @@
 #include <QLineEdit>
 #include <QPushButton>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -238,6 +239,7 @@ void SelectionPanel::Rebuild(const Snapshot& s) {
   } else if (sel.kind == "constraint") {
     title_->setText("Constraint " + Q(sel.name));
     form_layout_->addWidget(new QLabel("its parameters are in the tree", form_));
+    BuildSensorDelay({sel.name}, s);
     return;
   }
   title_->setText(
@@ -367,6 +369,62 @@ void SelectionPanel::BuildTendon(const TendonInfo& tendon, const Snapshot& s) {
   connect(remove, &QPushButton::clicked, this, [this, name] {
     link_.RemoveTendon(name);
     Say("removing tendon " + Q(name) + " (Undo brings it back) ...");
+  });
+  // the tendon's channels and its actuators'
+  std::vector<std::string> names = {tendon.name};
+  for (const auto& a : s.scene.actuators)
+    if (a.tendon == tendon.name) names.push_back(a.name);
+  BuildSensorDelay(names, s);
+}
+
+void SelectionPanel::BuildSensorDelay(const std::vector<std::string>& names, const Snapshot& s) {
+  const std::string undelayed = ".undelayed";
+  const auto is_undelayed = [&](const std::string& id) {
+    return id.size() > undelayed.size() &&
+           id.compare(id.size() - undelayed.size(), std::string::npos, undelayed) == 0;
+  };
+  std::set<std::string> delayed;  // the channels with a delay: each has its id.undelayed
+  for (const Channel& c : s.channels)
+    if (is_undelayed(c.id)) delayed.insert(c.id.substr(0, c.id.size() - undelayed.size()));
+  auto* channel = new QComboBox(form_);
+  channel->setObjectName("delay_channel");
+  for (const Channel& c : s.channels) {
+    if (!c.scalar() || c.writable || c.is_static || is_undelayed(c.id))
+      continue;  // a sensor reads a changing state; not an id.undelayed
+    const bool ours = std::any_of(names.begin(), names.end(), [&](const std::string& name) {
+      return c.id.rfind(s.scene.name + "." + name + ".", 0) == 0;
+    });
+    if (!ours) continue;
+    const QString unit = c.unit.empty() ? QString() : " [" + Q(c.unit) + "]";
+    channel->addItem(Q(c.id) + unit + (delayed.count(c.id) ? " (delayed)" : ""), Q(c.id));
+    if (delayed.count(c.id))
+      channel->setItemData(channel->count() - 1,
+                           "reads late now (" + Q(c.id) + ".undelayed is the true value); Apply "
+                           "sets another delay, 0 ms removes it",
+                           Qt::ToolTipRole);
+  }
+  if (channel->count() == 0) {
+    delete channel;
+    return;
+  }
+  auto* row = new QHBoxLayout;
+  row->addWidget(new QLabel("Sensor delay", form_));
+  row->addWidget(channel, 1);
+  QDoubleSpinBox* ms = Spin("delay_ms", 0, 1, 1, " ms");
+  ms->setToolTip(
+      "the channel reads its value this long ago, rounded to whole time steps (0 "
+      "removes the delay; id.undelayed reads the true value)");
+  row->addWidget(ms);
+  auto* apply = Button("Apply", "apply_delay", form_);
+  apply->setToolTip(
+      "set_measurement_delay: for the controllers, the DAQ, the plotter and "
+      "recordings (Undo removes it)");
+  row->addWidget(apply);
+  form_layout_->addLayout(row);
+  connect(apply, &QPushButton::clicked, this, [this, channel, ms] {
+    const std::string id = channel->currentData().toString().toStdString();
+    link_.SetMeasurementDelay(id, ms->value() / 1000);
+    Say(QString("delaying %1 by %2 ms ...").arg(Q(id)).arg(ms->value()));
   });
 }
 

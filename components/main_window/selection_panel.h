@@ -2,7 +2,7 @@
 // The Main Window's "Selection" panel: the entity selected on the Model (picked in the Scene
 // Renderer, in the parameter tree or by any client) with the edits it takes: a body's mass and
 // shape dimensions, an obstacle's size and place, a path point's position, removing a tendon or a
-// via point, and adding a tendon. Every edit is queued on the ModelLink; the Model validates it
+// via point, adding a tendon, and a sensor delay on a joint's or a tendon's channels. Every edit is queued on the ModelLink; the Model validates it
 // and a refused edit comes back as the link's last_error (the status bar), changing nothing.
 
 #include <QDialog>
@@ -70,6 +70,10 @@ class SelectionPanel : public QWidget {
   void BuildObstacle(const ObstacleInfo& obstacle);
   void BuildTendon(const TendonInfo& tendon, const Snapshot& s);
   void BuildPathPoint(const TendonInfo& tendon, unsigned index);
+  /// A "Sensor delay" row for the scalar state channels whose ids start with one of `names`
+  /// (scene.name.): a channel, its delay [ms] and Apply (set_measurement_delay); none without
+  /// such channels.
+  void BuildSensorDelay(const std::vector<std::string>& names, const Snapshot& s);
 
   ModelLink& link_;
   std::function<void(const QString&)> message_;

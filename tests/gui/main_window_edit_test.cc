@@ -2,8 +2,8 @@
 // parameter tree and the Selection panel follow the Model's selection (and a tree row selects on
 // the Model), an edit through the panel reaches the Model, Undo and Redo in the Edit menu are
 // named after the edit and take it back and forth, a refused edit shows the Model's reason and
-// changes nothing, and an edit by another client enables Undo in the window. Widgets run on
-// QT_QPA_PLATFORM=offscreen.
+// changes nothing, an edit by another client enables Undo in the window, and a sensor delay is set
+// on a joint's channel and taken back. Widgets run on QT_QPA_PLATFORM=offscreen.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -307,6 +307,63 @@ TEST_F(MainWindowEditTest, AddTendonAndRemoveItThroughThePanel) {
       [&] { return window_->findChild<QPushButton*>("remove_tendon") != nullptr; }, seconds(5)));
   QTest::mouseClick(Find<QPushButton>("remove_tendon"), Qt::LeftButton);
   EXPECT_TRUE(WaitInGui([&] { return !has_tendon("test_strap"); }, seconds(5)));
+}
+
+TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
+  auto has_channel = [&](const char* id) {
+    D::ChannelInfoSeq_var list = model_->list(id);
+    return list->length() == 1;
+  };
+  auto combo = [&] { return window_->findChild<QComboBox*>("delay_channel"); };
+  model_->select("constraint", "elbow", 0);
+  ASSERT_TRUE(WaitInGui([&] { return combo() != nullptr && combo()->count() > 0; }, seconds(5)))
+      << "a joint's panel offers its sensors";
+  const int position = combo()->findData("ecce_arm.elbow.position");
+  ASSERT_GE(position, 0) << combo()->itemText(0).toStdString();
+  EXPECT_EQ(combo()->itemText(position).toStdString(), "ecce_arm.elbow.position [rad]");
+  for (int k = 0; k < combo()->count(); ++k)  // its states only: no parameter, no command
+    EXPECT_TRUE(combo()->itemData(k).toString().startsWith("ecce_arm.elbow."))
+        << combo()->itemData(k).toString().toStdString();
+  combo()->setCurrentIndex(position);
+  Find<QDoubleSpinBox>("delay_ms")->setValue(20);
+  QTest::mouseClick(Find<QPushButton>("apply_delay"), Qt::LeftButton);
+  ASSERT_TRUE(
+      WaitInGui([&] { return has_channel("ecce_arm.elbow.position.undelayed"); }, seconds(5)))
+      << Status().toStdString();
+  auto* undo = Find<QAction>("undo");
+  ASSERT_TRUE(WaitInGui([&] { return undo->isEnabled(); }, seconds(5)));
+  EXPECT_EQ(undo->text().toStdString(), "&Undo delay elbow.position by 20 ms");
+  // the panel, rebuilt with the new channels, marks the delayed one and does not offer its
+  // undelayed twin
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return combo() != nullptr &&
+               combo()->findText("ecce_arm.elbow.position [rad] (delayed)") >= 0;
+      },
+      seconds(5)));
+  EXPECT_LT(combo()->findData("ecce_arm.elbow.position.undelayed"), 0);
+
+  // too long (beyond 1000 steps): the Model's reason in the status bar, nothing changed
+  const auto revision = M::EditStatus_var(model_->edit_status())->revision;
+  combo()->setCurrentIndex(combo()->findData("ecce_arm.elbow.position"));
+  Find<QDoubleSpinBox>("delay_ms")->setValue(20000);
+  QTest::mouseClick(Find<QPushButton>("apply_delay"), Qt::LeftButton);
+  EXPECT_TRUE(WaitInGui(
+      [&] { return Status().contains("elbow.position': delay must be in [0, 10] s, not 20"); },
+      seconds(5)))
+      << Status().toStdString();
+  EXPECT_FALSE(Status().contains("20.0")) << "the value as typed: " << Status().toStdString();
+  EXPECT_EQ(M::EditStatus_var(model_->edit_status())->revision, revision);
+
+  undo->trigger();
+  EXPECT_TRUE(
+      WaitInGui([&] { return !has_channel("ecce_arm.elbow.position.undelayed"); }, seconds(5)));
+
+  // a tendon's panel offers its actuator's sensors too
+  model_->select("tendon", "elbow_flexor", 0);
+  EXPECT_TRUE(WaitInGui(
+      [&] { return combo() != nullptr && combo()->findData("ecce_arm.elbow_flexor.current") >= 0; },
+      seconds(5)));
 }
 
 }  // namespace

@@ -30,6 +30,13 @@ const Body& BodyIn(const Scene& s, const std::string& name) {
   return BodyIn(const_cast<Scene&>(s), name);
 }
 
+// a value in a refusal as a user typed it: 20, 0.02, 1e+06, nan (std::to_string gives 20.000000)
+std::string Number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
 std::string Mm(const Eigen::Vector3d& p) {
   std::ostringstream out;
   out.precision(4);
@@ -100,8 +107,7 @@ Geometry WithDims(const Geometry& g, const std::vector<double>& dims) {
   // every other primitive: lengths, and at most 1 km (a typo in mm would give 1000 times)
   for (double d : dims)
     if (!(d > 0) || d > 1000)
-      Refuse("the " + kind + "'s dimensions must be lengths in (0, 1000] m, not " +
-             std::to_string(d));
+      Refuse("the " + kind + "'s dimensions must be lengths in (0, 1000] m, not " + Number(d));
   if (auto* b = std::get_if<Box>(&out)) b->size = {dims[0], dims[1], dims[2]};
   if (auto* s = std::get_if<Sphere>(&out)) s->radius = dims[0];
   if (auto* c = std::get_if<Capsule>(&out)) *c = {dims[0], dims[1]};
@@ -376,7 +382,7 @@ SceneEdit SetMeasurementDelay(const Scene& scene, const std::string& channel, do
   if (id.empty()) Refuse("a measurement delay needs a channel id");
   if (!std::isfinite(delay_s) || delay_s < 0 || delay_s > 10)
     Refuse("measurement delay of '" + id + "': delay must be in [0, 10] s, not " +
-           std::to_string(delay_s));
+           Number(delay_s));
   const auto& delays = scene.measurement_delays;
   const auto found = std::find_if(delays.begin(), delays.end(),
                                   [&](const MeasurementDelay& d) { return d.id == id; });
