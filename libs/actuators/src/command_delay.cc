@@ -73,11 +73,12 @@ void CommandDelay::SaveState(double* out) const {
   out[0] = static_cast<double>(steps_);
   out[1] = delayed_;
   out[2] = count_;
-  for (int k = 0; k < kCapacity; ++k) {
-    const bool used = k < count_;
+  // only the commands in flight: the engine saves every actuator before each step (for a
+  // rollback), and a line is mostly empty
+  for (int k = 0; k < count_; ++k) {
     const Pending& p = pending_[(head_ + k) % kCapacity];
-    out[3 + 2 * k] = used ? static_cast<double>(p.issued) : 0.0;
-    out[4 + 2 * k] = used ? p.value : 0.0;
+    out[3 + 2 * k] = static_cast<double>(p.issued);
+    out[4 + 2 * k] = p.value;
   }
 }
 

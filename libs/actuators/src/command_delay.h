@@ -39,6 +39,8 @@ class CommandDelay {
   /// an earlier one), the last command issued.
   double delayed() const { return delayed_; }
 
+  /// Writes the step count, the delayed command, the count and the commands in flight; the
+  /// values after them (up to kStateSize) are left as they are.
   void SaveState(double* out) const;
   /// Reads back what SaveState() wrote; a count of commands out of range empties the line.
   void RestoreState(const double* in);

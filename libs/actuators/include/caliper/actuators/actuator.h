@@ -71,7 +71,9 @@ class TendonActuator {
   /// Writes StateSize() values: everything Step() changes (states, outputs, solver start values
   /// and caches whose contents change results), so that RestoreState() puts the actuator back
   /// where a repeated Step() gives the same result bit for bit. Parameters and the command are
-  /// not part of it. Called before every physics step: a few stores, no allocation.
+  /// not part of it. Called before every physics step: a few stores, no allocation. A kind may
+  /// leave values it will not read back unwritten (the unused slots of a command delay line):
+  /// a caller that compares or stores states zeroes its buffer first.
   virtual void SaveState(double* out) const { (void)out; }
   /// Reads back the StateSize() values SaveState() wrote.
   virtual void RestoreState(const double* in) { (void)in; }
