@@ -38,11 +38,7 @@ void CommandDelay::Reset(double command) {
   delayed_ = command;
 }
 
-void CommandDelay::Issue(double command) {
-  if (delay_ == 0 && count_ == 0) {
-    delayed_ = command;  // no delay: followed from the next step on, as its state shows at once
-    return;
-  }
+void CommandDelay::Queue(double command) {
   if (count_ > 0) {
     Pending& back = pending_[(head_ + count_ - 1) % kCapacity];
     if (back.issued == steps_) {
@@ -56,17 +52,13 @@ void CommandDelay::Issue(double command) {
   ++count_;
 }
 
-double CommandDelay::Take(double dt) {
-  if (count_ > 0) {
-    if (dt != time_step_) SetTimeStep(dt);  // a caller that did not say its time step first
-    while (count_ > 0 && steps_ - pending_[head_].issued >= delay_steps_) {
-      delayed_ = pending_[head_].value;
-      head_ = (head_ + 1) % kCapacity;
-      --count_;
-    }
+void CommandDelay::Release(double dt) {
+  if (dt != time_step_) SetTimeStep(dt);  // a caller that did not say its time step first
+  while (count_ > 0 && steps_ - pending_[head_].issued >= delay_steps_) {
+    delayed_ = pending_[head_].value;
+    head_ = (head_ + 1) % kCapacity;
+    --count_;
   }
-  ++steps_;
-  return delayed_;
 }
 
 void CommandDelay::SaveState(double* out) const {

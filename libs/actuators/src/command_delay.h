@@ -30,11 +30,21 @@ class CommandDelay {
   /// Empties the line: the actuator has followed `command` since ever.
   void Reset(double command);
   /// A command given before the next step; a later one before the same step replaces it.
-  void Issue(double command);
+  void Issue(double command) {
+    if (delay_ == 0 && count_ == 0) {
+      delayed_ = command;  // no delay: followed from the next step on, as its state shows at once
+      return;
+    }
+    Queue(command);
+  }
   /// At the start of a step of dt [s]: the command the actuator follows through it (the last
   /// one issued at least the delay's steps ago). Throws as SetTimeStep() for a dt not told
   /// before that makes the delay too long.
-  double Take(double dt);
+  double Take(double dt) {
+    if (count_ > 0) Release(dt);
+    ++steps_;
+    return delayed_;
+  }
   /// The command followed in the last step taken; without a delay (and nothing in flight from
   /// an earlier one), the last command issued.
   double delayed() const { return delayed_; }
@@ -52,6 +62,8 @@ class CommandDelay {
   };
   static constexpr int kCapacity = kMaxSteps + 1;
   static int Steps(double delay, double dt);  // throws beyond the line
+  void Queue(double command);                 // into the line
+  void Release(double dt);                    // what is due at this step leaves the line
 
   double delay_ = 0;                 // [s]
   double time_step_ = 0;             // the engine's, once told [s]
