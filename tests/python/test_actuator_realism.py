@@ -50,9 +50,19 @@ def test_parameters_and_channels(new_session):
         with pytest.raises(caliper.InvalidParameter) as e:
             arm.set(f"{PREFIX}elbow_flexor.command_delay", 1.0)
         assert "at most 50 " in str(e.value)
+        # the muscle's excitation delay: a parameter in seconds, bounded as the motor's
+        arm.set(f"{PREFIX}biceps.command_delay", 0.03)
+        assert arm.parameters(f"{PREFIX}biceps.command_delay")[
+            f"{PREFIX}biceps.command_delay"] == (0.03, "s")
+        with pytest.raises(caliper.InvalidParameter) as e:
+            arm.set(f"{PREFIX}biceps.command_delay", 0.2)
+        assert "biceps" in str(e.value) and "at most 50 " in str(e.value)
         # the export carries what was set live
         scene = arm.export_scene().decode()
         assert 'name="thermal_time_constant_motor"' in scene and 'name="cogging_count"' in scene
+        biceps = scene[scene.index('<actuator name="biceps"'):]
+        biceps = biceps[:biceps.index("</actuator>")]
+        assert '<param name="command_delay" unit="s">0.03</param>' in biceps, biceps
 
 
 def test_co_contraction_heats_derates_and_warns(new_session):
