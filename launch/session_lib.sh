@@ -38,23 +38,26 @@ wait_bound() {  # INSTANCE
   die "$1 did not register; see $SESSION_DIR/*.out"
 }
 
+stop_process() {  # PID NAME: SIGTERM, up to 5 s, then SIGKILL (adds NAME to `left`)
+  kill -TERM "$1" 2>/dev/null || return 0
+  for _ in $(seq 1 50); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
+  left+=("$2")
+  kill -KILL "$1" 2>/dev/null || true
+}
+
 stop_session() {
   trap - EXIT
   trap '' INT TERM  # a second Ctrl-C must not cut the shutdown short
   local i pid left=()
   say "shutting the session down"
-  # components first (newest first), so that their last records still reach the logger
+  # components first (newest first), so that their last records still reach the logger; the
+  # naming service last; each gets 5 s, then SIGKILL, so that the shutdown is bounded
   for ((i = ${#SESSION_PIDS[@]} - 1; i >= 0; i--)); do
-    pid=${SESSION_PIDS[$i]}
-    kill -TERM "$pid" 2>/dev/null || continue
-    for _ in $(seq 1 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-    if kill -0 "$pid" 2>/dev/null; then
-      left+=("${SESSION_NAMES[$i]}")
-      kill -KILL "$pid" 2>/dev/null || true
-    fi
+    stop_process "${SESSION_PIDS[$i]}" "${SESSION_NAMES[$i]}"
   done
-  kill -TERM "$NS_PID" 2>/dev/null || true
-  wait 2>/dev/null || true
+  [ -z "${NS_PID:-}" ] || stop_process "$NS_PID" "naming service"
+  # reap them; only those it started (a bare `wait` would also wait for any other child)
+  for pid in "${SESSION_PIDS[@]}" ${NS_PID:+"$NS_PID"}; do wait "$pid" 2>/dev/null || true; done
   # the pointer to the newest session, unless a newer session has written its own since
   if [ "$(sed -n 3p "$LATEST" 2>/dev/null)" = "$SESSION_DIR" ]; then rm -f "$LATEST"; fi
   # sockets of processes that did not unlink theirs (omniNames, a killed component)
