@@ -634,6 +634,25 @@ int EditShowPath(const ModelRef& m, const std::vector<std::string>& a) {
   throw Failure(m.name + ": no tendon '" + a[0] + "'");
 }
 
+// `edit delays`: the channels that read late, with their delays in ms and in time steps.
+int EditShowDelays(const ModelRef& m, const std::vector<std::string>& a) {
+  NeedArgs(a, 0, "delays");
+  S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
+  if (d->sensor_delays.length() == 0) {
+    std::cout << "no channel reads late (edit delay CHANNEL SECONDS sets one)\n";
+    return 0;
+  }
+  std::cout << "CHANNEL                              DELAY [ms]   STEPS (of " << Num(d->time_step * 1e3)
+            << " ms)\n";
+  for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i) {
+    const S::SensorDelay& delay = d->sensor_delays[i];
+    std::cout << std::left << std::setw(37) << (std::string(d->name.in()) + "." + delay.id.in())
+              << std::right << std::setw(10) << Num(delay.delay * 1e3) << std::setw(8)
+              << std::lround(delay.delay / d->time_step) << std::left << "\n";
+  }
+  return 0;
+}
+
 // `edit kinds`: the actuator kinds with their parameters' defaults.
 int EditShowKinds(const ModelRef& m, const std::vector<std::string>& a) {
   NeedArgs(a, 0, "kinds");
@@ -738,6 +757,8 @@ int Edit(Client& client, std::vector<std::string>& args) {
     return EditShowPath(m, a);
   } else if (what == "kinds") {
     return EditShowKinds(m, a);
+  } else if (what == "delays") {
+    return EditShowDelays(m, a);
   } else if (what == "move" || what == "insert") {
     if (a.size() == 4 && what == "insert" && a[2] == "--wrap") a.erase(a.begin() + 2);
     if (what == "insert" && a.size() == 3) {
@@ -912,6 +933,7 @@ void AddModelVerbs(std::map<std::string, Verb>* verbs) {
       "    delay CHANNEL SECONDS              every reader sees CHANNEL that late (whole time\n"
       "                                       steps); 0 removes the delay; CHANNEL.undelayed\n"
       "                                       reads the true value\n"
+      "    delays                             the channels that read late: delay [ms], steps\n"
       "    undo / redo\n"
       "    pull BODY X Y Z [--stiffness K] [--for S]   spring the body's origin toward a world\n"
       "                                       point [m] until Ctrl-C (or S seconds), then release\n"

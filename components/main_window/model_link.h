@@ -107,6 +107,8 @@ struct SceneInfo {
   std::vector<TendonInfo> tendons;
   std::vector<ActuatorInfo> actuators;
   std::vector<std::string> constraints;
+  /// the delayed channels' delays [s], by their DAQ ids (scene.channel)
+  std::map<std::string, double> sensor_delays_s;
   const BodyInfo* FindBody(const std::string& n) const;
   const ObstacleInfo* FindObstacle(const std::string& n) const;
   const TendonInfo* FindTendon(const std::string& n) const;

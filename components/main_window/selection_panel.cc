@@ -383,9 +383,7 @@ void SelectionPanel::BuildSensorDelay(const std::vector<std::string>& names, con
     return id.size() > undelayed.size() &&
            id.compare(id.size() - undelayed.size(), std::string::npos, undelayed) == 0;
   };
-  std::set<std::string> delayed;  // the channels with a delay: each has its id.undelayed
-  for (const Channel& c : s.channels)
-    if (is_undelayed(c.id)) delayed.insert(c.id.substr(0, c.id.size() - undelayed.size()));
+  const std::map<std::string, double>& delays = scene_.sensor_delays_s;  // [s] by DAQ id
   auto* channel = new QComboBox(form_);
   channel->setObjectName("delay_channel");
   for (const Channel& c : s.channels) {
@@ -396,12 +394,20 @@ void SelectionPanel::BuildSensorDelay(const std::vector<std::string>& names, con
     });
     if (!ours) continue;
     const QString unit = c.unit.empty() ? QString() : " [" + Q(c.unit) + "]";
-    channel->addItem(Q(c.id) + unit + (delayed.count(c.id) ? " (delayed)" : ""), Q(c.id));
-    if (delayed.count(c.id))
-      channel->setItemData(channel->count() - 1,
-                           "reads late now (" + Q(c.id) + ".undelayed is the true value); Apply "
-                           "sets another delay, 0 ms removes it",
-                           Qt::ToolTipRole);
+    const auto delay = delays.find(c.id);
+    if (delay == delays.end()) {
+      channel->addItem(Q(c.id) + unit, Q(c.id));
+      continue;
+    }
+    const double delay_ms = delay->second * 1000;
+    channel->addItem(Q(c.id) + unit + QString(" (%1 ms late)").arg(delay_ms, 0, 'g', 6), Q(c.id));
+    channel->setItemData(channel->count() - 1, delay_ms, Qt::UserRole + 1);
+    channel->setItemData(channel->count() - 1,
+                         QString("reads %1 ms late (%2.undelayed is the true value); Apply sets "
+                                 "another delay, 0 ms removes it")
+                             .arg(delay_ms, 0, 'g', 6)
+                             .arg(Q(c.id)),
+                         Qt::ToolTipRole);
   }
   if (channel->count() == 0) {
     delete channel;
@@ -414,6 +420,12 @@ void SelectionPanel::BuildSensorDelay(const std::vector<std::string>& names, con
   ms->setToolTip(
       "the channel reads its value this long ago, rounded to whole time steps (0 "
       "removes the delay; id.undelayed reads the true value)");
+  // the chosen channel's delay now (0 without one)
+  const auto show_delay = [channel, ms](int index) {
+    ms->setValue(channel->itemData(index, Qt::UserRole + 1).toDouble());
+  };
+  show_delay(channel->currentIndex());
+  connect(channel, QOverload<int>::of(&QComboBox::currentIndexChanged), ms, show_delay);
   row->addWidget(ms);
   auto* apply = Button("Apply", "apply_delay", form_);
   apply->setToolTip(

@@ -201,6 +201,11 @@ S::Description* ToIdl(const sgal::Scene& scene) {
       }
     }
   }
+  d->sensor_delays.length(static_cast<CORBA::ULong>(scene.measurement_delays.size()));
+  for (CORBA::ULong i = 0; i < scene.measurement_delays.size(); ++i) {
+    d->sensor_delays[i].id = scene.measurement_delays[i].id.c_str();
+    d->sensor_delays[i].delay = scene.measurement_delays[i].delay;
+  }
   return d;
 }
 

@@ -333,15 +333,26 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
   auto* undo = Find<QAction>("undo");
   ASSERT_TRUE(WaitInGui([&] { return undo->isEnabled(); }, seconds(5)));
   EXPECT_EQ(undo->text().toStdString(), "&Undo delay elbow.position by 20 ms");
-  // the panel, rebuilt with the new channels, marks the delayed one and does not offer its
-  // undelayed twin
+  // the scene description carries the delay, as the scene names the channel
+  {
+    S::Description_var d = model_->scene_description();
+    ASSERT_EQ(d->sensor_delays.length(), 1u);
+    EXPECT_STREQ(d->sensor_delays[0].id.in(), "elbow.position");
+    EXPECT_DOUBLE_EQ(d->sensor_delays[0].delay, 0.02);
+  }
+  // the panel, rebuilt with the new channels, marks the delayed one with its delay and does not
+  // offer its undelayed twin
+  const QString delayed_text = "ecce_arm.elbow.position [rad] (20 ms late)";
   EXPECT_TRUE(WaitInGui(
-      [&] {
-        return combo() != nullptr &&
-               combo()->findText("ecce_arm.elbow.position [rad] (delayed)") >= 0;
-      },
-      seconds(5)));
+      [&] { return combo() != nullptr && combo()->findText(delayed_text) >= 0; }, seconds(5)));
   EXPECT_LT(combo()->findData("ecce_arm.elbow.position.undelayed"), 0);
+  // the spin box shows the chosen channel's delay: 20 ms, then 0 for an undelayed one
+  combo()->setCurrentIndex(combo()->findData("ecce_arm.elbow.position"));
+  EXPECT_DOUBLE_EQ(Find<QDoubleSpinBox>("delay_ms")->value(), 20);
+  const int other = combo()->findData("ecce_arm.elbow.velocity");
+  ASSERT_GE(other, 0);
+  combo()->setCurrentIndex(other);
+  EXPECT_DOUBLE_EQ(Find<QDoubleSpinBox>("delay_ms")->value(), 0);
 
   // too long (beyond 1000 steps): the Model's reason in the status bar, nothing changed
   const auto revision = M::EditStatus_var(model_->edit_status())->revision;
@@ -358,6 +369,14 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
   undo->trigger();
   EXPECT_TRUE(
       WaitInGui([&] { return !has_channel("ecce_arm.elbow.position.undelayed"); }, seconds(5)));
+  EXPECT_EQ(S::Description_var(model_->scene_description())->sensor_delays.length(), 0u);
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return combo() != nullptr && combo()->findText(delayed_text) < 0 &&
+               combo()->findText("ecce_arm.elbow.position [rad]") >= 0;
+      },
+      seconds(5)))
+      << "the mark goes with the delay";
 
   // a tendon's panel offers its actuator's sensors too
   model_->select("tendon", "elbow_flexor", 0);
