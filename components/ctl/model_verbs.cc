@@ -642,8 +642,8 @@ int EditShowDelays(const ModelRef& m, const std::vector<std::string>& a) {
     std::cout << "no channel reads late (edit delay CHANNEL SECONDS sets one)\n";
     return 0;
   }
-  std::cout << "CHANNEL                              DELAY [ms]   STEPS (of " << Num(d->time_step * 1e3)
-            << " ms)\n";
+  std::cout << "CHANNEL                              DELAY [ms]   STEPS (of "
+            << Num(d->time_step * 1e3) << " ms)\n";
   for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i) {
     const S::SensorDelay& delay = d->sensor_delays[i];
     std::cout << std::left << std::setw(37) << (std::string(d->name.in()) + "." + delay.id.in())

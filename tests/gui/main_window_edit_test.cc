@@ -343,8 +343,8 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
   // the panel, rebuilt with the new channels, marks the delayed one with its delay and does not
   // offer its undelayed twin
   const QString delayed_text = "ecce_arm.elbow.position [rad] (20 ms late)";
-  EXPECT_TRUE(WaitInGui(
-      [&] { return combo() != nullptr && combo()->findText(delayed_text) >= 0; }, seconds(5)));
+  EXPECT_TRUE(WaitInGui([&] { return combo() != nullptr && combo()->findText(delayed_text) >= 0; },
+                        seconds(5)));
   EXPECT_LT(combo()->findData("ecce_arm.elbow.position.undelayed"), 0);
   // the spin box shows the chosen channel's delay: 20 ms, then 0 for an undelayed one
   combo()->setCurrentIndex(combo()->findData("ecce_arm.elbow.position"));
