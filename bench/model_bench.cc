@@ -21,6 +21,7 @@
 #include "caliper/model.hh"
 #include "caliper/rtc/local_sockets.h"
 #include "caliper/rtc/naming.h"
+#include "caliper/simulation/model_core.h"
 #include "echo.hh"
 #include "support/process.h"
 
@@ -109,6 +110,24 @@ sgal::Scene Drifters(int n, int moving) {
   return s;
 }
 
+/// The Model's own work of the control cycle without CORBA [us]: the same set_commands of 10
+/// and get of 20 ids on a ModelCore of the shipped arm, paused, in this process (the median of 5
+/// blocks of 20,000). Run before the processes of the other figures start.
+std::pair<double, double> InProcessCalls(const std::string& root) {
+  simulation::ModelCore core;
+  core.Load(root + "/models/ecce_arm.dae");
+  std::vector<std::pair<std::string, double>> commands;
+  const auto actuators = core.Actuators();
+  for (size_t i = 0; i < 10; ++i)
+    commands.emplace_back(actuators[i % actuators.size()].name, 0.1 * i);
+  const auto channels = core.Channels(core.model_name() + ".*");
+  std::vector<std::string> ids;
+  for (size_t i = 0; i < 20; ++i) ids.push_back(channels[i * channels.size() / 20].id);
+  const double set = Median(20000, [&] { core.SetCommands(commands); });
+  const double get = Median(20000, [&] { core.Sample(ids); });
+  return {set, get};
+}
+
 class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
  public:
   explicit CountingObserver(int sleep_ms) : sleep_ms_(sleep_ms) {}
@@ -131,6 +150,13 @@ class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2], argv[3]);
+  const char* source_dir = std::getenv("CALIPER_SOURCE_DIR");
+  const auto [set_us, get_us] =
+      InProcessCalls(source_dir ? source_dir : CALIPER_SOURCE_DIR_DEFAULT);
+  std::printf(
+      "# the Model's own work of a control cycle, in process (ModelCore, no CORBA): "
+      "set_commands of 10 %.2f us, get of 20 ids %.2f us\n",
+      set_us, get_us);
   testing::TempDir dir;
   // every process's socket in the bench's own directory (gone with it)
   setenv("CALIPER_SOCKET_DIR", (dir.path() + "/sock").c_str(), 1);

@@ -364,36 +364,19 @@ class DcMotorTendon : public TendonActuator {
     return q;
   }
 
-  double Get(const std::string& name) const override {
-    const DcMotorParameters& p = motor_.parameters();
+  double Get(const std::string& name) const override { return Reader(name)(); }
+
+  std::function<double()> Reader(const std::string& name) const override {
     for (const MotorField& field : kMotorFields)
-      if (name == field.name) return p.*field.member;
-    if (name == "supply_voltage") return supply_voltage_;
-    if (name == "pretension") return pretension_;
+      if (name == field.name)
+        return [this, member = field.member] { return motor_.parameters().*member; };
+    if (name == "supply_voltage") return [this] { return supply_voltage_; };
+    if (name == "pretension") return [this] { return pretension_; };
     for (const DriverField& field : kDriverFields)
-      if (name == field.name) return driver_.*field.member;
-    const DcMotorState& s = motor_.state();
-    if (name == "current") return s.current;
-    if (name == "spool_speed") return s.spool_speed;
-    if (name == "spool_angle") return s.spool_angle;
-    if (name == "motor_speed") return motor_.motor_speed();
-    if (name == "line_length") return line_length_;
-    if (name == "elastic_length") return elastic_length_;
-    if (name == "tension") return tension_;
-    if (name == "voltage") return motor_.applied_voltage();
-    if (name == "power") return motor_.electrical_power();
-    if (name == "winding_temperature") return s.winding_temperature;
-    if (name == "housing_temperature") return s.housing_temperature;
-    if (name == "motor_torque") return motor_.motor_torque();
-    if (name == "friction_torque") return motor_.friction_torque();
-    if (name == "cogging_torque") return motor_.cogging_torque();
-    if (name == "hot_resistance") return motor_.hot_resistance();
-    if (name == "hot_torque_constant") return motor_.hot_torque_constant();
-    if (name == "current_limit_now") return motor_.current_limit();
-    if (name == "derating") return motor_.derating();
-    if (name == "driver_voltage") return driver_voltage_;
-    if (name == "delayed_command") return delay_.delayed();
-    if (HasElastic(name)) return elastic_->Get(name);
+      if (name == field.name) return [this, member = field.member] { return driver_.*member; };
+    for (size_t k = 0; k < std::size(kStates); ++k)
+      if (name == kStates[k].first) return [this, k] { return State(k); };
+    if (HasElastic(name)) return [this, name] { return elastic_->Get(name); };
     throw std::out_of_range(prefix_ + "unknown quantity '" + name + "'");
   }
 
@@ -466,6 +449,55 @@ class DcMotorTendon : public TendonActuator {
       {"derating", ""},
       {"driver_voltage", "V"},
       {"delayed_command", nullptr}};  // null: the command's unit
+
+  // state k of kStates
+  double State(size_t k) const {
+    const DcMotorState& s = motor_.state();
+    switch (k) {
+      case 0:
+        return s.current;
+      case 1:
+        return s.spool_speed;
+      case 2:
+        return s.spool_angle;
+      case 3:
+        return motor_.motor_speed();
+      case 4:
+        return line_length_;
+      case 5:
+        return elastic_length_;
+      case 6:
+        return tension_;
+      case 7:
+        return motor_.applied_voltage();
+      case 8:
+        return motor_.electrical_power();
+      case 9:
+        return s.winding_temperature;
+      case 10:
+        return s.housing_temperature;
+      case 11:
+        return motor_.motor_torque();
+      case 12:
+        return motor_.friction_torque();
+      case 13:
+        return motor_.cogging_torque();
+      case 14:
+        return motor_.hot_resistance();
+      case 15:
+        return motor_.hot_torque_constant();
+      case 16:
+        return motor_.current_limit();
+      case 17:
+        return motor_.derating();
+      case 18:
+        return driver_voltage_;
+      case 19:
+        return delay_.delayed();
+    }
+    throw std::logic_error("dc motor: no state " + std::to_string(k));
+  }
+  static_assert(std::size(kStates) == 20, "State() reads each of kStates");
 
   static void CheckDriver(const DriverField& field, double value) {
     Check(field.name, field.unit, value, field.whole ? Range::kWhole : Range::kNonNegative);

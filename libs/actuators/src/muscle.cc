@@ -245,6 +245,31 @@ class HillMuscle : public TendonActuator {
     return q;
   }
 
+  // a reader of state `name`, or none when it is not one of this muscle's states
+  std::function<double()> StateReader(const std::string& name) const {
+    if (name == "excitation") return [this] { return excitation_; };
+    if (name == "delayed_command") return [this] { return delay_.delayed(); };
+    if (name == "activation") return [this] { return activation_; };
+    if (name == "fiber_length")
+      return [this] { return elastic_ ? fiber_length_ : out_.fiber_length; };
+    if (name == "fiber_velocity") return [this] { return out_.fiber_velocity; };
+    if (name == "normalized_fiber_length") return [this] { return out_.norm_fiber_length; };
+    if (name == "normalized_fiber_velocity") return [this] { return out_.norm_fiber_velocity; };
+    if (name == "active_force_length") return [this] { return out_.active_force_length; };
+    if (name == "force_velocity") return [this] { return out_.force_velocity; };
+    if (name == "passive_force_length") return [this] { return out_.passive_force_length; };
+    if (name == "active_fiber_force") return [this] { return out_.active_fiber_force; };
+    if (name == "passive_force") return [this] { return out_.passive_force; };
+    if (name == "tension") return [this] { return out_.tension; };
+    if (curves_ != Curves::kMujoco) {
+      if (name == "pennation")
+        return [this] { return out_.pennation_cos < 0 ? kPi / 2 : std::acos(out_.pennation_cos); };
+      if (name == "tendon_length") return [this] { return out_.tendon_length; };
+      if (name == "tendon_strain") return [this] { return out_.tendon_strain; };
+    }
+    return nullptr;
+  }
+
   double Get(const std::string& name) const override {
     for (const auto& e : ParameterTable())
       if (e.name == name && AppliesTo(e.applies, curves_)) {
@@ -254,26 +279,13 @@ class HillMuscle : public TendonActuator {
     if (curves_ == Curves::kMujoco && name == "max_isometric_force") return MujocoF0();
     if (curves_ == Curves::kMujoco && name == "optimal_fiber_length") return MujocoL0();
     if (name == "command_delay") return delay_.delay();
-    if (name == "excitation") return excitation_;
-    if (name == "delayed_command") return delay_.delayed();
-    if (name == "activation") return activation_;
-    if (name == "fiber_length") return elastic_ ? fiber_length_ : out_.fiber_length;
-    if (name == "fiber_velocity") return out_.fiber_velocity;
-    if (name == "normalized_fiber_length") return out_.norm_fiber_length;
-    if (name == "normalized_fiber_velocity") return out_.norm_fiber_velocity;
-    if (name == "active_force_length") return out_.active_force_length;
-    if (name == "force_velocity") return out_.force_velocity;
-    if (name == "passive_force_length") return out_.passive_force_length;
-    if (name == "active_fiber_force") return out_.active_fiber_force;
-    if (name == "passive_force") return out_.passive_force;
-    if (name == "tension") return out_.tension;
-    if (curves_ != Curves::kMujoco) {
-      if (name == "pennation")
-        return out_.pennation_cos < 0 ? kPi / 2 : std::acos(out_.pennation_cos);
-      if (name == "tendon_length") return out_.tendon_length;
-      if (name == "tendon_strain") return out_.tendon_strain;
-    }
+    if (const auto read = StateReader(name)) return read();
     throw std::out_of_range(Prefix() + "no quantity '" + name + "'");
+  }
+
+  std::function<double()> Reader(const std::string& name) const override {
+    if (auto read = StateReader(name)) return read;
+    return TendonActuator::Reader(name);  // a parameter: read rarely
   }
 
   void Set(const std::string& name, double value) override {

@@ -297,6 +297,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<CouplingData> couplings_;
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
+  std::unordered_map<std::string, int> actuator_index_;  // into actuators_, by name
   std::vector<Isometry3d> poses_;        // body frames this step [m]
   std::vector<actuators::PointForce> forces_;  // a tendon's forces, storage kept between steps
   std::vector<Vector3d> coms_;           // centres of mass this step [m]
@@ -651,6 +652,8 @@ void BulletScene::BuildTendons() {
     }
   }
   actuators_.resize(scene_.actuators.size());
+  for (size_t i = 0; i < scene_.actuators.size(); ++i)
+    actuator_index_[scene_.actuators[i].name] = static_cast<int>(i);
   for (size_t i = 0; i < scene_.actuators.size(); ++i) {
     ActuatorData& a = actuators_[i];
     a.desc = &scene_.actuators[i];
@@ -1464,13 +1467,9 @@ std::vector<sgal::TendonState> BulletScene::TendonStates() const {
 void BulletScene::SetCommand(const std::string& actuator, double value) {
   if (!std::isfinite(value))
     throw std::invalid_argument("command for '" + actuator + "' is not finite");
-  for (auto& a : actuators_) {
-    if (a.desc->name == actuator) {
-      a.model->SetCommand(value);
-      return;
-    }
-  }
-  throw std::out_of_range("no actuator '" + actuator + "'");
+  const auto found = actuator_index_.find(actuator);
+  if (found == actuator_index_.end()) throw std::out_of_range("no actuator '" + actuator + "'");
+  actuators_[found->second].model->SetCommand(value);
 }
 
 void BulletScene::BuildParameters() {
@@ -1585,8 +1584,8 @@ void BulletScene::BuildParameters() {
           // a tuned model parameter goes into the description, so that a saved scene keeps it
           if (is_static) scene_.actuators[k].parameters[field] = v;
         };
-      add({n + field, q.unit, q.writable, q.is_static}, [model, field] { return model->Get(field); },
-          std::move(set));
+      // read through the kind's reader: no name lookup per read
+      add({n + field, q.unit, q.writable, q.is_static}, model->Reader(field), std::move(set));
     }
   }
 }

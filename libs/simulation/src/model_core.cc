@@ -303,6 +303,8 @@ void ModelCore::BuildLocked(std::unique_ptr<Loaded> loaded, bool edit) {
   registry_.Clear();
   const daq::SceneChannels channels = daq::RegisterScene(registry_, loaded->name, *loaded->physics);
   loaded->sampler = channels.sampler;
+  loaded->actuators.clear();
+  for (const auto& a : loaded->description->actuators) loaded->actuators.insert(a.name);
   for (const auto& id : channels.skipped)
     logging::Get("model").warn("channel %s not registered: the id is taken", id.c_str());
   // every command starts at zero in the new physics, as after MuJoCo's reset: a stop, reset or
@@ -653,9 +655,7 @@ void ModelCore::SetCommandsLocked(const std::vector<std::pair<std::string, doubl
     throw InvalidValue(std::to_string(commands.size()) + " commands in one call; at most " +
                        std::to_string(limits_.ids_per_call));
   for (const auto& [name, value] : commands) {
-    const auto& actuators = loaded_->description->actuators;
-    if (std::none_of(actuators.begin(), actuators.end(),
-                     [&](const sgal::Actuator& a) { return a.name == name; }))
+    if (loaded_->actuators.count(name) == 0)
       throw UnknownId("no actuator '" + name + "' in " + loaded_->source, name);
     if (!std::isfinite(value))
       throw InvalidValue("command for '" + name + "' is not finite");

@@ -1,17 +1,19 @@
 // The TendonActuator contract for every registered kind: SaveState/RestoreState put an actuator
 // back where a repeated step gives the same result bit for bit; the work of one step is bounded
 // (max_substep against the time step, the muscle's fibre sub-steps).
+#include "caliper/actuators/actuator.h"
+
 #include <gtest/gtest.h>
 
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "caliper/actuators/actuator.h"
 #include "caliper/actuators/dc_motor.h"
 #include "caliper/sgal/scene.h"
 
@@ -148,6 +150,93 @@ TEST(TendonActuator, RestoredStateRepeatsTheStepBitForBit) {
 
       // the engine sizes its buffer once
       EXPECT_EQ(a->StateSize(), saved.size());
+    }
+  }
+}
+
+TEST(TendonActuator, EachReaderReadsWhatGetReadsAsTheActuatorMoves) {
+  // the DAQ reads every channel through Reader(name); a kind's own readers skip the name lookup
+  // but must read what Get(name) reads, for parameters, states and the elastic element's values
+  auto variants = BuiltinVariants();
+  variants["dc_motor_tendon"].push_back(
+      {"heat, friction, cogging, driver",
+       Describe("dc_motor_tendon", {{"pretension", 5},
+                                    {"thermal_resistance_winding_housing", 1.6},
+                                    {"thermal_resistance_housing_ambient", 4.65},
+                                    {"thermal_time_constant_winding", 41.6},
+                                    {"thermal_time_constant_motor", 1120},
+                                    {"coulomb_friction", 1e-4},
+                                    {"cogging_amplitude", 1e-4},
+                                    {"pwm_levels", 1024},
+                                    {"command_delay", 0.003}}),
+       0.3, 0.05});
+  for (const auto& [kind, list] : variants) {
+    for (const Variant& v : list) {
+      SCOPED_TRACE(kind + " (" + v.label + ")");
+      auto a = Make(v.description);
+      const double dt = 1e-3;
+      a->SetTimeStep(dt);
+      a->Reset(v.path_length);
+      if (v.command != 0) a->SetCommand(v.command);
+      const auto quantities = a->Quantities();
+      std::vector<std::function<double()>> readers;
+      for (const Quantity& q : quantities) readers.push_back(a->Reader(q.name));
+      double length = v.path_length;
+      int differed = 0;  // readings that changed between the checks: the readers follow
+      std::vector<double> last(quantities.size(), 0.0);
+      for (int i = 0; i < 30; ++i) {
+        const double speed = 0.02 * std::cos(i * 0.3);
+        a->Step(length, speed, dt);
+        length += speed * dt;
+        if (i % 10 != 9) continue;
+        for (size_t k = 0; k < quantities.size(); ++k) {
+          const double got = readers[k]();
+          EXPECT_TRUE(SameBits(got, a->Get(quantities[k].name)))
+              << quantities[k].name << " at step " << i << ": reader " << got << ", Get "
+              << a->Get(quantities[k].name);
+          differed += i > 9 && !SameBits(got, last[k]);
+          last[k] = got;
+        }
+      }
+      EXPECT_GT(differed, 0) << "no reading changed as the actuator moved";
+      // a parameter set later is read by the reader made before
+      for (size_t k = 0; k < quantities.size(); ++k) {
+        if (!quantities[k].writable || !quantities[k].is_static) continue;
+        const double before = a->Get(quantities[k].name);
+        try {
+          a->Set(quantities[k].name, before * 1.001 + 1e-6);
+        } catch (const std::invalid_argument&) {
+          continue;  // out of its range: another parameter shows it
+        }
+        EXPECT_TRUE(SameBits(readers[k](), a->Get(quantities[k].name))) << quantities[k].name;
+        a->Set(quantities[k].name, before);
+      }
+      EXPECT_THROW(a->Reader("no_such_quantity"), std::out_of_range);
+      if (v.label != "heat, friction, cogging, driver") continue;
+      // each of the motor's states reads what its name says (Get and Reader share the table)
+      auto read = [&](const char* name) { return a->Reader(name)(); };
+      EXPECT_DOUBLE_EQ(read("motor_speed"), read("gear_ratio") * read("spool_speed"));
+      EXPECT_DOUBLE_EQ(read("power"), read("voltage") * read("current"));
+      EXPECT_TRUE(SameBits(read("tension"), a->tension()));
+      EXPECT_DOUBLE_EQ(read("delayed_command"), v.command);
+      EXPECT_GT(read("winding_temperature"), read("housing_temperature"))
+          << "the winding heats first";
+      EXPECT_GT(read("housing_temperature"), read("ambient_temperature"));
+      EXPECT_GT(read("hot_resistance"), read("resistance") * (1 + 1e-9)) << "a warm winding";
+      EXPECT_NE(read("friction_torque"), 0);
+      EXPECT_DOUBLE_EQ(
+          read("cogging_torque"),
+          read("cogging_amplitude") *
+              std::sin(read("cogging_count") * read("gear_ratio") * read("spool_angle") +
+                       read("cogging_phase")));
+      EXPECT_NE(read("cogging_torque"), 0);
+      // Coulomb's, smoothed, and viscous (no Stribeck peak without static_friction)
+      EXPECT_DOUBLE_EQ(read("friction_torque"),
+                       read("coulomb_friction") *
+                               std::tanh(read("motor_speed") / read("friction_smoothing_speed")) +
+                           read("viscous_friction") * read("motor_speed"));
+      EXPECT_EQ(read("current_limit_now"), read("current_limit"));
+      EXPECT_EQ(read("derating"), 0);
     }
   }
 }

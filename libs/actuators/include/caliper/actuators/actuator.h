@@ -94,6 +94,13 @@ class TendonActuator {
   virtual std::vector<Quantity> Quantities() const = 0;
   /// Throws std::out_of_range for an unknown name.
   virtual double Get(const std::string& name) const = 0;
+  /// A reader of quantity `name` for callers that read it often (the DAQ's channels): the name
+  /// is looked up once, here, not at each read. It reads what Get(name) would, and lives as long
+  /// as this actuator. Throws as Get does. The default calls Get(name) at each read.
+  virtual std::function<double()> Reader(const std::string& name) const {
+    Get(name);  // an unknown name throws now, not at a read
+    return [this, name] { return Get(name); };
+  }
   /// Throws std::out_of_range (unknown) or std::invalid_argument (read-only, out of range).
   virtual void Set(const std::string& name, double value) = 0;
 };

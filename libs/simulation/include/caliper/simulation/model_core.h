@@ -17,6 +17,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "caliper/core/scratch_directory.h"
@@ -310,6 +311,7 @@ class ModelCore {
     std::unique_ptr<sgal::PhysicsScene> physics;
     std::shared_ptr<daq::SceneSampler> sampler;
     std::map<std::string, double> commands;           // last command per actuator
+    std::unordered_set<std::string> actuators;        // the description's actuators' names
   };
   /// `edit`: the same scene edited (history, commands and step requests go on).
   void BuildLocked(std::unique_ptr<Loaded> loaded, bool edit = false);
