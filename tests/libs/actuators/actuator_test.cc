@@ -10,6 +10,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -84,6 +85,15 @@ std::map<std::string, std::vector<Variant>> BuiltinVariants() {
   };
 }
 
+/// The variant's actuator at time step `dt`, reset on its path, with its command sent.
+std::unique_ptr<TendonActuator> MakeReady(const Variant& v, double dt) {
+  auto a = Make(v.description);
+  a->SetTimeStep(dt);
+  a->Reset(v.path_length);
+  if (v.command != 0) a->SetCommand(v.command);
+  return a;
+}
+
 /// Every quantity's value, in Quantities() order.
 std::vector<double> Values(const TendonActuator& a) {
   std::vector<double> values;
@@ -112,11 +122,8 @@ TEST(TendonActuator, RestoredStateRepeatsTheStepBitForBit) {
   for (const auto& [kind, variants] : BuiltinVariants()) {
     for (const Variant& v : variants) {
       SCOPED_TRACE(kind + " (" + v.label + ")");
-      auto a = Make(v.description);
       const double dt = 1e-3;
-      a->SetTimeStep(dt);
-      a->Reset(v.path_length);
-      if (v.command != 0) a->SetCommand(v.command);
+      auto a = MakeReady(v, dt);
       // a moving path, so that every state (speeds, the Zener arm, the fibre) has something to do
       double length = v.path_length;
       for (int i = 0; i < 40; ++i) {
@@ -173,11 +180,8 @@ TEST(TendonActuator, EachReaderReadsWhatGetReadsAsTheActuatorMoves) {
   for (const auto& [kind, list] : variants) {
     for (const Variant& v : list) {
       SCOPED_TRACE(kind + " (" + v.label + ")");
-      auto a = Make(v.description);
       const double dt = 1e-3;
-      a->SetTimeStep(dt);
-      a->Reset(v.path_length);
-      if (v.command != 0) a->SetCommand(v.command);
+      auto a = MakeReady(v, dt);
       const auto quantities = a->Quantities();
       std::vector<std::function<double()>> readers;
       for (const Quantity& q : quantities) readers.push_back(a->Reader(q.name));
