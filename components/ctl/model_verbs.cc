@@ -646,9 +646,9 @@ int EditShowDelays(const ModelRef& m, const std::vector<std::string>& a) {
             << Num(d->time_step * 1e3) << " ms)\n";
   for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i) {
     const S::SensorDelay& delay = d->sensor_delays[i];
-    std::cout << std::left << std::setw(37) << (std::string(d->name.in()) + "." + delay.id.in())
-              << std::right << std::setw(10) << Num(delay.delay * 1e3) << std::setw(8)
-              << std::lround(delay.delay / d->time_step) << std::left << "\n";
+    std::cout << std::left << std::setw(37) << delay.id.in() << std::right << std::setw(10)
+              << Num(delay.delay * 1e3) << std::setw(8) << std::lround(delay.delay / d->time_step)
+              << std::left << "\n";
   }
   return 0;
 }

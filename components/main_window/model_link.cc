@@ -411,8 +411,7 @@ void ModelLink::ReadScene() {
   for (CORBA::ULong k = 0; k < d->constraints.length(); ++k)
     scene.constraints.push_back(d->constraints[k].name.in());
   for (CORBA::ULong k = 0; k < d->sensor_delays.length(); ++k)
-    scene.sensor_delays_s[scene.name + "." + d->sensor_delays[k].id.in()] =
-        d->sensor_delays[k].delay;
+    scene.sensor_delays_s[d->sensor_delays[k].id.in()] = d->sensor_delays[k].delay;
   M::ActuatorInfoSeq_var actuators = i.model->actuators();
   for (CORBA::ULong k = 0; k < actuators->length(); ++k)
     scene.actuators.push_back(

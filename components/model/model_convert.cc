@@ -201,9 +201,11 @@ S::Description* ToIdl(const sgal::Scene& scene) {
       }
     }
   }
+  // the ids as the DAQ lists them: after the Model's name for the scene (id-safe)
+  const std::string prefix = simulation::IdSafe(scene.name) + ".";
   d->sensor_delays.length(static_cast<CORBA::ULong>(scene.measurement_delays.size()));
   for (CORBA::ULong i = 0; i < scene.measurement_delays.size(); ++i) {
-    d->sensor_delays[i].id = scene.measurement_delays[i].id.c_str();
+    d->sensor_delays[i].id = (prefix + scene.measurement_delays[i].id).c_str();
     d->sensor_delays[i].delay = scene.measurement_delays[i].delay;
   }
   return d;

@@ -162,6 +162,16 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
           "Delays channel `id` by `delay_s` [s] for every reader (whole time steps); 0 removes "
           "its delay. `id + '.undelayed'` reads the true value.")
       .def(
+          "measurement_delays",
+          [](ModelObject& m) {
+            S::Description_var d = m.Run([&] { return m.ref.model->scene_description(); });
+            py::dict out;
+            for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i)
+              out[py::str(d->sensor_delays[i].id.in())] = d->sensor_delays[i].delay;
+            return out;
+          },
+          "The channels that read late: {id: delay [s]}, the ids as the DAQ lists them.")
+      .def(
           "set_shape_dims",
           [](ModelObject& m, const std::string& body, uint32_t index, const py::object& dims) {
             const std::vector<double> d = FiniteValues(dims, "dims_m");

@@ -333,11 +333,11 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
   auto* undo = Find<QAction>("undo");
   ASSERT_TRUE(WaitInGui([&] { return undo->isEnabled(); }, seconds(5)));
   EXPECT_EQ(undo->text().toStdString(), "&Undo delay elbow.position by 20 ms");
-  // the scene description carries the delay, as the scene names the channel
+  // the scene description carries the delay, with the channel as the DAQ lists it
   {
     S::Description_var d = model_->scene_description();
     ASSERT_EQ(d->sensor_delays.length(), 1u);
-    EXPECT_STREQ(d->sensor_delays[0].id.in(), "elbow.position");
+    EXPECT_STREQ(d->sensor_delays[0].id.in(), "ecce_arm.elbow.position");
     EXPECT_DOUBLE_EQ(d->sensor_delays[0].delay, 0.02);
   }
   // the panel, rebuilt with the new channels, marks the delayed one with its delay and does not

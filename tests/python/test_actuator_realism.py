@@ -164,8 +164,10 @@ def test_a_measurement_delay_set_live_lags_its_channel(new_session):
         started = arm.start_recording("delay_edit.caliper", [channel, "ecce_arm.elbow.position"],
                                       every=1, keyframe_every=50)
         assert started.recording
+        assert arm.measurement_delays() == {}
         status = arm.set_measurement_delay(channel, 0.002)  # 2 steps of 1 ms
         assert status.last == "delay elbow_flexor.current by 2 ms"
+        assert arm.measurement_delays() == {channel: 0.002}
         truth = []
         for k in range(12):
             arm.step(1)
@@ -182,6 +184,7 @@ def test_a_measurement_delay_set_live_lags_its_channel(new_session):
         arm.undo()
         arm.step(1)
         assert channel + ".undelayed" not in {c.id for c in arm.channels(f"{PREFIX}elbow_flexor.*")}
+        assert arm.measurement_delays() == {}
         stopped = arm.stop_recording()
         assert stopped.error == "" and stopped.steps == 13
         ok, report = caliper.verify(stopped.path)
