@@ -4,6 +4,7 @@
 //        in another process
 //   RATIO observer_bytes_*               bytes per update sent to an observer as more bodies move
 //   RATIO slow_observer_slowdown         steps per second with a 100 ms observer / without
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
@@ -88,6 +91,42 @@ double Median(int n, F&& f) {
   return runs[2];
 }
 
+/// Two kinds of call timed by turns: `rounds` rounds, each a block of `n` calls of `a` and one of
+/// `b` (which goes first alternates). Returns the medians of their blocks' times per call [us]
+/// and the median of the rounds' ratios a / b. A drift in this VM's speed of waking threads (it
+/// moves a call's time by tens of percent over seconds) then falls on both within a round and
+/// leaves the ratio alone, where one long block after the other measured the drift.
+struct Interleaved {
+  double a, b, ratio;
+};
+template <class A, class B>
+Interleaved ByTurns(int rounds, int n, A&& a, B&& b) {
+  auto block = [n](auto& f) {
+    const auto begin = Clock::now();
+    for (int i = 0; i < n; ++i) f();
+    return std::chrono::duration<double, std::micro>(Clock::now() - begin).count() / n;
+  };
+  std::vector<double> times_a, times_b, ratios;
+  for (int r = 0; r < rounds; ++r) {
+    double ta, tb;
+    if (r % 2 == 0) {
+      ta = block(a);
+      tb = block(b);
+    } else {
+      tb = block(b);
+      ta = block(a);
+    }
+    times_a.push_back(ta);
+    times_b.push_back(tb);
+    ratios.push_back(ta / tb);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  return {median(times_a), median(times_b), median(ratios)};
+}
+
 void Ratio(const char* name, double value, double target, bool lower_is_better = true) {
   const bool ok = lower_is_better ? value <= target : value >= target;
   std::printf("RATIO %s %.3f (target %.2f)%s\n", name, value, target, ok ? "" : "  <- off target");
@@ -128,6 +167,64 @@ std::pair<double, double> InProcessCalls(const std::string& root) {
   return {set, get};
 }
 
+/// Where the processes run. With `pin` and two or more CPUs allowed, this thread moves to the last
+/// of them, so that the processes it starts next (the naming service, the Model, the bare
+/// servants) inherit that CPU; Client() then moves it to the first, where the threads it starts
+/// later (its ORB's) inherit that one. Left to the kernel, this two-CPU VM puts a server's thread
+/// next to the client's in some blocks of calls (a call then takes about 23 us) and on the other
+/// CPU in others (60-90 us, two wake-ups of an idle CPU per call), and which it picks differs
+/// between the Model (more threads, whose wake-ups move it) and a bare servant: single runs of
+/// the ratio then read 0.8 to 3.5. Pinned, every call crosses between the same two CPUs.
+class Placement {
+ public:
+  explicit Placement(bool pin) {
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    if (!pin || sched_getaffinity(0, sizeof allowed, &allowed) != 0 || CPU_COUNT(&allowed) < 2)
+      return;
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+      if (!CPU_ISSET(cpu, &allowed)) continue;
+      if (client_ < 0) client_ = cpu;
+      server_ = cpu;
+    }
+    allowed_ = allowed;
+    if (!Move(server_)) client_ = server_ = -1;
+  }
+  // this thread, and those it starts from now on, on the client's CPU
+  void Client() const {
+    if (client_ >= 0) Move(client_);
+  }
+  // every thread of these processes and of this one back on all the CPUs allowed at the start
+  // (for the figures after the control cycle: pinned, a Model's stepping and its pushes to a slow
+  // observer would share one CPU)
+  void Release(const std::vector<pid_t>& processes) const {
+    if (client_ < 0) return;
+    std::vector<pid_t> all = processes;
+    all.push_back(getpid());
+    for (const pid_t pid : all) {
+      std::error_code error;
+      for (const auto& task :
+           std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", error))
+        sched_setaffinity(std::stoi(task.path().filename().string()), sizeof allowed_, &allowed_);
+    }
+  }
+  std::string Text() const {
+    if (client_ < 0) return "placement left to the kernel";
+    return "servers pinned to CPU " + std::to_string(server_) + ", the client to CPU " +
+           std::to_string(client_);
+  }
+
+ private:
+  static bool Move(int cpu) {
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    return sched_setaffinity(0, sizeof one, &one) == 0;
+  }
+  int client_ = -1, server_ = -1;
+  cpu_set_t allowed_;
+};
+
 class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
  public:
   explicit CountingObserver(int sleep_ms) : sleep_ms_(sleep_ms) {}
@@ -150,6 +247,19 @@ class CountingObserver : public virtual POA_Caliper::Scene::SceneObserver {
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::string(argv[1]) == "--echo-server") return RunEchoServer(argv[2], argv[3]);
+  bool pin = true;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--no-pin")) {
+      pin = false;
+    } else {
+      std::printf(
+          "Usage: model_bench [--no-pin]\n"
+          "A control cycle on caliper-model (the shipped arm) against a bare omniORB servant,\n"
+          "observer bytes and a slow observer. The servers run on the last CPU this process may\n"
+          "use and the client on the first; --no-pin leaves placement to the kernel.\n");
+      return std::strcmp(argv[i], "--help") ? 2 : 0;
+    }
+  }
   const char* source_dir = std::getenv("CALIPER_SOURCE_DIR");
   const auto [set_us, get_us] =
       InProcessCalls(source_dir ? source_dir : CALIPER_SOURCE_DIR_DEFAULT);
@@ -157,6 +267,7 @@ int main(int argc, char** argv) {
       "# the Model's own work of a control cycle, in process (ModelCore, no CORBA): "
       "set_commands of 10 %.2f us, get of 20 ids %.2f us\n",
       set_us, get_us);
+  const Placement placement(pin);
   testing::TempDir dir;
   // every process's socket in the bench's own directory (gone with it)
   setenv("CALIPER_SOCKET_DIR", (dir.path() + "/sock").c_str(), 1);
@@ -178,6 +289,8 @@ int main(int argc, char** argv) {
   testing::Process echo_tcp({argv[0], "--echo-server", tcp_ior_file, "giop:tcp:127.0.0.1:"},
                             dir.path() + "/echo-tcp.out");
 
+  placement.Client();
+  std::printf("# %s\n", placement.Text().c_str());
   CORBA::ORB_var orb = InitOrb(OrbOptions(rtc::kLocalEndpoint));
   M::Model_var arm;
   testing::WaitFor(
@@ -217,51 +330,70 @@ int main(int argc, char** argv) {
   arm->set_real_time_factor(1.0);
   arm->start();
   const int calls = 2000;
-  const double cycle = Median(calls, [&] {
+  auto model_cycle = [&] {
     arm->set_commands(commands);
     Caliper::Daq::ValueSeq_var v = arm->get(ids);
-  });
+  };
   // the same two calls on the bare servant, on a unix socket or on loopback TCP
   auto bare = [&](CaliperBench::EchoServer_ptr echo) {
-    return Median(calls, [&] {
+    return [echo, &commands, &ids] {
       echo->take_commands(commands);
       S::DoubleSeq_var v = echo->values_for(ids);
-    });
+    };
   };
-  const double raw = bare(server);
+  auto bare_unix = bare(server);
+  // 21 rounds of 500 cycles on each by turns (the ratio is the median of the rounds')
+  const Interleaved running = ByTurns(21, 500, model_cycle, bare_unix);
+  const double cycle = running.a, raw = running.b;
   // the same cycle with the Model paused: no step holds the lock or pushes to observers, so the
   // difference to the running cycle is what stepping adds, the rest what the Model's calls cost
   arm->pause();
-  const double paused = Median(calls, [&] {
-    arm->set_commands(commands);
-    Caliper::Daq::ValueSeq_var v = arm->get(ids);
-  });
+  const Interleaved paused_turns = ByTurns(11, 500, model_cycle, bare_unix);
+  const double paused = paused_turns.a;
   arm->start();
-  // single cycles while it runs: the slow ones are those that waited for steps holding the lock
-  std::vector<double> single;
-  for (int i = 0; i < 4 * calls; ++i) {
-    const auto begin = Clock::now();
-    arm->set_commands(commands);
-    Caliper::Daq::ValueSeq_var v = arm->get(ids);
-    single.push_back(std::chrono::duration<double, std::micro>(Clock::now() - begin).count());
-  }
-  std::sort(single.begin(), single.end());
-  std::printf("# control cycle %.1f us on caliper-model (running in real time), %.1f us with it "
-              "paused, %.1f us on a bare omniORB servant with the same payloads; single cycles "
-              "while running: median %.1f us, 99th percentile %.1f us, slowest %.1f us of %zu\n",
-              cycle, paused, raw, single[single.size() / 2], single[single.size() * 99 / 100],
-              single.back(), single.size());
-  Ratio("control_cycle_vs_raw_omniorb", cycle / raw, 1.05);  // issue #34 (before: 1.3)
+  // single cycles while it runs, then on the bare servant: the tail of the running Model's
+  // beyond the bare servant's is what waits for the steps (the lock, the CPU they share)
+  auto singles = [&](auto& cycle_once) {
+    std::vector<double> times;
+    for (int i = 0; i < 4 * calls; ++i) {
+      const auto begin = Clock::now();
+      cycle_once();
+      times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - begin).count());
+    }
+    std::sort(times.begin(), times.end());
+    return times;
+  };
+  const std::vector<double> single = singles(model_cycle);
+  const std::vector<double> single_bare = singles(bare_unix);
+  std::printf(
+      "# single cycles on the bare servant: median %.1f us, 99th percentile %.1f us, "
+      "slowest %.1f us of %zu\n",
+      single_bare[single_bare.size() / 2], single_bare[single_bare.size() * 99 / 100],
+      single_bare.back(), single_bare.size());
+  std::printf(
+      "# control cycle %.1f us on caliper-model (running in real time), %.1f us with it "
+      "paused (%.3f of the bare servant then), %.1f us on a bare omniORB servant with "
+      "the same payloads (medians of blocks of 500 timed by turns with the Model's); "
+      "single cycles while running: median %.1f us, 99th percentile %.1f us, slowest "
+      "%.1f us of %zu\n",
+      cycle, paused, paused_turns.ratio, raw, single[single.size() / 2],
+      single[single.size() * 99 / 100], single.back(), single.size());
+  // the median of the rounds' ratios (issue #34; 1.3 before)
+  Ratio("control_cycle_vs_raw_omniorb", running.ratio, 1.05);
   // what a session reachable only by its user costs: the same two calls on a unix socket in a
   // private directory against loopback TCP (which every user of the host could reach)
-  const double raw_tcp = bare(server_tcp);
-  std::printf("# two small calls (set 10 commands, get 20 values): %.1f us on a unix socket, "
-              "%.1f us on loopback TCP\n", raw, raw_tcp);
-  // on this 2-core VM the unix socket is the slower one (each call wakes a thread on the other
-  // core either way): the price of a session no other user can reach, against TLS on loopback,
-  // which costs more (docs/cluster.md)
-  Ratio("local_unix_vs_tcp_calls", raw / raw_tcp, 1.3);
+  auto bare_tcp = bare(server_tcp);
+  const Interleaved sockets = ByTurns(11, 500, bare_unix, bare_tcp);
+  std::printf(
+      "# two small calls (set 10 commands, get 20 values): %.1f us on a unix socket, "
+      "%.1f us on loopback TCP (timed by turns)\n",
+      sockets.a, sockets.b);
+  // the price of a session no other user can reach, against TLS on loopback, which costs more
+  // (docs/cluster.md). Pinned, the unix socket is the faster (about half); left to the kernel it
+  // was the slower on this VM, 1.1-1.9 (each call woke a thread on the other CPU either way)
+  Ratio("local_unix_vs_tcp_calls", sockets.ratio, 1.3);
   arm->pause();
+  placement.Release({model.pid(), echo.pid(), echo_tcp.pid()});
 
   // 2. observer bytes per update as more of 40 bodies move
   const int n = 40;
