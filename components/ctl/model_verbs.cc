@@ -637,17 +637,19 @@ int EditShowPath(const ModelRef& m, const std::vector<std::string>& a) {
 // `edit delays`: the channels that read late, with their delays in ms and in time steps.
 int EditShowDelays(const ModelRef& m, const std::vector<std::string>& a) {
   NeedArgs(a, 0, "delays");
-  S::Description_var d = Call(m, [&] { return m.model->scene_description(); });
-  if (d->sensor_delays.length() == 0) {
+  S::SensorDelaySeq_var delays = Call(m, [&] { return m.model->measurement_delays(); });
+  if (delays->length() == 0) {
     std::cout << "no channel reads late (edit delay CHANNEL SECONDS sets one)\n";
     return 0;
   }
-  std::cout << "CHANNEL                              DELAY [ms]   STEPS (of "
-            << Num(d->time_step * 1e3) << " ms)\n";
-  for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i) {
-    const S::SensorDelay& delay = d->sensor_delays[i];
+  M::SimulationStatus_var status = Call(m, [&] { return m.model->status(); });
+  const double dt = status->time_step;  // [s]
+  std::cout << "CHANNEL                              DELAY [ms]   STEPS (of " << Num(dt * 1e3)
+            << " ms)\n";
+  for (CORBA::ULong i = 0; i < delays->length(); ++i) {
+    const S::SensorDelay& delay = delays[i];
     std::cout << std::left << std::setw(37) << delay.id.in() << std::right << std::setw(10)
-              << Num(delay.delay * 1e3) << std::setw(8) << std::lround(delay.delay / d->time_step)
+              << Num(delay.delay * 1e3) << std::setw(8) << std::lround(delay.delay / dt)
               << std::left << "\n";
   }
   return 0;

@@ -201,14 +201,18 @@ S::Description* ToIdl(const sgal::Scene& scene) {
       }
     }
   }
+  SensorDelaysToIdl(scene, &d->sensor_delays);
+  return d;
+}
+
+void SensorDelaysToIdl(const sgal::Scene& scene, S::SensorDelaySeq* out) {
   // the ids as the DAQ lists them: after the Model's name for the scene (id-safe)
   const std::string prefix = simulation::IdSafe(scene.name) + ".";
-  d->sensor_delays.length(static_cast<CORBA::ULong>(scene.measurement_delays.size()));
+  out->length(static_cast<CORBA::ULong>(scene.measurement_delays.size()));
   for (CORBA::ULong i = 0; i < scene.measurement_delays.size(); ++i) {
-    d->sensor_delays[i].id = (prefix + scene.measurement_delays[i].id).c_str();
-    d->sensor_delays[i].delay = scene.measurement_delays[i].delay;
+    (*out)[i].id = (prefix + scene.measurement_delays[i].id).c_str();
+    (*out)[i].delay = scene.measurement_delays[i].delay;
   }
-  return d;
 }
 
 sgal::PathElement FromIdl(const S::PathPoint& p) {

@@ -16,6 +16,9 @@ namespace caliper::model {
 
 /// The scene description as viewers receive it.
 Caliper::Scene::Description* ToIdl(const sgal::Scene& scene);
+/// The scene's measurement delays, their ids as the DAQ lists them (after the Model's id-safe
+/// name for the scene).
+void SensorDelaysToIdl(const sgal::Scene& scene, Caliper::Scene::SensorDelaySeq* out);
 Caliper::Scene::Frame ToFrame(const sgal::Pose& p);
 sgal::Pose FromFrame(const Caliper::Scene::Frame& f);
 /// A shape's geometry; a mesh gets the index it has (or is given) in `meshes`.

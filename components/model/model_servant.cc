@@ -530,6 +530,16 @@ M::EditStatus* ModelServant::set_measurement_delay(const char* id, CORBA::Double
   });
 }
 
+S::SensorDelaySeq* ModelServant::measurement_delays() {
+  return Guard([&] {
+    const auto scene = core_.description();
+    if (!scene) throw NotAvailable("no scene is loaded (load one first)");
+    auto* out = new S::SensorDelaySeq;
+    SensorDelaysToIdl(*scene, out);
+    return out;
+  });
+}
+
 M::EditStatus* ModelServant::undo() {
   return Guard([&] { return ToIdl(core_.Undo()); });
 }

@@ -83,6 +83,7 @@ class ModelServant : public virtual POA_Caliper::Simulation::Model, public rtc::
   Caliper::Simulation::EditStatus* set_mass(const char* body, CORBA::Double mass_kg) override;
   Caliper::Simulation::EditStatus* set_measurement_delay(const char* id,
                                                          CORBA::Double delay_s) override;
+  Caliper::Scene::SensorDelaySeq* measurement_delays() override;
   Caliper::Simulation::EditStatus* undo() override;
   Caliper::Simulation::EditStatus* redo() override;
   Caliper::Simulation::EditStatus* edit_status() override;

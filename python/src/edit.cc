@@ -164,10 +164,10 @@ void BindEditing(py::class_<ModelObject, std::shared_ptr<ModelObject>>& c) {
       .def(
           "measurement_delays",
           [](ModelObject& m) {
-            S::Description_var d = m.Run([&] { return m.ref.model->scene_description(); });
+            S::SensorDelaySeq_var delays = m.Run([&] { return m.ref.model->measurement_delays(); });
             py::dict out;
-            for (CORBA::ULong i = 0; i < d->sensor_delays.length(); ++i)
-              out[py::str(d->sensor_delays[i].id.in())] = d->sensor_delays[i].delay;
+            for (CORBA::ULong i = 0; i < delays->length(); ++i)
+              out[py::str(delays[i].id.in())] = delays[i].delay;
             return out;
           },
           "The channels that read late: {id: delay [s]}, the ids as the DAQ lists them.")

@@ -339,6 +339,11 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
     ASSERT_EQ(d->sensor_delays.length(), 1u);
     EXPECT_STREQ(d->sensor_delays[0].id.in(), "ecce_arm.elbow.position");
     EXPECT_DOUBLE_EQ(d->sensor_delays[0].delay, 0.02);
+    // and so does the call that lists the delays alone
+    S::SensorDelaySeq_var delays = model_->measurement_delays();
+    ASSERT_EQ(delays->length(), 1u);
+    EXPECT_STREQ(delays[0].id.in(), "ecce_arm.elbow.position");
+    EXPECT_DOUBLE_EQ(delays[0].delay, 0.02);
   }
   // the panel, rebuilt with the new channels, marks the delayed one with its delay and does not
   // offer its undelayed twin
@@ -370,6 +375,7 @@ TEST_F(MainWindowEditTest, ASensorDelayOnAJointThroughThePanelAndUndo) {
   EXPECT_TRUE(
       WaitInGui([&] { return !has_channel("ecce_arm.elbow.position.undelayed"); }, seconds(5)));
   EXPECT_EQ(S::Description_var(model_->scene_description())->sensor_delays.length(), 0u);
+  EXPECT_EQ(S::SensorDelaySeq_var(model_->measurement_delays())->length(), 0u);
   EXPECT_TRUE(WaitInGui(
       [&] {
         return combo() != nullptr && combo()->findText(delayed_text) < 0 &&

@@ -447,6 +447,8 @@ TEST_F(ModelTest, WithoutASceneEveryCallRaisesItsDeclaredNotAvailableWithTheReas
   expect_unavailable("start", [&] { Model()->start(); });
   expect_unavailable("set_command", [&] { Model()->set_command("motor", 1.0); });
   expect_unavailable("set_time_step", [&] { Model()->set_time_step(0.002); });
+  expect_unavailable("measurement_delays",
+                     [&] { S::SensorDelaySeq_var d = Model()->measurement_delays(); });
 }
 
 // ------------------------------------------------------------------------ loading
