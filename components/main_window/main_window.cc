@@ -862,7 +862,7 @@ void MainWindow::OnCurrentItemChanged(QTreeWidgetItem* item) {
 void MainWindow::FollowSelection(const Snapshot& s) {
   const SelectionInfo& sel = s.selection;
   const SceneInfo& scene = s.scene;
-  const std::string head = scene.name + ".";
+  const std::string head = scene.daq_name + ".";
   auto group = [&](const std::string& name) { return GroupOf(head + name); };
   QTreeWidgetItem* current = nullptr;
   std::vector<QTreeWidgetItem*> also;  // rows shown selected beside the current one
@@ -996,7 +996,7 @@ void MainWindow::Refresh() {
     selection_shown_ = false;  // the new rows follow the selection again, quietly
   }
 
-  scene_name_ = s.scene.name;
+  scene_name_ = s.scene.daq_name;
   if (s.scene_version != scene_version_ || s.selection.revision != selection_revision_ ||
       !selection_shown_) {
     const bool moved = s.selection.revision != selection_revision_;

@@ -175,7 +175,7 @@ class MainWindow : public QMainWindow {
   std::uint64_t selection_revision_ = 0;
   bool selection_shown_ = false;                    // the Model's selection was followed once
   bool following_ = false;                          // the tree follows the Model's selection
-  std::string scene_name_;                          // the first part of the parameter ids
+  std::string scene_name_;  // the first part of the parameter ids (SceneInfo::daq_name)
   std::map<std::string, QTreeWidgetItem*> groups_;  // dotted prefix -> its group row
   std::map<std::string, QTreeWidgetItem*> items_;   // channel id -> its row
   std::uint64_t channels_version_ = 0;

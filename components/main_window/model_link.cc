@@ -14,6 +14,7 @@
 #include "caliper/client/scene_transfer.h"
 #include "caliper/client/session.h"
 #include "caliper/core/confined_path.h"
+#include "caliper/core/ids.h"
 #include "caliper/model.hh"
 #include "caliper/rtc.hh"
 #include "caliper/rtc/client_orb.h"
@@ -368,6 +369,7 @@ void ModelLink::ReadScene() {
   SceneInfo scene;
   S::Description_var d = i.model->scene_description();
   scene.name = d->name.in();
+  scene.daq_name = core::IdSafe(scene.name);
   for (CORBA::ULong k = 0; k < d->bodies.length(); ++k) {
     BodyInfo body;
     body.name = d->bodies[k].name.in();

@@ -101,7 +101,8 @@ struct ActuatorKindInfo {
 
 /// What the editing panels show of the loaded scene, read again after every edit.
 struct SceneInfo {
-  std::string name;  ///< the scene's name: the first part of its parameter ids
+  std::string name;      ///< the scene's name, as its file gives it ("ECCE Arm")
+  std::string daq_name;  ///< the first part of its DAQ ids, the Model's id-safe name ("ecce_arm")
   std::vector<BodyInfo> bodies;
   std::vector<ObstacleInfo> obstacles;
   std::vector<TendonInfo> tendons;

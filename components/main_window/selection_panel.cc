@@ -266,7 +266,7 @@ void SelectionPanel::BuildBody(const BodyInfo& body) {
     apply->setToolTip("set_mass: the inertia scales with the mass");
     row->addWidget(apply);
     form_layout_->addLayout(row);
-    mass_id_ = scene_.name + "." + body.name + ".mass";
+    mass_id_ = scene_.daq_name + "." + body.name + ".mass";
     connect(apply, &QPushButton::clicked, this, [this, name] {
       link_.SetMass(name, mass_->value());
       Say(QString("setting the mass of %1 to %2 kg ...").arg(Q(name)).arg(mass_->value()));
@@ -390,7 +390,7 @@ void SelectionPanel::BuildSensorDelay(const std::vector<std::string>& names, con
     if (!c.scalar() || c.writable || c.is_static || is_undelayed(c.id))
       continue;  // a sensor reads a changing state; not an id.undelayed
     const bool ours = std::any_of(names.begin(), names.end(), [&](const std::string& name) {
-      return c.id.rfind(s.scene.name + "." + name + ".", 0) == 0;
+      return c.id.rfind(s.scene.daq_name + "." + name + ".", 0) == 0;
     });
     if (!ours) continue;
     const QString unit = c.unit.empty() ? QString() : " [" + Q(c.unit) + "]";

@@ -71,7 +71,7 @@ class SelectionPanel : public QWidget {
   void BuildTendon(const TendonInfo& tendon, const Snapshot& s);
   void BuildPathPoint(const TendonInfo& tendon, unsigned index);
   /// A "Sensor delay" row for the scalar state channels whose ids start with one of `names`
-  /// (scene.name.): a channel, its delay [ms] and Apply (set_measurement_delay); none without
+  /// (scene.daq_name.): a channel, its delay [ms] and Apply (set_measurement_delay); none without
   /// such channels.
   void BuildSensorDelay(const std::vector<std::string>& names, const Snapshot& s);
 

@@ -119,6 +119,49 @@ TEST_F(MainWindowEditTest, TheTreeAndThePanelFollowTheModelsSelectionAndATreeRow
   EXPECT_EQ(tree->currentItem(), window_->GroupOf("ecce_arm.hand")) << "the row chosen stays";
 }
 
+TEST_F(MainWindowEditTest, ASceneWhoseNameIsNotIdSafeIsFollowedByItsDaqIds) {
+  // the arm renamed "ECCE Arm", sent by content: its channels start with the id-safe ecce_arm.
+  const char* source = std::getenv("CALIPER_SOURCE_DIR");
+  ASSERT_NE(source, nullptr);
+  std::string text = ReadFile(std::string(source) + "/models/ecce_arm.dae");
+  const std::string from = "<visual_scene id=\"visual_scene\" name=\"ecce_arm\">";
+  const size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), "<visual_scene id=\"visual_scene\" name=\"ECCE Arm\">");
+  M::Octets data(static_cast<CORBA::ULong>(text.size()));
+  data.length(static_cast<CORBA::ULong>(text.size()));
+  std::copy(text.begin(), text.end(), reinterpret_cast<char*>(data.get_buffer()));
+  model_->set_mass("forearm", 1.25);  // the load forgets it: the panel must show the file's 1.0
+  model_->load_scene_data("renamed_arm.dae", data);
+  ASSERT_STREQ(S::Description_var(model_->scene_description())->name.in(), "ECCE Arm");
+  // the tree follows the Model's selection by the DAQ's ids, and the panel reads the mass there
+  auto* tree = Find<QTreeWidget>("parameters");
+  model_->select("body", "forearm", 0);
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        return window_->GroupOf("ecce_arm.forearm") != nullptr &&
+               tree->currentItem() == window_->GroupOf("ecce_arm.forearm");
+      },
+      seconds(10)))
+      << "current row: "
+      << (tree->currentItem() ? tree->currentItem()->text(0).toStdString() : "none");
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        auto* mass = window_->findChild<QDoubleSpinBox*>("selection_mass");
+        return mass != nullptr && std::abs(mass->value() - 1.0) < 1e-9;
+      },
+      seconds(5)))
+      << "the panel shows the forearm's mass from ecce_arm.forearm.mass";
+  // a joint's Sensor delay row offers its channels
+  model_->select("constraint", "elbow", 0);
+  EXPECT_TRUE(WaitInGui(
+      [&] {
+        auto* combo = window_->findChild<QComboBox*>("delay_channel");
+        return combo != nullptr && combo->findData("ecce_arm.elbow.position") >= 0;
+      },
+      seconds(5)));
+}
+
 TEST_F(MainWindowEditTest, MassEditUndoRedoAndARefusedEdit) {
   auto* undo = Find<QAction>("undo");
   auto* redo = Find<QAction>("redo");

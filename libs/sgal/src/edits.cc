@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "caliper/core/ids.h"
+
 namespace caliper::sgal {
 
 namespace {
@@ -374,11 +376,10 @@ SceneEdit SetMass(const Scene& scene, const std::string& body, double mass_kg) {
 }
 
 SceneEdit SetMeasurementDelay(const Scene& scene, const std::string& channel, double delay_s) {
-  // the id as the model file names it, or as the DAQ lists it (after the scene's name)
-  const std::string prefix = scene.name + ".";
-  const std::string id = !scene.name.empty() && channel.rfind(prefix, 0) == 0
-                             ? channel.substr(prefix.size())
-                             : channel;
+  // the id as the model file names it, or as the DAQ lists it (after the scene's id-safe name:
+  // ecce_arm.elbow.position in a scene named "ECCE Arm")
+  const std::string prefix = core::IdSafe(scene.name) + ".";
+  const std::string id = channel.rfind(prefix, 0) == 0 ? channel.substr(prefix.size()) : channel;
   if (id.empty()) Refuse("a measurement delay needs a channel id");
   if (!std::isfinite(delay_s) || delay_s < 0 || delay_s > 10)
     Refuse("measurement delay of '" + id + "': delay must be in [0, 10] s, not " +

@@ -32,19 +32,6 @@ const char* ToString(RunState state) {
   return "?";
 }
 
-std::string IdSafe(const std::string& name) {
-  std::string out;
-  for (char c : name) {
-    const unsigned char u = static_cast<unsigned char>(c);
-    if (std::isalnum(u))
-      out += static_cast<char>(std::tolower(u));
-    else if (!out.empty() && out.back() != '_')
-      out += '_';
-  }
-  while (!out.empty() && out.back() == '_') out.pop_back();
-  return out.empty() ? "model" : out;
-}
-
 // Everything that belongs to one loaded scene.
 
 ModelCore::ModelCore(physics_bullet::Options options, Limits limits, PhysicsFactory factory)

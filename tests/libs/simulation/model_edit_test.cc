@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -321,6 +322,29 @@ TEST_F(ModelEdit, AMeasurementDelaySetLiveLagsItsChannelAndUndoRemovesIt) {
   refused("elbow_flexor.command", 0.002, "written from outside");
   refused("elbow_flexor.current", -1, "[0, 10] s");
   refused("elbow_flexor.current", 0, "has no measurement delay");
+}
+
+TEST_F(ModelEdit, ADelayByTheDaqsIdInASceneWhoseNameIsNotIdSafe) {
+  // the arm renamed "ECCE Arm": its channels start with the id-safe ecce_arm.
+  std::ifstream in(Model("ecce_arm.dae"), std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "<visual_scene id=\"visual_scene\" name=\"ecce_arm\">";
+  const size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), "<visual_scene id=\"visual_scene\" name=\"ECCE Arm\">");
+  core::ScratchDirectory dir("model-edit");
+  const std::string file = dir.path() + "/renamed.dae";
+  std::ofstream(file, std::ios::binary) << text;
+  core_.Load(file);
+  ASSERT_EQ(scene()->name, "ECCE Arm");
+  ASSERT_EQ(core_.model_name(), "ecce_arm");
+  const ModelCore::EditStatus set = core_.Edit([&](const sgal::Scene& s) {
+    return sgal::SetMeasurementDelay(s, "ecce_arm.elbow.position", 0.002);
+  });
+  EXPECT_EQ(set.last, "delay elbow.position by 2 ms");
+  ASSERT_EQ(scene()->measurement_delays.size(), 1u);
+  EXPECT_EQ(scene()->measurement_delays[0].id, "elbow.position");
+  EXPECT_EQ(Read(core_, "ecce_arm.elbow.position.undelayed").size(), 1u);
 }
 
 TEST_F(ModelEdit, ChangingOrRemovingADelayKeepsTheOthersInTheirOrder) {

@@ -20,21 +20,22 @@
 #include <unordered_set>
 #include <vector>
 
+#include "caliper/core/ids.h"
 #include "caliper/core/scratch_directory.h"
+#include "caliper/daq/daq_scene.h"
+#include "caliper/daq/recorder.h"
+#include "caliper/daq/registry.h"
+#include "caliper/experiment/experiment.h"
+#include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/recording/recording.h"
+#include "caliper/sgal/edits.h"
+#include "caliper/sgal/physics_scene.h"
 #include "caliper/simulation/core_types.h"
 #include "caliper/simulation/edit_history.h"
 #include "caliper/simulation/experiment_runner.h"
 #include "caliper/simulation/feeds.h"
 #include "caliper/simulation/replayer.h"
 #include "caliper/simulation/session_recorder.h"
-#include "caliper/sgal/edits.h"
-#include "caliper/daq/daq_scene.h"
-#include "caliper/daq/recorder.h"
-#include "caliper/daq/registry.h"
-#include "caliper/experiment/experiment.h"
-#include "caliper/physics_bullet/bullet_scene.h"
-#include "caliper/sgal/physics_scene.h"
 
 namespace caliper::simulation {
 
@@ -437,7 +438,7 @@ struct Verification {
 Verification VerifyRecording(const std::string& path,
                              const std::function<void(uint64_t, uint64_t)>& progress = nullptr);
 
-/// `arm.v2` from `Arm V2!`: lower case, letters, digits, underscores.
-std::string IdSafe(const std::string& name);
+/// `arm_v2` from `Arm V2!`: the first part of the scene's DAQ ids (caliper/core/ids.h).
+using core::IdSafe;
 
 }  // namespace caliper::simulation
