@@ -64,6 +64,15 @@ class MainWindowEditTest : public ModelProcessTest {
   }
 
   QString Status() { return window_->statusBar()->currentMessage(); }
+  // whether the Selection panel's mass shows `kg` within 5 s
+  bool PanelShowsMass(double kg) {
+    return WaitInGui(
+        [&] {
+          auto* mass = window_->findChild<QDoubleSpinBox*>("selection_mass");
+          return mass != nullptr && std::abs(mass->value() - kg) < 1e-9;
+        },
+        seconds(5));
+  }
   template <typename T>
   T* Find(const char* name) {
     T* w = window_->findChild<T*>(name);
@@ -145,12 +154,7 @@ TEST_F(MainWindowEditTest, ASceneWhoseNameIsNotIdSafeIsFollowedByItsDaqIds) {
       seconds(10)))
       << "current row: "
       << (tree->currentItem() ? tree->currentItem()->text(0).toStdString() : "none");
-  EXPECT_TRUE(WaitInGui(
-      [&] {
-        auto* mass = window_->findChild<QDoubleSpinBox*>("selection_mass");
-        return mass != nullptr && std::abs(mass->value() - 1.0) < 1e-9;
-      },
-      seconds(5)))
+  EXPECT_TRUE(PanelShowsMass(1.0))
       << "the panel shows the forearm's mass from ecce_arm.forearm.mass";
   // a joint's Sensor delay row offers its channels
   model_->select("constraint", "elbow", 0);
@@ -171,13 +175,7 @@ TEST_F(MainWindowEditTest, MassEditUndoRedoAndARefusedEdit) {
   EXPECT_NEAR(Get("ecce_arm.forearm.mass"), 1.0, 1e-6);
 
   model_->select("body", "forearm", 0);
-  ASSERT_TRUE(WaitInGui(
-      [&] {
-        auto* mass = window_->findChild<QDoubleSpinBox*>("selection_mass");
-        return mass != nullptr && std::abs(mass->value() - 1.0) < 1e-9;
-      },
-      seconds(5)))
-      << "the panel shows the forearm's mass";
+  ASSERT_TRUE(PanelShowsMass(1.0)) << "the panel shows the forearm's mass";
 
   // an edit through the panel
   Find<QDoubleSpinBox>("selection_mass")->setValue(1.3);
@@ -196,13 +194,7 @@ TEST_F(MainWindowEditTest, MassEditUndoRedoAndARefusedEdit) {
   ASSERT_TRUE(WaitInGui([&] { return redo->isEnabled(); }, seconds(5)));
   EXPECT_EQ(redo->text().toStdString(), "&Redo set the mass of forearm to 1.3 kg");
   EXPECT_FALSE(undo->isEnabled());
-  EXPECT_TRUE(WaitInGui(
-      [&] {
-        return std::abs(window_->findChild<QDoubleSpinBox*>("selection_mass")->value() - 1.0) <
-               1e-9;
-      },
-      seconds(5)))
-      << "the panel shows the Model's mass again";
+  EXPECT_TRUE(PanelShowsMass(1.0)) << "the panel shows the Model's mass again";
   redo->trigger();
   ASSERT_TRUE(
       WaitInGui([&] { return std::abs(Get("ecce_arm.forearm.mass") - 1.3) < 1e-6; }, seconds(5)));
