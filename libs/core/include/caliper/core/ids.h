@@ -6,8 +6,9 @@
 
 namespace caliper::core {
 
-/// `arm_v2` from `Arm V2!`: lower-case letters and digits, every other run of characters one
-/// underscore, none at the ends; "model" when nothing is left (an empty or unnamed scene).
+/// `arm_v2` from `Arm V2!`: ASCII letters (lower-cased) and digits, every other run of bytes one
+/// underscore, none at the ends; "model" when nothing is left (an empty or unnamed scene). The
+/// same under every locale.
 std::string IdSafe(const std::string& name);
 
 }  // namespace caliper::core
