@@ -122,7 +122,7 @@ class BatchRun {
   // ends with _exit) and the Models asked of the managers.
   int Finish(int rc);
   void WriteRun(size_t run, const M::Recording& recording);
-  void WriteSummary(double wall_s);
+  void WriteSummary(double wall_s, const std::vector<Outcome>& outcomes);
 
   Client& client_;
   BatchOptions options_;
@@ -134,6 +134,9 @@ class BatchRun {
   std::mutex written_mutex_;
   std::condition_variable written_cv_;
   std::vector<bool> written_;
+  // the summary's outcomes are taken: a run that ends after it keeps no file (the summary has it
+  // as interrupted)
+  bool summary_taken_ = false;
   std::vector<std::string> write_errors_;
   std::atomic<bool> stop_{false};
   std::vector<SpawnedModel> spawned_;  // asked of the managers; only these are used
@@ -272,6 +275,10 @@ void BatchRun::WriteRun(size_t run, const M::Recording& r) {
     channels.push_back({r.channels[i].id.in(), r.channels[i].unit.in(), r.channels[i].rows,
                         r.channels[i].cols});
   const std::string path = options_.out + "/runs/" + runs_[run].name + ".csv";
+  {
+    std::lock_guard<std::mutex> lock(written_mutex_);
+    if (summary_taken_) return;
+  }
   std::string error;
   try {
     core::WriteFileReplacing(path, [&](std::ostream& out) {
@@ -399,8 +406,7 @@ void BatchRun::Progress(bool last) {
     std::cerr << (tty ? "\r\033[K" : "") << line.str() << (tty && !last ? "" : "\n") << std::flush;
 }
 
-void BatchRun::WriteSummary(double wall_s) {
-  const auto outcomes = plan_.outcomes();
+void BatchRun::WriteSummary(double wall_s, const std::vector<Outcome>& outcomes) {
   core::WriteFileReplacing(options_.out + "/summary.csv", [&](std::ostream& out) {
     out << "name,status,model,attempts,duration [s],steps,samples,wall_time [s],"
            "load_wall_time [s],step_wall_time [s],retries,reason\n";
@@ -541,25 +547,28 @@ int BatchRun::Dispatch() {
     Progress(false);
   }
   stop_ = true;
+  std::vector<Outcome> summary;
   {
-    // every run that ended well has its file before the summary says so
+    // every run that ended well has its file before the summary says so; after an interruption
+    // runs still in flight may end meanwhile: the outcomes are taken again after each file, and a
+    // run that ends once they are taken for good writes none (the summary has it as interrupted)
     std::unique_lock<std::mutex> lock(written_mutex_);
-    const auto outcomes = plan_.outcomes();
     written_cv_.wait_for(lock, std::chrono::seconds(30), [&] {
-      for (size_t i = 0; i < outcomes.size(); ++i)
-        if (outcomes[i].state == Outcome::State::kDone && !written_[i]) return false;
+      summary = plan_.outcomes();
+      for (size_t i = 0; i < summary.size(); ++i)
+        if (summary[i].state == Outcome::State::kDone && !written_[i]) return false;
       return true;
     });
+    summary_taken_ = true;
   }
   const double wall = Since(begin_);
   Progress(true);
-  WriteSummary(wall);
+  WriteSummary(wall, summary);
   for (const auto& e : write_errors_) std::cerr << "error: " << e << "\n";
   const int rc = interrupted ? 130 : (plan_.failed() || !write_errors_.empty() ? 1 : 0);
   double sim_done = 0;
-  const auto outcomes = plan_.outcomes();
-  for (size_t i = 0; i < outcomes.size(); ++i)
-    if (outcomes[i].state == Outcome::State::kDone) sim_done += runs_[i].duration_s;
+  for (size_t i = 0; i < summary.size(); ++i)
+    if (summary[i].state == Outcome::State::kDone) sim_done += runs_[i].duration_s;
   WriteStatus(interrupted ? "interrupted" : rc == 0 ? "done" : "failed", 0, 0,
               wall > 0 ? sim_done / wall : 0, -1);
   return rc;
