@@ -435,17 +435,41 @@ int main(int argc, char** argv) {
     arm->pause();
     return (s1->steps - s0->steps) / 2.0;
   };
-  const double free_rate = rate();
   auto* slow = new CountingObserver(100);
   PortableServer::ObjectId_var slow_id = poa->activate_object(slow);
   CORBA::Object_var slow_ref = poa->id_to_reference(slow_id);
-  const CORBA::ULongLong observer = arm->add_observer(S::SceneObserver::_narrow(slow_ref));
-  const double slowed_rate = rate();
-  arm->remove_observer(observer);
-  std::printf("# steps per second: %.0f without an observer, %.0f with one taking 100 ms per "
-              "update (%llu updates received)\n", free_rate, slowed_rate,
-              static_cast<unsigned long long>(slow->updates_.load()));
-  Ratio("slow_observer_slowdown", free_rate / slowed_rate, 1.05);
+  auto slowed = [&] {
+    const CORBA::ULongLong observer = arm->add_observer(S::SceneObserver::_narrow(slow_ref));
+    const double steps_per_s = rate();
+    arm->remove_observer(observer);
+    return steps_per_s;
+  };
+  // by turns, as the control cycle: four pairs (which goes first alternates), the median of
+  // their ratios; one block after the other read 0.72-1.22 on this VM
+  std::vector<double> free_rates, slowed_rates, slowdowns;
+  for (int r = 0; r < 4; ++r) {
+    double free_rate, slowed_rate;
+    if (r % 2 == 0) {
+      free_rate = rate();
+      slowed_rate = slowed();
+    } else {
+      slowed_rate = slowed();
+      free_rate = rate();
+    }
+    free_rates.push_back(free_rate);
+    slowed_rates.push_back(slowed_rate);
+    slowdowns.push_back(free_rate / slowed_rate);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
+  };
+  std::printf(
+      "# steps per second: %.0f without an observer, %.0f with one taking 100 ms per "
+      "update (medians of four pairs by turns; %llu updates received)\n",
+      median(free_rates), median(slowed_rates),
+      static_cast<unsigned long long>(slow->updates_.load()));
+  Ratio("slow_observer_slowdown", median(slowdowns), 1.05);
   model.Signal(SIGTERM);
   echo.Signal(SIGTERM);
   echo_tcp.Signal(SIGTERM);
