@@ -78,53 +78,61 @@ int RunEchoServer(const std::string& ior_file, const std::string& endpoint) {
   return 0;
 }
 
+/// The median of `values` (the mean of the middle two for an even count).
+double MedianOf(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return 0.5 * (values[(n - 1) / 2] + values[n / 2]);
+}
+
+/// Time per call [us] of `n` calls of `f`.
+template <class F>
+double PerCall(int n, F& f) {
+  const auto begin = Clock::now();
+  for (int i = 0; i < n; ++i) f();
+  return std::chrono::duration<double, std::micro>(Clock::now() - begin).count() / n;
+}
+
 /// Median time per call [us] of `f` over `n` calls, 5 repetitions.
 template <class F>
 double Median(int n, F&& f) {
   std::vector<double> runs;
-  for (int r = 0; r < 5; ++r) {
-    const auto begin = Clock::now();
-    for (int i = 0; i < n; ++i) f();
-    runs.push_back(std::chrono::duration<double, std::micro>(Clock::now() - begin).count() / n);
-  }
-  std::sort(runs.begin(), runs.end());
-  return runs[2];
+  for (int r = 0; r < 5; ++r) runs.push_back(PerCall(n, f));
+  return MedianOf(runs);
 }
 
-/// Two kinds of call timed by turns: `rounds` rounds, each a block of `n` calls of `a` and one of
-/// `b` (which goes first alternates). Returns the medians of their blocks' times per call [us]
-/// and the median of the rounds' ratios a / b. A drift in this VM's speed of waking threads (it
-/// moves a call's time by tens of percent over seconds) then falls on both within a round and
-/// leaves the ratio alone, where one long block after the other measured the drift.
+/// Two figures measured by turns: `rounds` rounds, each one measurement of `a` and one of `b`
+/// (which goes first alternates). Returns the medians of their values and the median of the
+/// rounds' ratios a / b. A drift in this VM's speed (it moves a call's time by tens of percent
+/// over seconds) then falls on both within a round and leaves the ratio alone, where one long
+/// block after the other measured the drift.
 struct Interleaved {
   double a, b, ratio;
 };
 template <class A, class B>
-Interleaved ByTurns(int rounds, int n, A&& a, B&& b) {
-  auto block = [n](auto& f) {
-    const auto begin = Clock::now();
-    for (int i = 0; i < n; ++i) f();
-    return std::chrono::duration<double, std::micro>(Clock::now() - begin).count() / n;
-  };
-  std::vector<double> times_a, times_b, ratios;
+Interleaved ByTurns(int rounds, A&& a, B&& b) {
+  std::vector<double> values_a, values_b, ratios;
   for (int r = 0; r < rounds; ++r) {
-    double ta, tb;
+    double va, vb;
     if (r % 2 == 0) {
-      ta = block(a);
-      tb = block(b);
+      va = a();
+      vb = b();
     } else {
-      tb = block(b);
-      ta = block(a);
+      vb = b();
+      va = a();
     }
-    times_a.push_back(ta);
-    times_b.push_back(tb);
-    ratios.push_back(ta / tb);
+    values_a.push_back(va);
+    values_b.push_back(vb);
+    ratios.push_back(va / vb);
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
-  return {median(times_a), median(times_b), median(ratios)};
+  return {MedianOf(values_a), MedianOf(values_b), MedianOf(ratios)};
+}
+
+/// ByTurns of blocks of `n` calls of `a` and of `b`: times per call [us].
+template <class A, class B>
+Interleaved CallsByTurns(int rounds, int n, A& a, B& b) {
+  return ByTurns(
+      rounds, [&] { return PerCall(n, a); }, [&] { return PerCall(n, b); });
 }
 
 void Ratio(const char* name, double value, double target, bool lower_is_better = true) {
@@ -343,12 +351,12 @@ int main(int argc, char** argv) {
   };
   auto bare_unix = bare(server);
   // 21 rounds of 500 cycles on each by turns (the ratio is the median of the rounds')
-  const Interleaved running = ByTurns(21, 500, model_cycle, bare_unix);
+  const Interleaved running = CallsByTurns(21, 500, model_cycle, bare_unix);
   const double cycle = running.a, raw = running.b;
   // the same cycle with the Model paused: no step holds the lock or pushes to observers, so the
   // difference to the running cycle is what stepping adds, the rest what the Model's calls cost
   arm->pause();
-  const Interleaved paused_turns = ByTurns(11, 500, model_cycle, bare_unix);
+  const Interleaved paused_turns = CallsByTurns(11, 500, model_cycle, bare_unix);
   const double paused = paused_turns.a;
   arm->start();
   // single cycles while it runs, then on the bare servant: the tail of the running Model's
@@ -383,7 +391,7 @@ int main(int argc, char** argv) {
   // what a session reachable only by its user costs: the same two calls on a unix socket in a
   // private directory against loopback TCP (which every user of the host could reach)
   auto bare_tcp = bare(server_tcp);
-  const Interleaved sockets = ByTurns(11, 500, bare_unix, bare_tcp);
+  const Interleaved sockets = CallsByTurns(11, 500, bare_unix, bare_tcp);
   std::printf(
       "# two small calls (set 10 commands, get 20 values): %.1f us on a unix socket, "
       "%.1f us on loopback TCP (timed by turns)\n",
@@ -444,32 +452,14 @@ int main(int argc, char** argv) {
     arm->remove_observer(observer);
     return steps_per_s;
   };
-  // by turns, as the control cycle: four pairs (which goes first alternates), the median of
-  // their ratios; one block after the other read 0.72-1.22 on this VM
-  std::vector<double> free_rates, slowed_rates, slowdowns;
-  for (int r = 0; r < 4; ++r) {
-    double free_rate, slowed_rate;
-    if (r % 2 == 0) {
-      free_rate = rate();
-      slowed_rate = slowed();
-    } else {
-      slowed_rate = slowed();
-      free_rate = rate();
-    }
-    free_rates.push_back(free_rate);
-    slowed_rates.push_back(slowed_rate);
-    slowdowns.push_back(free_rate / slowed_rate);
-  }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
-  };
+  // by turns, as the control cycle: four pairs, the median of their ratios (one block after the
+  // other read 0.72-1.22 on this VM)
+  const Interleaved observed = ByTurns(4, rate, slowed);
   std::printf(
       "# steps per second: %.0f without an observer, %.0f with one taking 100 ms per "
       "update (medians of four pairs by turns; %llu updates received)\n",
-      median(free_rates), median(slowed_rates),
-      static_cast<unsigned long long>(slow->updates_.load()));
-  Ratio("slow_observer_slowdown", median(slowdowns), 1.05);
+      observed.a, observed.b, static_cast<unsigned long long>(slow->updates_.load()));
+  Ratio("slow_observer_slowdown", observed.ratio, 1.05);
   model.Signal(SIGTERM);
   echo.Signal(SIGTERM);
   echo_tcp.Signal(SIGTERM);
