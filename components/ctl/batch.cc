@@ -134,9 +134,6 @@ class BatchRun {
   std::mutex written_mutex_;
   std::condition_variable written_cv_;
   std::vector<bool> written_;
-  // the summary's outcomes are taken: a run that ends after it keeps no file (the summary has it
-  // as interrupted)
-  bool summary_taken_ = false;
   std::vector<std::string> write_errors_;
   std::atomic<bool> stop_{false};
   std::vector<SpawnedModel> spawned_;  // asked of the managers; only these are used
@@ -275,10 +272,6 @@ void BatchRun::WriteRun(size_t run, const M::Recording& r) {
     channels.push_back({r.channels[i].id.in(), r.channels[i].unit.in(), r.channels[i].rows,
                         r.channels[i].cols});
   const std::string path = options_.out + "/runs/" + runs_[run].name + ".csv";
-  {
-    std::lock_guard<std::mutex> lock(written_mutex_);
-    if (summary_taken_) return;
-  }
   std::string error;
   try {
     core::WriteFileReplacing(path, [&](std::ostream& out) {
@@ -547,19 +540,18 @@ int BatchRun::Dispatch() {
     Progress(false);
   }
   stop_ = true;
-  std::vector<Outcome> summary;
+  // after an interruption runs still in flight may end while the summary is written: closed, the
+  // plan keeps them unfinished (interrupted), and their results write no file
+  plan_.Close();
+  const std::vector<Outcome> summary = plan_.outcomes();  // no run ends any more
   {
-    // every run that ended well has its file before the summary says so; after an interruption
-    // runs still in flight may end meanwhile: the outcomes are taken again after each file, and a
-    // run that ends once they are taken for good writes none (the summary has it as interrupted)
+    // every run that ended well has its file before the summary says so
     std::unique_lock<std::mutex> lock(written_mutex_);
     written_cv_.wait_for(lock, std::chrono::seconds(30), [&] {
-      summary = plan_.outcomes();
       for (size_t i = 0; i < summary.size(); ++i)
         if (summary[i].state == Outcome::State::kDone && !written_[i]) return false;
       return true;
     });
-    summary_taken_ = true;
   }
   const double wall = Since(begin_);
   Progress(true);

@@ -32,11 +32,11 @@ std::optional<BatchPlan::Ticket> BatchPlan::Next(const std::string& model,
     }
   };
   skip_ended();
-  while (waiting_.empty() && ended_ != outcomes_.size() &&
+  while (!closed_ && waiting_.empty() && ended_ != outcomes_.size() &&
          changed_.wait_until(lock, deadline) != std::cv_status::timeout)
     skip_ended();
   skip_ended();
-  if (!waiting_.empty()) {
+  if (!closed_ && !waiting_.empty()) {
     const size_t run = waiting_.front();
     waiting_.pop_front();
     Outcome& o = outcomes_[run];
@@ -58,7 +58,8 @@ bool BatchPlan::Complete(const Ticket& ticket, Outcome result) {
   std::lock_guard<std::mutex> lock(mutex_);
   Outcome& o = outcomes_[ticket.run];
   Release(ticket);
-  if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return false;
+  if (closed_ || o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed)
+    return false;
   result.state = Outcome::State::kDone;
   result.retries = std::move(o.retries);
   result.attempts = o.attempts;
@@ -74,7 +75,7 @@ void BatchPlan::Fail(const Ticket& ticket, const std::string& reason) {
   if (!Live(ticket)) return;
   Outcome& o = outcomes_[ticket.run];
   Release(ticket);
-  if (o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
+  if (closed_ || o.state == Outcome::State::kDone || o.state == Outcome::State::kFailed) return;
   o.state = Outcome::State::kFailed;
   o.reason = reason;
   o.model = live_model_[ticket.run];
@@ -110,6 +111,13 @@ void BatchPlan::Abandon(const Ticket& ticket, bool stopping) {
   o.stopped = o.stopped || stopping;
   o.state = Outcome::State::kPending;
   waiting_.push_front(ticket.run);
+  changed_.notify_all();
+}
+
+void BatchPlan::Close() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  closed_ = true;
+  waiting_.clear();
   changed_.notify_all();
 }
 

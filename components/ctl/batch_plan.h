@@ -64,6 +64,11 @@ class BatchPlan {
   /// `stopping`: the batch is being stopped (the run is then said to have been stopped while it
   /// ran, if it does not end otherwise).
   void Abandon(const Ticket& ticket, bool stopping = false);
+  /// The batch was stopped and its outcomes are about to be reported: from now on a result
+  /// (Complete, Fail) no longer ends its run, which stays pending or running, so that what the
+  /// summary says of each run cannot change under it (and no result file appears beside a run
+  /// the summary calls interrupted). Nothing is handed out any more either.
+  void Close();
 
   bool finished() const;
   /// Returns when a run ends or `wait` has passed.
@@ -87,6 +92,7 @@ class BatchPlan {
   std::vector<std::string> live_model_;    // the model of the newest attempt, per run
   uint64_t next_token_ = 1;
   size_t ended_ = 0;
+  bool closed_ = false;
 };
 
 }  // namespace caliper::ctl

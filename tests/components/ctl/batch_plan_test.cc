@@ -156,6 +156,36 @@ TEST(BatchPlan, FirstResultWinsAndDuplicatesReturnFalse) {
   EXPECT_FALSE(plan.finished());
 }
 
+TEST(BatchPlan, AClosedPlanEndsNoRunAndHandsOutNone) {
+  // a stopped batch closes its plan before the summary: what the summary says cannot change
+  BatchPlan plan(5, 2);
+  std::vector<BatchPlan::Ticket> t;
+  for (const char* model : {"model1@a", "model2@b", "model3@c", "model4@d"}) {
+    const auto ticket = plan.Next(model, kNoWait);
+    ASSERT_TRUE(ticket);
+    t.push_back(*ticket);
+  }
+  EXPECT_TRUE(plan.Complete(t[0], Result("model1@a", 100)));
+  plan.Close();
+  EXPECT_FALSE(plan.Complete(t[1], Result("model2@b", 200))) << "so no file is written for it";
+  plan.Fail(t[2], "a fault after the stop");
+  plan.Abandon(t[3], true);  // its Model went down with the batch
+  const auto outcomes = plan.outcomes();
+  EXPECT_EQ(outcomes[0].state, State::kDone);
+  EXPECT_EQ(outcomes[1].state, State::kRunning) << "reported as interrupted, not done";
+  EXPECT_EQ(outcomes[2].state, State::kRunning) << "nor failed";
+  EXPECT_EQ(outcomes[3].state, State::kPending);
+  EXPECT_TRUE(outcomes[3].stopped);
+  EXPECT_EQ(outcomes[4].state, State::kPending);
+  EXPECT_EQ(plan.done(), 1u);
+  EXPECT_EQ(plan.failed(), 0u);
+  // the abandoned run waits again, but nothing is handed out, at once
+  const auto begin = Clock::now();
+  EXPECT_FALSE(plan.Next("model1@a", milliseconds(2000)));
+  EXPECT_LT(SecondsSince(begin), 1.0) << "a closed plan does not wait";
+  EXPECT_FALSE(plan.finished());
+}
+
 TEST(BatchPlan, CompleteAfterFailIsDropped) {
   BatchPlan plan(1, 2);
   const auto t = plan.Next("model1@a", kNoWait);
