@@ -48,15 +48,15 @@ def test_parameters_and_channels(new_session):
             arm.set(f"{PREFIX}elbow_flexor.cogging_count", 2.5)
         assert "cogging_count" in str(e.value) and "whole" in str(e.value)
         with pytest.raises(caliper.InvalidParameter) as e:
-            arm.set(f"{PREFIX}elbow_flexor.command_delay", 1.0)
-        assert "at most 50 " in str(e.value)
+            arm.set(f"{PREFIX}elbow_flexor.command_delay", 100.5)
+        assert "at most 100000 " in str(e.value)
         # the muscle's excitation delay: a parameter in seconds, bounded as the motor's
         arm.set(f"{PREFIX}biceps.command_delay", 0.03)
         assert arm.parameters(f"{PREFIX}biceps.command_delay")[
             f"{PREFIX}biceps.command_delay"] == (0.03, "s")
         with pytest.raises(caliper.InvalidParameter) as e:
-            arm.set(f"{PREFIX}biceps.command_delay", 0.2)
-        assert "biceps" in str(e.value) and "at most 50 " in str(e.value)
+            arm.set(f"{PREFIX}biceps.command_delay", 100.2)
+        assert "biceps" in str(e.value) and "at most 100000 " in str(e.value)
         # the export carries what was set live
         scene = arm.export_scene().decode()
         assert 'name="thermal_time_constant_motor"' in scene and 'name="cogging_count"' in scene

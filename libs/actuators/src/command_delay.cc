@@ -1,5 +1,6 @@
 #include "command_delay.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -25,38 +26,61 @@ void CommandDelay::SetDelay(double seconds) {
   const int steps = time_step_ > 0 ? Steps(seconds, time_step_) : 0;
   delay_ = seconds;
   delay_steps_ = steps;
+  Fit();
 }
 
 void CommandDelay::SetTimeStep(double dt) {
   delay_steps_ = Steps(delay_, dt);
   time_step_ = dt;
+  Fit();
+}
+
+void CommandDelay::Fit() {
+  const std::size_t size = pending_.size();
+  auto at = [&](int k) -> const Pending& { return pending_[(head_ + k) % size]; };
+  // of the commands due at the next step only the newest is followed (Release): the older ones
+  // go. The rest were issued within the last delay_steps_ steps, one per step, and one more may
+  // come before the next step.
+  int first = 0;
+  while (first + 1 < count_ && steps_ - at(first + 1).issued >= delay_steps_) ++first;
+  const int capacity = delay_steps_ + 2;
+  first = std::max(first, count_ - (capacity - 1));  // a state of another origin
+  if (first == 0 && size == static_cast<std::size_t>(capacity)) return;
+  std::vector<Pending> line(static_cast<std::size_t>(capacity));
+  for (int k = first; k < count_; ++k) line[k - first] = at(k);
+  pending_.swap(line);
+  count_ -= first;
+  head_ = 0;
 }
 
 void CommandDelay::Reset(double command) {
   head_ = count_ = 0;
   steps_ = 0;
   delayed_ = command;
+  Fit();
 }
 
 void CommandDelay::Queue(double command) {
+  const std::size_t capacity = pending_.size();
   if (count_ > 0) {
-    Pending& back = pending_[(head_ + count_ - 1) % kCapacity];
+    Pending& back = pending_[(head_ + count_ - 1) % capacity];
     if (back.issued == steps_) {
       back.value = command;
       return;
     }
   }
-  // the line never overflows: a step leaves at most delay_steps_ <= kMaxSteps commands in it,
-  // and one more arrives before the next
-  pending_[(head_ + count_) % kCapacity] = {steps_, command};
+  // the line never overflows (Fit): a step leaves at most delay_steps_ commands in it and one
+  // more arrives before the next; after Fit, the newest due one, the not yet due and one more
+  pending_[(head_ + count_) % capacity] = {steps_, command};
   ++count_;
 }
 
 void CommandDelay::Release(double dt) {
   if (dt != time_step_) SetTimeStep(dt);  // a caller that did not say its time step first
+  const int capacity = static_cast<int>(pending_.size());
   while (count_ > 0 && steps_ - pending_[head_].issued >= delay_steps_) {
     delayed_ = pending_[head_].value;
-    head_ = (head_ + 1) % kCapacity;
+    head_ = (head_ + 1) % capacity;
     --count_;
   }
 }
@@ -68,19 +92,42 @@ void CommandDelay::SaveState(double* out) const {
   // only the commands in flight: the engine saves every actuator before each step (for a
   // rollback), and a line is mostly empty
   for (int k = 0; k < count_; ++k) {
-    const Pending& p = pending_[(head_ + k) % kCapacity];
+    const Pending& p = pending_[(head_ + k) % pending_.size()];
     out[3 + 2 * k] = static_cast<double>(p.issued);
     out[4 + 2 * k] = p.value;
   }
+}
+
+namespace {
+// the count of commands in flight a state holds, -1 when it is no count of a line
+int CountIn(const double* in) {
+  const double count = in[2];
+  if (!(count >= 0 && count <= CommandDelay::kMaxSteps + 1) || count != std::floor(count))
+    return -1;
+  return static_cast<int>(count);
+}
+}  // namespace
+
+bool CommandDelay::Readable(const double* in, std::size_t n) {
+  // a line's state: 3 values and two per place, no more places than the longest delay has
+  if (n < 3 || (n - 3) % 2 != 0 || (n - 3) / 2 > static_cast<std::size_t>(kMaxSteps) + 2)
+    return false;
+  const int count = CountIn(in);
+  return count >= 0 && 3 + 2 * static_cast<std::size_t>(count) <= n;
 }
 
 void CommandDelay::RestoreState(const double* in) {
   steps_ = static_cast<std::int64_t>(in[0]);
   delayed_ = in[1];
   head_ = 0;
-  count_ = in[2] >= 0 && in[2] <= kCapacity ? static_cast<int>(in[2]) : 0;
+  count_ = std::max(0, CountIn(in));
+  // saved under this delay (a step's rollback): into the line as it is, no allocation; under a
+  // longer one, the line may hold more than this one's, and Fit keeps what will be followed
+  if (static_cast<std::size_t>(count_) > pending_.size())
+    pending_.resize(static_cast<std::size_t>(count_));
   for (int k = 0; k < count_; ++k)
     pending_[k] = {static_cast<std::int64_t>(in[3 + 2 * k]), in[4 + 2 * k]};
+  Fit();
 }
 
 }  // namespace caliper::actuators

@@ -6,21 +6,19 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace caliper::actuators {
 
 class CommandDelay {
  public:
-  /// The most time steps a command may be delayed by. The line holds as many commands in flight
-  /// in every actuator alike: a state's size may not depend on a parameter a live edit changes
-  /// (recordings restore keyframes into scenes built from the edited description).
-  static constexpr int kMaxSteps = 50;
-  /// Values SaveState() writes: the step count, the delayed command, the commands in flight
-  /// and each one's (step issued, value).
-  static constexpr std::size_t kStateSize = 3 + 2 * (kMaxSteps + 1);
+  /// The most time steps a command may be delayed by (100 s at 1 ms): a bound against a typo, not
+  /// against memory. The line holds as many commands as the delay has steps (and its state as
+  /// many values), so that a state without a delay stays small and a long one fits.
+  static constexpr int kMaxSteps = 100000;
 
   /// The delay [s]; throws std::invalid_argument "parameter 'command_delay' ..." when it is
-  /// negative or not finite, or longer than the line at the time step already known.
+  /// negative or not finite, or longer than kMaxSteps at the time step already known.
   void SetDelay(double seconds);
   double delay() const { return delay_; }
   /// The engine's time step [s]; throws std::invalid_argument when the delay would take more
@@ -49,10 +47,19 @@ class CommandDelay {
   /// an earlier one), the last command issued.
   double delayed() const { return delayed_; }
 
-  /// Writes the step count, the delayed command, the count and the commands in flight; the
-  /// values after them (up to kStateSize) are left as they are.
+  /// How many values SaveState() may write: 3 and two per place in the line, which has the
+  /// delay's steps and two more. It changes with SetDelay() and SetTimeStep() alone.
+  std::size_t StateSize() const { return 3 + 2 * pending_.size(); }
+  /// Writes the step count, the delayed command, the count and the commands in flight (each
+  /// one's step issued and value); the values after them (up to StateSize()) are left as they
+  /// are.
   void SaveState(double* out) const;
-  /// Reads back what SaveState() wrote; a count of commands out of range empties the line.
+  /// Whether `n` values hold what SaveState() wrote with a line of any length: 3 and two per
+  /// place, a count of commands in flight that is a whole number and whose commands fit.
+  static bool Readable(const double* in, std::size_t n);
+  /// Reads back what SaveState() wrote, under this delay or another: of commands that a longer
+  /// line held, those due at the next step but the newest are dropped, as they would never be
+  /// followed. A count of commands out of range empties the line.
   void RestoreState(const double* in);
 
  private:
@@ -60,15 +67,16 @@ class CommandDelay {
     std::int64_t issued;  // the step before which it was given
     double value;
   };
-  static constexpr int kCapacity = kMaxSteps + 1;
   static int Steps(double delay, double dt);  // throws beyond the line
   void Queue(double command);                 // into the line
   void Release(double dt);                    // what is due at this step leaves the line
+  // the line to the delay's steps and two more, keeping the commands that will be followed
+  void Fit();
 
-  double delay_ = 0;                 // [s]
-  double time_step_ = 0;             // the engine's, once told [s]
-  int delay_steps_ = 0;              // delay_ in steps of time_step_
-  Pending pending_[kCapacity] = {};  // a ring, oldest at head_
+  double delay_ = 0;                                        // [s]
+  double time_step_ = 0;                                    // the engine's, once told [s]
+  int delay_steps_ = 0;                                     // delay_ in steps of time_step_
+  std::vector<Pending> pending_ = std::vector<Pending>(2);  // a ring, oldest at head_
   int head_ = 0;
   int count_ = 0;
   std::int64_t steps_ = 0;  // steps taken since Reset

@@ -114,7 +114,7 @@ const DriverField kDriverFields[] = {
     {"slew_rate", "V/s", &DriverParameters::slew_rate, false,
      "fastest change of the driver's output voltage (0: none)"},
     {"command_delay", "s", &DriverParameters::command_delay, false,
-     "time from a command to the driver, rounded to whole time steps (at most 50 of them)"},
+     "time from a command to the driver, rounded to whole time steps (at most 100,000 of them)"},
 };
 
 constexpr double kDefaultSupplyVoltage = 12;  // [V]
@@ -295,8 +295,11 @@ class DcMotorTendon : public TendonActuator {
   double tension() const override { return tension_; }
 
   // the motor's, what the step reports and the driver's, the elastic element's, the delay line's
-  std::size_t StateSize() const override {
-    return kOwnState + elastic_state_ + CommandDelay::kStateSize;
+  std::size_t StateSize() const override { return kOwnState + elastic_state_ + delay_.StateSize(); }
+
+  bool Restorable(const double* in, std::size_t n) const override {
+    const std::size_t fixed = kOwnState + elastic_state_;
+    return n > fixed && CommandDelay::Readable(in + fixed, n - fixed);
   }
 
   void SaveState(double* out) const override {

@@ -190,7 +190,11 @@ class HillMuscle : public TendonActuator {
 
   // the activation, the fibre length and the outputs Get() reports (the solvers start afresh
   // from these in every step), then the excitations in flight
-  std::size_t StateSize() const override { return 2 + kOutputValues + CommandDelay::kStateSize; }
+  std::size_t StateSize() const override { return 2 + kOutputValues + delay_.StateSize(); }
+  bool Restorable(const double* in, std::size_t n) const override {
+    const std::size_t fixed = 2 + kOutputValues;
+    return n > fixed && CommandDelay::Readable(in + fixed, n - fixed);
+  }
   void SaveState(double* out) const override {
     out[0] = activation_;
     out[1] = fiber_length_;
@@ -907,7 +911,7 @@ void RegisterMuscleKinds() {
   }
   specs.push_back({"command_delay", "s", 0, false,
                    "time from an excitation command to the muscle (a nerve's conduction), "
-                   "rounded to whole time steps (at most 50 of them)"});
+                   "rounded to whole time steps (at most 100,000 of them)"});
   RegisterKind("hill_muscle", std::move(specs), MakeHillMuscle);
 }
 

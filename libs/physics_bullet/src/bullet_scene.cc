@@ -266,6 +266,8 @@ class BulletScene : public sgal::PhysicsScene {
   // the state at the start of a step (bodies, tendons, actuators, delayed channels), and putting
   // it back
   void SaveStepState();
+  // each actuator's place in actuator_states_, after anything that may change a StateSize()
+  void LayOutActuatorStates();
   void RestoreStepState();
   [[noreturn]] void FailStep();
   std::string Describe(const StepStage& stage) const;
@@ -662,9 +664,8 @@ void BulletScene::BuildTendons() {
     for (size_t t = 0; t < scene_.tendons.size(); ++t)
       if (scene_.tendons[t].name == a.desc->tendon) a.tendon = static_cast<int>(t);
     tendons_[a.tendon].actuators.push_back(static_cast<int>(i));
-    a.state_offset = actuator_states_.size();
-    actuator_states_.resize(a.state_offset + a.model->StateSize());
   }
+  LayOutActuatorStates();
   double largest = 0;
   for (const auto& b : scene_.bodies)
     for (const auto& shape : b.shapes) {
@@ -1299,11 +1300,14 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   if (s.actuators.size() != actuators_.size() || s.commands.size() != actuators_.size())
     refuse(std::to_string(s.actuators.size()) + " actuator states for a scene of " +
            std::to_string(actuators_.size()) + " actuators");
+  // a state may be longer or shorter than the actuator's own (a command delay's line saved under
+  // another delay): the actuator says whether it reads it
   for (size_t k = 0; k < actuators_.size(); ++k)
-    if (!s.actuators[k].empty() && s.actuators[k].size() != actuators_[k].model->StateSize())
-      refuse("actuator '" + actuators_[k].desc->name + "' has " +
-             std::to_string(actuators_[k].model->StateSize()) + " state values, not " +
-             std::to_string(s.actuators[k].size()));
+    if (!s.actuators[k].empty() &&
+        !actuators_[k].model->Restorable(s.actuators[k].data(), s.actuators[k].size()))
+      refuse("actuator '" + actuators_[k].desc->name + "' cannot read the " +
+             std::to_string(s.actuators[k].size()) + " state values given (its own are " +
+             std::to_string(actuators_[k].model->StateSize()) + ")");
   size_t remembered = 0;  // the values the delayed channels hold
   for (const auto& d : delays_) remembered += d.ring.size();
   if (!s.measurements.empty() && s.measurements.size() != remembered)
@@ -1393,6 +1397,7 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     // passive elements take no command (and refuse one): only what differs is set
     if (s.commands[k] != a.model->command()) a.model->SetCommand(s.commands[k]);
   }
+  LayOutActuatorStates();  // a restored delay line may be longer than the actuator's was
   // the tension reads what the actuators carried over hold; the speed is the last step's as an
   // exact state gives it, else none (no jump from the length before an edit)
   for (size_t ti = 0; ti < tendons_.size(); ++ti) {
@@ -1706,6 +1711,16 @@ void BulletScene::SetParameter(const std::string& id, double value) {
   const ParameterEntry& p = parameters_[index];
   if (!p.set) throw std::invalid_argument(id + " is read-only (a state of the simulation)");
   p.set(value);
+  LayOutActuatorStates();  // a command delay or a time step may change an actuator's state size
+}
+
+void BulletScene::LayOutActuatorStates() {
+  size_t offset = 0;
+  for (auto& a : actuators_) {
+    a.state_offset = offset;
+    offset += a.model->StateSize();
+  }
+  actuator_states_.resize(offset);
 }
 
 }  // namespace
@@ -1717,7 +1732,7 @@ std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options 
 std::string EngineId() {
   const int v = btGetVersion();
   return "bullet " + std::to_string(v / 100) + "." + std::to_string(v % 100) +
-         (sizeof(btScalar) == sizeof(double) ? " double" : " float") + ", state layout 2";
+         (sizeof(btScalar) == sizeof(double) ? " double" : " float") + ", state layout 3";
 }
 
 }  // namespace caliper::physics_bullet

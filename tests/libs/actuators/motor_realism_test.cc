@@ -593,7 +593,7 @@ TEST(Driver, PwmQuantisesAndSlewLimits) {
 
 TEST(Driver, RefusesDelaysBeyondItsLineAndBadValues) {
   sgal::Actuator description = MotorTendon();
-  description.parameters["command_delay"] = 0.5;
+  description.parameters["command_delay"] = 100.5;
   auto a = Make(description);
   try {
     a->SetTimeStep(1e-3);
@@ -601,23 +601,23 @@ TEST(Driver, RefusesDelaysBeyondItsLineAndBadValues) {
   } catch (const std::invalid_argument& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("flexor"), std::string::npos) << m;
-    EXPECT_NE(m.find("500 time steps"), std::string::npos) << m;
-    EXPECT_NE(m.find("at most 50 "), std::string::npos) << m;
+    EXPECT_NE(m.find("100500 time steps"), std::string::npos) << m;
+    EXPECT_NE(m.find("at most 100000 "), std::string::npos) << m;
   }
   // live, the same bound
   description.parameters["command_delay"] = 0;
   auto live = Make(description);
   live->SetTimeStep(1e-3);
-  live->Set("command_delay", 0.05);
+  live->Set("command_delay", 100);  // 100,000 steps: the longest line
   try {
-    live->Set("command_delay", 0.051);
+    live->Set("command_delay", 100.001);
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("51 time steps"), std::string::npos) << m;
-    EXPECT_NE(m.find("at most 50 "), std::string::npos) << m;
+    EXPECT_NE(m.find("100001 time steps"), std::string::npos) << m;
+    EXPECT_NE(m.find("at most 100000 "), std::string::npos) << m;
   }
-  EXPECT_EQ(live->Get("command_delay"), 0.05);
+  EXPECT_EQ(live->Get("command_delay"), 100);
   description.parameters["pwm_levels"] = 10.5;
   EXPECT_THROW(Make(description), std::invalid_argument);
   description.parameters["pwm_levels"] = 0;

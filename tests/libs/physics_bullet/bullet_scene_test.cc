@@ -522,6 +522,80 @@ TEST(BulletScene, AFaultingStepPutsTheDelayedChannelsBack) {
   }
 }
 
+// A command delay lengthened live to 200 steps (four times the line's old bound): the motor's
+// state grows with its line, and a faulting step (after the motor has taken its command) puts
+// all 200 commands in flight back. Shortened live, the line keeps what will still be followed;
+// the state saved under the long delay restores into a scene built with the short one (as a
+// scene edit carries it over) and goes on bit for bit as the scene shortened live.
+TEST(BulletScene, ALongCommandDelayEditedLiveKeepsItsCommandsInFlight) {
+  testing::RegisterTestKinds();
+  const auto command = [](int step) { return 0.05 * std::sin(0.03 * step); };  // [V]
+  auto faulting = MakePulledPendulum(false);
+  auto reference = MakePulledPendulum(false);
+  const auto motor = [](const sgal::Scene& scene) {
+    size_t k = 0;
+    while (scene.actuators.at(k).name != "motor") ++k;
+    return k;
+  };
+  const auto motor_state_size = [&](const sgal::PhysicsScene& scene) {
+    return scene.SaveDynamicState().actuators.at(motor(scene.description())).size();
+  };
+  const size_t undelayed = motor_state_size(*faulting);
+  for (auto* scene : {faulting.get(), reference.get()})
+    scene->SetParameter("motor.command_delay", 0.2);
+  EXPECT_EQ(motor_state_size(*faulting), undelayed + 2 * 200);
+  auto step_both = [&](int step) {
+    for (auto* scene : {faulting.get(), reference.get()}) {
+      scene->SetCommand("motor", command(step));
+      scene->Step();
+    }
+  };
+  for (int i = 0; i < 250; ++i) step_both(i);
+  EXPECT_EQ(faulting->GetParameter("motor.delayed_command"), command(249 - 200));
+  faulting->SetCommand("motor", command(250));
+  const auto before = Everything(*faulting);
+  faulting->SetParameter("faulty.fail", 1);
+  ExpectFaultingStep(faulting.get(), "injected fault", 0.251);
+  faulting->SetParameter("faulty.fail", 0);
+  ExpectSameBits(before, Everything(*faulting));
+  for (int i = 250; i < 300; ++i) step_both(i);
+  ExpectSameBits(Everything(*reference), Everything(*faulting));
+  EXPECT_EQ(faulting->GetParameter("motor.delayed_command"), command(299 - 200));
+
+  // saved with 200 commands in flight, then shortened live to 20 steps
+  const sgal::DynamicState saved = faulting->SaveDynamicState();
+  faulting->SetParameter("motor.command_delay", 0.02);
+  EXPECT_EQ(motor_state_size(*faulting), undelayed + 2 * 20);
+  sgal::Scene edited = PulledPendulum(false);
+  edited.actuators[motor(edited)].parameters["command_delay"] = 0.02;
+  auto restored = MakeScene(edited);
+  restored->RestoreDynamicState(saved);
+  EXPECT_EQ(motor_state_size(*restored), undelayed + 2 * 20);
+  faulting->ResetCaches();  // as a keyframe does: the hinge's warm start from the same place
+  restored->ResetCaches();
+  for (int i = 300; i < 400; ++i) {
+    for (auto* scene : {faulting.get(), restored.get()}) {
+      scene->SetCommand("motor", command(i));
+      scene->Step();
+    }
+    // at once the command of 20 steps before, no longer that of 200
+    ASSERT_EQ(faulting->GetParameter("motor.delayed_command"), command(i - 20)) << i;
+  }
+  ExpectSameBits(Everything(*faulting), Everything(*restored));
+  EXPECT_GT(std::abs(faulting->GetParameter("motor.current")), 1e-3) << "the motor ran";
+
+  // a state that is no delay line's is refused, naming the actuator
+  sgal::DynamicState wrong = saved;
+  wrong.actuators[motor(edited)].pop_back();
+  try {
+    restored->RestoreDynamicState(wrong);
+    ADD_FAILURE() << "a cut state was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("actuator 'motor' cannot read"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(BulletScene, AnExplodingBodyPutsTheActuatorsBackToo) {
   sgal::Scene s;
   s.gravity = Vector3d(5000, 0, 0);  // 5 m/s more each step: over the 1000 m/s limit at step 5

@@ -80,6 +80,7 @@ class FaultyMotor : public actuators::TendonActuator {
   double tension() const override { return motor_->tension(); }
   size_t StateSize() const override { return motor_->StateSize(); }
   void SaveState(double* out) const override { motor_->SaveState(out); }
+  bool Restorable(const double* in, size_t n) const override { return motor_->Restorable(in, n); }
   void RestoreState(const double* in) override { motor_->RestoreState(in); }
   void SetTimeStep(double dt) override { motor_->SetTimeStep(dt); }
   void SetCommand(double v) override { motor_->SetCommand(v); }

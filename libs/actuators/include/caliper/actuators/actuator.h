@@ -65,8 +65,11 @@ class TendonActuator {
   /// The tension of the last Step [N].
   virtual double tension() const = 0;
 
-  /// How many values SaveState() writes; fixed for the actuator's lifetime. The default, 0, is
-  /// for kinds whose Step() changes nothing.
+  /// How many values SaveState() writes at most. It may change with a parameter or the time step
+  /// (a command delay's line holds as many commands as the delay has steps) and with
+  /// RestoreState(), never within Step() or with a command: a caller that keeps a buffer for
+  /// it sizes the buffer again after Set(), SetTimeStep() and RestoreState(). The default, 0,
+  /// is for kinds whose Step() changes nothing.
   virtual std::size_t StateSize() const { return 0; }
   /// Writes StateSize() values: everything Step() changes (states, outputs, solver start values
   /// and caches whose contents change results), so that RestoreState() puts the actuator back
@@ -75,7 +78,16 @@ class TendonActuator {
   /// leave values it will not read back unwritten (the unused slots of a command delay line):
   /// a caller that compares or stores states zeroes its buffer first.
   virtual void SaveState(double* out) const { (void)out; }
-  /// Reads back the StateSize() values SaveState() wrote.
+  /// Whether RestoreState() can read the `n` values at `in`, which SaveState() of this kind with
+  /// these options wrote, perhaps under other parameters (a state saved before a live edit of
+  /// the command delay, in a recording's keyframe or carried over by a scene edit). The
+  /// default: exactly StateSize() values.
+  virtual bool Restorable(const double* in, std::size_t n) const {
+    (void)in;
+    return n == StateSize();
+  }
+  /// Reads back the values SaveState() wrote (StateSize() of them, or any count Restorable()
+  /// accepted).
   virtual void RestoreState(const double* in) { (void)in; }
 
   /// The time step the engine will call Step() with [s]. Kinds whose work per step depends on
