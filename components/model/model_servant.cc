@@ -320,11 +320,27 @@ D::ChannelInfoSeq* ModelServant::list(const char* pattern) {
 
 D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
   return Guard<D::NotAvailable>([&] {
-    const auto values = core_.Sample(FromIdl(ids));
-    auto* out = new D::ValueSeq;
-    out->length(static_cast<CORBA::ULong>(values.size()));
-    for (CORBA::ULong i = 0; i < values.size(); ++i) (*out)[i] = ToIdl(values[i]);
-    return out;
+    // a controller's every cycle: the ids read where they arrived, the values into buffers that
+    // keep their memory (no string or vector per id)
+    thread_local std::vector<const char*> names;
+    thread_local std::vector<daq::Shape> shapes;
+    thread_local std::vector<double> values;
+    names.resize(ids.length());
+    for (CORBA::ULong i = 0; i < ids.length(); ++i) names[i] = ids[i].in();
+    core_.SampleInto(names.data(), names.size(), &shapes, &values);
+    D::ValueSeq_var out = new D::ValueSeq;
+    out->length(static_cast<CORBA::ULong>(shapes.size()));
+    const double* at = values.data();
+    for (CORBA::ULong i = 0; i < shapes.size(); ++i) {
+      D::Value& v = out[i];
+      v.rows = shapes[i].rows;
+      v.cols = shapes[i].cols;
+      const auto n = static_cast<CORBA::ULong>(shapes[i].size());
+      v.data.length(n);
+      for (CORBA::ULong k = 0; k < n; ++k) v.data[k] = at[k];
+      at += n;
+    }
+    return out._retn();
   });
 }
 

@@ -158,18 +158,43 @@ std::vector<double> Registry::Get(const std::string& id) const {
 }
 
 std::vector<Reading> Registry::Sample(const std::vector<std::string>& ids) const {
-  std::vector<Handle> handles;
-  handles.reserve(ids.size());
-  for (const auto& id : ids) handles.push_back(Resolve(id));
+  std::vector<const char*> names(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) names[i] = ids[i].c_str();
+  std::vector<Shape> shapes;
+  std::vector<double> values;
+  SampleInto(names.data(), names.size(), &shapes, &values);
   std::vector<Reading> out(ids.size());
+  const double* at = values.data();
   for (size_t i = 0; i < ids.size(); ++i) {
-    const ChannelInfo& info = slots_[handles[i].slot].info;
-    out[i].id = info.id;
-    out[i].shape = info.shape;
-    out[i].values.resize(info.shape.size());
-    Read(handles[i], out[i].values.data());
+    out[i].id = ids[i];
+    out[i].shape = shapes[i];
+    out[i].values.assign(at, at + shapes[i].size());
+    at += shapes[i].size();
   }
   return out;
+}
+
+void Registry::SampleInto(const char* const* ids, size_t count, std::vector<Shape>* shapes,
+                          std::vector<double>* values) const {
+  // every id resolved before anything is read; the key and the handles keep their memory from
+  // call to call in each thread
+  thread_local std::string key;
+  thread_local std::vector<Handle> handles;
+  handles.resize(count);
+  shapes->resize(count);
+  size_t total = 0;
+  for (size_t i = 0; i < count; ++i) {
+    key.assign(ids[i]);
+    if (!TryResolve(key, &handles[i])) throw UnknownId(key);
+    (*shapes)[i] = slots_[handles[i].slot].info.shape;
+    total += (*shapes)[i].size();
+  }
+  values->resize(total);
+  double* out = values->data();
+  for (size_t i = 0; i < count; ++i) {
+    Read(handles[i], out);
+    out += (*shapes)[i].size();
+  }
 }
 
 void Registry::Set(const std::string& id, const std::vector<double>& values) {

@@ -701,14 +701,29 @@ std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids)
   return SampleLocked(ids);
 }
 
-std::vector<daq::Reading> ModelCore::SampleLocked(const std::vector<std::string>& ids) const {
-  if (ids.size() > limits_.ids_per_call)
-    throw LimitExceeded(std::to_string(ids.size()) + " ids in one call; at most " +
-                        std::to_string(limits_.ids_per_call) + " (split the request)",
+void ModelCore::RequireCanSampleLocked(size_t count) const {
+  if (count > limits_.ids_per_call)
+    throw LimitExceeded(std::to_string(count) + " ids in one call; at most " +
+                            std::to_string(limits_.ids_per_call) + " (split the request)",
                         limits_.ids_per_call);
   Require(true);
+}
+
+std::vector<daq::Reading> ModelCore::SampleLocked(const std::vector<std::string>& ids) const {
+  RequireCanSampleLocked(ids.size());
   try {
     return registry_.Sample(ids);
+  } catch (const daq::UnknownId& e) {
+    throw UnknownId(e.what(), e.id());
+  }
+}
+
+void ModelCore::SampleInto(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
+                           std::vector<double>* values) const {
+  const auto lock = Lock();
+  RequireCanSampleLocked(count);
+  try {
+    registry_.SampleInto(ids, count, shapes, values);
   } catch (const daq::UnknownId& e) {
     throw UnknownId(e.what(), e.id());
   }

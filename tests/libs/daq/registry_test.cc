@@ -132,6 +132,38 @@ TEST_F(Fixture, ReportsShapesAndSamplesValuesWithThem) {
   EXPECT_EQ(registry.Get("arm.wrist.current"), std::vector<double>{0.25});
 }
 
+// SampleInto, what a controller's `get` reads every cycle: the same shapes and values as Sample
+// in flat buffers, which it overwrites; an unknown id is refused before anything is read, and the
+// id it names is the one given (not the last one resolved in the same thread)
+TEST_F(Fixture, SamplesIntoFlatBuffersAsSampleDoes) {
+  const char* ids[] = {"arm.hand.rotation", "arm.elbow.current", "arm.hand.position",
+                       "arm.elbow.current"};
+  std::vector<Shape> shapes = {Shape::Vector(7)};
+  std::vector<double> values(40, -1.0);
+  registry.SampleInto(ids, 4, &shapes, &values);
+  EXPECT_EQ(shapes, (std::vector<Shape>{Shape::Matrix(3, 3), Shape::Scalar(), Shape::Vector(3),
+                                        Shape::Scalar()}));
+  EXPECT_EQ(values, (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9, -0.5, 0.1, 0.2, 0.3, -0.5}));
+  std::vector<double> flat;
+  for (const Reading& r :
+       registry.Sample({"arm.hand.rotation", "arm.elbow.current", "arm.hand.position"}))
+    flat.insert(flat.end(), r.values.begin(), r.values.end());
+  EXPECT_EQ(flat, std::vector<double>(values.begin(), values.end() - 1));
+  // again with fewer: the buffers shrink to them
+  currents["elbow"] = 2.5;
+  registry.SampleInto(ids + 1, 1, &shapes, &values);
+  EXPECT_EQ(shapes, std::vector<Shape>{Shape::Scalar()});
+  EXPECT_EQ(values, std::vector<double>{2.5});
+  int reads = 0;
+  registry.Add(Info("arm.counted", "-"), [&reads](double* out) { out[0] = ++reads; });
+  const char* bad[] = {"arm.counted", "arm.knee.current", "arm.elbow.current"};
+  ExpectThrowsWith<UnknownId>([&] { registry.SampleInto(bad, 3, &shapes, &values); },
+                              "unknown id 'arm.knee.current'");
+  EXPECT_EQ(reads, 0) << "a channel was read before the unknown id was refused";
+  registry.SampleInto(bad, 1, &shapes, &values);
+  EXPECT_EQ(values, std::vector<double>{1});
+}
+
 TEST_F(Fixture, SetsWritableChannels) {
   registry.Set("arm.elbow.command", {12.0});
   EXPECT_EQ(commands["elbow"], 12.0);

@@ -191,6 +191,12 @@ class Registry {
   /// The current values of `ids`, in order. Throws UnknownId for the first unknown id before
   /// reading anything.
   std::vector<Reading> Sample(const std::vector<std::string>& ids) const;
+  /// The same without a copy of each id or a vector per value, for a caller that reads ids every
+  /// cycle (a controller's `get`): the shapes of the `count` ids at `ids` (each NUL-terminated)
+  /// and their values one after the other (row-major each) into the two buffers, which are
+  /// overwritten. Throws UnknownId for the first unknown id before reading anything.
+  void SampleInto(const char* const* ids, size_t count, std::vector<Shape>* shapes,
+                  std::vector<double>* values) const;
 
   /// Writes a channel. Throws UnknownId for an unknown id, InvalidValue for a read-only channel,
   /// a count that does not fit the shape, a NaN or infinite value, or a value the setter refuses.

@@ -264,6 +264,10 @@ class ModelCore {
   // channels (parameters and states) through the DAQ registry
   std::vector<daq::ChannelInfo> Channels(const std::string& pattern) const;
   std::vector<daq::Reading> Sample(const std::vector<std::string>& ids) const;
+  /// Sample() into flat buffers, without a copy of each id (daq::Registry::SampleInto): what a
+  /// controller's `get` reads every cycle. The same checks and exceptions.
+  void SampleInto(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
+                  std::vector<double>* values) const;
   /// Applied at once, between two steps even while running (the lock makes it a step boundary),
   /// after the commands still queued; a bad shape, a non-finite value and the engine's own
   /// refusal (a negative mass, a bound) are raised to the caller.
@@ -356,6 +360,8 @@ class ModelCore {
   uint64_t StepRequestLocked(std::unique_lock<std::mutex>& lock, uint64_t n);
   void SetCommandsLocked(const std::vector<std::pair<std::string, double>>& commands);
   std::vector<daq::Reading> SampleLocked(const std::vector<std::string>& ids) const;
+  // what every read of `count` ids requires: at most ids_per_call of them, a scene
+  void RequireCanSampleLocked(size_t count) const;
   void PublishLocked();
   void RewindLocked();
   /// The achieved real-time factor over the wall time since the last measurement, once at least
