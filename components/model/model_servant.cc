@@ -68,6 +68,38 @@ auto Guard(F&& f) -> decltype(f()) {
   }
 }
 
+// What a controller's `get` and `control_cycle` read every cycle, in buffers of the serving
+// thread that keep their memory: the ids where they arrived (no string per id), the shapes and
+// the values one after the other (no vector per value).
+struct FlatValues {
+  std::vector<const char*> names;
+  std::vector<daq::Shape> shapes;
+  std::vector<double> values;
+
+  // the reply: a Daq::Value per id
+  void Fill(D::ValueSeq* out) const {
+    out->length(static_cast<CORBA::ULong>(shapes.size()));
+    const double* at = values.data();
+    for (CORBA::ULong i = 0; i < shapes.size(); ++i) {
+      D::Value& v = (*out)[i];
+      v.rows = shapes[i].rows;
+      v.cols = shapes[i].cols;
+      const auto n = static_cast<CORBA::ULong>(shapes[i].size());
+      v.data.length(n);
+      for (CORBA::ULong k = 0; k < n; ++k) v.data[k] = at[k];
+      at += n;
+    }
+  }
+};
+
+// this thread's buffers, with the names of `ids`
+FlatValues& Flat(const S::StringSeq& ids) {
+  thread_local FlatValues flat;
+  flat.names.resize(ids.length());
+  for (CORBA::ULong i = 0; i < ids.length(); ++i) flat.names[i] = ids[i].in();
+  return flat;
+}
+
 // the largest GIOP message this process sends or receives (corba.max_message_size) [bytes]
 double MaxMessageBytes(const core::Config& config) {
   return config.GetDouble("corba.max_message_size") * (1 << 20);
@@ -128,11 +160,14 @@ M::CycleResult* ModelServant::control_cycle(const M::CommandSeq& commands, CORBA
   std::vector<std::pair<std::string, double>> list;
   for (CORBA::ULong i = 0; i < commands.length(); ++i)
     list.emplace_back(commands[i].actuator.in(), commands[i].value);
-  const ModelCore::Cycle cycle = Guard([&] { return core_.ControlCycle(list, n, FromIdl(ids)); });
+  FlatValues& flat = Flat(ids);
+  const uint64_t steps = Guard([&] {
+    return core_.ControlCycleInto(list, n, flat.names.data(), flat.names.size(), &flat.shapes,
+                                  &flat.values);
+  });
   auto result = std::make_unique<M::CycleResult>();
-  result->steps = static_cast<CORBA::ULong>(cycle.steps);
-  result->values.length(static_cast<CORBA::ULong>(cycle.values.size()));
-  for (CORBA::ULong i = 0; i < cycle.values.size(); ++i) result->values[i] = ToIdl(cycle.values[i]);
+  result->steps = static_cast<CORBA::ULong>(steps);
+  flat.Fill(&result->values);
   return result.release();
 }
 
@@ -320,26 +355,10 @@ D::ChannelInfoSeq* ModelServant::list(const char* pattern) {
 
 D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
   return Guard<D::NotAvailable>([&] {
-    // a controller's every cycle: the ids read where they arrived, the values into buffers that
-    // keep their memory (no string or vector per id)
-    thread_local std::vector<const char*> names;
-    thread_local std::vector<daq::Shape> shapes;
-    thread_local std::vector<double> values;
-    names.resize(ids.length());
-    for (CORBA::ULong i = 0; i < ids.length(); ++i) names[i] = ids[i].in();
-    core_.SampleInto(names.data(), names.size(), &shapes, &values);
+    FlatValues& flat = Flat(ids);
+    core_.SampleInto(flat.names.data(), flat.names.size(), &flat.shapes, &flat.values);
     D::ValueSeq_var out = new D::ValueSeq;
-    out->length(static_cast<CORBA::ULong>(shapes.size()));
-    const double* at = values.data();
-    for (CORBA::ULong i = 0; i < shapes.size(); ++i) {
-      D::Value& v = out[i];
-      v.rows = shapes[i].rows;
-      v.cols = shapes[i].cols;
-      const auto n = static_cast<CORBA::ULong>(shapes[i].size());
-      v.data.length(n);
-      for (CORBA::ULong k = 0; k < n; ++k) v.data[k] = at[k];
-      at += n;
-    }
+    flat.Fill(&out.inout());
     return out._retn();
   });
 }

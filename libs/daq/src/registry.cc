@@ -163,6 +163,12 @@ std::vector<Reading> Registry::Sample(const std::vector<std::string>& ids) const
   std::vector<Shape> shapes;
   std::vector<double> values;
   SampleInto(names.data(), names.size(), &shapes, &values);
+  return ToReadings(ids, shapes, values);
+}
+
+std::vector<Reading> ToReadings(const std::vector<std::string>& ids,
+                                const std::vector<Shape>& shapes,
+                                const std::vector<double>& values) {
   std::vector<Reading> out(ids.size());
   const double* at = values.data();
   for (size_t i = 0; i < ids.size(); ++i) {

@@ -394,14 +394,27 @@ uint64_t ModelCore::StepNow(uint64_t n) {
 ModelCore::Cycle ModelCore::ControlCycle(
     const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
     const std::vector<std::string>& ids) {
+  std::vector<const char*> names(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) names[i] = ids[i].c_str();
+  std::vector<daq::Shape> shapes;
+  std::vector<double> values;
+  Cycle out;
+  out.steps = ControlCycleInto(commands, n, names.data(), names.size(), &shapes, &values);
+  out.values = daq::ToReadings(ids, shapes, values);
+  return out;
+}
+
+uint64_t ModelCore::ControlCycleInto(const std::vector<std::pair<std::string, double>>& commands,
+                                     uint64_t n, const char* const* ids, size_t count,
+                                     std::vector<daq::Shape>* shapes, std::vector<double>* values) {
   auto lock = Lock();
   RequireCanStepLocked();
-  SampleLocked(ids);  // ids it cannot read are refused before anything changes
+  // ids it cannot read are refused before anything changes
+  SampleIntoLocked(ids, count, shapes, values);
   if (!commands.empty()) SetCommandsLocked(commands);
-  Cycle out;
-  out.steps = StepRequestLocked(lock, n);
-  out.values = SampleLocked(ids);
-  return out;
+  const uint64_t steps = StepRequestLocked(lock, n);
+  SampleIntoLocked(ids, count, shapes, values);
+  return steps;
 }
 
 uint64_t ModelCore::StepRequestLocked(std::unique_lock<std::mutex>& lock, uint64_t n) {
@@ -721,6 +734,12 @@ std::vector<daq::Reading> ModelCore::SampleLocked(const std::vector<std::string>
 void ModelCore::SampleInto(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
                            std::vector<double>* values) const {
   const auto lock = Lock();
+  SampleIntoLocked(ids, count, shapes, values);
+}
+
+void ModelCore::SampleIntoLocked(const char* const* ids, size_t count,
+                                 std::vector<daq::Shape>* shapes,
+                                 std::vector<double>* values) const {
   RequireCanSampleLocked(count);
   try {
     registry_.SampleInto(ids, count, shapes, values);

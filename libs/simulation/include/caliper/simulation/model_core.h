@@ -148,6 +148,10 @@ class ModelCore {
   };
   Cycle ControlCycle(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
                      const std::vector<std::string>& ids);
+  /// The same into flat buffers, without a copy of each id (as SampleInto): the steps taken.
+  uint64_t ControlCycleInto(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
+                            const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
+                            std::vector<double>* values);
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
   Status status() const;
@@ -362,6 +366,8 @@ class ModelCore {
   std::vector<daq::Reading> SampleLocked(const std::vector<std::string>& ids) const;
   // what every read of `count` ids requires: at most ids_per_call of them, a scene
   void RequireCanSampleLocked(size_t count) const;
+  void SampleIntoLocked(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
+                        std::vector<double>* values) const;
   void PublishLocked();
   void RewindLocked();
   /// The achieved real-time factor over the wall time since the last measurement, once at least
