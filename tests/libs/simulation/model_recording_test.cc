@@ -33,8 +33,9 @@ std::vector<double> Read(ModelCore& core, const std::string& id) {
 constexpr const char* kHand = "ecce_arm.hand.position";
 constexpr const char* kTension = "ecce_arm.elbow_flexor.tendon.tension";
 
-// 1.2 s of the arm: motors driven and changed, a tuned stiffness, a pull and its release, a
-// via point moved; the hand's position at every step of the run
+// 1.2 s of the arm: motors driven and changed, a command delay lengthened and shortened live, a
+// tuned stiffness, a pull and its release, a via point moved; the hand's position at every step
+// of the run
 struct Session {
   std::vector<std::vector<double>> hand;  // after each step from the recording's start
   std::vector<double> hand_at_599;
@@ -55,7 +56,12 @@ Session RecordSession(ModelCore& core, const std::string& file) {
     }
   };
   core.SetCommands({{"elbow_flexor", 6.0}});
-  run(150);
+  run(120);
+  // a command delay lengthened live with commands in flight (the motor's state grows with it),
+  // carried through the edit below, and shortened after it
+  core.SetChannel("ecce_arm.elbow_flexor.command_delay", {0.08});
+  core.SetCommands({{"elbow_flexor", 5.0}});
+  run(30);
   core.SetChannel("ecce_arm.elbow_flexor.stiffness", {4000});
   core.SetCommands({{"shoulder_flexor", 4.0}, {"elbow_flexor", 2.0}});
   run(200);
@@ -64,8 +70,11 @@ Session RecordSession(ModelCore& core, const std::string& file) {
   run(63);
   // an edit while the pull holds: the pull goes on in the edited scene
   core.Edit([&](const sgal::Scene& sc) { return sgal::SetMass(sc, "forearm", 1.2); });
+  EXPECT_EQ(Read(core, "ecce_arm.elbow_flexor.command_delay"), std::vector<double>{0.08})
+      << "the edit kept the delay set live";
   run(87);
   core.ReleasePull();
+  core.SetChannel("ecce_arm.elbow_flexor.command_delay", {0.015});
   run(62);
   s.hand_at_599 = Read(core, kHand);
   run(1);  // step 600 of the session (37 + 563)
