@@ -68,9 +68,8 @@ auto Guard(F&& f) -> decltype(f()) {
   }
 }
 
-// What a controller's `get` and `control_cycle` read every cycle, in buffers of the serving
-// thread that keep their memory: the ids where they arrived (no string per id), the shapes and
-// the values one after the other (no vector per value).
+// What a controller's `get` and `control_cycle` read: the ids where they arrived (no string per
+// id), the shapes and the values one after the other (no vector per value).
 struct FlatValues {
   std::vector<const char*> names;
   std::vector<daq::Shape> shapes;
@@ -92,13 +91,32 @@ struct FlatValues {
   }
 };
 
-// this thread's buffers, with the names of `ids`
-FlatValues& Flat(const S::StringSeq& ids) {
-  thread_local FlatValues flat;
-  flat.names.resize(ids.length());
-  for (CORBA::ULong i = 0; i < ids.length(); ++i) flat.names[i] = ids[i].in();
-  return flat;
-}
+// The buffers of one call of `ids`, with their names. A controller's cycle reads a few ids every
+// cycle: their buffers are the serving thread's, kept from call to call. A larger call, or one
+// whose values outgrew what a thread keeps, has buffers of its own, freed when it returns.
+class FlatCall {
+ public:
+  explicit FlatCall(const S::StringSeq& ids) : flat_(ids.length() <= kKeptIds ? Kept() : own_) {
+    flat_.names.resize(ids.length());
+    for (CORBA::ULong i = 0; i < ids.length(); ++i) flat_.names[i] = ids[i].in();
+  }
+  ~FlatCall() {
+    if (flat_.values.capacity() > kKeptValues) std::vector<double>().swap(flat_.values);
+  }
+  FlatCall(const FlatCall&) = delete;
+  FlatCall& operator=(const FlatCall&) = delete;
+  FlatValues* operator->() { return &flat_; }
+
+ private:
+  static constexpr CORBA::ULong kKeptIds = 1024;
+  static constexpr size_t kKeptValues = 1 << 16;
+  static FlatValues& Kept() {
+    thread_local FlatValues kept;
+    return kept;
+  }
+  FlatValues own_;
+  FlatValues& flat_;
+};
 
 // the largest GIOP message this process sends or receives (corba.max_message_size) [bytes]
 double MaxMessageBytes(const core::Config& config) {
@@ -160,14 +178,14 @@ M::CycleResult* ModelServant::control_cycle(const M::CommandSeq& commands, CORBA
   std::vector<std::pair<std::string, double>> list;
   for (CORBA::ULong i = 0; i < commands.length(); ++i)
     list.emplace_back(commands[i].actuator.in(), commands[i].value);
-  FlatValues& flat = Flat(ids);
+  FlatCall flat(ids);
   const uint64_t steps = Guard([&] {
-    return core_.ControlCycleInto(list, n, flat.names.data(), flat.names.size(), &flat.shapes,
-                                  &flat.values);
+    return core_.ControlCycle(list, n, flat->names.data(), flat->names.size(), &flat->shapes,
+                              &flat->values);
   });
   auto result = std::make_unique<M::CycleResult>();
   result->steps = static_cast<CORBA::ULong>(steps);
-  flat.Fill(&result->values);
+  flat->Fill(&result->values);
   return result.release();
 }
 
@@ -355,10 +373,10 @@ D::ChannelInfoSeq* ModelServant::list(const char* pattern) {
 
 D::ValueSeq* ModelServant::get(const S::StringSeq& ids) {
   return Guard<D::NotAvailable>([&] {
-    FlatValues& flat = Flat(ids);
-    core_.SampleInto(flat.names.data(), flat.names.size(), &flat.shapes, &flat.values);
+    FlatCall flat(ids);
+    core_.SampleInto(flat->names.data(), flat->names.size(), &flat->shapes, &flat->values);
     D::ValueSeq_var out = new D::ValueSeq;
-    flat.Fill(&out.inout());
+    flat->Fill(&out.inout());
     return out._retn();
   });
 }

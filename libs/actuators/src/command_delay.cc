@@ -37,7 +37,7 @@ void CommandDelay::SetTimeStep(double dt) {
 
 void CommandDelay::Fit() {
   const std::size_t size = pending_.size();
-  auto at = [&](int k) -> const Pending& { return pending_[(head_ + k) % size]; };
+  auto at = [&](int k) -> const Pending& { return pending_[Slot(k)]; };
   // of the commands due at the next step only the newest is followed (Release): the older ones
   // go. The rest were issued within the last delay_steps_ steps, one per step, and one more may
   // come before the next step.
@@ -61,9 +61,8 @@ void CommandDelay::Reset(double command) {
 }
 
 void CommandDelay::Queue(double command) {
-  const std::size_t capacity = pending_.size();
   if (count_ > 0) {
-    Pending& back = pending_[(head_ + count_ - 1) % capacity];
+    Pending& back = pending_[Slot(count_ - 1)];
     if (back.issued == steps_) {
       back.value = command;
       return;
@@ -71,16 +70,15 @@ void CommandDelay::Queue(double command) {
   }
   // the line never overflows (Fit): a step leaves at most delay_steps_ commands in it and one
   // more arrives before the next; after Fit, the newest due one, the not yet due and one more
-  pending_[(head_ + count_) % capacity] = {steps_, command};
+  pending_[Slot(count_)] = {steps_, command};
   ++count_;
 }
 
 void CommandDelay::Release(double dt) {
   if (dt != time_step_) SetTimeStep(dt);  // a caller that did not say its time step first
-  const int capacity = static_cast<int>(pending_.size());
   while (count_ > 0 && steps_ - pending_[head_].issued >= delay_steps_) {
     delayed_ = pending_[head_].value;
-    head_ = (head_ + 1) % capacity;
+    head_ = Slot(1);
     --count_;
   }
 }
@@ -92,7 +90,7 @@ void CommandDelay::SaveState(double* out) const {
   // only the commands in flight: the engine saves every actuator before each step (for a
   // rollback), and a line is mostly empty
   for (int k = 0; k < count_; ++k) {
-    const Pending& p = pending_[(head_ + k) % pending_.size()];
+    const Pending& p = pending_[Slot(k)];
     out[3 + 2 * k] = static_cast<double>(p.issued);
     out[4 + 2 * k] = p.value;
   }

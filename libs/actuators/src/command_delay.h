@@ -70,6 +70,12 @@ class CommandDelay {
   static int Steps(double delay, double dt);  // throws beyond the line
   void Queue(double command);                 // into the line
   void Release(double dt);                    // what is due at this step leaves the line
+  // the place of the k-th command from the oldest, 0 <= k < the line's length (no division: this
+  // runs for every command in flight at every step's SaveState)
+  std::size_t Slot(int k) const {
+    const std::size_t i = static_cast<std::size_t>(head_ + k);
+    return i < pending_.size() ? i : i - pending_.size();
+  }
   // the line to the delay's steps and two more, keeping the commands that will be followed
   void Fit();
 

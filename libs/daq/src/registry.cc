@@ -163,12 +163,6 @@ std::vector<Reading> Registry::Sample(const std::vector<std::string>& ids) const
   std::vector<Shape> shapes;
   std::vector<double> values;
   SampleInto(names.data(), names.size(), &shapes, &values);
-  return ToReadings(ids, shapes, values);
-}
-
-std::vector<Reading> ToReadings(const std::vector<std::string>& ids,
-                                const std::vector<Shape>& shapes,
-                                const std::vector<double>& values) {
   std::vector<Reading> out(ids.size());
   const double* at = values.data();
   for (size_t i = 0; i < ids.size(); ++i) {
@@ -182,10 +176,14 @@ std::vector<Reading> ToReadings(const std::vector<std::string>& ids,
 
 void Registry::SampleInto(const char* const* ids, size_t count, std::vector<Shape>* shapes,
                           std::vector<double>* values) const {
-  // every id resolved before anything is read; the key and the handles keep their memory from
-  // call to call in each thread
+  // every id resolved before anything is read. The key and the handles of a call of a few ids (a
+  // controller's cycle) keep their memory from call to call in each thread; a larger call's
+  // handles are its own, freed when it returns
+  constexpr size_t kKeptHandles = 1024;
   thread_local std::string key;
-  thread_local std::vector<Handle> handles;
+  thread_local std::vector<Handle> kept;
+  std::vector<Handle> own;
+  std::vector<Handle>& handles = count <= kKeptHandles ? kept : own;
   handles.resize(count);
   shapes->resize(count);
   size_t total = 0;

@@ -391,22 +391,9 @@ uint64_t ModelCore::StepNow(uint64_t n) {
   return StepRequestLocked(lock, n);
 }
 
-ModelCore::Cycle ModelCore::ControlCycle(
-    const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
-    const std::vector<std::string>& ids) {
-  std::vector<const char*> names(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) names[i] = ids[i].c_str();
-  std::vector<daq::Shape> shapes;
-  std::vector<double> values;
-  Cycle out;
-  out.steps = ControlCycleInto(commands, n, names.data(), names.size(), &shapes, &values);
-  out.values = daq::ToReadings(ids, shapes, values);
-  return out;
-}
-
-uint64_t ModelCore::ControlCycleInto(const std::vector<std::pair<std::string, double>>& commands,
-                                     uint64_t n, const char* const* ids, size_t count,
-                                     std::vector<daq::Shape>* shapes, std::vector<double>* values) {
+uint64_t ModelCore::ControlCycle(const std::vector<std::pair<std::string, double>>& commands,
+                                 uint64_t n, const char* const* ids, size_t count,
+                                 std::vector<daq::Shape>* shapes, std::vector<double>* values) {
   auto lock = Lock();
   RequireCanStepLocked();
   // ids it cannot read are refused before anything changes
@@ -709,26 +696,23 @@ std::vector<daq::ChannelInfo> ModelCore::Channels(const std::string& pattern) co
   return channels;
 }
 
-std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
-  const auto lock = Lock();
-  return SampleLocked(ids);
-}
-
-void ModelCore::RequireCanSampleLocked(size_t count) const {
+template <class Read>
+auto ModelCore::ReadLocked(size_t count, Read&& read) const -> decltype(read()) {
   if (count > limits_.ids_per_call)
     throw LimitExceeded(std::to_string(count) + " ids in one call; at most " +
                             std::to_string(limits_.ids_per_call) + " (split the request)",
                         limits_.ids_per_call);
   Require(true);
-}
-
-std::vector<daq::Reading> ModelCore::SampleLocked(const std::vector<std::string>& ids) const {
-  RequireCanSampleLocked(ids.size());
   try {
-    return registry_.Sample(ids);
+    return read();
   } catch (const daq::UnknownId& e) {
     throw UnknownId(e.what(), e.id());
   }
+}
+
+std::vector<daq::Reading> ModelCore::Sample(const std::vector<std::string>& ids) const {
+  const auto lock = Lock();
+  return ReadLocked(ids.size(), [&] { return registry_.Sample(ids); });
 }
 
 void ModelCore::SampleInto(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
@@ -740,12 +724,7 @@ void ModelCore::SampleInto(const char* const* ids, size_t count, std::vector<daq
 void ModelCore::SampleIntoLocked(const char* const* ids, size_t count,
                                  std::vector<daq::Shape>* shapes,
                                  std::vector<double>* values) const {
-  RequireCanSampleLocked(count);
-  try {
-    registry_.SampleInto(ids, count, shapes, values);
-  } catch (const daq::UnknownId& e) {
-    throw UnknownId(e.what(), e.id());
-  }
+  ReadLocked(count, [&] { registry_.SampleInto(ids, count, shapes, values); });
 }
 
 void ModelCore::SetChannel(const std::string& id, const std::vector<double>& values) {

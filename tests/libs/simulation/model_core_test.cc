@@ -124,6 +124,13 @@ TEST(ModelCore, StopEndsAStepRequestAndRewinds) {
 // keeps them. "Not driven" is checked against a Model that never had a command.
 TEST(ModelCore, AControlCycleIsTheThreeCallsUnderOneLockAndARefusalChangesNothing) {
   const char* const kPosition = "pendulum_tendon.pendulum.position";
+  std::vector<daq::Shape> shapes;
+  std::vector<double> values;
+  // one cycle reading `ids` into shapes and values: the steps taken
+  auto cycle = [&](ModelCore& core, const std::vector<std::pair<std::string, double>>& commands,
+                   std::vector<const char*> ids) {
+    return core.ControlCycle(commands, 20, ids.data(), ids.size(), &shapes, &values);
+  };
   ModelCore three, one;
   three.Load(Model("pendulum_tendon.dae"));
   one.Load(Model("pendulum_tendon.dae"));
@@ -131,20 +138,18 @@ TEST(ModelCore, AControlCycleIsTheThreeCallsUnderOneLockAndARefusalChangesNothin
   for (double volts : {6.0, 2.0, 4.5}) {
     three.SetCommands({{motor, volts}});
     ASSERT_EQ(three.StepNow(20), 20u);
-    const ModelCore::Cycle cycle = one.ControlCycle({{motor, volts}}, 20, {kPosition});
-    EXPECT_EQ(cycle.steps, 20u);
-    ASSERT_EQ(cycle.values.size(), 1u);
-    EXPECT_EQ(cycle.values[0].values, three.Sample({kPosition}).at(0).values);
+    EXPECT_EQ(cycle(one, {{motor, volts}}, {kPosition}), 20u);
+    EXPECT_EQ(shapes, std::vector<daq::Shape>{daq::Shape::Vector(3)});  // the body's position
+    EXPECT_EQ(values, three.Sample({kPosition}).at(0).values);
   }
   const uint64_t steps = one.status().steps;
-  EXPECT_THROW(one.ControlCycle({{motor, 1.0}}, 20, {"no.such.id"}), UnknownId);
-  EXPECT_THROW(one.ControlCycle({{motor, 1.0}, {"no_such_motor", 1.0}}, 20, {kPosition}),
-               UnknownId);
-  EXPECT_THROW(one.ControlCycle({{motor, std::nan("")}}, 20, {kPosition}), InvalidValue);
+  EXPECT_THROW(cycle(one, {{motor, 1.0}}, {"no.such.id"}), UnknownId);
+  EXPECT_THROW(cycle(one, {{motor, 1.0}, {"no_such_motor", 1.0}}, {kPosition}), UnknownId);
+  EXPECT_THROW(cycle(one, {{motor, std::nan("")}}, {kPosition}), InvalidValue);
   EXPECT_EQ(one.status().steps, steps) << "a refused cycle stepped";
   EXPECT_EQ(one.ActuatorStates().at(0).command, 4.5) << "a refused cycle changed a command";
   one.Start();
-  EXPECT_THROW(one.ControlCycle({{motor, 1.0}}, 20, {kPosition}), NotAvailable);
+  EXPECT_THROW(cycle(one, {{motor, 1.0}}, {kPosition}), NotAvailable);
   one.Pause();
   EXPECT_EQ(one.ActuatorStates().at(0).command, 4.5)
       << "a cycle refused while running changed a command";

@@ -224,11 +224,6 @@ class Registry {
   uint64_t version_ = 0;
 };
 
-/// The readings of `ids` from the buffers Registry::SampleInto filled for them.
-std::vector<Reading> ToReadings(const std::vector<std::string>& ids,
-                                const std::vector<Shape>& shapes,
-                                const std::vector<double>& values);
-
 /// Whether `text` matches the glob `pattern`, as fnmatch(3) without flags: `*` any run of
 /// characters, dots included; `?` one character; `[abc]`, `[a-z]`, `[!a]` one of a set; `\x`
 /// the character x itself.

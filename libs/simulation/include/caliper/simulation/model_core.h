@@ -141,17 +141,11 @@ class ModelCore {
   /// One lock-step control cycle under one lock: checks the ids (LimitExceeded, UnknownId) and
   /// the commands (SetCommands' errors) and StepNow's preconditions before anything changes,
   /// applies the commands (none: allowed in a replay too), runs StepNow's request of `n` steps
-  /// and reads `ids` after them, before another client can step or write.
-  struct Cycle {
-    uint64_t steps = 0;
-    std::vector<daq::Reading> values;
-  };
-  Cycle ControlCycle(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
-                     const std::vector<std::string>& ids);
-  /// The same into flat buffers, without a copy of each id (as SampleInto): the steps taken.
-  uint64_t ControlCycleInto(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
-                            const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
-                            std::vector<double>* values);
+  /// and reads the `count` ids at `ids` after them, before another client can step or write,
+  /// into `shapes` and `values` as SampleInto does. Returns the steps taken.
+  uint64_t ControlCycle(const std::vector<std::pair<std::string, double>>& commands, uint64_t n,
+                        const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
+                        std::vector<double>* values);
   void SetTimeStep(double seconds);
   void SetRealTimeFactor(double factor);
   Status status() const;
@@ -363,9 +357,10 @@ class ModelCore {
   void RequireCanStepLocked() const;
   uint64_t StepRequestLocked(std::unique_lock<std::mutex>& lock, uint64_t n);
   void SetCommandsLocked(const std::vector<std::pair<std::string, double>>& commands);
-  std::vector<daq::Reading> SampleLocked(const std::vector<std::string>& ids) const;
-  // what every read of `count` ids requires: at most ids_per_call of them, a scene
-  void RequireCanSampleLocked(size_t count) const;
+  // `read` of `count` ids from the registry, as every read of ids is checked (at most
+  // ids_per_call of them, a scene) and its unknown id reported
+  template <class Read>
+  auto ReadLocked(size_t count, Read&& read) const -> decltype(read());
   void SampleIntoLocked(const char* const* ids, size_t count, std::vector<daq::Shape>* shapes,
                         std::vector<double>* values) const;
   void PublishLocked();
