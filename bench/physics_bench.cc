@@ -3,6 +3,7 @@
 //   RATIO <name> <value> (target <target>)
 // measured in this run (medians of several repetitions), never compared with stored times.
 #include <mujoco/mujoco.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
@@ -72,10 +73,13 @@ std::vector<double> Time(const std::vector<const Case*>& cases, bool fastest = f
 
 double Time(const Case& one, bool fastest = false) { return Time({&one}, fastest)[0]; }
 
-Case CaliperCase(const TreeOptions& tree, bool contact) {
+int g_threads = 1;  // physics_bullet::Options::threads of the Caliper cases (--threads)
+
+Case CaliperCase(const TreeOptions& tree, bool contact, int threads = g_threads) {
   auto scene = std::make_shared<std::unique_ptr<sgal::PhysicsScene>>();
   physics_bullet::Options options;
   options.tendon_body_contact = contact;
+  options.threads = threads;
   return {[=](int start) {
             TreeOptions o = tree;
             o.start = start;
@@ -160,6 +164,7 @@ Case PassiveCase(const TreeOptions& tree) {
   auto plain = std::make_shared<std::unique_ptr<sgal::PhysicsScene>>();
   physics_bullet::Options no_contact;
   no_contact.tendon_body_contact = false;
+  no_contact.threads = g_threads;
   return {[=](int start) mutable {
             *plain = physics_bullet::MakeScene(describe(start, &lengths), no_contact);
           },
@@ -213,17 +218,21 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      g_threads = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--verbose")) verbose = true;
     else {
-      std::printf("Usage: physics_bench [--steps N] [--repeats R] [--only CASE] [--verbose]\n"
-                  "40-body tree, 39 hinges, 80 tendons, dt = 1 ms. A step time is the mean over\n"
-                  "R runs of N steps (default %d and %d), each run from the next of %d starting\n"
-                  "poses (upright and tilted by %.2f rad), the same for every engine.\n"
-                  "--verbose prints each run's time.\n"
-                  "--only times one case (for profiling): tree_contact, tree_free,\n"
-                  "spanning_on, spanning_off, tree_bare (no tendons), passive (ligaments, no tendon\n"
-                  "contact), raw_bullet.\n",
-                  steps, repeats, kStarts, kStartTilt);
+      std::printf(
+          "Usage: physics_bench [--steps N] [--repeats R] [--threads N] [--only CASE] [--verbose]\n"
+          "40-body tree, 39 hinges, 80 tendons, dt = 1 ms. A step time is the mean over\n"
+          "R runs of N steps (default %d and %d), each run from the next of %d starting\n"
+          "poses (upright and tilted by %.2f rad), the same for every engine.\n"
+          "--verbose prints each run's time.\n"
+          "--threads N runs the Caliper cases on N threads (Options::threads; 1).\n"
+          "--only times one case (for profiling): tree_contact, tree_free,\n"
+          "spanning_on, spanning_off, tree_bare (no tendons), passive (ligaments, no tendon\n"
+          "contact), raw_bullet.\n",
+          steps, repeats, kStarts, kStartTilt);
       return std::strcmp(argv[i], "--help") ? 2 : 0;
     }
   }
@@ -344,5 +353,21 @@ int main(int argc, char** argv) {
   for (const auto& [n, t] : by_tendons) std::printf(" %.0f: %.1f", n, t);
   std::printf("\n");
   Ratio("tendon_cost_growth_exponent", exponent(by_tendons), 1.05);
+
+  // Options::threads: the contact tree on two threads against one, by turns (the figures above
+  // are on --threads, one by default)
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  if (sched_getaffinity(0, sizeof(cpus), &cpus) == 0 && CPU_COUNT(&cpus) >= 2) {
+    const Case one = CaliperCase(contact, true, 1), two = CaliperCase(contact, true, 2);
+    const std::vector<double> by_threads = Time({&one, &two});
+    std::printf("# step time [us], floor + self contact: one thread %.1f, two %.1f\n",
+                by_threads[0], by_threads[1]);
+    Ratio("two_threads_vs_one_contact_tree", by_threads[1] / by_threads[0], 0.9);
+  } else {
+    std::printf(
+        "# two_threads_vs_one_contact_tree not measured: this process may run on one "
+        "processor only\n");
+  }
   return 0;
 }

@@ -46,6 +46,10 @@ std::vector<core::ConfigKey> ModelComponent::ConfigKeys() {
       {"model.autostart", Type::kBool, "false", "start simulating once loaded and active"},
       {"model.tendon_contact", Type::kBool, "true",
        "bend tendons around bodies they would cut through"},
+      {"model.physics_threads", Type::kInt, "1",
+       "threads that advance the tendons and search contacts at the end of each step (1 = one, "
+       "0 = every processor this process may run on); the same results on any count",
+       0, 8},
       {"model.inject_fault", Type::kString, "",
        "for tests of the fault path: KIND@STEP makes step STEP of the first scene built throw "
        "(KIND: simulation_fault, bad_alloc, out_of_range, runtime_error, unknown); '' = never"},
@@ -58,6 +62,7 @@ ModelComponent::ModelComponent(rtc::Runtime& runtime)
     : runtime_(runtime), autostart_(runtime.config().GetBool("model.autostart")) {
   physics_bullet::Options options;
   options.tendon_body_contact = runtime.config().GetBool("model.tendon_contact");
+  options.threads = static_cast<int>(runtime.config().GetInt("model.physics_threads"));
   const InjectedFault fault = ParseInjectedFault(runtime.config().GetString("model.inject_fault"));
   if (fault.kind != InjectedFault::Kind::kNone)
     logging::Get("model").warn("model.inject_fault: step %llu of the first scene will throw",

@@ -1,11 +1,13 @@
 #include "caliper/physics_bullet/bullet_scene.h"
 
-#include <btBulletDynamicsCommon.h>
 #include <LinearMath/btConvexHullComputer.h>
+#include <btBulletDynamicsCommon.h>
+#include <omp.h>
+#include <sched.h>
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <exception>
@@ -206,6 +208,72 @@ std::string CurrentException() {
   }
 }
 
+// A Bullet world whose contact search for the next step can run at the end of this one, when
+// nothing it reads changes in between: the poses a step starts from are those the last one ended
+// at, and stepSimulation's work before its search (kinematic bodies' velocities, gravity, each
+// moving body's swept pose from its velocity) changes none of what the search reads. So the
+// search can run beside the tendons' end-of-step work, which reads Caliper's copy of the poses.
+class AheadWorld : public btDiscreteDynamicsWorld {
+ public:
+  using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
+
+  /// The next step's contact search, now, for a step of dt [s]: the moving bodies' boxes swept to
+  /// where their velocities take them, as predictUnconstraintMotion will sweep them (their own
+  /// swept poses are put back: they are part of the saved state). Nothing when a body has
+  /// damping, which that sweep applies to its velocity first (Caliper's bodies have none).
+  void DetectAhead(btScalar dt) {
+    swept_.resize(m_nonStaticRigidBodies.size());
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
+      const btRigidBody* body = m_nonStaticRigidBodies[i];
+      if (body->getLinearDamping() != 0 || body->getAngularDamping() != 0) return;
+    }
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
+      btRigidBody* body = m_nonStaticRigidBodies[i];
+      swept_[i] = body->getInterpolationWorldTransform();
+      if (!body->isStaticOrKinematicObject())
+        body->predictIntegratedTransform(dt, body->getInterpolationWorldTransform());
+    }
+    btDispatcherInfo& info = getDispatchInfo();  // as internalSingleStepSimulation sets it
+    info.m_timeStep = dt;
+    info.m_stepCount = 0;
+    info.m_debugDraw = getDebugDrawer();
+    btCollisionWorld::performDiscreteCollisionDetection();
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i)
+      m_nonStaticRigidBodies[i]->setInterpolationWorldTransform(swept_[i]);
+    ahead_ = true;
+  }
+  /// After anything that may change what the search reads (a parameter, a restored state, new
+  /// caches): the next step searches again itself.
+  void ForgetAhead() { ahead_ = false; }
+
+  void performDiscreteCollisionDetection() override {
+    if (ahead_) {
+      ahead_ = false;  // found already, for these poses
+      return;
+    }
+    btCollisionWorld::performDiscreteCollisionDetection();
+  }
+
+ private:
+  bool ahead_ = false;
+  std::vector<btTransform> swept_;
+};
+
+// Options::threads as a count: 0 is every processor this process may run on (its affinity, which
+// a batch system's allocation sets), at most kMaxThreads
+int ResolveThreads(int threads) {
+  constexpr int kMaxThreads = 8;
+  if (threads < 0)
+    throw std::invalid_argument("physics threads must be >= 0 (0: automatic), got " +
+                                std::to_string(threads));
+  if (threads == 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    threads = sched_getaffinity(0, sizeof(set), &set) == 0 ? CPU_COUNT(&set) : 1;
+  }
+  return std::clamp(threads, 1, kMaxThreads);
+}
+
 class BulletScene : public sgal::PhysicsScene {
  public:
   BulletScene(const sgal::Scene& scene, Options options);
@@ -241,6 +309,14 @@ class BulletScene : public sgal::PhysicsScene {
   void UpdateJoints();
   void RefreshWorldShapes();
   void EvaluateTendons();
+  // one tendon's path (bent around the bodies, with this thread's buffers) at this step's poses
+  void EvaluateTendon(size_t index, actuators::ContactScratch* scratch);
+  // the end of a step for every tendon: its path, its speed over the step and its actuators'
+  // step, on options_.threads threads (each tendon on one; the same bits whatever the count); the
+  // first failing tendon's exception (in tendon order) is rethrown with stage_ naming it
+  void AdvanceTendons();
+  // AdvanceTendons' work for one tendon; sets *stage to what it is doing
+  void AdvanceTendon(size_t index, actuators::ContactScratch* scratch, StepStage* stage);
   void ApplyTendonForces();
   void ApplyJointSprings();
   void ApplyJointFriction();
@@ -292,7 +368,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btDbvtBroadphase> broadphase_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
-  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  std::unique_ptr<AheadWorld> world_;
   std::unique_ptr<btRigidBody> fixed_body_;  // the world side of joints with one body
   std::vector<BodyData> bodies_;
   std::vector<JointData> joints_;
@@ -310,8 +386,16 @@ class BulletScene : public sgal::PhysicsScene {
                                             // sized once
   StepStage stage_;                         // what the step is doing (for a fault's message)
   double detour_reach_ = 0.1;  // 2.1 times the largest finite shape bounding radius [m]
-  // tendon-body contact's buffers, reused by every tendon and step (no allocation per step)
-  actuators::ContactScratch contact_scratch_;
+  // tendon-body contact's buffers, one per thread, reused by every tendon and step (no
+  // allocation per step)
+  std::vector<actuators::ContactScratch> contact_scratch_;
+  int threads_ = 1;  // that advance the tendons (options_.threads resolved)
+  // per job of AdvanceTendons (the contact search, then a tendon each): the exception it threw, and
+  // where
+  std::vector<std::exception_ptr> job_faults_;
+  std::vector<StepStage> job_fault_stages_;
+  // AdvanceTendons' time on one thread and on threads_, moving means [s] (0: not measured yet)
+  double serial_seconds_ = 0, parallel_seconds_ = 0;
   // every shape's bounding ball at this step's poses, packed for QueryShapes' scan
   struct ContactBall {
     double x, y, z;  // centre [m]
@@ -401,12 +485,14 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
     for (const auto& e : errors) msg << "\n  " << e;
     throw std::invalid_argument(msg.str());
   }
+  threads_ = ResolveThreads(options_.threads);
+  contact_scratch_.resize(static_cast<size_t>(threads_));
   configuration_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
-                                                     solver_.get(), configuration_.get());
+  world_ = std::make_unique<AheadWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
+                                        configuration_.get());
   world_->setGravity(ToBt(scene_.gravity, scale_));
   // each solver iteration sweeps every constraint and contact: bounded like actuator sub-steps
   if (scene_.settings.solver_iterations < 1 ||
@@ -760,13 +846,19 @@ void BulletScene::QueryShapes(const Vector3d& a, const Vector3d& b, double pad,
 }
 
 void BulletScene::EvaluateTendons() {
+  for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+    stage_ = {StepStage::kTendon, static_cast<int>(ti)};
+    EvaluateTendon(ti, &contact_scratch_[0]);
+  }
+}
+
+void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) {
   // the path's speed is measured from its lengths at the ends of a step (Step): the points'
   // velocities are not needed
   static const Isometry3d kWorld = Isometry3d::Identity();
   auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
-  for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+  {
     TendonData& t = tendons_[ti];
-    stage_ = {StepStage::kTendon, static_cast<int>(ti)};
     t.world.resize(t.elements.size());
     for (size_t k = 0; k < t.elements.size(); ++k) {
       const ElementRef& ref = t.elements[k];
@@ -800,9 +892,108 @@ void BulletScene::EvaluateTendons() {
       actuators::ContactOptions contact;
       contact.margin = t.desc->radius;
       contact.detour_reach = detour_reach_ + 2 * contact.margin;  // the reaches grow by it
-      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, &contact_scratch_,
+      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, scratch,
                                                &t.contact_memory, contact_travel_);
     }
+  }
+}
+
+void BulletScene::AdvanceTendons() {
+  const int n = static_cast<int>(tendons_.size());
+  if (threads_ <= 1) {  // Bullet searches the contacts inside the next step
+    for (int ti = 0; ti < n; ++ti) AdvanceTendon(ti, &contact_scratch_[0], &stage_);
+    return;
+  }
+  const bool ahead = options_.search_contacts_ahead;
+  auto serial = [&] {
+    for (int ti = 0; ti < n; ++ti) AdvanceTendon(ti, &contact_scratch_[0], &stage_);
+    stage_ = {StepStage::kWorld, -1};
+    if (ahead) world_->DetectAhead(static_cast<btScalar>(dt_));
+  };
+  // Handing the work to the threads and waiting for the last costs a few microseconds: more
+  // than a light scene's tendons (springs, no contact) cost on one. Each way's time is measured
+  // (a moving mean, a sample at most twice the mean: a thread the system held up once does not
+  // decide), the faster one taken, and the other tried again every kProbeSteps steps, as contacts
+  // come and go. Either way gives the same bits.
+  constexpr uint64_t kProbeSteps = 64;
+  const bool parallel_faster = parallel_seconds_ < serial_seconds_;
+  const bool parallel = steps_ % kProbeSteps == 0 ? !parallel_faster : parallel_faster;
+  const auto start = std::chrono::steady_clock::now();
+  auto measured = [&](double* mean) {
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    *mean = *mean == 0 ? seconds : 0.75 * *mean + 0.25 * std::min(seconds, 2 * *mean);
+  };
+  if (!parallel) {
+    serial();
+    measured(&serial_seconds_);
+    return;
+  }
+  // job 0 is Bullet's contact search for the next step (AheadWorld), the others a tendon each:
+  // each tendon's work reads Caliper's copy of the poses and the shapes of this step and writes
+  // only its own tendon and actuators. A thread takes the next job when done with one.
+  job_faults_.assign(tendons_.size() + 1, nullptr);
+  job_fault_stages_.resize(tendons_.size() + 1);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
+  for (int job = 0; job <= n; ++job) {
+    StepStage stage;
+    try {
+      if (job == 0) {
+        if (ahead) world_->DetectAhead(static_cast<btScalar>(dt_));
+      } else {
+        AdvanceTendon(job - 1, &contact_scratch_[omp_get_thread_num()], &stage);
+      }
+    } catch (...) {  // an exception must not leave the parallel loop
+      job_faults_[job] = std::current_exception();
+      job_fault_stages_[job] = stage;
+    }
+  }
+  // the first fault in the serial order: the tendons', then the search's
+  for (int k = 1; k <= n + 1; ++k) {
+    const int job = k % (n + 1);
+    if (job_faults_[job]) {
+      stage_ = job_fault_stages_[job];
+      std::rethrow_exception(job_faults_[job]);
+    }
+  }
+  measured(&parallel_seconds_);
+}
+
+void BulletScene::AdvanceTendon(size_t ti, actuators::ContactScratch* scratch, StepStage* stage) {
+  TendonData& t = tendons_[ti];
+  t.speed_known = t.previous_length >= 0;
+  t.previous_length = t.geometry.length;
+  t.mean_speed = t.geometry.speed;
+  *stage = {StepStage::kTendon, static_cast<int>(ti)};
+  EvaluateTendon(ti, scratch);
+  // the mean lengthening speed over the step: the path's motion the actuators integrate along
+  // (length at the start + speed * dt is exactly the length at the end); the speed at the end,
+  // for what reads it directly (dampers, force-velocity), from the last two means to second
+  // order (the mean lags it by half a step)
+  t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
+  const double end_speed =
+      t.speed_known ? t.geometry.speed + 0.5 * (t.geometry.speed - t.mean_speed) : t.geometry.speed;
+  t.end_speed = end_speed;
+  t.tension = 0;
+  for (int index : t.actuators) {
+    *stage = {StepStage::kActuator, index};
+    ActuatorData& a = actuators_[index];
+    const double f = a.model->Step(t.previous_length, t.geometry.speed, dt_, end_speed);
+    if (!std::isfinite(f))
+      throw StepFault(Describe(*stage) + ": tension is not finite (" + std::to_string(f) +
+                          ") at t = " + std::to_string(time_ + dt_) +
+                          " s; simulation stopped at t = " + std::to_string(time_) + " s (step " +
+                          std::to_string(steps_) + ")",
+                      a.desc->name, time_ + dt_);
+    if (std::abs(f) > options_.max_tension)
+      throw StepFault(
+          Describe(*stage) + ": tension " + std::to_string(f) + " N beyond the engine's bound of " +
+              std::to_string(options_.max_tension) + " N (path speed " +
+              std::to_string(t.geometry.speed) + " m/s) at t = " + std::to_string(time_ + dt_) +
+              " s; simulation stopped at t = " + std::to_string(time_) + " s (step " +
+              std::to_string(steps_) + ")",
+          a.desc->name, time_ + dt_);
+    t.tension += f;
   }
 }
 
@@ -1031,6 +1222,7 @@ void BulletScene::SaveStepState() {
 }
 
 void BulletScene::RestoreStepState() {
+  world_->ForgetAhead();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     btRigidBody& rb = *bodies_[i].rigid;
     // velocities first: setting the transform copies them into the interpolation state, as a
@@ -1128,46 +1320,8 @@ void BulletScene::Step() {
     CheckState();
     CacheBodyPoses();
     UpdateJoints();
-    for (auto& t : tendons_) {
-      t.speed_known = t.previous_length >= 0;
-      t.previous_length = t.geometry.length;
-      t.mean_speed = t.geometry.speed;
-    }
     RefreshWorldShapes();
-    EvaluateTendons();
-    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
-      TendonData& t = tendons_[ti];
-      // the mean lengthening speed over the step: the path's motion the actuators integrate
-      // along (length at the start + speed * dt is exactly the length at the end); the speed at
-      // the end, for what reads it directly (dampers, force-velocity), from the last two means
-      // to second order (the mean lags it by half a step)
-      t.geometry.speed = (t.geometry.length - t.previous_length) / dt_;
-      const double end_speed = t.speed_known
-                                   ? t.geometry.speed + 0.5 * (t.geometry.speed - t.mean_speed)
-                                   : t.geometry.speed;
-      t.end_speed = end_speed;
-      t.tension = 0;
-      for (int index : t.actuators) {
-        stage_ = {StepStage::kActuator, index};
-        ActuatorData& a = actuators_[index];
-        const double f = a.model->Step(t.previous_length, t.geometry.speed, dt_, end_speed);
-        if (!std::isfinite(f))
-          throw StepFault(Describe(stage_) + ": tension is not finite (" + std::to_string(f) +
-                              ") at t = " + std::to_string(time_ + dt_) +
-                              " s; simulation stopped at t = " + std::to_string(time_) +
-                              " s (step " + std::to_string(steps_) + ")",
-                          a.desc->name, time_ + dt_);
-        if (std::abs(f) > options_.max_tension)
-          throw StepFault(Describe(stage_) + ": tension " + std::to_string(f) +
-                              " N beyond the engine's bound of " +
-                              std::to_string(options_.max_tension) + " N (path speed " +
-                              std::to_string(t.geometry.speed) + " m/s) at t = " +
-                              std::to_string(time_ + dt_) + " s; simulation stopped at t = " +
-                              std::to_string(time_) + " s (step " + std::to_string(steps_) + ")",
-                          a.desc->name, time_ + dt_);
-        t.tension += f;
-      }
-    }
+    AdvanceTendons();
     PushMeasurements();
   } catch (...) {
     FailStep();
@@ -1269,6 +1423,7 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
 
 
 void BulletScene::ResetCaches() {
+  world_->ForgetAhead();
   // every body and constraint out (their contact manifolds go with their pairs), a new broad
   // phase, then all back in the order the constructor adds them, at their present poses
   std::vector<std::pair<int, int>> filters;
@@ -1288,6 +1443,7 @@ void BulletScene::ResetCaches() {
 }
 
 void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
+  world_->ForgetAhead();
   auto refuse = [](const std::string& what) {
     throw std::invalid_argument("restoring the dynamic state: " + what);
   };
@@ -1705,6 +1861,7 @@ double BulletScene::GetParameter(const std::string& id) const {
 }
 
 void BulletScene::SetParameter(const std::string& id, double value) {
+  world_->ForgetAhead();  // a friction, a mass, the time step: the next step searches itself
   const int index = ParameterIndex(id);
   if (index < 0) throw std::out_of_range("no parameter '" + id + "'");
   if (!std::isfinite(value)) throw std::invalid_argument(id + ": value is not finite");

@@ -18,6 +18,14 @@ struct Options {
   /// A tendon tension beyond this [N] counts as an exploding actuator (a muscle driven past its
   /// curves by a path that jumped): the step that computed it faults, before the tension acts.
   double max_tension = 1e6;
+  /// Threads that advance the tendons at the end of each step (their paths, contact with the
+  /// bodies and actuators, one tendon per thread at a time): 1 serial; 0 every processor the
+  /// process may run on; at most 8. The results are the same bits whatever the count.
+  int threads = 1;
+  /// With threads > 1, Bullet's contact search for the next step runs at the end of this one,
+  /// beside the tendons' work, rather than inside the next step: the same bits either way; off
+  /// only to compare.
+  bool search_contacts_ahead = true;
 };
 
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
