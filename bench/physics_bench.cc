@@ -3,7 +3,6 @@
 //   RATIO <name> <value> (target <target>)
 // measured in this run (medians of several repetitions), never compared with stored times.
 #include <mujoco/mujoco.h>
-#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
@@ -356,9 +355,7 @@ int main(int argc, char** argv) {
 
   // Options::threads: the contact tree on two threads against one, by turns (the figures above
   // are on --threads, one by default)
-  cpu_set_t cpus;
-  CPU_ZERO(&cpus);
-  if (sched_getaffinity(0, sizeof(cpus), &cpus) == 0 && CPU_COUNT(&cpus) >= 2) {
+  if (physics_bullet::ThreadCount(0) >= 2) {
     const Case one = CaliperCase(contact, true, 1), two = CaliperCase(contact, true, 2);
     const std::vector<double> by_threads = Time({&one, &two});
     std::printf("# step time [us], floor + self contact: one thread %.1f, two %.1f\n",

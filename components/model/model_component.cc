@@ -63,6 +63,11 @@ ModelComponent::ModelComponent(rtc::Runtime& runtime)
   physics_bullet::Options options;
   options.tendon_body_contact = runtime.config().GetBool("model.tendon_contact");
   options.threads = static_cast<int>(runtime.config().GetInt("model.physics_threads"));
+  if (options.threads != 1)
+    logging::Get("model").info(
+        "model.physics_threads = %d: the tendons and the contact search on %d threads at the end "
+        "of each step",
+        options.threads, physics_bullet::ThreadCount(options.threads));
   const InjectedFault fault = ParseInjectedFault(runtime.config().GetString("model.inject_fault"));
   if (fault.kind != InjectedFault::Kind::kNone)
     logging::Get("model").warn("model.inject_fault: step %llu of the first scene will throw",

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <typeinfo>
 #include <unordered_map>
 #include <utility>
@@ -259,21 +261,6 @@ class AheadWorld : public btDiscreteDynamicsWorld {
   std::vector<btTransform> swept_;
 };
 
-// Options::threads as a count: 0 is every processor this process may run on (its affinity, which
-// a batch system's allocation sets), at most kMaxThreads
-int ResolveThreads(int threads) {
-  constexpr int kMaxThreads = 8;
-  if (threads < 0)
-    throw std::invalid_argument("physics threads must be >= 0 (0: automatic), got " +
-                                std::to_string(threads));
-  if (threads == 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    threads = sched_getaffinity(0, sizeof(set), &set) == 0 ? CPU_COUNT(&set) : 1;
-  }
-  return std::clamp(threads, 1, kMaxThreads);
-}
-
 class BulletScene : public sgal::PhysicsScene {
  public:
   BulletScene(const sgal::Scene& scene, Options options);
@@ -485,7 +472,7 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
     for (const auto& e : errors) msg << "\n  " << e;
     throw std::invalid_argument(msg.str());
   }
-  threads_ = ResolveThreads(options_.threads);
+  threads_ = ThreadCount(options_.threads);
   contact_scratch_.resize(static_cast<size_t>(threads_));
   configuration_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
@@ -934,20 +921,35 @@ void BulletScene::AdvanceTendons() {
   // only its own tendon and actuators. A thread takes the next job when done with one.
   job_faults_.assign(tendons_.size() + 1, nullptr);
   job_fault_stages_.resize(tendons_.size() + 1);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
-  for (int job = 0; job <= n; ++job) {
+  auto run = [&](int job, int thread) {
     StepStage stage;
     try {
       if (job == 0) {
         if (ahead) world_->DetectAhead(static_cast<btScalar>(dt_));
       } else {
-        AdvanceTendon(job - 1, &contact_scratch_[omp_get_thread_num()], &stage);
+        AdvanceTendon(job - 1, &contact_scratch_[thread], &stage);
       }
     } catch (...) {  // an exception must not leave the parallel loop
       job_faults_[job] = std::current_exception();
       job_fault_stages_[job] = stage;
     }
-  }
+  };
+#if defined(__SANITIZE_THREAD__)
+  // ThreadSanitizer cannot see libgomp's fork and join (libgomp is not built with it): the same
+  // jobs, claimed the same way, on threads it sees start and end, so that it still finds two jobs
+  // that touch the same data
+  std::atomic<int> next{0};
+  auto claim = [&](int thread) {
+    for (int job = next++; job <= n; job = next++) run(job, thread);
+  };
+  std::vector<std::thread> helpers;
+  for (int thread = 1; thread < threads_; ++thread) helpers.emplace_back(claim, thread);
+  claim(0);
+  for (auto& helper : helpers) helper.join();
+#else
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
+  for (int job = 0; job <= n; ++job) run(job, omp_get_thread_num());
+#endif
   // the first fault in the serial order: the tendons', then the search's
   for (int k = 1; k <= n + 1; ++k) {
     const int job = k % (n + 1);
@@ -1881,6 +1883,19 @@ void BulletScene::LayOutActuatorStates() {
 }
 
 }  // namespace
+
+int ThreadCount(int threads) {
+  constexpr int kMaxThreads = 8;
+  if (threads < 0)
+    throw std::invalid_argument("physics threads must be >= 0 (0: automatic), got " +
+                                std::to_string(threads));
+  if (threads == 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    threads = sched_getaffinity(0, sizeof(set), &set) == 0 ? CPU_COUNT(&set) : 1;
+  }
+  return std::clamp(threads, 1, kMaxThreads);
+}
 
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options) {
   return std::make_unique<BulletScene>(scene, options);

@@ -28,6 +28,11 @@ struct Options {
   bool search_contacts_ahead = true;
 };
 
+/// The threads Options::threads asks for: 0 is every processor this process may run on (its
+/// affinity, which a batch system's allocation sets), and at most 8. Throws std::invalid_argument
+/// for a negative count.
+int ThreadCount(int threads);
+
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
 /// an actuator that cannot be made (unknown kind, missing parameter), or a step whose work has no
 /// bound (solver_iterations outside [1, 10^4], a time step an actuator cannot take in 10^4
