@@ -381,8 +381,17 @@ class BulletScene : public sgal::PhysicsScene {
   // where
   std::vector<std::exception_ptr> job_faults_;
   std::vector<StepStage> job_fault_stages_;
-  // AdvanceTendons' time on one thread and on threads_, moving means [s] (0: not measured yet)
-  double serial_seconds_ = 0, parallel_seconds_ = 0;
+  // Which way AdvanceTendons runs, by whole steps' times (threads_ > 1): ChooseThreads() before
+  // a step, TimeStep() after it
+  struct ThreadChoice {
+    bool parallel_preferred = false;
+    double mean[2] = {0, 0};  // a step's time one way (serial, parallel) [s]; 0: not measured
+    double sum[2] = {0, 0};   // this cycle's steps each way [s]
+    int count[2] = {0, 0};
+  } choice_;
+  bool parallel_now_ = false;  // this step's way
+  void ChooseThreads();
+  void TimeStep(double seconds);
   // every shape's bounding ball at this step's poses, packed for QueryShapes' scan
   struct ContactBall {
     double x, y, z;  // centre [m]
@@ -885,37 +894,46 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
   }
 }
 
+// Handing the work to the threads and waiting for the last costs a few microseconds, more than a
+// light scene's tendons (springs, no contact) cost on one, and a thread that waits for work keeps
+// a processor busy, which may slow the rest of the step where processors share a core. So whole
+// steps are timed each way: every kCycle steps, the first kProbe go the other way. A way's mean
+// is taken over the steps of a cycle but the first after a change (which still follows the other
+// way), each at most four times the mean (a step the system held up once does not decide), and
+// the faster way is kept for the next cycle. Either way gives the same bits.
+constexpr uint64_t kCycle = 256, kProbe = 8;
+
+void BulletScene::ChooseThreads() {
+  const uint64_t phase = steps_ % kCycle;
+  parallel_now_ = phase < kProbe ? !choice_.parallel_preferred : choice_.parallel_preferred;
+}
+
+void BulletScene::TimeStep(double seconds) {
+  const uint64_t phase = steps_ % kCycle;  // of the step just taken (steps_ not yet counted)
+  ThreadChoice& c = choice_;
+  const int way = parallel_now_ ? 1 : 0;
+  if (phase != 0 && phase != kProbe) {
+    c.sum[way] += c.mean[way] > 0 ? std::min(seconds, 4 * c.mean[way]) : seconds;
+    ++c.count[way];
+  }
+  if (phase != kCycle - 1) return;
+  for (int w = 0; w < 2; ++w) {
+    if (c.count[w] == 0) continue;
+    const double mean = c.sum[w] / c.count[w];
+    c.mean[w] = c.mean[w] == 0 ? mean : 0.5 * (c.mean[w] + mean);
+    c.sum[w] = 0;
+    c.count[w] = 0;
+  }
+  if (c.mean[0] > 0 && c.mean[1] > 0) c.parallel_preferred = c.mean[1] < c.mean[0];
+}
+
 void BulletScene::AdvanceTendons() {
   const int n = static_cast<int>(tendons_.size());
-  if (threads_ <= 1) {  // Bullet searches the contacts inside the next step
+  if (threads_ <= 1 || !parallel_now_) {  // Bullet searches the contacts inside the next step
     for (int ti = 0; ti < n; ++ti) AdvanceTendon(ti, &contact_scratch_[0], &stage_);
     return;
   }
   const bool ahead = options_.search_contacts_ahead;
-  auto serial = [&] {
-    for (int ti = 0; ti < n; ++ti) AdvanceTendon(ti, &contact_scratch_[0], &stage_);
-    stage_ = {StepStage::kWorld, -1};
-    if (ahead) world_->DetectAhead(static_cast<btScalar>(dt_));
-  };
-  // Handing the work to the threads and waiting for the last costs a few microseconds: more
-  // than a light scene's tendons (springs, no contact) cost on one. Each way's time is measured
-  // (a moving mean, a sample at most twice the mean: a thread the system held up once does not
-  // decide), the faster one taken, and the other tried again every kProbeSteps steps, as contacts
-  // come and go. Either way gives the same bits.
-  constexpr uint64_t kProbeSteps = 64;
-  const bool parallel_faster = parallel_seconds_ < serial_seconds_;
-  const bool parallel = steps_ % kProbeSteps == 0 ? !parallel_faster : parallel_faster;
-  const auto start = std::chrono::steady_clock::now();
-  auto measured = [&](double* mean) {
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    *mean = *mean == 0 ? seconds : 0.75 * *mean + 0.25 * std::min(seconds, 2 * *mean);
-  };
-  if (!parallel) {
-    serial();
-    measured(&serial_seconds_);
-    return;
-  }
   // job 0 is Bullet's contact search for the next step (AheadWorld), the others a tendon each:
   // each tendon's work reads Caliper's copy of the poses and the shapes of this step and writes
   // only its own tendon and actuators. A thread takes the next job when done with one.
@@ -958,7 +976,6 @@ void BulletScene::AdvanceTendons() {
       std::rethrow_exception(job_faults_[job]);
     }
   }
-  measured(&parallel_seconds_);
 }
 
 void BulletScene::AdvanceTendon(size_t ti, actuators::ContactScratch* scratch, StepStage* stage) {
@@ -1308,6 +1325,8 @@ void BulletScene::Step() {
   // the step (from the end of the last one), then the paths are evaluated where the bodies went
   // and each actuator advances along the path's motion over the same step. Tendon length, speed
   // and tension at the end of a step belong to the same instant as the bodies' poses.
+  const auto started = std::chrono::steady_clock::now();
+  if (threads_ > 1) ChooseThreads();
   SaveStepState();
   try {
     // poses, joints and tendon paths were brought up to date at the end of the last step (or at
@@ -1328,6 +1347,8 @@ void BulletScene::Step() {
   } catch (...) {
     FailStep();
   }
+  if (threads_ > 1)
+    TimeStep(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   time_ += dt_;
   ++steps_;
 }
