@@ -131,4 +131,13 @@ if (launcher session --headless --port 2809) >"$WORK/port2" 2>&1; then
 else grep -q -- "--port is for network mode" "$WORK/port2" && pass "--port without --listen refused" ||
   { cat "$WORK/port2"; fail "--port without --listen: no reason"; }; fi
 
+# --physics-threads: a count of 0-8, refused otherwise before anything starts
+for bad in 9 -1 two; do
+  if (launcher session --headless --physics-threads "$bad") >"$WORK/threads" 2>&1; then
+    fail "--physics-threads $bad accepted"
+  else grep -q -- "--physics-threads needs a count of 0-8" "$WORK/threads" &&
+    pass "--physics-threads $bad refused" ||
+    { cat "$WORK/threads"; fail "--physics-threads $bad: no reason"; }; fi
+done
+
 finish
