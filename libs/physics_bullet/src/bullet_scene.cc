@@ -853,44 +853,42 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
   // velocities are not needed
   static const Isometry3d kWorld = Isometry3d::Identity();
   auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
-  {
-    TendonData& t = tendons_[ti];
-    t.world.resize(t.elements.size());
-    for (size_t k = 0; k < t.elements.size(); ++k) {
-      const ElementRef& ref = t.elements[k];
-      const sgal::PathElement& e = *ref.desc;
-      actuators::WorldElement& w = t.world[k];
-      w.kind = e.kind;
-      w.body = ref.body;
-      if (e.kind == sgal::PathElement::Kind::kPoint) {
-        w.point = pose(ref.body) * e.position;
-        w.velocity.setZero();
-        w.friction = e.friction;
-      } else {
-        const sgal::WrapObstacle* o = ref.obstacle;
-        const Isometry3d& body_pose = pose(ref.body);
-        w.obstacle.kind = o->kind;
-        w.obstacle.pose = body_pose * o->pose.ToIsometry();
-        w.obstacle.radius = o->radius;
-        w.obstacle.length = o->length;
-        w.velocity.setZero();
-        if (e.side) w.side = body_pose * (*e.side);
-      }
+  TendonData& t = tendons_[ti];
+  t.world.resize(t.elements.size());
+  for (size_t k = 0; k < t.elements.size(); ++k) {
+    const ElementRef& ref = t.elements[k];
+    const sgal::PathElement& e = *ref.desc;
+    actuators::WorldElement& w = t.world[k];
+    w.kind = e.kind;
+    w.body = ref.body;
+    if (e.kind == sgal::PathElement::Kind::kPoint) {
+      w.point = pose(ref.body) * e.position;
+      w.velocity.setZero();
+      w.friction = e.friction;
+    } else {
+      const sgal::WrapObstacle* o = ref.obstacle;
+      const Isometry3d& body_pose = pose(ref.body);
+      w.obstacle.kind = o->kind;
+      w.obstacle.pose = body_pose * o->pose.ToIsometry();
+      w.obstacle.radius = o->radius;
+      w.obstacle.length = o->length;
+      w.velocity.setZero();
+      if (e.side) w.side = body_pose * (*e.side);
     }
-    t.path.Evaluate(t.world, &t.geometry);
-    t.contacts = 0;
-    if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
-      // captures only `this`: held inside the std::function, no allocation
-      const actuators::ShapeQuery query = [this](const Vector3d& a, const Vector3d& b, double pad,
-                                                 std::vector<const actuators::WorldShape*>* out) {
-        QueryShapes(a, b, pad, out);
-      };
-      actuators::ContactOptions contact;
-      contact.margin = t.desc->radius;
-      contact.detour_reach = detour_reach_ + 2 * contact.margin;  // the reaches grow by it
-      t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, scratch,
-                                               &t.contact_memory, contact_travel_);
-    }
+  }
+  t.path.Evaluate(t.world, &t.geometry);
+  t.contacts = 0;
+  if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
+    // captures only `this`: held inside the std::function, no allocation
+    const actuators::ShapeQuery query = [this](const Vector3d& a, const Vector3d& b, double pad,
+                                               std::vector<const actuators::WorldShape*>* out) {
+      QueryShapes(a, b, pad, out);
+    };
+    actuators::ContactOptions contact;
+    contact.margin = t.desc->radius;
+    contact.detour_reach = detour_reach_ + 2 * contact.margin;  // the reaches grow by it
+    t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, scratch,
+                                             &t.contact_memory, contact_travel_);
   }
 }
 
