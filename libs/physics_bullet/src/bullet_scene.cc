@@ -385,6 +385,7 @@ class BulletScene : public sgal::PhysicsScene {
   // a step, TimeStep() after it
   struct ThreadChoice {
     bool parallel_preferred = false;
+    uint64_t step = 0;        // in this cycle
     double mean[2] = {0, 0};  // a step's time one way (serial, parallel) [s]; 0: not measured
     double sum[2] = {0, 0};   // this cycle's steps each way [s]
     int count[2] = {0, 0};
@@ -895,34 +896,37 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
 // Handing the work to the threads and waiting for the last costs a few microseconds, more than a
 // light scene's tendons (springs, no contact) cost on one, and a thread that waits for work keeps
 // a processor busy, which may slow the rest of the step where processors share a core. So whole
-// steps are timed each way: every kCycle steps, the first kProbe go the other way. A way's mean
-// is taken over the steps of a cycle but the first after a change (which still follows the other
-// way), each at most four times the mean (a step the system held up once does not decide), and
-// the faster way is kept for the next cycle. Either way gives the same bits.
+// steps are timed each way, in cycles: the first kProbe steps of a cycle go the other way. A
+// way's mean is taken over a cycle's steps but the first after a change (which still follows the
+// other way), each at most four times the last mean (a step the system held up once does not
+// decide); each cycle decides afresh, as contacts come and go.
+// Several threads are kept for the next cycle only when they save at least 5 % of a step, since
+// the waiting thread keeps a processor busy that other programs (the GUI, other Models) could
+// use. Either way gives the same bits.
 constexpr uint64_t kCycle = 256, kProbe = 8;
+constexpr double kGain = 0.95;
 
 void BulletScene::ChooseThreads() {
-  const uint64_t phase = steps_ % kCycle;
-  parallel_now_ = phase < kProbe ? !choice_.parallel_preferred : choice_.parallel_preferred;
+  const ThreadChoice& c = choice_;
+  parallel_now_ = c.step < kProbe ? !c.parallel_preferred : c.parallel_preferred;
 }
 
 void BulletScene::TimeStep(double seconds) {
-  const uint64_t phase = steps_ % kCycle;  // of the step just taken (steps_ not yet counted)
   ThreadChoice& c = choice_;
   const int way = parallel_now_ ? 1 : 0;
-  if (phase != 0 && phase != kProbe) {
+  if (c.step != 0 && c.step != kProbe) {
     c.sum[way] += c.mean[way] > 0 ? std::min(seconds, 4 * c.mean[way]) : seconds;
     ++c.count[way];
   }
-  if (phase != kCycle - 1) return;
+  if (++c.step < kCycle) return;
   for (int w = 0; w < 2; ++w) {
     if (c.count[w] == 0) continue;
-    const double mean = c.sum[w] / c.count[w];
-    c.mean[w] = c.mean[w] == 0 ? mean : 0.5 * (c.mean[w] + mean);
+    c.mean[w] = c.sum[w] / c.count[w];  // this cycle's: the load changes as contacts come and go
     c.sum[w] = 0;
     c.count[w] = 0;
   }
-  if (c.mean[0] > 0 && c.mean[1] > 0) c.parallel_preferred = c.mean[1] < c.mean[0];
+  if (c.mean[0] > 0 && c.mean[1] > 0) c.parallel_preferred = c.mean[1] < kGain * c.mean[0];
+  c.step = 0;
 }
 
 void BulletScene::AdvanceTendons() {
