@@ -908,7 +908,8 @@ constexpr double kGain = 0.95;
 
 void BulletScene::ChooseThreads() {
   const ThreadChoice& c = choice_;
-  parallel_now_ = c.step < kProbe ? !c.parallel_preferred : c.parallel_preferred;
+  parallel_now_ =
+      !options_.choose_threads || (c.step < kProbe ? !c.parallel_preferred : c.parallel_preferred);
 }
 
 void BulletScene::TimeStep(double seconds) {

@@ -24,11 +24,14 @@ sgal::Scene Tree(bool spanning, int start) {
   return bench::MakeTree(o);
 }
 
+// threads > 1: every step on the threads (Options::choose_threads off), so that each step tests
+// them, unless `choose` (the engine's choice by the steps' times)
 std::unique_ptr<sgal::PhysicsScene> Make(const sgal::Scene& scene, int threads,
-                                         bool search_ahead = true) {
+                                         bool search_ahead = true, bool choose = false) {
   Options options;
   options.threads = threads;
   options.search_contacts_ahead = search_ahead;
+  options.choose_threads = choose;
   auto made = MakeScene(scene, options);
   // the motors pull unevenly, so that the tendons' work and contacts differ from one to the next
   for (size_t i = 0; i < scene.actuators.size(); ++i)
@@ -77,6 +80,7 @@ TEST(ParallelTendons, TheTreeStepsToTheSameBitsOnAnyThreadCount) {
     std::vector<std::unique_ptr<sgal::PhysicsScene>> parallel;
     parallel.push_back(Make(scene, 2, false));  // the tendons alone on two threads
     for (const int threads : {2, 3}) parallel.push_back(Make(scene, threads));
+    parallel.push_back(Make(scene, 2, true, true));  // one way or the other, as timed
     // the same tree without floor and self contact: how far the contacts moved it
     bench::TreeOptions o;
     o.spanning_tendons = spanning;
@@ -92,8 +96,8 @@ TEST(ParallelTendons, TheTreeStepsToTheSameBitsOnAnyThreadCount) {
       most_contacts = std::max(most_contacts, Contacts(*serial));
       // between steps, a live edit of the time step (the search made ahead swept the bodies for
       // the old one), and a state restored from 200 steps before (the search was for other poses)
-      const std::vector<sgal::PhysicsScene*> all = {serial.get(), parallel[0].get(),
-                                                    parallel[1].get(), parallel[2].get()};
+      std::vector<sgal::PhysicsScene*> all = {serial.get()};
+      for (auto& p : parallel) all.push_back(p.get());
       if (step == 1100) back = serial->SaveDynamicState();
       if (step == 1200)
         for (auto* edited : all) edited->SetParameter("simulation.time_step", 5e-4);

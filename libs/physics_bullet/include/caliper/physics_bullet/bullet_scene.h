@@ -22,6 +22,10 @@ struct Options {
   /// bodies and actuators, one tendon per thread at a time): 1 serial; 0 every processor the
   /// process may run on; at most 8. The results are the same bits whatever the count.
   int threads = 1;
+  /// With threads > 1: the engine times whole steps on one thread and on `threads` and takes
+  /// them only where they save at least 5 % of a step (docs/physics.md). false: every step on
+  /// `threads` (tests, and scenes known to gain).
+  bool choose_threads = true;
   /// With threads > 1, Bullet's contact search for the next step runs at the end of this one,
   /// beside the tendons' work, rather than inside the next step: the same bits either way; off
   /// only to compare.
