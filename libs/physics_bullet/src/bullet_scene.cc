@@ -1328,8 +1328,12 @@ void BulletScene::Step() {
   // the step (from the end of the last one), then the paths are evaluated where the bodies went
   // and each actuator advances along the path's motion over the same step. Tendon length, speed
   // and tension at the end of a step belong to the same instant as the bodies' poses.
-  const auto started = std::chrono::steady_clock::now();
-  if (threads_ > 1) ChooseThreads();
+  // the way for this step and the time it takes, only where there is a choice
+  std::chrono::steady_clock::time_point started;
+  if (threads_ > 1) {
+    started = std::chrono::steady_clock::now();
+    ChooseThreads();
+  }
   SaveStepState();
   try {
     // poses, joints and tendon paths were brought up to date at the end of the last step (or at
