@@ -212,6 +212,8 @@ bool TimeOnly(const std::string& name) {
 int main(int argc, char** argv) {
   using namespace caliper;
   using namespace caliper::bench;
+  // waiting threads spin as long as in the Model (GOMP_SPINCOUNT, unless the environment sets it)
+  physics_bullet::BoundThreadSpin(argv);
   std::string only;  // one case to time alone
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atoi(argv[++i]);

@@ -1,6 +1,8 @@
 #include "model_component.h"
 
+#include <cstdlib>
 #include <log4cpp/Priority.hh>
+#include <string>
 
 #include "caliper/logging.hh"
 #include "caliper/logging/log.h"
@@ -63,11 +65,19 @@ ModelComponent::ModelComponent(rtc::Runtime& runtime)
   physics_bullet::Options options;
   options.tendon_body_contact = runtime.config().GetBool("model.tendon_contact");
   options.threads = static_cast<int>(runtime.config().GetInt("model.physics_threads"));
-  if (options.threads != 1)
+  if (options.threads != 1) {
+    // what BoundThreadSpin set in model_main, or the user's own choice
+    const char* spin = std::getenv("GOMP_SPINCOUNT");
+    const char* policy = std::getenv("OMP_WAIT_POLICY");
+    const std::string waiting =
+        spin     ? std::string("spins ") + spin + " turns (GOMP_SPINCOUNT) before it sleeps"
+        : policy ? std::string("waits as OMP_WAIT_POLICY=") + policy + " says"
+                 : "spins libgomp's default 300000 turns before it sleeps";
     logging::Get("model").info(
         "model.physics_threads = %d: the tendons and the contact search on %d threads at the end "
-        "of each step",
-        options.threads, physics_bullet::ThreadCount(options.threads));
+        "of each step; a thread waiting for work %s",
+        options.threads, physics_bullet::ThreadCount(options.threads), waiting.c_str());
+  }
   const InjectedFault fault = ParseInjectedFault(runtime.config().GetString("model.inject_fault"));
   if (fault.kind != InjectedFault::Kind::kNone)
     logging::Get("model").warn("model.inject_fault: step %llu of the first scene will throw",

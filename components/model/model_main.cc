@@ -8,6 +8,9 @@
 
 int main(int argc, char** argv) {
   using namespace caliper;
+  // a thread waiting for the next step's jobs spins at most kThreadSpinCount turns (starts again
+  // with GOMP_SPINCOUNT set, unless the environment chose)
+  physics_bullet::BoundThreadSpin(argv);
   // re-simulating a recording for caliper-ctl replay --verify: no session, no CORBA
   if (argc == 3 && std::strcmp(argv[1], "--verify") == 0) return model::VerifyMain(argv[2]);
   rtc::ComponentType type;

@@ -4,13 +4,18 @@
 #include <btBulletDynamicsCommon.h>
 #include <omp.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -1923,6 +1928,23 @@ int ThreadCount(int threads) {
     threads = sched_getaffinity(0, sizeof(set), &set) == 0 ? CPU_COUNT(&set) : 1;
   }
   return std::clamp(threads, 1, kMaxThreads);
+}
+
+void BoundThreadSpin(char** argv) {
+  if (std::getenv("GOMP_SPINCOUNT") != nullptr || std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+  const std::string count = std::to_string(kThreadSpinCount);
+  if (setenv("GOMP_SPINCOUNT", count.c_str(), 1) != 0) return;
+  // the program's own path, so that the process keeps its name (comm: `ps`, `pgrep NAME`);
+  // /proc/self/exe itself if that path is gone (the program rebuilt since it started)
+  std::array<char, 4096> path{};
+  const ssize_t length = readlink("/proc/self/exe", path.data(), path.size() - 1);
+  if (length > 0) execv(path.data(), argv);
+  execv("/proc/self/exe", argv);
+  const int error = errno;  // execv returns only on failure
+  std::fprintf(stderr,
+               "%s: could not start again with GOMP_SPINCOUNT=%s (%s): threads waiting for work "
+               "spin as long as libgomp's default\n",
+               argv[0], count.c_str(), std::strerror(error));
 }
 
 std::unique_ptr<sgal::PhysicsScene> MakeScene(const sgal::Scene& scene, Options options) {

@@ -37,6 +37,22 @@ struct Options {
 /// for a negative count.
 int ThreadCount(int threads);
 
+/// How many turns a thread waiting for the next step's jobs spins before it sleeps (libgomp's
+/// GOMP_SPINCOUNT) in the processes that call BoundThreadSpin. libgomp's own default, 300,000,
+/// kept the second thread of a real-time session spinning for about half of every 1 ms step (the
+/// shipped arm's Model at 0.4-0.7 of a processor on two threads, 0.05 on one). 10,000 covers the
+/// gap between two steps run back to back (Bullet's part, about 60 us on the contact tree), so
+/// batch runs keep the threads' gain; 3,000 lost it on this machine (docs/physics.md).
+constexpr long kThreadSpinCount = 10000;
+
+/// Call first in main, with main's argv, in a process that may step a scene on several threads.
+/// libgomp reads its spin count from the environment once, as it loads, before main runs. Unless
+/// the environment sets GOMP_SPINCOUNT or OMP_WAIT_POLICY (the user's choice, kept), this sets
+/// GOMP_SPINCOUNT=kThreadSpinCount and executes the program again (/proc/self/exe) with the same
+/// arguments: the same process, as its parent sees it. Returns where there is nothing to do, or
+/// where the new start fails (then with a line on stderr, and libgomp's default spin).
+void BoundThreadSpin(char** argv);
+
 /// Builds the scene. Throws std::invalid_argument listing every problem sgal::Validate finds, or
 /// an actuator that cannot be made (unknown kind, missing parameter), or a step whose work has no
 /// bound (solver_iterations outside [1, 10^4], a time step an actuator cannot take in 10^4
