@@ -1941,6 +1941,7 @@ void BoundThreadSpin(char** argv) {
   if (length > 0) execv(path.data(), argv);
   execv("/proc/self/exe", argv);
   const int error = errno;  // execv returns only on failure
+  unsetenv("GOMP_SPINCOUNT");  // libgomp has its default: what the Model's log line then says
   std::fprintf(stderr,
                "%s: could not start again with GOMP_SPINCOUNT=%s (%s): threads waiting for work "
                "spin as long as libgomp's default\n",
