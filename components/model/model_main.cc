@@ -1,4 +1,5 @@
 // caliper-model: the Model component.
+#include "caliper/physics_bullet/bullet_scene.h"
 #include "caliper/rtc/runtime.h"
 #include "model_component.h"
 #include "model_servant.h"
