@@ -16,8 +16,9 @@ namespace {
 
 // the probe's output (stdout and stderr) run under `env` (env(1)'s arguments)
 std::string RunProbe(const std::string& env) {
-  const std::string command = "env -u GOMP_SPINCOUNT -u OMP_WAIT_POLICY " + env + " " +
-                              THREAD_SPIN_PROBE + " 'one two' '' three 2>&1";
+  // the probe's path quoted: a clone's path may hold spaces (not single quotes)
+  const std::string command = "env -u GOMP_SPINCOUNT -u OMP_WAIT_POLICY " + env + " '" +
+                              THREAD_SPIN_PROBE + "' 'one two' '' three 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   EXPECT_NE(pipe, nullptr) << command;
   if (pipe == nullptr) return "";
