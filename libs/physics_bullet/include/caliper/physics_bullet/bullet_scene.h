@@ -39,10 +39,10 @@ int ThreadCount(int threads);
 
 /// How many turns a thread waiting for the next step's jobs spins before it sleeps (libgomp's
 /// GOMP_SPINCOUNT) in the processes that call BoundThreadSpin. libgomp's own default, 300,000,
-/// kept the second thread of a real-time session spinning for about half of every 1 ms step (the
-/// shipped arm's Model at 0.4-0.7 of a processor on two threads, 0.05 on one). 10,000 covers the
-/// gap between two steps run back to back (Bullet's part, about 60 us on the contact tree), so
-/// batch runs keep the threads' gain; 3,000 lost it on this machine (docs/physics.md).
+/// kept the second thread of a real-time session spinning for about half of every 1 ms step
+/// (the shipped arm's Model at 0.4-0.8 of a processor on two threads, 0.05-0.08 on one). 10,000
+/// covers the gap between two steps run back to back (Bullet's part, about 60 us on the contact
+/// tree), so batch runs keep the threads' gain; 3,000 lost it on this machine (docs/physics.md).
 constexpr long kThreadSpinCount = 10000;
 
 /// Call first in main, with main's argv, in a process that may step a scene on several threads.
