@@ -488,6 +488,7 @@ BulletScene::BulletScene(const sgal::Scene& scene, Options options)
     throw std::invalid_argument(msg.str());
   }
   threads_ = ThreadCount(options_.threads);
+  parallel_now_ = threads_ > 1 && !options_.choose_threads;  // else ChooseThreads, each step
   contact_scratch_.resize(static_cast<size_t>(threads_));
   configuration_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
@@ -913,8 +914,7 @@ constexpr double kGain = 0.95;
 
 void BulletScene::ChooseThreads() {
   const ThreadChoice& c = choice_;
-  parallel_now_ =
-      !options_.choose_threads || (c.step < kProbe ? !c.parallel_preferred : c.parallel_preferred);
+  parallel_now_ = c.step < kProbe ? !c.parallel_preferred : c.parallel_preferred;
 }
 
 void BulletScene::TimeStep(double seconds) {
@@ -1334,8 +1334,9 @@ void BulletScene::Step() {
   // and each actuator advances along the path's motion over the same step. Tendon length, speed
   // and tension at the end of a step belong to the same instant as the bodies' poses.
   // the way for this step and the time it takes, only where there is a choice
+  const bool choosing = threads_ > 1 && options_.choose_threads;
   std::chrono::steady_clock::time_point started;
-  if (threads_ > 1) {
+  if (choosing) {
     started = std::chrono::steady_clock::now();
     ChooseThreads();
   }
@@ -1359,7 +1360,7 @@ void BulletScene::Step() {
   } catch (...) {
     FailStep();
   }
-  if (threads_ > 1)
+  if (choosing)
     TimeStep(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   time_ += dt_;
   ++steps_;
@@ -1455,7 +1456,6 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
       s.measurements.push_back(d.ring[(d.head + i) % d.ring.size()]);
   return s;
 }
-
 
 void BulletScene::ResetCaches() {
   world_->ForgetAhead();
