@@ -9,8 +9,8 @@
 
 int main(int argc, char** argv) {
   using namespace caliper;
-  // a thread waiting for the next step's jobs spins at most kThreadSpinCount turns (starts again
-  // with GOMP_SPINCOUNT set, unless the environment chose)
+  // a thread waiting for the next step's jobs spins for about kThreadSpinTime (starts again with
+  // GOMP_SPINCOUNT set to that many turns on this processor, unless the environment chose)
   physics_bullet::BoundThreadSpin(argv);
   // re-simulating a recording for caliper-ctl replay --verify: no session, no CORBA
   if (argc == 3 && std::strcmp(argv[1], "--verify") == 0) return model::VerifyMain(argv[2]);

@@ -1930,9 +1930,38 @@ int ThreadCount(int threads) {
   return std::clamp(threads, 1, kMaxThreads);
 }
 
+long SpinTurns(double seconds, double seconds_per_turn) {
+  if (!(seconds_per_turn > 0) || !std::isfinite(seconds_per_turn)) return kFallbackSpinTurns;
+  const double turns = std::round(seconds / seconds_per_turn);
+  if (!(turns >= kMinSpinTurns)) return kMinSpinTurns;
+  if (!(turns <= kMaxSpinTurns)) return kMaxSpinTurns;
+  return static_cast<long>(turns);
+}
+
+double MeasureSpinTurn() {
+  constexpr int kTurns = 2000;
+  std::atomic<int> word{0};  // what a waiting thread reads at every turn, never set here
+  double fastest = std::numeric_limits<double>::infinity();
+  for (int run = 0; run < 8; ++run) {
+    const auto begin = std::chrono::steady_clock::now();
+    for (int i = 0; i < kTurns; ++i) {
+      if (word.load(std::memory_order_relaxed) != 0) break;
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();  // libgomp's cpu_relax on x86
+#else
+      __asm__ volatile("" ::: "memory");  // libgomp's generic cpu_relax
+#endif
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    fastest = std::min(fastest, seconds / kTurns);
+  }
+  return fastest;
+}
+
 void BoundThreadSpin(char** argv) {
   if (std::getenv("GOMP_SPINCOUNT") != nullptr || std::getenv("OMP_WAIT_POLICY") != nullptr) return;
-  const std::string count = std::to_string(kThreadSpinCount);
+  const std::string count = std::to_string(SpinTurns(kThreadSpinTime, MeasureSpinTurn()));
   if (setenv("GOMP_SPINCOUNT", count.c_str(), 1) != 0) return;
   // the program's own path, so that the process keeps its name (comm: `ps`, `pgrep NAME`);
   // /proc/self/exe itself if that path is gone (the program rebuilt since it started)

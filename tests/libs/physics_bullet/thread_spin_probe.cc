@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   std::fflush(stdout);  // the exec would drop what is buffered
   caliper::physics_bullet::BoundThreadSpin(argv);
   for (int i = 1; i < argc; ++i) std::printf("arg %d [%s]\n", i, argv[i]);
-  std::printf("after pid=%d\n", static_cast<int>(getpid()));
+  const char* after = std::getenv("GOMP_SPINCOUNT");
+  std::printf("after pid=%d GOMP_SPINCOUNT=%s\n", static_cast<int>(getpid()), after ? after : "-");
   // the process's name as ps and pgrep see it
   char name[64] = {};
   if (FILE* comm = std::fopen("/proc/self/comm", "r")) {

@@ -1,11 +1,14 @@
 // BoundThreadSpin: a process that may step on several threads starts again once with
-// GOMP_SPINCOUNT = kThreadSpinCount, the same process and arguments, and libgomp reads it; a
-// spin count or wait policy the environment sets is kept, and nothing starts again.
+// GOMP_SPINCOUNT set to the turns of kThreadSpinTime on this processor, the same process and
+// arguments, and libgomp reads it; a spin count or wait policy the environment sets is kept, and
+// nothing starts again. SpinTurns and MeasureSpinTurn, which size the count.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
+#include <limits>
 #include <regex>
 #include <string>
 
@@ -39,27 +42,60 @@ int Count(const std::string& text, const std::string& pattern) {
 
 TEST(ThreadSpin, StartsAgainOnceWithTheBoundedSpinAndTheSameArguments) {
   const std::string out = RunProbe("");
-  const std::string count = std::to_string(kThreadSpinCount);
   // first without the variable, then once more with it: the same process
   EXPECT_EQ(Count(out, "start pid="), 2) << out;
   std::smatch first;
   ASSERT_TRUE(std::regex_search(out, first, std::regex("start pid=(\\d+) GOMP_SPINCOUNT=-\n")))
       << out;
   const std::string pid = first[1];
-  EXPECT_NE(out.find("start pid=" + pid + " GOMP_SPINCOUNT=" + count + "\n"), std::string::npos)
+  std::smatch second;
+  ASSERT_TRUE(
+      std::regex_search(out, second, std::regex("start pid=" + pid + " GOMP_SPINCOUNT=(\\d+)\n")))
       << out;
-  EXPECT_NE(out.find("after pid=" + pid + "\n"), std::string::npos) << out;
+  const std::string count = second[1];
+  EXPECT_NE(out.find("after pid=" + pid + " GOMP_SPINCOUNT=" + count + "\n"), std::string::npos)
+      << out;
   // the name ps and pgrep match (its first 15 characters), not /proc/self/exe's "exe"
   EXPECT_NE(out.find("comm thread_spin_pro\n"), std::string::npos) << out;
   EXPECT_NE(out.find("arg 1 [one two]\narg 2 []\narg 3 [three]\n"), std::string::npos) << out;
   // libgomp read it as it loaded
   EXPECT_NE(out.find("GOMP_SPINCOUNT = '" + count + "'"), std::string::npos) << out;
+  // the turns of kThreadSpinTime on this processor, as this process measures them (within a
+  // factor of 3: either measurement may run on a busy machine)
+  const double turns = std::stod(count);
+  const double here = static_cast<double>(SpinTurns(kThreadSpinTime, MeasureSpinTurn()));
+  EXPECT_GE(turns, kMinSpinTurns);
+  EXPECT_LE(turns, kMaxSpinTurns);
+  EXPECT_GT(turns, here / 3) << "measured here: " << here;
+  EXPECT_LT(turns, here * 3) << "measured here: " << here;
+}
+
+TEST(ThreadSpin, TurnsForATimeAtATurnsTime) {
+  EXPECT_EQ(SpinTurns(250e-6, 25e-9), 10000);
+  EXPECT_EQ(SpinTurns(250e-6, 47e-9), 5319);              // rounded: 5319.1
+  EXPECT_EQ(SpinTurns(250e-6, 1e-6), kMinSpinTurns);      // 250: too short to cover a gap
+  EXPECT_EQ(SpinTurns(250e-6, 1e-10), kMaxSpinTurns);     // 2.5 million: libgomp's default
+  EXPECT_EQ(SpinTurns(250e-6, 0.0), kFallbackSpinTurns);  // a clock that saw no time
+  EXPECT_EQ(SpinTurns(250e-6, -1e-9), kFallbackSpinTurns);
+  EXPECT_EQ(SpinTurns(250e-6, std::numeric_limits<double>::quiet_NaN()), kFallbackSpinTurns);
+  EXPECT_EQ(SpinTurns(250e-6, std::numeric_limits<double>::infinity()), kFallbackSpinTurns);
+}
+
+TEST(ThreadSpin, ATurnTakesAPauseHintsTime) {
+  // a load and a pause hint: more than nothing, far less than a microsecond on any processor
+  const double turn = MeasureSpinTurn();
+  EXPECT_GT(turn, 0.0);
+  EXPECT_LT(turn, 1e-6);
+  // the fastest of its runs: measured again, within a factor of 3
+  const double again = MeasureSpinTurn();
+  EXPECT_LT(std::max(turn, again) / std::min(turn, again), 3.0) << turn << " " << again;
 }
 
 TEST(ThreadSpin, KeepsTheEnvironmentsSpinCount) {
   const std::string out = RunProbe("GOMP_SPINCOUNT=1234");
   EXPECT_EQ(Count(out, "start pid="), 1) << out;
   EXPECT_NE(out.find("GOMP_SPINCOUNT = '1234'"), std::string::npos) << out;
+  EXPECT_NE(out.find(" GOMP_SPINCOUNT=1234\n"), std::string::npos) << out;  // after the call
   EXPECT_NE(out.find("arg 1 [one two]\narg 2 []\narg 3 [three]\n"), std::string::npos) << out;
 }
 
@@ -68,9 +104,10 @@ TEST(ThreadSpin, KeepsTheEnvironmentsWaitPolicy) {
   const std::string out = RunProbe("OMP_WAIT_POLICY=active");
   EXPECT_EQ(Count(out, "start pid="), 1) << out;
   EXPECT_NE(out.find("OMP_WAIT_POLICY = 'ACTIVE'"), std::string::npos) << out;
-  EXPECT_EQ(out.find("GOMP_SPINCOUNT = '" + std::to_string(kThreadSpinCount) + "'"),
-            std::string::npos)
-      << out;
+  EXPECT_NE(out.find(" GOMP_SPINCOUNT=-\n"), std::string::npos) << out;
+  EXPECT_EQ(Count(out, "GOMP_SPINCOUNT=\\d"), 0) << out;
+  EXPECT_NE(out.find("after pid="), std::string::npos) << out;
+  EXPECT_EQ(Count(out, "GOMP_SPINCOUNT=-\n"), 2) << out;  // at the start and after the call
 }
 
 }  // namespace

@@ -37,18 +37,35 @@ struct Options {
 /// for a negative count.
 int ThreadCount(int threads);
 
-/// How many turns a thread waiting for the next step's jobs spins before it sleeps (libgomp's
-/// GOMP_SPINCOUNT) in the processes that call BoundThreadSpin. libgomp's own default, 300,000,
-/// kept the second thread of a real-time session spinning for about half of every 1 ms step
-/// (the shipped arm's Model at 0.4-0.8 of a processor on two threads, 0.05-0.08 on one). 10,000
-/// covers the gap between two steps run back to back (Bullet's part, about 60 us on the contact
-/// tree), so batch runs keep the threads' gain; 3,000 lost it on this machine (docs/physics.md).
-constexpr long kThreadSpinCount = 10000;
+/// How long a thread waiting for the next step's jobs spins before it sleeps, in the processes
+/// that call BoundThreadSpin [s]. libgomp's own default, 300,000 turns, kept the second thread of
+/// a real-time session spinning for about half of every 1 ms step (the shipped arm's Model at
+/// 0.4-0.8 of a processor on two threads, 0.05-0.08 on one). 250 us covers the gap between two
+/// steps run back to back (Bullet's part, about 60 us on the contact tree, with the wake-ups of a
+/// loaded machine), so batch runs keep the threads' gain; 75 us lost it on this machine
+/// (docs/physics.md).
+constexpr double kThreadSpinTime = 250e-6;
+
+/// The turns of libgomp's wait (GOMP_SPINCOUNT) that take `seconds` at `seconds_per_turn`,
+/// rounded, within [kMinSpinTurns, kMaxSpinTurns]; kFallbackSpinTurns where seconds_per_turn is
+/// not a positive finite time (a clock that could not measure it).
+long SpinTurns(double seconds, double seconds_per_turn);
+constexpr long kMinSpinTurns = 1000;
+constexpr long kMaxSpinTurns = 300000;  // libgomp's default
+/// 250 us on the machine the figures were measured on (AMD EPYC, 25 ns a turn).
+constexpr long kFallbackSpinTurns = 10000;
+
+/// One turn of libgomp's wait on this processor [s]: a relaxed load of the word it waits on and
+/// the processor's pause hint (x86's `pause`, whose time differs by more than ten times between
+/// processors; libgomp's cpu_relax). The fastest of 8 timed runs of 2000 turns, so that a
+/// preemption while it runs does not lengthen it (0.4 ms in all at 25 ns a turn).
+double MeasureSpinTurn();
 
 /// Call first in main, with main's argv, in a process that may step a scene on several threads.
 /// libgomp reads its spin count from the environment once, as it loads, before main runs. Unless
 /// the environment sets GOMP_SPINCOUNT or OMP_WAIT_POLICY (the user's choice, kept), this sets
-/// GOMP_SPINCOUNT=kThreadSpinCount and executes the program again (/proc/self/exe) with the same
+/// GOMP_SPINCOUNT to the turns of kThreadSpinTime on this processor (SpinTurns of
+/// MeasureSpinTurn) and executes the program again (/proc/self/exe) with the same
 /// arguments: the same process, as its parent sees it. Returns where there is nothing to do, or
 /// where the new start fails (then with a line on stderr, and libgomp's default spin).
 void BoundThreadSpin(char** argv);
