@@ -189,7 +189,7 @@ bool TimeOnly(const std::string& name) {
     o.self_contact = false;
   }
   if (name == "spanning_on" || name == "spanning_off") o.spanning_tendons = true;
-  if (name == "spanning_off") contact = false;
+  if (name == "spanning_off" || name == "tree_contact_off") contact = false;
   if (name == "tree_bare") o.tendons = 0;
   if (name == "passive") {
     std::printf("# step time [us]: %s %.1f\n", name.c_str(), Time(PassiveCase(o)));
@@ -199,8 +199,8 @@ bool TimeOnly(const std::string& name) {
     std::printf("# step time [us]: %s %.1f\n", name.c_str(), Time(RawBulletCase(o)));
     return true;
   }
-  if (name != "tree_contact" && name != "tree_free" && name != "spanning_on" &&
-      name != "spanning_off" && name != "tree_bare")
+  if (name != "tree_contact" && name != "tree_contact_off" && name != "tree_free" &&
+      name != "spanning_on" && name != "spanning_off" && name != "tree_bare")
     return false;
   std::printf("# step time [us]: %s %.1f\n", name.c_str(), TimeCaliper(o, contact));
   return true;
@@ -230,7 +230,8 @@ int main(int argc, char** argv) {
           "poses (upright and tilted by %.2f rad), the same for every engine.\n"
           "--verbose prints each run's time.\n"
           "--threads N runs the Caliper cases on N threads (Options::threads; 1).\n"
-          "--only times one case (for profiling): tree_contact, tree_free,\n"
+          "--only times one case (for profiling): tree_contact, tree_contact_off (its\n"
+          "tendons without tendon-body contact), tree_free,\n"
           "spanning_on, spanning_off, tree_bare (no tendons), passive (ligaments, no tendon\n"
           "contact), raw_bullet.\n",
           steps, repeats, kStarts, kStartTilt);
