@@ -51,6 +51,7 @@ void CommandDelay::Fit() {
   pending_.swap(line);
   count_ -= first;
   head_ = 0;
+  ++refits_;
 }
 
 void CommandDelay::Reset(double command) {
@@ -94,6 +95,25 @@ void CommandDelay::SaveState(double* out) const {
     out[3 + 2 * k] = static_cast<double>(p.issued);
     out[4 + 2 * k] = p.value;
   }
+}
+
+void CommandDelay::SaveStepState(double* out) const {
+  out[0] = static_cast<double>(steps_);
+  out[1] = delayed_;
+  out[2] = head_;
+  out[3] = count_;
+  out[4] = static_cast<double>(refits_);
+}
+
+void CommandDelay::RestoreStepState(const double* in) {
+  if (static_cast<double>(refits_) != in[4])
+    throw std::logic_error(
+        "command delay: the line was laid out anew since its step state was saved (a step at a "
+        "time step not told before); the step cannot be put back");
+  steps_ = static_cast<std::int64_t>(in[0]);
+  delayed_ = in[1];
+  head_ = static_cast<int>(in[2]);
+  count_ = static_cast<int>(in[3]);
 }
 
 namespace {

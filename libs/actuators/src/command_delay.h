@@ -62,6 +62,16 @@ class CommandDelay {
   /// followed. A count of commands out of range empties the line.
   void RestoreState(const double* in);
 
+  /// What one step changes, for putting that step back (the engine saves it before every step):
+  /// Take() only moves the line's start past the commands it releases and leaves them in place,
+  /// so the step count, the command followed, the start and the count put it back, however
+  /// many commands are in flight. SaveState() copies each of them: a 10 s delay under a command
+  /// every 1 ms step is 20,000 values. Between the two calls only Take() runs, at the time step
+  /// SetTimeStep() last told (another would refit the line: RestoreStepState() then throws
+  /// std::logic_error). Five values.
+  void SaveStepState(double* out) const;
+  void RestoreStepState(const double* in);
+
  private:
   struct Pending {
     std::int64_t issued;  // the step before which it was given
@@ -87,6 +97,7 @@ class CommandDelay {
   int count_ = 0;
   std::int64_t steps_ = 0;  // steps taken since Reset
   double delayed_ = 0;      // the command followed
+  std::int64_t refits_ = 0;  // lines Fit() laid out anew (what a step's state cannot put back)
 };
 
 }  // namespace caliper::actuators

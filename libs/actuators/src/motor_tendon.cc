@@ -303,35 +303,21 @@ class DcMotorTendon : public TendonActuator {
   }
 
   void SaveState(double* out) const override {
-    motor_.SaveState(out);
-    out += DcMotor::kStateSize;
-    out[0] = path_length_;
-    out[1] = path_speed_;
-    out[2] = line_length_;
-    out[3] = elastic_length_;
-    out[4] = tension_;
-    out[5] = driver_voltage_;
-    out[6] = warned_ ? 1 : 0;
-    out += kOwnState - DcMotor::kStateSize;
-    if (elastic_state_ > 0) elastic_->SaveState(out);
-    out += elastic_state_;
-    delay_.SaveState(out);
+    SaveOwnState(out);
+    delay_.SaveState(out + kOwnState + elastic_state_);
+  }
+  void SaveStepState(double* out) const override {
+    SaveOwnState(out);
+    delay_.SaveStepState(out + kOwnState + elastic_state_);
   }
 
   void RestoreState(const double* in) override {
-    motor_.RestoreState(in);
-    in += DcMotor::kStateSize;
-    path_length_ = in[0];
-    path_speed_ = in[1];
-    line_length_ = in[2];
-    elastic_length_ = in[3];
-    tension_ = in[4];
-    driver_voltage_ = in[5];
-    warned_ = in[6] != 0;
-    in += kOwnState - DcMotor::kStateSize;
-    if (elastic_state_ > 0) elastic_->RestoreState(in);
-    in += elastic_state_;
-    delay_.RestoreState(in);
+    RestoreOwnState(in);
+    delay_.RestoreState(in + kOwnState + elastic_state_);
+  }
+  void RestoreStepState(const double* in) override {
+    RestoreOwnState(in);
+    delay_.RestoreStepState(in + kOwnState + elastic_state_);
   }
 
   void SetTimeStep(double dt) override {
@@ -431,6 +417,35 @@ class DcMotorTendon : public TendonActuator {
   }
 
  private:
+  // the motor's, what the step reports and the driver's, the elastic element's
+  void SaveOwnState(double* out) const {
+    motor_.SaveState(out);
+    out += DcMotor::kStateSize;
+    out[0] = path_length_;
+    out[1] = path_speed_;
+    out[2] = line_length_;
+    out[3] = elastic_length_;
+    out[4] = tension_;
+    out[5] = driver_voltage_;
+    out[6] = warned_ ? 1 : 0;
+    out += kOwnState - DcMotor::kStateSize;
+    if (elastic_state_ > 0) elastic_->SaveState(out);
+  }
+
+  void RestoreOwnState(const double* in) {
+    motor_.RestoreState(in);
+    in += DcMotor::kStateSize;
+    path_length_ = in[0];
+    path_speed_ = in[1];
+    line_length_ = in[2];
+    elastic_length_ = in[3];
+    tension_ = in[4];
+    driver_voltage_ = in[5];
+    warned_ = in[6] != 0;
+    in += kOwnState - DcMotor::kStateSize;
+    if (elastic_state_ > 0) elastic_->RestoreState(in);
+  }
+
   static constexpr std::pair<const char*, const char*> kStates[] = {
       {"current", "A"},
       {"spool_speed", "rad/s"},

@@ -196,16 +196,20 @@ class HillMuscle : public TendonActuator {
     return n > fixed && CommandDelay::Readable(in + fixed, n - fixed);
   }
   void SaveState(double* out) const override {
-    out[0] = activation_;
-    out[1] = fiber_length_;
-    std::memcpy(out + 2, &out_, sizeof out_);
+    SaveOwnState(out);
     delay_.SaveState(out + 2 + kOutputValues);
   }
+  void SaveStepState(double* out) const override {
+    SaveOwnState(out);
+    delay_.SaveStepState(out + 2 + kOutputValues);
+  }
   void RestoreState(const double* in) override {
-    activation_ = in[0];
-    fiber_length_ = in[1];
-    std::memcpy(static_cast<void*>(&out_), in + 2, sizeof out_);
+    RestoreOwnState(in);
     delay_.RestoreState(in + 2 + kOutputValues);
+  }
+  void RestoreStepState(const double* in) override {
+    RestoreOwnState(in);
+    delay_.RestoreStepState(in + 2 + kOutputValues);
   }
 
   void SetTimeStep(double dt) override {
@@ -350,6 +354,17 @@ class HillMuscle : public TendonActuator {
   }
 
  private:
+  void SaveOwnState(double* out) const {
+    out[0] = activation_;
+    out[1] = fiber_length_;
+    std::memcpy(out + 2, &out_, sizeof out_);
+  }
+  void RestoreOwnState(const double* in) {
+    activation_ = in[0];
+    fiber_length_ = in[1];
+    std::memcpy(static_cast<void*>(&out_), in + 2, sizeof out_);
+  }
+
   static const std::vector<std::pair<const char*, const char*>>& OutputNames() {
     static const std::vector<std::pair<const char*, const char*>> names = {
         {"fiber_velocity", "m/s"},

@@ -141,7 +141,7 @@ struct ActuatorData {
   const sgal::Actuator* desc = nullptr;
   std::unique_ptr<actuators::TendonActuator> model;
   int tendon = -1;
-  size_t state_offset = 0;  // of its SaveState() in the scene's buffer
+  size_t state_offset = 0;  // of its SaveStepState() in the scene's buffer
 };
 
 struct Snapshot {
@@ -374,7 +374,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
   std::vector<Snapshot> snapshot_;          // bodies at the start of the step
-  std::vector<double> actuator_states_;     // actuators' SaveState() at the start of the step,
+  std::vector<double> actuator_states_;     // actuators' SaveStepState() at the start of the step,
                                             // sized once
   StepStage stage_;                         // what the step is doing (for a fault's message)
   double detour_reach_ = 0.1;  // 2.1 times the largest finite shape bounding radius [m]
@@ -1241,7 +1241,7 @@ void BulletScene::SaveStepState() {
     t.saved_previous_length = t.previous_length;
     t.saved_tension = t.tension;
   }
-  for (const auto& a : actuators_) a.model->SaveState(actuator_states_.data() + a.state_offset);
+  for (const auto& a : actuators_) a.model->SaveStepState(actuator_states_.data() + a.state_offset);
   for (auto& d : delays_) {
     d.saved_head = d.head;
     d.saved_oldest = d.ring[d.head];
@@ -1264,7 +1264,7 @@ void BulletScene::RestoreStepState() {
     t.previous_length = t.saved_previous_length;
     t.tension = t.saved_tension;
   }
-  for (auto& a : actuators_) a.model->RestoreState(actuator_states_.data() + a.state_offset);
+  for (auto& a : actuators_) a.model->RestoreStepState(actuator_states_.data() + a.state_offset);
   for (auto& d : delays_) {
     d.head = d.saved_head;
     d.ring[d.head] = d.saved_oldest;

@@ -1,11 +1,14 @@
 // The command delay every commanded kind has (`command_delay` [s], state `delayed_command`), here
 // on hill_muscle in each of its forms: a delayed muscle is the same muscle fed its commands late
-// by hand, bit for bit; commands in flight survive SaveState/RestoreState; the bounds of the line.
+// by hand, bit for bit; commands in flight survive SaveState/RestoreState, and a step is put back
+// by SaveStepState/RestoreStepState; the bounds of the line.
 // dc_motor_tendon's driver delay is checked in motor_realism_test.cc (a delayed PD loop).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <limits>
 #include <map>
@@ -128,6 +131,66 @@ TEST(CommandDelay, ExcitationsInFlightSurviveSaveAndRestoreBitForBit) {
         ASSERT_EQ(a->tension(), b->tension()) << i;
       }
     }
+  }
+}
+
+// What the engine saves before each step to put a failed one back: a few values whatever the
+// line holds (2,000 excitations in flight here, 4,000 values of the whole state), and steps put
+// back by them leave the muscle as the whole state does, bit for bit, going on alike. A step at a
+// time step not told before lays the line out anew, which they cannot put back: refused.
+TEST(CommandDelay, StepsArePutBackByAFewValuesWhateverTheLineHolds) {
+  const double dt = 1e-3;
+  for (const Form& form : Forms()) {
+    SCOPED_TRACE(form.name);
+    std::map<std::string, double> parameters = form.parameters;
+    parameters["command_delay"] = 2.0;  // 2,000 steps
+    auto a = MakeMuscle(form.options, parameters);
+    auto b = MakeMuscle(form.options, parameters);
+    for (auto* m : {a.get(), b.get()}) {
+      m->SetTimeStep(dt);
+      m->Reset(PathLength(form, 0));
+    }
+    auto step = [&](TendonActuator* m, int i) {
+      const double speed = 0.01 * 0.002 / dt * std::cos(0.002 * i);
+      m->Step(PathLength(form, i), speed, dt, speed);
+    };
+    for (int i = 0; i < 2500; ++i) {
+      a->SetCommand(Excitation(i));
+      step(a.get(), i);
+    }
+    a->SetCommand(Excitation(2500));
+    const size_t n = a->StateSize();
+    EXPECT_GT(n, 4000u);
+    std::vector<double> whole(n, 0.0), step_state(n, -7.0), after(n, 0.0);
+    a->SaveState(whole.data());
+    a->SaveStepState(step_state.data());
+    const auto written = static_cast<size_t>(
+        std::count_if(step_state.begin(), step_state.end(), [](double v) { return v != -7.0; }));
+    EXPECT_LT(written, 40u) << "of " << n;
+    // three steps, then put back
+    for (int i = 2500; i < 2503; ++i) step(a.get(), i);
+    a->SaveState(after.data());
+    EXPECT_NE(std::memcmp(whole.data(), after.data(), n * sizeof(double)), 0) << "they moved";
+    a->RestoreStepState(step_state.data());
+    a->SaveState(after.data());
+    EXPECT_EQ(std::memcmp(whole.data(), after.data(), n * sizeof(double)), 0);
+    b->RestoreState(whole.data());
+    for (int i = 2500; i < 2700; ++i) {
+      if (i > 2500) {
+        a->SetCommand(Excitation(i));
+        b->SetCommand(Excitation(i));
+      }
+      step(a.get(), i);
+      step(b.get(), i);
+      ASSERT_EQ(a->Get("activation"), b->Get("activation")) << i;
+      ASSERT_EQ(a->Get("delayed_command"), Excitation(i - 2000)) << i;
+      ASSERT_EQ(a->tension(), b->tension()) << i;
+    }
+    // a step at 2 ms without SetTimeStep: the line is laid out for 1,000 steps
+    a->SaveStepState(step_state.data());
+    step(a.get(), 2700);
+    a->Step(PathLength(form, 2701), 0, 2 * dt, 0);
+    EXPECT_THROW(a->RestoreStepState(step_state.data()), std::logic_error);
   }
 }
 

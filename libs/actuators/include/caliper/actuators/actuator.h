@@ -74,7 +74,8 @@ class TendonActuator {
   /// Writes StateSize() values: everything Step() changes (states, outputs, solver start values
   /// and caches whose contents change results), so that RestoreState() puts the actuator back
   /// where a repeated Step() gives the same result bit for bit. Parameters and the command are
-  /// not part of it. Called before every physics step: a few stores, no allocation. A kind may
+  /// not part of it. Called for a saved state (a recording's keyframe, a scene edit) and, unless
+  /// the kind says less in SaveStepState(), before every physics step: no allocation. A kind may
   /// leave values it will not read back unwritten (the unused slots of a command delay line):
   /// a caller that compares or stores states zeroes its buffer first.
   virtual void SaveState(double* out) const { (void)out; }
@@ -89,6 +90,13 @@ class TendonActuator {
   /// Reads back the values SaveState() wrote (StateSize() of them, or any count Restorable()
   /// accepted).
   virtual void RestoreState(const double* in) { (void)in; }
+
+  /// What the engine saves before every step to put a failed step back: at most StateSize()
+  /// values, read back only by RestoreStepState() of the same actuator after Step() calls alone
+  /// (no parameter, time step or state written between). The default is the whole state; a
+  /// kind whose state holds much that a step only reads (a command delay's line) saves less.
+  virtual void SaveStepState(double* out) const { SaveState(out); }
+  virtual void RestoreStepState(const double* in) { RestoreState(in); }
 
   /// The time step the engine will call Step() with [s]. Kinds whose work per step depends on
   /// a parameter (internal sub-steps) refuse with std::invalid_argument a time step that would
