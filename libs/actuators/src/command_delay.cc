@@ -88,8 +88,7 @@ void CommandDelay::SaveState(double* out) const {
   out[0] = static_cast<double>(steps_);
   out[1] = delayed_;
   out[2] = count_;
-  // only the commands in flight: the engine saves every actuator before each step (for a
-  // rollback), and a line is mostly empty
+  // only the commands in flight (a keyframe of a mostly empty line stays small)
   for (int k = 0; k < count_; ++k) {
     const Pending& p = pending_[Slot(k)];
     out[3 + 2 * k] = static_cast<double>(p.issued);
@@ -139,8 +138,8 @@ void CommandDelay::RestoreState(const double* in) {
   delayed_ = in[1];
   head_ = 0;
   count_ = std::max(0, CountIn(in));
-  // saved under this delay (a step's rollback): into the line as it is, no allocation; under a
-  // longer one, the line may hold more than this one's, and Fit keeps what will be followed
+  // saved under this delay: into the line as it is, no allocation; under a longer one, the line
+  // may hold more than this one's, and Fit keeps what will be followed
   if (static_cast<std::size_t>(count_) > pending_.size())
     pending_.resize(static_cast<std::size_t>(count_));
   for (int k = 0; k < count_; ++k)

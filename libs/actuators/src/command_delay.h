@@ -81,7 +81,7 @@ class CommandDelay {
   void Queue(double command);                 // into the line
   void Release(double dt);                    // what is due at this step leaves the line
   // the place of the k-th command from the oldest, 0 <= k < the line's length (no division: this
-  // runs for every command in flight at every step's SaveState)
+  // runs for every command in flight in SaveState and Queue)
   std::size_t Slot(int k) const {
     const std::size_t i = static_cast<std::size_t>(head_ + k);
     return i < pending_.size() ? i : i - pending_.size();

@@ -439,6 +439,26 @@ void ExpectFaultingStep(sgal::PhysicsScene* scene, const std::string& detail, do
   }
 }
 
+// An actuator that cannot put its step back (TendonActuator's contract broken, here on purpose)
+// is reported after everything else was put back: the bodies, the other actuators, the joints'
+// and the paths' readings.
+TEST(BulletScene, AnActuatorThatCannotPutItsStepBackIsReportedAfterTheRest) {
+  testing::RegisterTestKinds();
+  auto faulting = MakePulledPendulum(false);
+  for (int i = 0; i < 25; ++i) faulting->Step();
+  const auto before = Everything(*faulting);
+  faulting->SetParameter("faulty.fail", 6);
+  try {
+    faulting->Step();
+    ADD_FAILURE() << "the step went on";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "injected restore fault");
+  }
+  EXPECT_EQ(faulting->steps(), 25u);
+  faulting->SetParameter("faulty.fail", 0);
+  ExpectSameBits(before, Everything(*faulting));
+}
+
 TEST(BulletScene, AnyFaultInAStepEndsAtTheStartOfThatStep) {
   testing::RegisterTestKinds();
   const std::pair<int, std::string> faults[] = {

@@ -51,8 +51,9 @@ class ConstantTension : public actuators::TendonActuator {
 /// while its parameter `fail` is set: 1 throws std::runtime_error("injected fault"), 2
 /// std::bad_alloc, 3 returns a NaN tension, 4 throws an int; 5 steps well, but the next reading
 /// of one of its quantities (a delayed channel's, at the end of the step) throws
-/// std::runtime_error("injected reading fault") once and sets `fail` back to 0. Its state is the
-/// motor's.
+/// std::runtime_error("injected reading fault") once and sets `fail` back to 0; 6 throws
+/// std::runtime_error("injected fault") and then, putting its step back, std::logic_error
+/// ("injected restore fault") after the motor's state is back. Its state is the motor's.
 class FaultyMotor : public actuators::TendonActuator {
  public:
   explicit FaultyMotor(const sgal::Actuator& a) : fail_(actuators::ParameterOr(a, "fail", 0)) {
@@ -66,6 +67,7 @@ class FaultyMotor : public actuators::TendonActuator {
     const double tension = motor_->Step(length, speed, dt, end_speed);  // the motor has moved on
     switch (static_cast<int>(fail_)) {
       case 1:
+      case 6:
         throw std::runtime_error("injected fault");
       case 2:
         throw std::bad_alloc();
@@ -82,6 +84,11 @@ class FaultyMotor : public actuators::TendonActuator {
   void SaveState(double* out) const override { motor_->SaveState(out); }
   bool Restorable(const double* in, size_t n) const override { return motor_->Restorable(in, n); }
   void RestoreState(const double* in) override { motor_->RestoreState(in); }
+  void SaveStepState(double* out) const override { motor_->SaveStepState(out); }
+  void RestoreStepState(const double* in) override {
+    motor_->RestoreStepState(in);
+    if (fail_ == 6) throw std::logic_error("injected restore fault");
+  }
   void SetTimeStep(double dt) override { motor_->SetTimeStep(dt); }
   void SetCommand(double v) override { motor_->SetCommand(v); }
   double command() const override { return motor_->command(); }
@@ -118,7 +125,8 @@ inline void RegisterTestKinds() {
       [](const sgal::Actuator& a) { return std::make_unique<ConstantTension>(a); });
   auto faulty = actuators::KindParameters("dc_motor_tendon");
   faulty.push_back(
-      {"fail", "", 0, false, "0 none, 1 runtime_error, 2 bad_alloc, 3 NaN, 4 int, 5 a reading"});
+      {"fail", "", 0, false,
+       "0 none, 1 runtime_error, 2 bad_alloc, 3 NaN, 4 int, 5 a reading, 6 a step put back"});
   actuators::RegisterKind("test_faulty_motor", faulty, [](const sgal::Actuator& a) {
     return std::make_unique<FaultyMotor>(a);
   });

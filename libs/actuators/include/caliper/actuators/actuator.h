@@ -94,7 +94,9 @@ class TendonActuator {
   /// What the engine saves before every step to put a failed step back: at most StateSize()
   /// values, read back only by RestoreStepState() of the same actuator after Step() calls alone
   /// (no parameter, time step or state written between). The default is the whole state; a
-  /// kind whose state holds much that a step only reads (a command delay's line) saves less.
+  /// kind whose state holds much that a step only reads (a command delay's line) saves less,
+  /// and may throw std::logic_error from RestoreStepState() where that contract was broken (a
+  /// Step() at a time step SetTimeStep() did not tell), after putting back what it can.
   virtual void SaveStepState(double* out) const { SaveState(out); }
   virtual void RestoreStepState(const double* in) { RestoreState(in); }
 

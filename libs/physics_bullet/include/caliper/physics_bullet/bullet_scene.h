@@ -57,8 +57,9 @@ constexpr long kFallbackSpinTurns = 10000;
 
 /// One turn of libgomp's wait on this processor [s]: a relaxed load of the word it waits on and
 /// the processor's pause hint (x86's `pause`, whose time differs by more than ten times between
-/// processors; libgomp's cpu_relax). The fastest of 8 timed runs of 2000 turns, so that a
-/// preemption while it runs does not lengthen it (0.4 ms in all at 25 ns a turn).
+/// processors, and which takes a number of the core's cycles; libgomp's cpu_relax). The fastest
+/// of timed runs of 2000 turns over at least 2 ms (8 to 64 runs), so that neither a preemption
+/// nor a core still raising its clock as the program starts lengthens it.
 double MeasureSpinTurn();
 
 /// Call first in main, with main's argv, in a process that may step a scene on several threads.
