@@ -616,6 +616,36 @@ TEST(BulletScene, ALongCommandDelayEditedLiveKeepsItsCommandsInFlight) {
   }
 }
 
+// The same for a muscle's excitations: a faulting step (after the muscle has taken its
+// excitation) puts its 200 in flight back, and it goes on bit for bit as one that never faulted.
+TEST(BulletScene, AFaultingStepPutsBackAMusclesExcitationsInFlight) {
+  testing::RegisterTestKinds();
+  const auto excitation = [](int step) { return 0.3 + 0.2 * std::sin(0.05 * step); };  // [-]
+  auto faulting = MakePulledPendulum(false);
+  auto reference = MakePulledPendulum(false);
+  for (auto* scene : {faulting.get(), reference.get()})
+    scene->SetParameter("muscle.command_delay", 0.2);
+  auto step_both = [&](int step) {
+    for (auto* scene : {faulting.get(), reference.get()}) {
+      scene->SetCommand("muscle", excitation(step));
+      scene->Step();
+    }
+  };
+  for (int i = 0; i < 250; ++i) step_both(i);
+  faulting->SetCommand("muscle", excitation(250));
+  const auto before = Everything(*faulting);
+  faulting->SetParameter("faulty.fail", 1);
+  ExpectFaultingStep(faulting.get(), "injected fault", 0.251);
+  faulting->SetParameter("faulty.fail", 0);
+  ExpectSameBits(before, Everything(*faulting));
+  for (int i = 250; i < 300; ++i) {
+    step_both(i);
+    ASSERT_EQ(faulting->GetParameter("muscle.delayed_command"), excitation(i - 200)) << i;
+  }
+  ExpectSameBits(Everything(*reference), Everything(*faulting));
+  EXPECT_GT(faulting->GetParameter("muscle.tension"), 0);
+}
+
 TEST(BulletScene, AnExplodingBodyPutsTheActuatorsBackToo) {
   sgal::Scene s;
   s.gravity = Vector3d(5000, 0, 0);  // 5 m/s more each step: over the 1000 m/s limit at step 5
