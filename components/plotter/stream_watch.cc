@@ -14,6 +14,7 @@ void StreamWatch::Start(double sim_time, uint32_t every_n_steps, Clock::time_poi
   every_n_steps_ = every_n_steps;
   watch_time_ = sim_time;
   watch_wall_ = now;
+  last_poll_ = now;
   quiet_for_ = 0;
 }
 
@@ -24,13 +25,15 @@ bool StreamWatch::Quiet(bool running, double sim_time, double time_step, double 
     watch_time_ = last_sample;
     watch_wall_ = last_batch;
   }
-  // rewound: watch from here
-  if (sim_time < watch_time_) {
+  const double threshold = QuietThreshold(silence_s_, every_n_steps_, time_step);
+  const double since_poll = std::chrono::duration<double>(now - last_poll_).count();
+  last_poll_ = now;
+  // rewound, or this process was not running for longer than the threshold: watch from here
+  if (sim_time < watch_time_ || since_poll > threshold) {
     watch_time_ = sim_time;
     watch_wall_ = now;
   }
   quiet_for_ = sim_time - watch_time_;
-  const double threshold = QuietThreshold(silence_s_, every_n_steps_, time_step);
   const double quiet_wall = std::chrono::duration<double>(now - watch_wall_).count();
   return running && quiet_for_ > threshold && quiet_wall > threshold;
 }

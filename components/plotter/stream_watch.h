@@ -34,7 +34,10 @@ class StreamWatch {
   /// the time of the newest sample received (NaN when none), received at `last_batch`. True when
   /// the stream is quiet: the Model runs and both the simulated and the wall time since the last
   /// sign of life exceed QuietThreshold. A simulated time that went back (a reset) restarts the
-  /// watch.
+  /// watch, and so does a poll that comes more than QuietThreshold after the previous one (or
+  /// Start): this process did not run meanwhile (SIGSTOP, a suspended laptop, a starved
+  /// machine), so the batches sent to it could not be taken in yet, and the stream gets the
+  /// threshold again from now before it counts as quiet.
   bool Quiet(bool running, double sim_time, double time_step, double last_sample,
              Clock::time_point last_batch, Clock::time_point now);
 
@@ -46,6 +49,7 @@ class StreamWatch {
   uint32_t every_n_steps_ = 1;
   double watch_time_ = 0;           // [s] simulated time of the last sign of life of the stream
   Clock::time_point watch_wall_{};  // and when it was seen
+  Clock::time_point last_poll_{};   // the previous Quiet or Start
   double quiet_for_ = 0;            // [s]
 };
 

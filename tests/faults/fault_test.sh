@@ -64,6 +64,9 @@ freeze() {  # NAME WHAT (observer|subscription)
     pass "the $name is served again ${t} s after SIGCONT ($what kept)"
   else
     fail "the $name was not served again within $BACK s of SIGCONT"
+    # what the Model said of its observers and subscriptions since the freeze (time, message)
+    tail -n +"$((lines + 1))" "$(session_log)" | grep -E $'\tcaliper\\.model\\.(daq|observers)\t' |
+      cut -f1,9 | sed 's/^/  /'
   fi
 }
 freeze renderer observer

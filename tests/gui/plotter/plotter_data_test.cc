@@ -634,5 +634,40 @@ TEST(StreamWatchTest, ADenseStreamThatStopsIsQuietAfterTheSilenceAndAResetRestar
   EXPECT_TRUE(watch.Quiet(true, 2.6, 0.001, 1.95, at(1.0), at(5.3)));
 }
 
+TEST(StreamWatchTest, AProcessThatDidNotRunGivesItsStreamTheSilenceAgainBeforeItIsQuiet) {
+  // the plotter stopped (SIGSTOP) for 5 s while the Model ran on: at its first poll after SIGCONT
+  // the batches sent meanwhile are still unread in its sockets, so that poll must not count the
+  // 5 s as silence (it would subscribe anew and the Model's retries of the old subscription, which
+  // the batches answer, would be for nothing)
+  using Clock = StreamWatch::Clock;
+  const Clock::time_point t0 = Clock::now();
+  auto at = [&](double s) {
+    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  StreamWatch watch(2.0);
+  watch.Start(0.0, 1, at(0));
+  for (double t = 0.25; t <= 10; t += 0.25)
+    ASSERT_FALSE(watch.Quiet(true, t, 0.001, t - 0.02, at(t - 0.01), at(t))) << "at " << t;
+  // stopped from 10 to 15 s: the first poll after it sees no newer batch yet
+  EXPECT_FALSE(watch.Quiet(true, 15.0, 0.001, 9.98, at(9.99), at(15.0)));
+  EXPECT_DOUBLE_EQ(watch.quiet_for(), 0.0);
+  // the batches come: never quiet
+  EXPECT_FALSE(watch.Quiet(true, 15.25, 0.001, 15.2, at(15.1), at(15.25)));
+  // they do not come: quiet once the silence passed again, counted from the poll after SIGCONT
+  StreamWatch silent(2.0);
+  silent.Start(0.0, 1, at(0));
+  EXPECT_FALSE(silent.Quiet(true, 10.0, 0.001, 9.98, at(9.99), at(10.0)));  // a starved poll
+  for (double t = 10.25; t < 12.0; t += 0.25)
+    ASSERT_FALSE(silent.Quiet(true, t, 0.001, 9.98, at(9.99), at(t))) << "at " << t;
+  EXPECT_TRUE(silent.Quiet(true, 12.25, 0.001, 9.98, at(9.99), at(12.25)));
+  EXPECT_NEAR(silent.quiet_for(), 2.25, 1e-9);
+  // a poll late by less than the silence (a slow status call) counts the time as silence
+  StreamWatch slow(2.0);
+  slow.Start(0.0, 1, at(0));
+  EXPECT_FALSE(slow.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
+  EXPECT_FALSE(slow.Quiet(true, 2.3, 0.001, 0.45, at(0.46), at(2.3)));
+  EXPECT_TRUE(slow.Quiet(true, 4.0, 0.001, 0.45, at(0.46), at(4.0)));
+}
+
 }  // namespace
 }  // namespace caliper::plotter
