@@ -575,6 +575,15 @@ TEST(ChannelLayoutTest, SaysWhyAMatrixOfMoreThan64ElementsGivesNoCurve) {
 
 // ------------------------------------------------------------------------ quiet streams
 
+/// Wall times given in seconds from the test's start.
+struct WallAt {
+  using Clock = StreamWatch::Clock;
+  Clock::time_point t0 = Clock::now();
+  Clock::time_point operator()(double s) const {
+    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
+};
+
 TEST(StreamWatchTest, WaitsLongerThanTheGapBetweenSparseSamples) {
   // every step: the configured silence; sparse samples: three intervals and a batch
   EXPECT_DOUBLE_EQ(QuietThreshold(2.0, 1, 0.001), 2.0);
@@ -586,17 +595,13 @@ TEST(StreamWatchTest, WaitsLongerThanTheGapBetweenSparseSamples) {
 
 TEST(StreamWatchTest, ASparseStreamThatDeliversIsNeverQuiet) {
   // one sample every 5 s of simulated time, the Model at real time
-  using Clock = StreamWatch::Clock;
-  const Clock::time_point t0 = Clock::now();
-  auto at = [&](double s) {
-    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
-  };
+  const WallAt at;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   StreamWatch watch(2.0);
   watch.Start(0.0, 5000, at(0));
   // polls every 250 ms for 60 s; a sample at 5, 10, ... arrives 50 ms later
   double last_sample = nan;
-  Clock::time_point last_batch{};
+  WallAt::Clock::time_point last_batch{};
   for (double t = 0.25; t <= 60; t += 0.25) {
     const double due = std::floor((t - 0.05) / 5) * 5;
     if (due >= 5 && (std::isnan(last_sample) || due > last_sample)) {
@@ -614,11 +619,7 @@ TEST(StreamWatchTest, ASparseStreamThatDeliversIsNeverQuiet) {
 }
 
 TEST(StreamWatchTest, ADenseStreamThatStopsIsQuietAfterTheSilenceAndAResetRestartsTheWatch) {
-  using Clock = StreamWatch::Clock;
-  const Clock::time_point t0 = Clock::now();
-  auto at = [&](double s) {
-    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
-  };
+  const WallAt at;
   StreamWatch watch(2.0);
   watch.Start(1.0, 1, at(0));
   EXPECT_FALSE(watch.Quiet(true, 2.0, 0.001, 1.95, at(1.0), at(1.0)));
@@ -639,11 +640,7 @@ TEST(StreamWatchTest, AProcessThatDidNotRunGivesItsStreamTheSilenceAgainBeforeIt
   // the batches sent meanwhile are still unread in its sockets, so that poll must not count the
   // 5 s as silence (it would subscribe anew and the Model's retries of the old subscription, which
   // the batches answer, would be for nothing)
-  using Clock = StreamWatch::Clock;
-  const Clock::time_point t0 = Clock::now();
-  auto at = [&](double s) {
-    return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
-  };
+  const WallAt at;
   StreamWatch watch(2.0);
   watch.Start(0.0, 1, at(0));
   for (double t = 0.25; t <= 10; t += 0.25)
