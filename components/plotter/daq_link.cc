@@ -76,9 +76,8 @@ struct DaqLink::Shared {
   size_t held_values = 0;   // ValuesOf the batches in `held`
   size_t inbox_values = 0;  // ValuesOf the batches in `inbox`
   size_t inbox_capacity = 4096;
-  uint64_t next_batch = 1;
+  BatchSequence sequence;  // the current subscription's batch numbers
   uint64_t received = 0;
-  uint64_t missing = 0;
   uint64_t dropped = 0;
   uint64_t discarded = 0;          // held batches of a layout that had changed
   double last_sample_time = kNaN;  // [s] of the current subscription
@@ -98,10 +97,9 @@ struct DaqLink::Shared {
 
   // with the mutex held
   void Accept(ReceivedBatch&& b) {
-    b.layout = layout;
-    if (b.number > next_batch) missing += b.number - next_batch;
-    if (b.number >= next_batch) next_batch = b.number + 1;
     ++received;
+    if (!sequence.Take(b.number)) return;  // older than what was taken in: left out
+    b.layout = layout;
     if (!b.times.empty()) {
       if (!std::isnan(last_sample_time) && b.times.front() < last_sample_time) checking = true;
       last_sample_time = b.times.back();
@@ -158,7 +156,7 @@ struct DaqLink::Shared {
     if (id != 0) {
       current = id;
       layout = id_layout;
-      next_batch = 1;
+      sequence.Restart();
       last_sample_time = kNaN;
       model_layout = 0;  // a new subscription starts at the Model's layout 1
       last_batch_wall = Clock::now();
@@ -263,7 +261,8 @@ LinkStatus DaqLink::status() const {
   s.consumer_failures = impl_->servant->failures();
   std::lock_guard<std::mutex> shared_lock(shared_->mutex);
   s.batches_received = shared_->received;
-  s.batches_missing = shared_->missing;
+  s.batches_missing = shared_->sequence.missing();
+  s.batches_late = shared_->sequence.late();
   s.batches_dropped = shared_->dropped;
   s.batches_discarded = shared_->discarded;
   return s;

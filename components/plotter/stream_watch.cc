@@ -38,4 +38,14 @@ bool StreamWatch::Quiet(bool running, double sim_time, double time_step, double 
   return running && quiet_for_ > threshold && quiet_wall > threshold;
 }
 
+bool BatchSequence::Take(uint64_t number) {
+  if (number < next_) {
+    ++late_;
+    return false;
+  }
+  missing_ += number - next_;
+  next_ = number + 1;
+  return true;
+}
+
 }  // namespace caliper::plotter

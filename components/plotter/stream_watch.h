@@ -2,7 +2,7 @@
 // Whether a DAQ stream has gone quiet: the Model runs but no sample of the subscription has come
 // for a while (e.g. the Model dropped the subscriber), so the plotter subscribes again. How long
 // "a while" is depends on the subscription: one sample every n steps may leave seconds of
-// simulated time between samples. No Qt, no CORBA.
+// simulated time between samples. And which of a stream's batches come late. No Qt, no CORBA.
 
 #include <chrono>
 #include <cstdint>
@@ -51,6 +51,28 @@ class StreamWatch {
   Clock::time_point watch_wall_{};  // and when it was seen
   Clock::time_point last_poll_{};   // the previous Quiet or Start
   double quiet_for_ = 0;            // [s]
+};
+
+/// The batch numbers of the current subscription as they arrive (the Model numbers each
+/// subscription's batches 1, 2, 3, ...; a gap is batches it dropped). Each push goes on its own
+/// call, so after pushes that timed out (a plotter stopped, suspended or starved) the batches
+/// still unread in its sockets are taken in by several ORB threads at once, and an older batch
+/// can come after a newer one. Its samples are older than those shown: taken in, they would read
+/// as a reset of the Model and clear the plot's history. Such a batch is late and left out; the
+/// Model counted it as dropped, and it stays counted as missing here.
+class BatchSequence {
+ public:
+  /// A new subscription: its numbers start again at 1 (the counts go on).
+  void Restart() { next_ = 1; }
+  /// Batch `number` arrived: false when it is late (a number below one taken before).
+  bool Take(uint64_t number);
+  uint64_t missing() const { return missing_; }  ///< numbers skipped, over all subscriptions
+  uint64_t late() const { return late_; }        ///< batches left out as late
+
+ private:
+  uint64_t next_ = 1;
+  uint64_t missing_ = 0;
+  uint64_t late_ = 0;
 };
 
 }  // namespace caliper::plotter

@@ -666,5 +666,27 @@ TEST(StreamWatchTest, AProcessThatDidNotRunGivesItsStreamTheSilenceAgainBeforeIt
   EXPECT_TRUE(slow.Quiet(true, 4.0, 0.001, 0.45, at(0.46), at(4.0)));
 }
 
+TEST(BatchSequenceTest, LeavesOutABatchThatComesAfterALaterOneAndCountsTheGaps) {
+  BatchSequence seq;
+  EXPECT_TRUE(seq.Take(1));
+  EXPECT_TRUE(seq.Take(2));
+  // pushes 3-5 timed out while the plotter was stopped; at SIGCONT the Model's next push (6) is
+  // read before them
+  EXPECT_TRUE(seq.Take(6));
+  EXPECT_EQ(seq.missing(), 3u);
+  EXPECT_FALSE(seq.Take(4));
+  EXPECT_FALSE(seq.Take(3));
+  EXPECT_FALSE(seq.Take(6));  // the same number again
+  EXPECT_TRUE(seq.Take(7));
+  EXPECT_EQ(seq.missing(), 3u);  // the late ones were counted missing when 6 came
+  EXPECT_EQ(seq.late(), 3u);
+  // a new subscription starts at 1 again; the counts go on
+  seq.Restart();
+  EXPECT_TRUE(seq.Take(1));
+  EXPECT_TRUE(seq.Take(3));
+  EXPECT_EQ(seq.missing(), 4u);
+  EXPECT_EQ(seq.late(), 3u);
+}
+
 }  // namespace
 }  // namespace caliper::plotter
