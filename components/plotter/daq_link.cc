@@ -255,6 +255,11 @@ DaqLink::~DaqLink() {
   }
 }
 
+std::string DaqLink::ConsumerReference() const {
+  CORBA::String_var ior = impl_->orb->object_to_string(impl_->consumer);
+  return ior.in();
+}
+
 LinkStatus DaqLink::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   LinkStatus s = status_;

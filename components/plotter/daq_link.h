@@ -103,6 +103,9 @@ class DaqLink {
 
   /// The options it was made with.
   const Options& options() const { return options_; }
+  /// The stringified reference of the consumer the Model pushes batches to (what the link gives
+  /// the Model at each subscribe).
+  std::string ConsumerReference() const;
 
   struct Impl;    ///< the worker's CORBA state
   struct Shared;  ///< shared with the consumer servant
