@@ -538,6 +538,7 @@ void DaqLink::Subscribe(const std::vector<std::string>& ids, uint32_t every, dou
 
 void DaqLink::Poll(const Request& request) {
   Impl& i = *impl_;
+  i.watch->PollStarts(Clock::now());
   Shared& sh = *shared_;
   CheckClosing();
   M::SimulationStatus_var s = i.model->status();

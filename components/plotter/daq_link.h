@@ -50,7 +50,7 @@ struct LinkStatus {
   uint64_t subscriptions_made = 0;      ///< counts successful subscribe calls
   uint64_t batches_received = 0;        ///< of the current subscriptions, since start
   uint64_t batches_missing = 0;         ///< batch numbers skipped (the Model dropped them)
-  /// of those, batches that came after a later one and were left out (see BatchSequence)
+  /// batches numbered below one already taken, left out (see BatchSequence)
   uint64_t batches_late = 0;
   uint64_t batches_dropped = 0;         ///< dropped here: the GUI took none for too long
   uint64_t batches_discarded = 0;  ///< held after a reset or reload, of a layout that had changed

@@ -26,7 +26,9 @@ bool StreamWatch::Quiet(bool running, double sim_time, double time_step, double 
     watch_wall_ = last_batch;
   }
   const double threshold = QuietThreshold(silence_s_, every_n_steps_, time_step);
-  const double since_poll = std::chrono::duration<double>(now - last_poll_).count();
+  const Clock::time_point start = poll_start_.value_or(now);
+  poll_start_.reset();
+  const double since_poll = std::chrono::duration<double>(start - last_poll_).count();
   last_poll_ = now;
   // rewound, or this process was not running for longer than the threshold: watch from here
   if (sim_time < watch_time_ || since_poll > threshold) {
@@ -39,12 +41,13 @@ bool StreamWatch::Quiet(bool running, double sim_time, double time_step, double 
 }
 
 bool BatchSequence::Take(uint64_t number) {
-  if (number < next_) {
+  if (number < next_ && next_ - number <= kLateBatches) {
     ++late_;
     return false;
   }
-  missing_ += number - next_;
-  next_ = number + 1;
+  if (number >= next_) missing_ += number - next_;
+  // the last number there is stays the next one (no wrap to 0)
+  next_ = number == UINT64_MAX ? number : number + 1;
   return true;
 }
 

@@ -664,6 +664,19 @@ TEST(StreamWatchTest, AProcessThatDidNotRunGivesItsStreamTheSilenceAgainBeforeIt
   EXPECT_FALSE(slow.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
   EXPECT_FALSE(slow.Quiet(true, 2.3, 0.001, 0.45, at(0.46), at(2.3)));
   EXPECT_TRUE(slow.Quiet(true, 4.0, 0.001, 0.45, at(0.46), at(4.0)));
+  // the gap runs to the start of a poll: two slow calls of a poll (2.2 s after a start 0.25 s
+  // after the previous poll) are not time the process did not run, and the silence is seen
+  StreamWatch calls(2.0);
+  calls.Start(0.0, 1, at(0));
+  EXPECT_FALSE(calls.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
+  calls.PollStarts(at(0.75));
+  EXPECT_TRUE(calls.Quiet(true, 2.95, 0.001, 0.45, at(0.46), at(2.95)));
+  // and a poll that starts 5 s late still restarts the count
+  StreamWatch stopped(2.0);
+  stopped.Start(0.0, 1, at(0));
+  EXPECT_FALSE(stopped.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
+  stopped.PollStarts(at(5.5));
+  EXPECT_FALSE(stopped.Quiet(true, 5.6, 0.001, 0.45, at(0.46), at(5.6)));
 }
 
 TEST(BatchSequenceTest, LeavesOutABatchThatComesAfterALaterOneAndCountsTheGaps) {
@@ -686,6 +699,23 @@ TEST(BatchSequenceTest, LeavesOutABatchThatComesAfterALaterOneAndCountsTheGaps) 
   EXPECT_TRUE(seq.Take(3));
   EXPECT_EQ(seq.missing(), 4u);
   EXPECT_EQ(seq.late(), 3u);
+}
+
+TEST(BatchSequenceTest, TakesANumberFarBelowAsNumberingAnewAndDoesNotWrap) {
+  BatchSequence seq;
+  const uint64_t far = BatchSequence::kLateBatches + 10;
+  EXPECT_TRUE(seq.Take(far));  // the next is far + 1
+  EXPECT_FALSE(seq.Take(11));  // kLateBatches below it: late
+  EXPECT_TRUE(seq.Take(10));   // further: numbered anew from 10, nothing counted missing
+  EXPECT_EQ(seq.late(), 1u);
+  EXPECT_EQ(seq.missing(), far - 1);
+  EXPECT_TRUE(seq.Take(11));
+  // the last number there is: the next is not 0
+  EXPECT_TRUE(seq.Take(UINT64_MAX));
+  EXPECT_FALSE(seq.Take(UINT64_MAX - 1));
+  EXPECT_TRUE(seq.Take(1));  // far below: numbered anew
+  EXPECT_TRUE(seq.Take(2));
+  EXPECT_FALSE(seq.Take(1));
 }
 
 }  // namespace
