@@ -658,25 +658,25 @@ TEST(StreamWatchTest, AProcessThatDidNotRunGivesItsStreamTheSilenceAgainBeforeIt
     ASSERT_FALSE(silent.Quiet(true, t, 0.001, 9.98, at(9.99), at(t))) << "at " << t;
   EXPECT_TRUE(silent.Quiet(true, 12.25, 0.001, 9.98, at(9.99), at(12.25)));
   EXPECT_NEAR(silent.quiet_for(), 2.25, 1e-9);
+  // the next cases: a stream whose last batch (t = 0.45 s) came at 0.46 s, polled at t; a poll
+  // that started at `started` when given
+  auto poll = [&](StreamWatch& w, double t, double started = -1) {
+    if (started >= 0) w.PollStarts(at(started));
+    return w.Quiet(true, t, 0.001, 0.45, at(0.46), at(t));
+  };
+  StreamWatch slow(2.0), calls(2.0), stopped(2.0);
+  for (StreamWatch* w : {&slow, &calls, &stopped}) {
+    w->Start(0.0, 1, at(0));
+    EXPECT_FALSE(poll(*w, 0.5));
+  }
   // a poll late by less than the silence (a slow status call) counts the time as silence
-  StreamWatch slow(2.0);
-  slow.Start(0.0, 1, at(0));
-  EXPECT_FALSE(slow.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
-  EXPECT_FALSE(slow.Quiet(true, 2.3, 0.001, 0.45, at(0.46), at(2.3)));
-  EXPECT_TRUE(slow.Quiet(true, 4.0, 0.001, 0.45, at(0.46), at(4.0)));
+  EXPECT_FALSE(poll(slow, 2.3));
+  EXPECT_TRUE(poll(slow, 4.0));
   // the gap runs to the start of a poll: two slow calls of a poll (2.2 s after a start 0.25 s
   // after the previous poll) are not time the process did not run, and the silence is seen
-  StreamWatch calls(2.0);
-  calls.Start(0.0, 1, at(0));
-  EXPECT_FALSE(calls.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
-  calls.PollStarts(at(0.75));
-  EXPECT_TRUE(calls.Quiet(true, 2.95, 0.001, 0.45, at(0.46), at(2.95)));
+  EXPECT_TRUE(poll(calls, 2.95, 0.75));
   // and a poll that starts 5 s late still restarts the count
-  StreamWatch stopped(2.0);
-  stopped.Start(0.0, 1, at(0));
-  EXPECT_FALSE(stopped.Quiet(true, 0.5, 0.001, 0.45, at(0.46), at(0.5)));
-  stopped.PollStarts(at(5.5));
-  EXPECT_FALSE(stopped.Quiet(true, 5.6, 0.001, 0.45, at(0.46), at(5.6)));
+  EXPECT_FALSE(poll(stopped, 5.6, 5.5));
 }
 
 TEST(BatchSequenceTest, LeavesOutABatchThatComesAfterALaterOneAndCountsTheGaps) {
