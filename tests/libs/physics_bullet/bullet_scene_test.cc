@@ -439,6 +439,16 @@ void ExpectFaultingStep(sgal::PhysicsScene* scene, const std::string& detail, do
   }
 }
 
+// the next step of `scene`, made to fail in 'faulty' at `time` [s], leaves the scene as it was,
+// bit for bit
+void ExpectAFaultingStepPutBack(sgal::PhysicsScene* scene, double time) {
+  const auto before = Everything(*scene);
+  scene->SetParameter("faulty.fail", 1);
+  ExpectFaultingStep(scene, "injected fault", time);
+  scene->SetParameter("faulty.fail", 0);
+  ExpectSameBits(before, Everything(*scene));
+}
+
 // An actuator that cannot put its step back (TendonActuator's contract broken, here on purpose)
 // is reported after everything else was put back: the bodies, the other actuators, the joints'
 // and the paths' readings.
@@ -573,11 +583,7 @@ TEST(BulletScene, ALongCommandDelayEditedLiveKeepsItsCommandsInFlight) {
   for (int i = 0; i < 250; ++i) step_both(i);
   EXPECT_EQ(faulting->GetParameter("motor.delayed_command"), command(249 - 200));
   faulting->SetCommand("motor", command(250));
-  const auto before = Everything(*faulting);
-  faulting->SetParameter("faulty.fail", 1);
-  ExpectFaultingStep(faulting.get(), "injected fault", 0.251);
-  faulting->SetParameter("faulty.fail", 0);
-  ExpectSameBits(before, Everything(*faulting));
+  ExpectAFaultingStepPutBack(faulting.get(), 0.251);
   for (int i = 250; i < 300; ++i) step_both(i);
   ExpectSameBits(Everything(*reference), Everything(*faulting));
   EXPECT_EQ(faulting->GetParameter("motor.delayed_command"), command(299 - 200));
@@ -633,11 +639,7 @@ TEST(BulletScene, AFaultingStepPutsBackAMusclesExcitationsInFlight) {
   };
   for (int i = 0; i < 250; ++i) step_both(i);
   faulting->SetCommand("muscle", excitation(250));
-  const auto before = Everything(*faulting);
-  faulting->SetParameter("faulty.fail", 1);
-  ExpectFaultingStep(faulting.get(), "injected fault", 0.251);
-  faulting->SetParameter("faulty.fail", 0);
-  ExpectSameBits(before, Everything(*faulting));
+  ExpectAFaultingStepPutBack(faulting.get(), 0.251);
   for (int i = 250; i < 300; ++i) {
     step_both(i);
     ASSERT_EQ(faulting->GetParameter("muscle.delayed_command"), excitation(i - 200)) << i;
