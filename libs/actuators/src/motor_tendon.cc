@@ -129,9 +129,14 @@ std::string Prefix(const sgal::Actuator& a) {
   return "actuator '" + a.name + "' (" + a.kind + "): ";
 }
 
-void RequireFinite(const std::string& prefix, const char* what, double value) {
-  if (!std::isfinite(value))
-    throw std::invalid_argument(prefix + what + " must be finite, got " + Number(value));
+[[noreturn, gnu::cold, gnu::noinline]] void ThrowNotFinite(const std::string& prefix,
+                                                           const char* what, double value) {
+  throw std::invalid_argument(prefix + what + " must be finite, got " + Number(value));
+}
+
+// checked in every step of every actuator: the test inline, the message out of the way
+inline void RequireFinite(const std::string& prefix, const char* what, double value) {
+  if (!std::isfinite(value)) ThrowNotFinite(prefix, what, value);
 }
 
 // the tendon seen from the spool: an inextensible line paid in by the spool, in series with the

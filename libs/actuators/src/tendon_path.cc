@@ -278,16 +278,22 @@ void TendonPath::Evaluate(const std::vector<WorldElement>& elements, PathGeometr
   path.length = 0;
   path.speed = 0;
   path.points.reserve(elements.size() + 16);
-  // velocity of every path point, and whether the piece after it runs along an obstacle surface
-  // (scratch kept between calls: this runs for every tendon in every step)
-  thread_local std::vector<Vector3d> velocity;
-  thread_local std::vector<bool> on_surface_after;
-  velocity.clear();
-  on_surface_after.clear();
+  // Each straight piece is measured as its end point is added: its length, and d/dt of length
+  // (unit vector . relative velocity). The pieces along a surface between a wrap's points were
+  // counted exactly by the wrap and add no speed: their ends are tangent points, where the
+  // tangent lines' rate of change along the surface is zero to first order.
+  Vector3d last_velocity = Vector3d::Zero();  // of the last point added
+  bool along_surface = false;                 // whether the piece from the last point does
   auto add = [&](const Vector3d& p, const Vector3d& v, int body, double friction, bool on_wrap) {
+    if (!path.points.empty() && !along_surface) {
+      const Vector3d d = p - path.points.back().position;
+      const double len = d.norm();
+      path.length += len;
+      if (len > kTiny) path.speed += d.dot(v - last_velocity) / len;
+    }
     path.points.push_back(PathPoint{p, body, friction, on_wrap});
-    velocity.push_back(v);
-    on_surface_after.push_back(false);
+    last_velocity = v;
+    along_surface = false;
   };
 
   for (size_t i = 0; i < elements.size(); ++i) {
@@ -302,24 +308,20 @@ void TendonPath::Evaluate(const std::vector<WorldElement>& elements, PathGeometr
         // their own axis)
         for (size_t k = 0; k < wrap.points.size(); ++k) {
           add(wrap.points[k], w.velocity, w.body, 0, true);
-          if (k + 1 < wrap.points.size()) on_surface_after.back() = true;
+          along_surface = k + 1 < wrap.points.size();
         }
         path.length += wrap.length;
       }
     }
     add(e.point, e.velocity, e.body, e.friction, false);
   }
+}
 
-  // straight pieces: length and d/dt of length (unit vector . relative velocity); the pieces along
-  // a surface were counted exactly above and add no speed: their ends are tangent points, where
-  // the tangent lines' rate of change along the surface is zero to first order
-  for (size_t k = 0; k + 1 < path.points.size(); ++k) {
-    if (on_surface_after[k]) continue;
-    const Vector3d d = path.points[k + 1].position - path.points[k].position;
-    const double len = d.norm();
-    path.length += len;
-    if (len > kTiny) path.speed += d.dot(velocity[k + 1] - velocity[k]) / len;
-  }
+double StraightLength(const std::vector<PathPoint>& points) {
+  double length = 0;
+  for (size_t k = 0; k + 1 < points.size(); ++k)
+    length += (points[k + 1].position - points[k].position).norm();
+  return length;
 }
 
 std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {

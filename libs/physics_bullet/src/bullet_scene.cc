@@ -46,12 +46,12 @@ using Eigen::Vector3d;
 // the most constraint solver iterations a scene may ask for per step
 constexpr int kMaxSolverIterations = actuators::kMaxSubstepsPerStep;
 
-btVector3 ToBt(const Vector3d& v, double s = 1.0) {
+inline btVector3 ToBt(const Vector3d& v, double s = 1.0) {
   return btVector3(static_cast<btScalar>(v.x() * s), static_cast<btScalar>(v.y() * s),
                    static_cast<btScalar>(v.z() * s));
 }
 
-Vector3d FromBt(const btVector3& v, double s = 1.0) {
+inline Vector3d FromBt(const btVector3& v, double s = 1.0) {
   return Vector3d(v.x(), v.y(), v.z()) / s;
 }
 
@@ -73,6 +73,7 @@ struct BodyData {
   // the inverse of com_in_body's rotation as a quaternion (BodyStates), taken once
   Eigen::Quaterniond body_in_com_rotation = Eigen::Quaterniond::Identity();
   bool com_is_body_frame = true;  // com_in_body is the identity: body and Bullet frames coincide
+  bool dynamic = false;           // moved by forces (neither static nor kinematic)
   std::vector<actuators::WorldShape> world_shapes;  // refreshed each step when contact is on
   std::vector<Isometry3d> shape_poses;               // shapes in the body frame
 };
@@ -86,10 +87,25 @@ struct JointData {
            b_z = Vector3d::UnitZ();
   std::unique_ptr<btTypedConstraint> constraint;
   int body_a = -1, body_b = -1;
-  double position = 0;  // [rad] or [m]
+  // [m] for a slider. For a hinge, where its whole turns are counted from (0 at a build, a
+  // restored state's angle): JointPosition() gives its angle [rad].
+  double position = 0;
   double velocity = 0;  // [rad/s] or [m/s]
   Vector3d axis = Vector3d::UnitZ();  // world, this step
+  // a hinge's last reading: the cosine and sine of its angle (both scaled by the same factor);
+  // the whole turns to add to atan2's angle; false: count them afresh from `position` at the next
+  // UpdateJoints
+  double reading_cos = 1, reading_sin = 0;
+  double turns = 0;
+  bool turns_counted = false;
 };
+
+/// A joint's position: a hinge's angle [rad], whole turns counted (read on demand: the step only
+/// counts turns, so that an angle nobody reads costs no atan2), a slider's travel [m].
+double JointPosition(const JointData& j) {
+  if (j.desc->kind != sgal::ConstraintKind::kHinge) return j.position;
+  return std::atan2(j.reading_sin, j.reading_cos) + 2 * M_PI * j.turns;
+}
 
 /// A path element with its names resolved once.
 struct ElementRef {
@@ -120,6 +136,8 @@ struct TendonData {
   actuators::ContactMemory contact_memory;
   std::vector<int> actuators;
   bool has_wraps = false;  // the path keeps a side per wrap from step to step
+  // points alone, at least two (a path TendonPath::Evaluate accepts): EvaluateTendon places them
+  bool points_only = false;
   // the state at the start of the step, put back when the step fails
   actuators::TendonPath saved_path;       // only when has_wraps
   double saved_speed = 0;
@@ -317,7 +335,7 @@ class BulletScene : public sgal::PhysicsScene {
   double JointInverseInertia(const JointData& j) const;
   void ApplyCouplings();
   void PushJoint(const JointData& j, double load);
-  void CheckState();
+  void CheckState();  // of what CacheBodyPoses took from Bullet: call it first
   void BuildParameters();
   // the delayed channels (after BuildParameters): their rings, their parameters read late and
   // the `.undelayed` parameters
@@ -528,7 +546,8 @@ void BulletScene::BuildBody(size_t index) {
   const sgal::Body& desc = scene_.bodies[index];
   BodyData& data = bodies_[index];
   data.desc = &desc;
-  const bool dynamic = desc.type == sgal::BodyType::kDynamic;
+  data.dynamic = desc.type == sgal::BodyType::kDynamic;
+  const bool dynamic = data.dynamic;
   const double s = scale_;
 
   // Bullet wants the body frame at the centre of mass along the principal axes
@@ -642,8 +661,13 @@ void BulletScene::CacheBodyPoses() {
     // body frame = com frame * inverse(com in body), in matrices (no quaternion round trip on
     // the path every tendon and joint reads)
     Isometry3d& frame = poses_[i];
-    frame.linear().noalias() = com_rotation * com_in_body.linear().transpose();
-    frame.translation() = com - frame.linear() * com_in_body.translation();
+    if (bodies_[i].com_is_body_frame) {
+      frame.linear() = com_rotation;
+      frame.translation() = com;
+    } else {
+      frame.linear().noalias() = com_rotation * com_in_body.linear().transpose();
+      frame.translation() = com - frame.linear() * com_in_body.translation();
+    }
     coms_[i] = com;
     velocities_[i] = FromBt(rb.getLinearVelocity(), scale_);
     spins_[i] = FromBt(rb.getAngularVelocity());
@@ -741,6 +765,10 @@ void BulletScene::BuildTendons() {
       t.elements.push_back(ref);
       t.has_wraps |= e.kind != sgal::PathElement::Kind::kPoint;
     }
+    t.points_only = !t.has_wraps && t.elements.size() >= 2;
+    // a side per element, none wrapping, as TendonPath::Evaluate would keep them (the exact
+    // state holds them)
+    if (t.points_only) t.path.set_wrap_sides(std::vector<int>(t.elements.size(), 0));
   }
   actuators_.resize(scene_.actuators.size());
   for (size_t i = 0; i < scene_.actuators.size(); ++i)
@@ -860,30 +888,56 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
   // velocities are not needed
   static const Isometry3d kWorld = Isometry3d::Identity();
   auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
+  // a point in the world (rotation and translation written out: at -O2 Eigen's transform product
+  // went out of line here)
+  auto place = [&](const ElementRef& ref, Vector3d* out) {
+    const Isometry3d& body_pose = pose(ref.body);
+    out->noalias() = body_pose.linear() * ref.desc->position;
+    *out += body_pose.translation();
+  };
   TendonData& t = tendons_[ti];
-  t.world.resize(t.elements.size());
-  for (size_t k = 0; k < t.elements.size(); ++k) {
-    const ElementRef& ref = t.elements[k];
-    const sgal::PathElement& e = *ref.desc;
-    actuators::WorldElement& w = t.world[k];
-    w.kind = e.kind;
-    w.body = ref.body;
-    if (e.kind == sgal::PathElement::Kind::kPoint) {
-      w.point = pose(ref.body) * e.position;
-      w.velocity.setZero();
-      w.friction = e.friction;
-    } else {
-      const sgal::WrapObstacle* o = ref.obstacle;
-      const Isometry3d& body_pose = pose(ref.body);
-      w.obstacle.kind = o->kind;
-      w.obstacle.pose = body_pose * o->pose.ToIsometry();
-      w.obstacle.radius = o->radius;
-      w.obstacle.length = o->length;
-      w.velocity.setZero();
-      if (e.side) w.side = body_pose * (*e.side);
+  if (t.points_only) {
+    // what TendonPath::Evaluate makes of points alone, without going through its elements (the
+    // cost of most of a light scene's tendons): the points where their bodies are and straight
+    // pieces between them; the speed is measured from lengths (above)
+    std::vector<actuators::PathPoint>& points = t.geometry.points;
+    points.resize(t.elements.size());  // contacts inserted last step go
+    for (size_t k = 0; k < t.elements.size(); ++k) {
+      const ElementRef& ref = t.elements[k];
+      actuators::PathPoint& p = points[k];
+      place(ref, &p.position);
+      p.body = ref.body;
+      p.friction = ref.desc->friction;
+      p.on_wrap = false;
+      p.contact = false;
     }
+    t.geometry.length = actuators::StraightLength(points);
+    t.geometry.speed = 0;
+  } else {
+    t.world.resize(t.elements.size());
+    for (size_t k = 0; k < t.elements.size(); ++k) {
+      const ElementRef& ref = t.elements[k];
+      const sgal::PathElement& e = *ref.desc;
+      actuators::WorldElement& w = t.world[k];
+      w.kind = e.kind;
+      w.body = ref.body;
+      if (e.kind == sgal::PathElement::Kind::kPoint) {
+        place(ref, &w.point);
+        w.velocity.setZero();
+        w.friction = e.friction;
+      } else {
+        const sgal::WrapObstacle* o = ref.obstacle;
+        const Isometry3d& body_pose = pose(ref.body);
+        w.obstacle.kind = o->kind;
+        w.obstacle.pose = body_pose * o->pose.ToIsometry();
+        w.obstacle.radius = o->radius;
+        w.obstacle.length = o->length;
+        w.velocity.setZero();
+        if (e.side) w.side = body_pose * (*e.side);
+      }
+    }
+    t.path.Evaluate(t.world, &t.geometry);
   }
-  t.path.Evaluate(t.world, &t.geometry);
   t.contacts = 0;
   if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
     // captures only `this`: held inside the std::function, no allocation
@@ -1031,7 +1085,7 @@ void BulletScene::ApplyTendonForces() {
     stage_ = {StepStage::kTendon, static_cast<int>(ti)};
     actuators::PathForces(t.geometry, t.tension, &forces_);
     for (const auto& f : forces_) {
-      if (f.body < 0 || scene_.bodies[f.body].type != sgal::BodyType::kDynamic) continue;
+      if (f.body < 0 || !bodies_[f.body].dynamic) continue;
       bodies_[f.body].rigid->applyForce(ToBt(f.force, scale_), ToBt(f.position - coms_[f.body], scale_));
     }
   }
@@ -1060,11 +1114,21 @@ void BulletScene::UpdateJoints() {
       const Vector3d xa = rb.transpose() * (pa.linear() * j.a_x);
       const double cos = xa.dot(j.b_x);
       const double sin = xa.dot(j.b_y);
-      // whole turns counted: the branch of the angle nearest the last position (a hinge turns
-      // far less than half a turn in a step), so that a continuous joint, a multi-turn limit
-      // (a UR5's +-2 pi) and a coupling's leader read on past +-pi instead of jumping
-      const double turn = std::atan2(sin, cos) - j.position;
-      j.position += turn - 2 * M_PI * std::nearbyint(turn * (0.5 / M_PI));
+      // whole turns counted, so that a continuous joint, a multi-turn limit (a UR5's +-2 pi) and
+      // a coupling's leader read on past +-pi instead of jumping: the angle's branch nearest the
+      // position carried over, then one turn more or less each time the reading passes +-pi (a
+      // hinge turns far less than half a turn in a step). It passes there when the sine's sign
+      // (atan2's branch) changes where the chord between the two readings crosses the negative
+      // x axis.
+      if (!j.turns_counted) {
+        j.turns = std::nearbyint((j.position - std::atan2(sin, cos)) * (0.5 / M_PI));
+        j.turns_counted = true;
+      } else if (std::signbit(sin) != std::signbit(j.reading_sin)) {
+        const double x = j.reading_cos * std::abs(sin) + cos * std::abs(j.reading_sin);
+        if (x < 0 || (x == 0 && j.reading_cos + cos < 0)) j.turns += std::signbit(sin) ? 1 : -1;
+      }
+      j.reading_cos = cos;
+      j.reading_sin = sin;
       j.velocity = axis.dot(spin(j.body_a) - spin(j.body_b));
     } else {
       const Vector3d at_a = pa * j.frame_a.translation();
@@ -1081,7 +1145,7 @@ void BulletScene::ApplyJointSprings() {
     if (c.kind != sgal::ConstraintKind::kHinge && c.kind != sgal::ConstraintKind::kSlider) continue;
     const sgal::JointSpring& sp = c.springs[0];
     if (sp.stiffness == 0 && sp.damping == 0) continue;
-    PushJoint(j, -(sp.stiffness * (j.position - sp.rest) + sp.damping * j.velocity));
+    PushJoint(j, -(sp.stiffness * (JointPosition(j) - sp.rest) + sp.damping * j.velocity));
   }
 }
 
@@ -1150,7 +1214,7 @@ void BulletScene::ApplyCouplings() {
     const double m = 1 / inverse;
     k.stiffness = m * w * w;
     k.damping = 2 * m * w;
-    const double error = follower.position - (ratio * leader.position + k.desc->offset);
+    const double error = JointPosition(follower) - (ratio * JointPosition(leader) + k.desc->offset);
     const double rate = follower.velocity - ratio * leader.velocity;
     // the generalised force on q_f, and by the chain rule -ratio times it on q_l
     const double load = -(k.stiffness * error + k.damping * rate);
@@ -1200,11 +1264,11 @@ void BulletScene::ApplyJointFriction() {
 }
 
 void BulletScene::CheckState() {
+  // what CacheBodyPoses took from Bullet
   for (size_t i = 0; i < bodies_.size(); ++i) {
-    const btRigidBody& rb = *bodies_[i].rigid;
-    const Vector3d p = FromBt(rb.getCenterOfMassPosition(), scale_);
-    const Vector3d v = FromBt(rb.getLinearVelocity(), scale_);
-    const Vector3d w = FromBt(rb.getAngularVelocity());
+    const Vector3d& p = coms_[i];
+    const Vector3d& v = velocities_[i];
+    const Vector3d& w = spins_[i];
     std::string problem;
     if (!p.allFinite() || !v.allFinite() || !w.allFinite()) {
       problem = "non-finite state";
@@ -1361,8 +1425,8 @@ void BulletScene::Step() {
     ApplyCouplings();
     ApplyPull();
     world_->stepSimulation(static_cast<btScalar>(dt_), 0, static_cast<btScalar>(dt_));
-    CheckState();
     CacheBodyPoses();
+    CheckState();
     UpdateJoints();
     RefreshWorldShapes();
     AdvanceTendons();
@@ -1438,7 +1502,7 @@ sgal::DynamicState BulletScene::SaveDynamicState() const {
   s.time = time_;
   s.steps = steps_;
   s.bodies = BodyStates();
-  for (const auto& j : joints_) s.joint_positions.push_back(j.position);
+  for (const auto& j : joints_) s.joint_positions.push_back(JointPosition(j));
   for (const auto& b : bodies_) {
     const btRigidBody& rb = *b.rigid;
     PutTransform(rb.getCenterOfMassTransform(), &s.engine);
@@ -1555,7 +1619,10 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   }
   time_ = s.time;
   steps_ = s.steps;
-  for (size_t j = 0; j < joints_.size(); ++j) joints_[j].position = s.joint_positions[j];
+  for (size_t j = 0; j < joints_.size(); ++j) {
+    joints_[j].position = s.joint_positions[j];
+    joints_[j].turns_counted = false;  // a hinge counts on from this angle
+  }
   // the tendons' part of an exact state: the length at the start of the step that ended here,
   // and the wrap sides the path goes on from (set before the path is evaluated)
   std::vector<double> previous(tendons_.size(), -1);
@@ -1745,7 +1812,7 @@ void BulletScene::BuildParameters() {
     if (!hinge && j->desc->kind != sgal::ConstraintKind::kSlider) continue;
     const std::string& n = j->desc->name;
     sgal::JointSpring* spring = &scene_.constraints[k].springs[0];
-    add({n + ".position", hinge ? "rad" : "m", false, false}, [j] { return j->position; });
+    add({n + ".position", hinge ? "rad" : "m", false, false}, [j] { return JointPosition(*j); });
     add({n + ".velocity", hinge ? "rad/s" : "m/s", false, false}, [j] { return j->velocity; });
     add({n + ".spring_stiffness", hinge ? "N m/rad" : "N/m", true, true},
         [spring] { return spring->stiffness; }, [spring, n](double v) {

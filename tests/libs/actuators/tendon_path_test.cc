@@ -70,6 +70,28 @@ void ExpectOnSurface(const PathGeometry& g, const Vector3d& centre, double radiu
   }
 }
 
+// What an engine that places a path of points itself measures (StraightLength) is what Evaluate
+// gives such a path, bit for bit; a wrap's arc is not among its straight pieces.
+TEST(TendonPathTest, StraightLengthIsWhatEvaluateMeasuresOfPointsAlone) {
+  const std::vector<WorldElement> points = {Point({0, 0, 0}), Point({0.3, 0.1, -0.2}, 2),
+                                            Point({0.31, 0.7, 0.05}, 3), Point({1e-3, 2, 0}, 4)};
+  const PathGeometry g = Evaluate(points);
+  ASSERT_EQ(g.points.size(), 4u);
+  EXPECT_EQ(actuators::StraightLength(g.points), g.length);
+  EXPECT_NEAR(g.length,
+              Vector3d(0.3, 0.1, -0.2).norm() + Vector3d(0.01, 0.6, 0.25).norm() +
+                  Vector3d(0.309, 1.3, -0.05).norm(),
+              1e-15);
+  EXPECT_EQ(actuators::StraightLength({}), 0.0);
+  EXPECT_EQ(actuators::StraightLength({g.points[0]}), 0.0);
+
+  const PathGeometry wrapped =
+      Evaluate({Point({-2, 0.5, 0}), Cylinder({0, 0, 0}, 1), Point({2, 0.5, 0})});
+  ASSERT_GT(CountOnWrap(wrapped), 2);
+  // the chords between the arc's samples are shorter than the arc Evaluate measures exactly
+  EXPECT_LT(actuators::StraightLength(wrapped.points), wrapped.length);
+}
+
 TEST(TendonPathTest, StraightPathIsTheSegmentLength) {
   const PathGeometry g = Evaluate({Point({0, 0, 0}), Point({3, 4, 0})});
   EXPECT_DOUBLE_EQ(g.length, 5.0);

@@ -71,6 +71,11 @@ class TendonPath {
   std::vector<int> wrap_side_;  // per wrap element: 0 not wrapping, +1 / -1 side taken
 };
 
+/// The length of the straight pieces between consecutive points [m]: a path of points alone, as
+/// TendonPath::Evaluate measures it (an engine that places such a path's points itself measures it
+/// with this).
+double StraightLength(const std::vector<PathPoint>& points);
+
 /// The forces a tension [N] (at the actuator end, the first point) exerts: each point is pulled
 /// toward its neighbours. With capstan friction at a point the tension changes there by
 /// exp(-+mu alpha), alpha the angle the path turns, depending on the sliding direction
