@@ -635,7 +635,7 @@ class DcMotorTendon : public TendonActuator {
 };
 
 // a passive tension-only spring-damper along the tendon
-class Ligament : public TendonActuator {
+class Ligament final : public TendonActuator {
  public:
   explicit Ligament(const sgal::Actuator& a) : prefix_(Prefix(a)) {
     const double rest = ParameterOr(a, "rest_length", 0);
@@ -690,6 +690,9 @@ class Ligament : public TendonActuator {
     length_ = in[1];
     speed_ = in[2];
   }
+  // all of it, in one call (the engine saves it before every step)
+  void SaveStepState(double* out) const override { SaveState(out); }
+  void RestoreStepState(const double* in) override { RestoreState(in); }
 
   void SetCommand(double) override {
     throw std::invalid_argument(prefix_ + "a ligament is passive and takes no command");

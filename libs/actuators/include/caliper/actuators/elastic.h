@@ -106,7 +106,7 @@ class ElasticElement {
 };
 
 /// F = k (l - l_rest) + c dl/dt when l > l_rest, then F = max(F, 0); 0 when slack. Stateless.
-class LinearSpringDamper : public ElasticElement {
+class LinearSpringDamper final : public ElasticElement {
  public:
   /// stiffness [N/m] > 0, damping [N s/m] >= 0, rest_length [m] > 0; throws
   /// std::invalid_argument naming a parameter out of range.
