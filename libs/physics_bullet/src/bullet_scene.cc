@@ -1582,6 +1582,45 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
   if (exact && s.engine.size() < bodies_.size() * kBodyEngineValues + 4 * tendons_.size())
     refuse("the engine state has " + std::to_string(s.engine.size()) + " values, too few for " +
            std::to_string(bodies_.size()) + " bodies");
+  // the tendons' part of an exact state, read (and refused) before anything changes: the length
+  // at the start of the step that ended here, and the wrap sides the path goes on from (set
+  // before the path is evaluated)
+  std::vector<double> previous(tendons_.size(), -1);
+  std::vector<double> mean_speeds(tendons_.size(), 0);
+  std::vector<double> end_speeds(tendons_.size(), 0);
+  std::vector<std::vector<int>> wrap_sides(tendons_.size());
+  if (exact) {
+    // after the bodies' values
+    const double* in = s.engine.data() + bodies_.size() * kBodyEngineValues;
+    const double* end = s.engine.data() + s.engine.size();
+    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
+      if (end - in < 4) refuse("the engine state ends before the tendons'");
+      previous[ti] = *in++;
+      mean_speeds[ti] = *in++;
+      end_speeds[ti] = *in++;
+      const double count = *in++;
+      const size_t elements = tendons_[ti].elements.size();
+      if (!(count == 0 || count == static_cast<double>(elements)))
+        refuse("tendon '" + tendons_[ti].desc->name + "' has " + std::to_string(elements) +
+               " path elements, the engine state gives wrap sides for " + std::to_string(count));
+      const size_t n = static_cast<size_t>(count);
+      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
+      std::vector<int> sides(n);
+      for (size_t k = 0; k < n; ++k) {
+        const double side = *in++;
+        if (!(side == -1 || side == 0 || side == 1))
+          refuse("tendon '" + tendons_[ti].desc->name + "': a wrap side must be -1, 0 or 1");
+        sides[k] = static_cast<int>(side);
+      }
+      // a path of points alone keeps a side per element, none wrapping (BuildTendons), also
+      // from a state that gives none
+      if (tendons_[ti].points_only) sides.assign(elements, 0);
+      wrap_sides[ti] = std::move(sides);
+    }
+    if (in != end)
+      refuse("the engine state has " + std::to_string(end - in) +
+             " values more than this scene's bodies and tendons hold (a state of another scene)");
+  }
   const double* in = s.engine.data();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     btRigidBody& rb = *bodies_[i].rigid;
@@ -1623,38 +1662,8 @@ void BulletScene::RestoreDynamicState(const sgal::DynamicState& s) {
     joints_[j].position = s.joint_positions[j];
     joints_[j].turns_counted = false;  // a hinge counts on from this angle
   }
-  // the tendons' part of an exact state: the length at the start of the step that ended here,
-  // and the wrap sides the path goes on from (set before the path is evaluated)
-  std::vector<double> previous(tendons_.size(), -1);
-  std::vector<double> mean_speeds(tendons_.size(), 0);
-  std::vector<double> end_speeds(tendons_.size(), 0);
-  if (exact) {
-    const double* end = s.engine.data() + s.engine.size();
-    for (size_t ti = 0; ti < tendons_.size(); ++ti) {
-      if (end - in < 4) refuse("the engine state ends before the tendons'");
-      previous[ti] = *in++;
-      mean_speeds[ti] = *in++;
-      end_speeds[ti] = *in++;
-      const double count = *in++;
-      const size_t elements = tendons_[ti].elements.size();
-      if (!(count == 0 || count == static_cast<double>(elements)))
-        refuse("tendon '" + tendons_[ti].desc->name + "' has " + std::to_string(elements) +
-               " path elements, the engine state gives wrap sides for " + std::to_string(count));
-      const size_t n = static_cast<size_t>(count);
-      if (static_cast<size_t>(end - in) < n) refuse("the engine state ends in a tendon's wraps");
-      std::vector<int> sides(n);
-      for (size_t k = 0; k < n; ++k) {
-        const double side = *in++;
-        if (!(side == -1 || side == 0 || side == 1))
-          refuse("tendon '" + tendons_[ti].desc->name + "': a wrap side must be -1, 0 or 1");
-        sides[k] = static_cast<int>(side);
-      }
-      tendons_[ti].path.set_wrap_sides(std::move(sides));
-    }
-    if (in != end)
-      refuse("the engine state has " + std::to_string(end - in) +
-             " values more than this scene's bodies and tendons hold (a state of another scene)");
-  }
+  for (size_t ti = 0; ti < tendons_.size(); ++ti)
+    if (exact) tendons_[ti].path.set_wrap_sides(std::move(wrap_sides[ti]));
   CacheBodyPoses();
   UpdateJoints();  // counted turns continue from the positions carried over
   RefreshWorldShapes();

@@ -955,6 +955,27 @@ TEST(BulletScene, HingePositionCountsWholeTurns) {
   EXPECT_NEAR(last, 10.0, 1e-3);
 }
 
+// A step that fails while a hinge passes +-pi is put back with the turn it counted: the wheel is
+// where it was, bit for bit, and the step taken again reads past pi, not a turn below it.
+TEST(BulletScene, AFaultingStepPutsBackTheTurnItCounted) {
+  testing::RegisterTestKinds();
+  sgal::Scene description = SpinningWheel();
+  // the test kind that fails on purpose, on a tendon along the axle (no torque on the wheel)
+  description.tendons.push_back(TendonTo("t_faulty", Vector3d(0, 0, 1), "wheel"));
+  description.actuators.push_back(
+      {"faulty", "test_faulty_motor", "t_faulty", {{"pretension", 1}, {"stiffness", 2000}}, {}});
+  auto physics = MakeScene(description);
+  for (int i = 0; i < 314; ++i) physics->Step();  // 10 rad/s: 3.14 rad, pi in the next step
+  const double before = physics->GetParameter("axle.position");
+  ASSERT_LT(before, M_PI);
+  ASSERT_GT(before, M_PI - 0.01);
+  ExpectAFaultingStepPutBack(physics.get(), 0.315);
+  EXPECT_EQ(physics->GetParameter("axle.position"), before);
+  physics->Step();
+  EXPECT_GT(physics->GetParameter("axle.position"), M_PI);
+  EXPECT_NEAR(physics->GetParameter("axle.position"), before + 0.01, 1e-4);
+}
+
 // The step counts a hinge's turns without computing its angle, which is read on demand: a wheel
 // nobody reads while it spins either way still reads its whole turns, and a state saved at 10 rad
 // goes on from 10 rad in a scene built afresh.
@@ -973,12 +994,21 @@ TEST(BulletScene, HingeCountsTurnsThatNobodyRead) {
     auto fresh = MakeScene(description);
     fresh->RestoreDynamicState(saved);
     EXPECT_EQ(fresh->GetParameter("axle.position"), at_1s) << "spin " << spin;
+    EXPECT_EQ(fresh->SaveDynamicState().engine, saved.engine) << "spin " << spin;
+    // by the body poses alone (as a scene edit carries a run over): the turns from the angle
+    sgal::DynamicState by_poses = saved;
+    by_poses.engine.clear();
+    auto edited = MakeScene(description);
+    edited->RestoreDynamicState(by_poses);
+    EXPECT_NEAR(edited->GetParameter("axle.position"), at_1s, 1e-6) << "spin " << spin;
     for (int i = 0; i < 500; ++i) {
       physics->Step();
       fresh->Step();
+      edited->Step();
     }
     EXPECT_NEAR(physics->GetParameter("axle.position"), 1.5 * spin, 1e-3) << "spin " << spin;
     EXPECT_NEAR(fresh->GetParameter("axle.position"), 1.5 * spin, 1e-3) << "spin " << spin;
+    EXPECT_NEAR(edited->GetParameter("axle.position"), 1.5 * spin, 1e-3) << "spin " << spin;
   }
 }
 
@@ -1074,10 +1104,22 @@ TEST(BulletSceneDynamicState, RestoredIntoAFreshSceneItGoesOnAsTheOriginal) {
   // side that is not -1, 0 or +1
   const size_t count = kEngineValuesPerBody + 3;
   ASSERT_EQ(saved.engine[count], 2.0);
+  // refused in the tendons' part, after the bodies' values: the scene is left as it was
+  const sgal::DynamicState kept = fresh->SaveDynamicState();
   wrong = saved;
   wrong.engine[count] = 1;
   wrong.engine.erase(wrong.engine.begin() + count + 1);
+  wrong.engine[0] += 0.5;  // the first body's pose, which a refused state must not reach
   EXPECT_THROW(fresh->RestoreDynamicState(wrong), std::invalid_argument);
+  EXPECT_EQ(fresh->SaveDynamicState().engine, kept.engine) << "a refused state changed the scene";
+  // a state that gives no sides (count 0) restores; the path of two points still keeps one per
+  // element, so the next saved state is the original's again
+  wrong = saved;
+  wrong.engine[count] = 0;
+  wrong.engine.erase(wrong.engine.begin() + count + 1, wrong.engine.begin() + count + 3);
+  auto no_sides = MakeScene(s);
+  no_sides->RestoreDynamicState(wrong);
+  EXPECT_EQ(no_sides->SaveDynamicState().engine, saved.engine);
   wrong = saved;
   wrong.engine[count + 1] = 2;
   try {

@@ -764,6 +764,30 @@ TEST(TendonContact, FindsABodyARestoreMovedOntoTheString) {
   EXPECT_GT(scene->TendonStates()[0].length, 2.0);
 }
 
+TEST(TendonContact, AStringTheBallLeavesRunsStraightAgain) {
+  // pressing on the ball, the string has more than its two points; moved away from it by a
+  // restore, it is the straight line between them again, before and after a step
+  testing::RegisterTestKinds();
+  auto scene = physics_bullet::MakeScene(StringOverBall(true));
+  scene->Step();
+  ASSERT_GT(scene->TendonStates()[0].contacts, 0);
+  ASSERT_GT(scene->TendonStates()[0].points.size(), 2u);
+  sgal::DynamicState state = scene->SaveDynamicState();
+  state.engine.clear();  // go by the body poses
+  state.bodies[0].pose.position = Vector3d(0, 0, -5);
+  state.bodies[0].linear_velocity.setZero();
+  scene->RestoreDynamicState(state);
+  for (int step = 0; step < 2; ++step) {
+    const auto tendon = scene->TendonStates()[0];
+    EXPECT_EQ(tendon.contacts, 0) << "step " << step;
+    ASSERT_EQ(tendon.points.size(), 2u) << "step " << step;
+    EXPECT_EQ(tendon.points[0], Vector3d(-1, 0, 0)) << "step " << step;
+    EXPECT_EQ(tendon.points[1], Vector3d(1, 0, 0)) << "step " << step;
+    EXPECT_EQ(tendon.length, 2.0) << "step " << step;
+    scene->Step();
+  }
+}
+
 TEST(TendonContact, NoticesABallRisingIntoAStringItClearedBefore) {
   // the ball rises from 0.4 m below the string: while it stays clear the engine may skip the
   // string's search, and it must find the ball at the first step its top reaches the string
