@@ -317,13 +317,6 @@ void TendonPath::Evaluate(const std::vector<WorldElement>& elements, PathGeometr
   }
 }
 
-double StraightLength(const std::vector<PathPoint>& points) {
-  double length = 0;
-  for (size_t k = 0; k + 1 < points.size(); ++k)
-    length += (points[k + 1].position - points[k].position).norm();
-  return length;
-}
-
 std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {
   std::vector<PointForce> forces;
   PathForces(path, tension, &forces);
@@ -331,38 +324,14 @@ std::vector<PointForce> PathForces(const PathGeometry& path, double tension) {
 }
 
 void PathForces(const PathGeometry& path, double tension, std::vector<PointForce>* out) {
-  const size_t n = path.points.size();
+  const std::vector<PathPoint>& points = path.points;
   std::vector<PointForce>& forces = *out;
-  forces.resize(n);
-  for (size_t k = 0; k < n; ++k) {
-    forces[k].body = path.points[k].body;
-    forces[k].position = path.points[k].position;
-    forces[k].force.setZero();
-  }
-  if (n < 2) return;
-
-  // capstan: when the path shortens or holds (speed <= 0) the actuator at the first point pulls
-  // the tendon through, so tension falls by exp(-mu alpha) past each point with friction; when it
-  // lengthens (speed > 0) the tendon is dragged out against the actuator and tension rises by
-  // exp(mu alpha) toward the far end. One pass: each piece's direction, the one before it kept
-  const double sign = path.speed > 0 ? 1.0 : -1.0;
-  double t = tension;
-  Vector3d before = Vector3d::Zero();  // the last piece's direction (zero for a point)
-  for (size_t k = 0; k + 1 < n; ++k) {
-    const Vector3d d = path.points[k + 1].position - path.points[k].position;
-    // one root: d / |d| is what normalized() computes
-    const double length = d.norm();
-    const Vector3d unit = length > kTiny ? Vector3d(d * (1 / length)) : Vector3d::Zero();
-    const double mu = path.points[k].friction;
-    if (k > 0 && mu > 0 && !before.isZero() && !unit.isZero()) {
-      const double straight = std::acos(std::clamp(-before.dot(unit), -1.0, 1.0));
-      const double alpha = kPi - straight;
-      t *= std::exp(sign * mu * alpha);
-    }
-    before = unit;
-    forces[k].force += t * unit;
-    forces[k + 1].force -= t * unit;
-  }
+  forces.resize(points.size());
+  EmitPathForces(points, path.speed, tension, [&](size_t k, const Vector3d& force) {
+    forces[k].body = points[k].body;
+    forces[k].position = points[k].position;
+    forces[k].force = force;
+  });
 }
 
 }  // namespace caliper::actuators

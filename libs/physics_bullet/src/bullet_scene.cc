@@ -138,6 +138,10 @@ struct TendonData {
   bool has_wraps = false;  // the path keeps a side per wrap from step to step
   // points alone, at least two (a path TendonPath::Evaluate accepts): EvaluateTendon places them
   bool points_only = false;
+  // the directions of a path of points alone, kept from placing them for the forces of the next
+  // step; they are the geometry's only while `straight` (no contact point was inserted since)
+  std::vector<Vector3d> units;
+  bool straight = false;
   // the state at the start of the step, put back when the step fails
   actuators::TendonPath saved_path;       // only when has_wraps
   double saved_speed = 0;
@@ -319,14 +323,22 @@ class BulletScene : public sgal::PhysicsScene {
   void UpdateJoints();
   void RefreshWorldShapes();
   void EvaluateTendons();
-  // one tendon's path (bent around the bodies, with this thread's buffers) at this step's poses
-  void EvaluateTendon(size_t index, actuators::ContactScratch* scratch);
+  // one tendon's path (bent around the bodies, with this thread's buffers) at this step's poses;
+  // with `placed`, a path of points alone is where PlaceStraight put it and is only bent
+  void EvaluateTendon(size_t index, actuators::ContactScratch* scratch, bool placed = false);
+  // a path of points alone at this step's poses, straight: its points, length and directions
+  // (never throws)
+  void PlaceStraight(TendonData& t) const;
   // the end of a step for every tendon: its path, its speed over the step and its actuators'
   // step, on options_.threads threads (each tendon on one; the same bits whatever the count); the
   // first failing tendon's exception (in tendon order) is rethrown with stage_ naming it
   void AdvanceTendons();
   // AdvanceTendons' work for one tendon; sets *stage to what it is doing
   void AdvanceTendon(size_t index, actuators::ContactScratch* scratch, StepStage* stage);
+  // its parts: what the step starts from (never throws), and the path's speed with the actuators'
+  // step once the path is evaluated
+  static void BeginTendonStep(TendonData& t);
+  void ActuateTendon(size_t index, StepStage* stage);
   void ApplyTendonForces();
   void ApplyJointSprings();
   void ApplyJointFriction();
@@ -386,8 +398,7 @@ class BulletScene : public sgal::PhysicsScene {
   std::vector<TendonData> tendons_;
   std::vector<ActuatorData> actuators_;
   std::unordered_map<std::string, int> actuator_index_;  // into actuators_, by name
-  std::vector<Isometry3d> poses_;        // body frames this step [m]
-  std::vector<actuators::PointForce> forces_;  // a tendon's forces, storage kept between steps
+  std::vector<Isometry3d> poses_;                        // body frames this step [m]
   std::vector<Vector3d> coms_;           // centres of mass this step [m]
   std::vector<Vector3d> velocities_;     // of the centres of mass [m/s]
   std::vector<Vector3d> spins_;          // angular velocities [rad/s]
@@ -883,36 +894,42 @@ void BulletScene::EvaluateTendons() {
   }
 }
 
-void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) {
+const Isometry3d kWorldPose = Isometry3d::Identity();  // where a point on the world (-1) is
+
+// a point of a path in the world (rotation and translation written out: at -O2 Eigen's transform
+// product went out of line here, and GCC left even this function out of line unless told)
+[[gnu::always_inline]] inline void Place(const std::vector<Isometry3d>& poses,
+                                         const ElementRef& ref, Vector3d* out) {
+  const Isometry3d& body_pose = ref.body < 0 ? kWorldPose : poses[ref.body];
+  out->noalias() = body_pose.linear() * ref.desc->position;
+  *out += body_pose.translation();
+}
+
+void BulletScene::PlaceStraight(TendonData& t) const {
+  // what TendonPath::Evaluate makes of points alone, without going through its elements (the
+  // cost of most of a light scene's tendons): the points where their bodies are and straight
+  // pieces between them; the speed is measured from lengths (AdvanceTendon)
+  std::vector<actuators::PathPoint>& points = t.geometry.points;
+  points.resize(t.elements.size());  // contacts inserted last step go
+  for (size_t k = 0; k < t.elements.size(); ++k) {
+    const ElementRef& ref = t.elements[k];
+    actuators::PathPoint& p = points[k];
+    Place(poses_, ref, &p.position);
+    p.body = ref.body;
+    p.friction = ref.desc->friction;
+    p.on_wrap = false;
+    p.contact = false;
+  }
+  t.geometry.length = actuators::StraightPieces(points, &t.units);
+  t.geometry.speed = 0;
+}
+
+void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch, bool placed) {
   // the path's speed is measured from its lengths at the ends of a step (Step): the points'
   // velocities are not needed
-  static const Isometry3d kWorld = Isometry3d::Identity();
-  auto pose = [&](int body) -> const Isometry3d& { return body < 0 ? kWorld : poses_[body]; };
-  // a point in the world (rotation and translation written out: at -O2 Eigen's transform product
-  // went out of line here)
-  auto place = [&](const ElementRef& ref, Vector3d* out) {
-    const Isometry3d& body_pose = pose(ref.body);
-    out->noalias() = body_pose.linear() * ref.desc->position;
-    *out += body_pose.translation();
-  };
   TendonData& t = tendons_[ti];
   if (t.points_only) {
-    // what TendonPath::Evaluate makes of points alone, without going through its elements (the
-    // cost of most of a light scene's tendons): the points where their bodies are and straight
-    // pieces between them; the speed is measured from lengths (above)
-    std::vector<actuators::PathPoint>& points = t.geometry.points;
-    points.resize(t.elements.size());  // contacts inserted last step go
-    for (size_t k = 0; k < t.elements.size(); ++k) {
-      const ElementRef& ref = t.elements[k];
-      actuators::PathPoint& p = points[k];
-      place(ref, &p.position);
-      p.body = ref.body;
-      p.friction = ref.desc->friction;
-      p.on_wrap = false;
-      p.contact = false;
-    }
-    t.geometry.length = actuators::StraightLength(points);
-    t.geometry.speed = 0;
+    if (!placed) PlaceStraight(t);
   } else {
     t.world.resize(t.elements.size());
     for (size_t k = 0; k < t.elements.size(); ++k) {
@@ -922,12 +939,12 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
       w.kind = e.kind;
       w.body = ref.body;
       if (e.kind == sgal::PathElement::Kind::kPoint) {
-        place(ref, &w.point);
+        Place(poses_, ref, &w.point);
         w.velocity.setZero();
         w.friction = e.friction;
       } else {
         const sgal::WrapObstacle* o = ref.obstacle;
-        const Isometry3d& body_pose = pose(ref.body);
+        const Isometry3d& body_pose = ref.body < 0 ? kWorldPose : poses_[ref.body];
         w.obstacle.kind = o->kind;
         w.obstacle.pose = body_pose * o->pose.ToIsometry();
         w.obstacle.radius = o->radius;
@@ -939,6 +956,7 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
     t.path.Evaluate(t.world, &t.geometry);
   }
   t.contacts = 0;
+  t.straight = t.points_only;
   if (options_.tendon_body_contact && t.desc->collide_with_bodies) {
     // captures only `this`: held inside the std::function, no allocation
     const actuators::ShapeQuery query = [this](const Vector3d& a, const Vector3d& b, double pad,
@@ -950,6 +968,7 @@ void BulletScene::EvaluateTendon(size_t ti, actuators::ContactScratch* scratch) 
     contact.detour_reach = detour_reach_ + 2 * contact.margin;  // the reaches grow by it
     t.contacts = actuators::WrapAroundBodies(&t.geometry, query, contact, scratch,
                                              &t.contact_memory, contact_travel_);
+    t.straight = t.points_only && t.contacts == 0;
   }
 }
 
@@ -992,7 +1011,17 @@ void BulletScene::TimeStep(double seconds) {
 void BulletScene::AdvanceTendons() {
   const int n = static_cast<int>(tendons_.size());
   if (threads_ <= 1 || !parallel_now_) {  // Bullet searches the contacts inside the next step
-    for (int ti = 0; ti < n; ++ti) AdvanceTendon(ti, &contact_scratch_[0], &stage_);
+    // the straight paths placed first, all of them, so that their roots and divisions overlap
+    // (between the actuators' calls one tendon's ran alone); nothing of this throws
+    for (TendonData& t : tendons_) {
+      BeginTendonStep(t);
+      if (t.points_only) PlaceStraight(t);
+    }
+    for (int ti = 0; ti < n; ++ti) {
+      stage_ = {StepStage::kTendon, ti};
+      EvaluateTendon(ti, &contact_scratch_[0], true);
+      ActuateTendon(ti, &stage_);
+    }
     return;
   }
   const bool ahead = options_.search_contacts_ahead;
@@ -1040,13 +1069,21 @@ void BulletScene::AdvanceTendons() {
   }
 }
 
-void BulletScene::AdvanceTendon(size_t ti, actuators::ContactScratch* scratch, StepStage* stage) {
-  TendonData& t = tendons_[ti];
+void BulletScene::BeginTendonStep(TendonData& t) {
   t.speed_known = t.previous_length >= 0;
   t.previous_length = t.geometry.length;
   t.mean_speed = t.geometry.speed;
+}
+
+void BulletScene::AdvanceTendon(size_t ti, actuators::ContactScratch* scratch, StepStage* stage) {
+  BeginTendonStep(tendons_[ti]);
   *stage = {StepStage::kTendon, static_cast<int>(ti)};
   EvaluateTendon(ti, scratch);
+  ActuateTendon(ti, stage);
+}
+
+void BulletScene::ActuateTendon(size_t ti, StepStage* stage) {
+  TendonData& t = tendons_[ti];
   // the mean lengthening speed over the step: the path's motion the actuators integrate along
   // (length at the start + speed * dt is exactly the length at the end); the speed at the end,
   // for what reads it directly (dampers, force-velocity), from the last two means to second
@@ -1083,10 +1120,18 @@ void BulletScene::ApplyTendonForces() {
     const TendonData& t = tendons_[ti];
     if (t.tension <= 0) continue;
     stage_ = {StepStage::kTendon, static_cast<int>(ti)};
-    actuators::PathForces(t.geometry, t.tension, &forces_);
-    for (const auto& f : forces_) {
-      if (f.body < 0 || !bodies_[f.body].dynamic) continue;
-      bodies_[f.body].rigid->applyForce(ToBt(f.force, scale_), ToBt(f.position - coms_[f.body], scale_));
+    const std::vector<actuators::PathPoint>& points = t.geometry.points;
+    auto apply = [&](size_t k, const Vector3d& force) {
+      const int body = points[k].body;
+      if (body < 0 || !bodies_[body].dynamic) return;
+      bodies_[body].rigid->applyForce(ToBt(force, scale_),
+                                      ToBt(points[k].position - coms_[body], scale_));
+    };
+    if (t.straight) {  // the directions placing the points found (the same bits)
+      actuators::EmitPathForces(
+          points, t.geometry.speed, t.tension, [&](size_t k) { return t.units[k]; }, apply);
+    } else {
+      actuators::EmitPathForces(points, t.geometry.speed, t.tension, apply);
     }
   }
 }

@@ -70,26 +70,75 @@ void ExpectOnSurface(const PathGeometry& g, const Vector3d& centre, double radiu
   }
 }
 
-// What an engine that places a path of points itself measures (StraightLength) is what Evaluate
-// gives such a path, bit for bit; a wrap's arc is not among its straight pieces.
-TEST(TendonPathTest, StraightLengthIsWhatEvaluateMeasuresOfPointsAlone) {
+Vector3d Sum(const std::vector<actuators::PointForce>& forces) {
+  Vector3d s = Vector3d::Zero();
+  for (const auto& f : forces) s += f.force;
+  return s;
+}
+
+// What an engine that places a path of points itself measures (StraightPieces) is what Evaluate
+// gives such a path, bit for bit; the directions it keeps are the pieces'; a wrap's arc is not
+// among its straight pieces.
+TEST(TendonPathTest, StraightPiecesAreWhatEvaluateMeasuresOfPointsAlone) {
   const std::vector<WorldElement> points = {Point({0, 0, 0}), Point({0.3, 0.1, -0.2}, 2),
                                             Point({0.31, 0.7, 0.05}, 3), Point({1e-3, 2, 0}, 4)};
   const PathGeometry g = Evaluate(points);
   ASSERT_EQ(g.points.size(), 4u);
-  EXPECT_EQ(actuators::StraightLength(g.points), g.length);
+  std::vector<Vector3d> units;
+  EXPECT_EQ(actuators::StraightPieces(g.points, &units), g.length);
   EXPECT_NEAR(g.length,
               Vector3d(0.3, 0.1, -0.2).norm() + Vector3d(0.01, 0.6, 0.25).norm() +
                   Vector3d(0.309, 1.3, -0.05).norm(),
               1e-15);
-  EXPECT_EQ(actuators::StraightLength({}), 0.0);
-  EXPECT_EQ(actuators::StraightLength({g.points[0]}), 0.0);
+  ASSERT_EQ(units.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    const Vector3d d = g.points[k + 1].position - g.points[k].position;
+    EXPECT_NEAR((units[k] - d.normalized()).norm(), 0, 1e-15) << "piece " << k;
+  }
+  EXPECT_EQ(actuators::StraightPieces({}, &units), 0.0);
+  EXPECT_TRUE(units.empty());
+  EXPECT_EQ(actuators::StraightPieces({g.points[0]}, &units), 0.0);
+  EXPECT_TRUE(units.empty());
+  // two points on top of each other: a piece without a direction (it pulls nowhere)
+  EXPECT_EQ(actuators::StraightPieces({g.points[1], g.points[1]}, &units), 0.0);
+  ASSERT_EQ(units.size(), 1u);
+  EXPECT_EQ(units[0], Vector3d::Zero());
 
   const PathGeometry wrapped =
       Evaluate({Point({-2, 0.5, 0}), Cylinder({0, 0, 0}, 1), Point({2, 0.5, 0})});
   ASSERT_GT(CountOnWrap(wrapped), 2);
   // the chords between the arc's samples are shorter than the arc Evaluate measures exactly
-  EXPECT_LT(actuators::StraightLength(wrapped.points), wrapped.length);
+  EXPECT_LT(actuators::StraightPieces(wrapped.points, &units), wrapped.length);
+}
+
+// Forces handed out from the directions StraightPieces kept (what the engine applies) are
+// PathForces' to the bit, with capstan friction either way and with a piece of no length.
+TEST(TendonPathTest, ForcesFromKeptDirectionsArePathForcesBits) {
+  std::vector<WorldElement> elements = {Point({0, 0, 0}, 0), Point({1, 0.2, 0}, 1, 0.3),
+                                        Point({1, 0.2, 0}, 2, 0.1), Point({1.1, 1, 0.4}, -1, 0.2),
+                                        Point({2, 1.5, -0.3}, 3)};
+  PathGeometry g = Evaluate(elements);
+  ASSERT_EQ(g.points.size(), 5u);
+  std::vector<Vector3d> units;
+  actuators::StraightPieces(g.points, &units);
+  for (const double speed : {-0.2, 0.0, 0.3}) {
+    g.speed = speed;
+    const auto expected = PathForces(g, 42.5);
+    std::vector<std::pair<size_t, Vector3d>> emitted;
+    actuators::EmitPathForces(
+        g.points, g.speed, 42.5, [&](size_t k) { return units[k]; },
+        [&](size_t k, const Vector3d& f) { emitted.emplace_back(k, f); });
+    ASSERT_EQ(emitted.size(), expected.size());
+    for (size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(emitted[k].first, k);
+      EXPECT_EQ(emitted[k].second, expected[k].force) << "point " << k << ", speed " << speed;
+      EXPECT_EQ(expected[k].body, g.points[k].body);
+      EXPECT_EQ(expected[k].position, g.points[k].position);
+    }
+    // friction acted: the tension changed on the way (the via point's body took the difference)
+    EXPECT_GT(std::abs(expected.back().force.norm() - 42.5), 1e-3);
+    EXPECT_LT(Sum(expected).norm(), 1e-12);
+  }
 }
 
 TEST(TendonPathTest, StraightPathIsTheSegmentLength) {
@@ -345,12 +394,6 @@ TEST(TendonPathTest, SpeedMatchesTheFiniteDifferenceOfLength) {
   inside.velocity = Vector3d(0.1, 0.3, 0);
   ExpectSpeedMatchesDifference(
       {point({-3, 1.2, 0}, {0.2, 0, 0.1}), inside, point({1.5, 2, 0.5}, {0, -0.4, 0})}, true);
-}
-
-Vector3d Sum(const std::vector<actuators::PointForce>& forces) {
-  Vector3d s = Vector3d::Zero();
-  for (const auto& f : forces) s += f.force;
-  return s;
 }
 
 TEST(TendonPathTest, ForcesPullPointsTowardTheirNeighboursAndSumToZero) {

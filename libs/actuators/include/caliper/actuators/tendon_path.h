@@ -5,7 +5,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -71,10 +72,77 @@ class TendonPath {
   std::vector<int> wrap_side_;  // per wrap element: 0 not wrapping, +1 / -1 side taken
 };
 
-/// The length of the straight pieces between consecutive points [m]: a path of points alone, as
-/// TendonPath::Evaluate measures it (an engine that places such a path's points itself measures it
-/// with this).
-double StraightLength(const std::vector<PathPoint>& points);
+/// The direction of the piece a -> b, and its length into *length [m]: zero for a piece shorter
+/// than 1e-12 m (it pulls nowhere). What PathForces takes of each piece.
+inline Eigen::Vector3d PieceUnit(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 double* length) {
+  const Eigen::Vector3d d = b - a;
+  *length = d.norm();  // one root: d / |d| is what normalized() computes
+  return *length > 1e-12 ? Eigen::Vector3d(d * (1 / *length)) : Eigen::Vector3d::Zero();
+}
+
+/// A path of points alone as TendonPath::Evaluate measures it: the length of its straight pieces
+/// [m], bit for bit, with each piece's direction (PieceUnit) into *units, for EmitPathForces. An
+/// engine that places such a path's points itself measures it with this.
+inline double StraightPieces(const std::vector<PathPoint>& points,
+                             std::vector<Eigen::Vector3d>* units) {
+  const size_t pieces = points.empty() ? 0 : points.size() - 1;
+  units->resize(pieces);
+  double length = 0;
+  for (size_t k = 0; k < pieces; ++k) {
+    double piece;
+    (*units)[k] = PieceUnit(points[k].position, points[k + 1].position, &piece);
+    length += piece;
+  }
+  return length;
+}
+
+/// PathForces' arithmetic with the forces handed out instead of stored: `unit(k)` gives piece k's
+/// direction (points k to k + 1, as PieceUnit), `emit(k, force)` takes the whole force on point k
+/// [N], in point order. An engine that kept the pieces' directions from placing the points
+/// applies the forces straight from here, with PathForces' bits.
+template <class Unit, class Emit>
+void EmitPathForces(const std::vector<PathPoint>& points, double speed, double tension, Unit&& unit,
+                    Emit&& emit) {
+  const size_t n = points.size();
+  if (n < 2) {
+    for (size_t k = 0; k < n; ++k) emit(k, Eigen::Vector3d::Zero());
+    return;
+  }
+  // capstan: when the path shortens or holds (speed <= 0) the actuator at the first point pulls
+  // the tendon through, so tension falls by exp(-mu alpha) past each point with friction; when it
+  // lengthens (speed > 0) the tendon is dragged out against the actuator and tension rises by
+  // exp(mu alpha) toward the far end. One pass: each piece's direction, the one before it kept
+  const double sign = speed > 0 ? 1.0 : -1.0;
+  double t = tension;
+  Eigen::Vector3d before = Eigen::Vector3d::Zero();   // the last piece's direction (zero at first)
+  Eigen::Vector3d pending = Eigen::Vector3d::Zero();  // the force on point k from piece k - 1
+  for (size_t k = 0; k + 1 < n; ++k) {
+    const Eigen::Vector3d u = unit(k);
+    const double mu = points[k].friction;
+    if (k > 0 && mu > 0 && !before.isZero() && !u.isZero()) {
+      const double straight = std::acos(std::clamp(-before.dot(u), -1.0, 1.0));
+      t *= std::exp(sign * mu * (3.14159265358979323846 - straight));
+    }
+    before = u;
+    pending += t * u;
+    emit(k, pending);
+    pending.setZero();
+    pending -= t * u;
+  }
+  emit(n - 1, pending);
+}
+
+/// The same, each piece's direction found from the points.
+template <class Emit>
+void EmitPathForces(const std::vector<PathPoint>& points, double speed, double tension,
+                    Emit&& emit) {
+  auto unit = [&](size_t k) {
+    double length;
+    return PieceUnit(points[k].position, points[k + 1].position, &length);
+  };
+  EmitPathForces(points, speed, tension, unit, emit);
+}
 
 /// The forces a tension [N] (at the actuator end, the first point) exerts: each point is pulled
 /// toward its neighbours. With capstan friction at a point the tension changes there by
